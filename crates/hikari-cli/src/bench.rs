@@ -1,0 +1,245 @@
+//! `hikari bench`: per-pass GPU timings. Benchmarks print numbers; they never pass or fail.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use clap::{Args, Subcommand};
+use serde_json::json;
+
+use hikari_render::graph::{FrameResult, GraphRuntime};
+use hikari_render::passes::graph_check::{EmptyParams, GraphCheck};
+use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::{ContextOptions, GpuContext, Renderer};
+
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Render N frames of a scene and print per-pass GPU median/min/max.
+    Frame(FrameArgs),
+    /// Frame-graph overhead: frames of N near-empty passes, CPU and GPU cost per pass.
+    Overhead(OverheadArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct FrameArgs {
+    #[arg(long, default_value = "boxes")]
+    scene: String,
+    #[arg(long)]
+    camera: Option<String>,
+    #[arg(long, default_value_t = 1920)]
+    width: u32,
+    #[arg(long, default_value_t = 1080)]
+    height: u32,
+    /// Frames measured.
+    #[arg(long, default_value_t = 100)]
+    frames: u32,
+    /// Frames rendered first and not measured.
+    #[arg(long, default_value_t = 10)]
+    warmup: u32,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct OverheadArgs {
+    /// Passes per frame.
+    #[arg(long, default_value_t = 60)]
+    passes: u32,
+    #[arg(long, default_value_t = 200)]
+    frames: u32,
+    #[arg(long, default_value_t = 20)]
+    warmup: u32,
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(cmd: BenchCommand) -> anyhow::Result<()> {
+    match cmd {
+        BenchCommand::Frame(a) => frame(a),
+        BenchCommand::Overhead(a) => overhead(a),
+    }
+}
+
+#[derive(Default, Clone, Copy, Debug)]
+struct Stats {
+    median: f64,
+    min: f64,
+    max: f64,
+}
+
+impl Stats {
+    fn of(mut v: Vec<f64>) -> Option<Self> {
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(|a, b| a.total_cmp(b));
+        Some(Self { median: v[v.len() / 2], min: v[0], max: v[v.len() - 1] })
+    }
+
+    fn json(&self) -> serde_json::Value {
+        json!({ "median": self.median, "min": self.min, "max": self.max })
+    }
+}
+
+fn ms(d: std::time::Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// The `--timings` table of a single frame.
+pub fn print_single_frame(r: &FrameResult) {
+    println!("{:<32} {:>10} {:>10}", "pass", "GPU ms", "CPU us");
+    for t in &r.timings {
+        let gpu = t.gpu_ms.map_or("n/a".to_string(), |v| format!("{v:.4}"));
+        println!("{:<32} {:>10} {:>10.1}", t.name, gpu, t.cpu_us);
+    }
+    if let Some(s) = r.gpu_span_ms {
+        println!("{:<32} {:>10.4}", "frame (first to last pass)", s);
+    }
+}
+
+fn frame(a: FrameArgs) -> anyhow::Result<()> {
+    let scene = crate::render::load_scene(&a.scene)?;
+    let settings = crate::render::settings(&scene, a.camera.as_deref(), a.width, a.height, 14.0)?;
+    anyhow::ensure!(a.frames > 0, "--frames must be at least 1");
+    let ctx = GpuContext::new(&ContextOptions::from_env())?;
+    let adapter = ctx.describe();
+    let startup = ctx.startup;
+    let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);
+    let t0 = Instant::now();
+    let mut renderer = Renderer::new(ctx, &scene)?;
+    let setup_ms = ms(t0.elapsed());
+    for _ in 0..a.warmup {
+        renderer.render(&settings, false)?;
+    }
+    let mut per_pass: BTreeMap<String, (usize, Vec<f64>, Vec<f64>)> = BTreeMap::new();
+    let (mut spans, mut encode) = (Vec::new(), Vec::new());
+    for _ in 0..a.frames {
+        let f = renderer.render(&settings, false)?;
+        for (i, t) in f.result.timings.iter().enumerate() {
+            let e = per_pass.entry(t.name.clone()).or_insert((i, vec![], vec![]));
+            e.1.extend(t.gpu_ms);
+            e.2.push(t.cpu_us);
+        }
+        spans.extend(f.result.gpu_span_ms);
+        encode.push(f.result.cpu_encode_us);
+    }
+    let mut rows: Vec<_> = per_pass.into_iter().collect();
+    rows.sort_by_key(|(_, (i, _, _))| *i);
+    let rows: Vec<(String, Option<Stats>, Stats)> = rows
+        .into_iter()
+        .map(|(name, (_, gpu, cpu))| (name, Stats::of(gpu), Stats::of(cpu).unwrap_or_default()))
+        .collect();
+    let span = Stats::of(spans);
+    let encode = Stats::of(encode).unwrap_or_default();
+    if a.json {
+        let passes: Vec<_> = rows
+            .iter()
+            .map(|(n, g, c)| json!({ "name": n, "gpu_ms": g.map(|s| s.json()), "cpu_us": c.json() }))
+            .collect();
+        let out = json!({
+            "benchmark": "frame",
+            "adapter": adapter,
+            "scene": a.scene,
+            "width": a.width, "height": a.height, "frames": a.frames,
+            "triangles": renderer.scene().triangles,
+            "startup_ms": { "instance": ms(startup.instance), "adapter": ms(startup.adapter), "device": ms(startup.device), "total": ms(startup.total()) },
+            "pipelines_and_upload_ms": setup_ms,
+            "timestamps": has_timestamps,
+            "passes": passes,
+            "frame_gpu_ms": span.map(|s| s.json()),
+            "frame_cpu_encode_us": encode.json(),
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!("adapter: {adapter}");
+    println!("startup: {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1}); pipelines + scene upload {:.1} ms",
+        ms(startup.total()), ms(startup.instance), ms(startup.adapter), ms(startup.device), setup_ms);
+    println!("scene {} ({} triangles), {}x{}, {} frames after {} warm-up", a.scene, renderer.scene().triangles, a.width, a.height, a.frames, a.warmup);
+    println!("{:<32} {:>10} {:>10} {:>10} {:>12}", "pass", "GPU med ms", "min", "max", "CPU med us");
+    for (name, g, c) in &rows {
+        match g {
+            Some(g) => println!("{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}", name, g.median, g.min, g.max, c.median),
+            None => println!("{:<32} {:>10} {:>10} {:>10} {:>12.1}", name, "n/a", "", "", c.median),
+        }
+    }
+    match span {
+        Some(s) => println!("{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}", "frame (first to last pass)", s.median, s.min, s.max, encode.median),
+        None => println!("no GPU timestamps on this adapter; CPU encode median {:.1} us", encode.median),
+    }
+    Ok(())
+}
+
+/// CPU microseconds to record and encode one frame of `passes` empty passes, and the GPU span.
+fn overhead_frame(ctx: &GpuContext, rt: &mut GraphRuntime, check: &GraphCheck, passes: u32) -> anyhow::Result<(f64, Option<f64>, Vec<f64>)> {
+    let t0 = Instant::now();
+    let mut g = rt.begin_frame(ctx);
+    let (sink, _) = g.persistent_buffer("overhead.sink", 256)?;
+    for i in 0..passes {
+        g.pass("overhead.empty")
+            .constants(&EmptyParams { value: [i as f32, 0.0, 0.0, 0.0] })
+            .write(sink)
+            .dispatch(&check.empty, [1, 1, 1])?;
+    }
+    let record_us = t0.elapsed().as_secs_f64() * 1e6;
+    let r = g.execute()?;
+    let gpu: Vec<f64> = r.timings.iter().filter_map(|t| t.gpu_ms).collect();
+    Ok((record_us + r.cpu_encode_us, r.gpu_span_ms, gpu))
+}
+
+fn overhead(a: OverheadArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(a.passes >= 2, "--passes must be at least 2");
+    anyhow::ensure!(a.frames > 0, "--frames must be at least 1");
+    let ctx = GpuContext::new(&ContextOptions::from_env())?;
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
+    let check = GraphCheck::new(&ctx, &mut lib)?;
+    let mut rt = GraphRuntime::new();
+    let mut measure = |passes: u32| -> anyhow::Result<(Stats, Option<Stats>, Option<Stats>)> {
+        for _ in 0..a.warmup {
+            overhead_frame(&ctx, &mut rt, &check, passes)?;
+        }
+        let (mut cpu, mut span, mut each) = (vec![], vec![], vec![]);
+        for _ in 0..a.frames {
+            let (c, s, e) = overhead_frame(&ctx, &mut rt, &check, passes)?;
+            cpu.push(c);
+            span.extend(s);
+            each.extend(e);
+        }
+        Ok((Stats::of(cpu).unwrap(), Stats::of(span), Stats::of(each)))
+    };
+    let (cpu1, span1, _) = measure(1)?;
+    let (cpun, spann, each) = measure(a.passes)?;
+    let n = a.passes as f64;
+    // The slope between a 1-pass and an N-pass frame is the cost each added pass brings,
+    // free of the per-frame fixed cost (submission, timestamp resolve).
+    let cpu_per_pass = (cpun.median - cpu1.median) / (n - 1.0);
+    let gpu_per_pass_us = spann.map(|s| s.median * 1e3 / n);
+    if a.json {
+        let out = json!({
+            "benchmark": "overhead",
+            "adapter": ctx.describe(),
+            "passes": a.passes, "frames": a.frames,
+            "cpu_frame_us_1_pass": cpu1.json(),
+            "cpu_frame_us_n_passes": cpun.json(),
+            "cpu_us_per_pass": cpu_per_pass,
+            "gpu_span_ms_1_pass": span1.map(|s| s.json()),
+            "gpu_span_ms_n_passes": spann.map(|s| s.json()),
+            "gpu_us_per_pass": gpu_per_pass_us,
+            "gpu_ms_each_empty_pass": each.map(|s| s.json()),
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!("adapter: {}", ctx.describe());
+    println!("frames of 1 and {} empty compute passes (one uniform + one storage binding, 1 workgroup), {} frames each", a.passes, a.frames);
+    println!("CPU record+encode per frame: 1 pass {:.1} us, {} passes {:.1} us (median)", cpu1.median, a.passes, cpun.median);
+    println!("CPU overhead per pass: {cpu_per_pass:.2} us");
+    match (spann, each) {
+        (Some(s), Some(e)) => {
+            println!("GPU span of {} passes: {:.4} ms median (min {:.4}, max {:.4})", a.passes, s.median, s.min, s.max);
+            println!("GPU time per pass (span / passes): {:.2} us; each empty pass alone: {:.2} us median", s.median * 1e3 / n, e.median * 1e3);
+        }
+        _ => println!("no GPU timestamps on this adapter"),
+    }
+    Ok(())
+}

@@ -1,0 +1,28 @@
+#define_import_path hikari::view
+
+// The camera of the frame. Reverse-Z with an infinite far plane: depth 1 at the near plane,
+// 0 at infinity (the cleared value, so depth 0 means "sky").
+struct View {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    // xyz: camera position in metres; w unused.
+    position: vec4<f32>,
+    // width, height, 1 / width, 1 / height in pixels.
+    viewport: vec4<f32>,
+}
+
+// World position of the pixel centre `pixel` at reverse-Z depth `depth`.
+fn world_from_depth(view: View, pixel: vec2<u32>, depth: f32) -> vec3<f32> {
+    let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;
+    let ndc = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    let w = view.inv_view_proj * ndc;
+    return w.xyz / w.w;
+}
+
+// Unit direction from the camera through the pixel centre (valid at depth 0 too).
+fn view_ray(view: View, pixel: vec2<u32>) -> vec3<f32> {
+    let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;
+    // A point on the near plane, which reverse-Z puts at depth 1.
+    let near = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
+    return normalize(near.xyz / near.w - view.position.xyz);
+}

@@ -1,0 +1,223 @@
+//! The GPU context: instance, adapter, device and queue, chosen headless from the environment.
+//!
+//! Optional features are requested only when the adapter has them, and everything that uses
+//! them checks [`GpuContext::has`] first, so the renderer runs (more slowly, or without GPU
+//! timings) on adapters that lack them.
+
+use std::time::{Duration, Instant};
+
+use crate::error::RenderError;
+
+/// Features hikari uses when present; none of them is required.
+pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
+    .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS)
+    .union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES)
+    .union(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+    .union(wgpu::Features::SHADER_F16)
+    .union(wgpu::Features::SUBGROUP)
+    .union(wgpu::Features::FLOAT32_FILTERABLE);
+
+/// How long each step of start-up took; `hikari bench` reports it.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StartupTimes {
+    pub instance: Duration,
+    pub adapter: Duration,
+    pub device: Duration,
+}
+
+impl StartupTimes {
+    pub fn total(&self) -> Duration {
+        self.instance + self.adapter + self.device
+    }
+}
+
+/// Options for [`GpuContext::new`]. `Default` reads nothing; use [`ContextOptions::from_env`].
+#[derive(Clone, Debug, Default)]
+pub struct ContextOptions {
+    /// Backends to try; `None` means all that this build enables.
+    pub backends: Option<wgpu::Backends>,
+    /// Case-insensitive substring of the adapter name to pick.
+    pub adapter_name: Option<String>,
+    /// Ask for wgpu's validation layers (slower; for debugging).
+    pub validation: bool,
+}
+
+impl ContextOptions {
+    /// Reads `WGPU_BACKEND` (e.g. `vulkan`, `metal`, `dx12`, `gl`) and `WGPU_ADAPTER_NAME`.
+    pub fn from_env() -> Self {
+        Self {
+            backends: wgpu::Backends::from_env(),
+            adapter_name: std::env::var("WGPU_ADAPTER_NAME").ok().filter(|s| !s.is_empty()),
+            validation: std::env::var("HIKARI_GPU_VALIDATION").is_ok_and(|v| v == "1"),
+        }
+    }
+}
+
+/// Everything a pass needs to talk to the GPU.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub features: wgpu::Features,
+    pub limits: wgpu::Limits,
+    pub startup: StartupTimes,
+}
+
+impl GpuContext {
+    /// Creates a headless context. Fails with [`RenderError::NoAdapter`] (which tells the user
+    /// how to get a driver) rather than panicking when no adapter can be found.
+    pub fn new(options: &ContextOptions) -> Result<Self, RenderError> {
+        pollster::block_on(Self::new_async(options))
+    }
+
+    pub async fn new_async(options: &ContextOptions) -> Result<Self, RenderError> {
+        let t0 = Instant::now();
+        let backends = options
+            .backends
+            .unwrap_or_else(wgpu::Instance::enabled_backend_features);
+        let mut flags = wgpu::InstanceFlags::from_build_config();
+        if options.validation {
+            flags |= wgpu::InstanceFlags::VALIDATION;
+        } else {
+            flags.remove(wgpu::InstanceFlags::VALIDATION | wgpu::InstanceFlags::DEBUG);
+        }
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        desc.flags = flags;
+        let instance = wgpu::Instance::new(desc);
+        let t1 = Instant::now();
+
+        let adapter = Self::pick_adapter(&instance, backends, options.adapter_name.as_deref()).await?;
+        let info = adapter.get_info();
+        let t2 = Instant::now();
+
+        let features = adapter.features() & OPTIONAL_FEATURES;
+        let adapter_limits = adapter.limits();
+        // Ask for what the adapter offers for the limits that large frames hit (storage
+        // buffers of a BVH, 3D textures of the atmosphere and froxels); keep the rest default.
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: adapter_limits.max_storage_buffer_binding_size,
+            max_buffer_size: adapter_limits.max_buffer_size,
+            max_storage_buffers_per_shader_stage: adapter_limits
+                .max_storage_buffers_per_shader_stage,
+            max_storage_textures_per_shader_stage: adapter_limits
+                .max_storage_textures_per_shader_stage,
+            max_sampled_textures_per_shader_stage: adapter_limits
+                .max_sampled_textures_per_shader_stage,
+            max_texture_dimension_2d: adapter_limits.max_texture_dimension_2d,
+            max_texture_dimension_3d: adapter_limits.max_texture_dimension_3d,
+            max_compute_workgroup_storage_size: adapter_limits.max_compute_workgroup_storage_size,
+            max_compute_invocations_per_workgroup: adapter_limits
+                .max_compute_invocations_per_workgroup,
+            max_compute_workgroup_size_x: adapter_limits.max_compute_workgroup_size_x,
+            max_compute_workgroup_size_y: adapter_limits.max_compute_workgroup_size_y,
+            max_compute_workgroup_size_z: adapter_limits.max_compute_workgroup_size_z,
+            max_color_attachment_bytes_per_sample: adapter_limits
+                .max_color_attachment_bytes_per_sample,
+            ..wgpu::Limits::default().using_resolution(adapter_limits.clone())
+        };
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("hikari"),
+                required_features: features,
+                required_limits: limits.clone(),
+                experimental_features: wgpu::ExperimentalFeatures::disabled(),
+                memory_hints: wgpu::MemoryHints::Performance,
+                trace: wgpu::Trace::Off,
+            })
+            .await
+            .map_err(|e| RenderError::Device(e.to_string()))?;
+        let t3 = Instant::now();
+
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            info,
+            features,
+            limits,
+            startup: StartupTimes {
+                instance: t1 - t0,
+                adapter: t2 - t1,
+                device: t3 - t2,
+            },
+        })
+    }
+
+    async fn pick_adapter(
+        instance: &wgpu::Instance,
+        backends: wgpu::Backends,
+        name: Option<&str>,
+    ) -> Result<wgpu::Adapter, RenderError> {
+        let adapters = instance.enumerate_adapters(backends).await;
+        let seen: Vec<String> = adapters
+            .iter()
+            .map(|a| {
+                let i = a.get_info();
+                format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
+            })
+            .collect();
+        if let Some(name) = name {
+            let want = name.to_lowercase();
+            return adapters
+                .into_iter()
+                .find(|a| a.get_info().name.to_lowercase().contains(&want))
+                .ok_or_else(|| RenderError::AdapterNotFound {
+                    wanted: name.to_string(),
+                    seen,
+                });
+        }
+        // Prefer real GPUs, then integrated, then CPU drivers (lavapipe): the order a user
+        // with both a GPU and Mesa installed expects.
+        let rank = |a: &wgpu::Adapter| match a.get_info().device_type {
+            wgpu::DeviceType::DiscreteGpu => 0,
+            wgpu::DeviceType::IntegratedGpu => 1,
+            wgpu::DeviceType::VirtualGpu => 2,
+            wgpu::DeviceType::Other => 3,
+            wgpu::DeviceType::Cpu => 4,
+        };
+        adapters
+            .into_iter()
+            .filter(|a| a.get_info().backend != wgpu::Backend::Noop)
+            .min_by_key(rank)
+            .ok_or(RenderError::NoAdapter { backends })
+    }
+
+    /// Whether an optional feature was granted.
+    pub fn has(&self, f: wgpu::Features) -> bool {
+        self.features.contains(f)
+    }
+
+    /// Whether `format` can be bound as a read-write storage texture here.
+    pub fn supports_read_write_storage(&self, format: wgpu::TextureFormat) -> bool {
+        self.has(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
+            && self
+                .adapter
+                .get_texture_format_features(format)
+                .flags
+                .contains(wgpu::TextureFormatFeatureFlags::STORAGE_READ_WRITE)
+    }
+
+    /// A one-line description for logs and `hikari info`.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?}, driver {} {})",
+            self.info.name,
+            self.info.backend,
+            self.info.device_type,
+            self.info.driver,
+            self.info.driver_info
+        )
+    }
+
+    /// Blocks until the GPU is idle.
+    pub fn wait_idle(&self) -> Result<(), RenderError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| RenderError::Device(e.to_string()))
+    }
+}

@@ -1,0 +1,48 @@
+//! Errors of the render crate. Every variant names what went wrong and where, so the CLI can
+//! print it as is.
+
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum RenderError {
+    #[error(
+        "no GPU adapter found for backends {backends:?}.\n\
+         hikari needs a Vulkan, Metal, DX12 or GL driver. On a machine without a GPU, install the \
+         CPU Vulkan driver: `sudo apt-get install mesa-vulkan-drivers` (Debian/Ubuntu), then run \
+         with WGPU_BACKEND=vulkan. `cargo xtask setup` does this for you."
+    )]
+    NoAdapter { backends: wgpu::Backends },
+
+    #[error(
+        "WGPU_ADAPTER_NAME={wanted:?} matches no adapter; adapters found: {}",
+        if seen.is_empty() { "none".to_string() } else { seen.join("; ") }
+    )]
+    AdapterNotFound { wanted: String, seen: Vec<String> },
+
+    #[error("could not create the GPU device: {0}")]
+    Device(String),
+
+    #[error("shader {path}: {message}")]
+    Shader { path: String, message: String },
+
+    #[error("pass `{pass}`: {message}")]
+    Pass { pass: String, message: String },
+
+    #[error("frame graph: {0}")]
+    Graph(String),
+
+    #[error("{what} of {requested} exceeds this GPU's limit of {limit}")]
+    Limit {
+        what: String,
+        requested: u64,
+        limit: u64,
+    },
+
+    #[error("GPU error during {during}: {message}")]
+    Gpu { during: String, message: String },
+
+    #[error("writing {path}: {message}")]
+    Output { path: String, message: String },
+}
+
+pub type Result<T, E = RenderError> = std::result::Result<T, E>;

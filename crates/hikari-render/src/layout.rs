@@ -1,0 +1,50 @@
+//! Rust mirrors of WGSL structs are checked against naga's layout of the WGSL, field by field,
+//! in a test (`tests/struct_layout.rs`), so the two never drift.
+
+/// A Rust struct's layout as the layout test compares it with the WGSL struct of that name.
+#[derive(Debug)]
+pub struct StructLayout {
+    /// WGSL struct name (the Rust struct has the same name and field names).
+    pub name: &'static str,
+    /// Entry shader that declares or imports the struct.
+    pub shader: &'static str,
+    pub size: usize,
+    pub fields: Vec<(&'static str, usize)>,
+}
+
+/// `gpu_layout!(Type, "shader/path.wgsl", [field, ...])`.
+#[macro_export]
+macro_rules! gpu_layout {
+    ($t:ty, $shader:literal, [$($f:ident),* $(,)?]) => {
+        $crate::layout::StructLayout {
+            name: stringify!($t),
+            shader: $shader,
+            size: ::std::mem::size_of::<$t>(),
+            fields: vec![$((stringify!($f), ::std::mem::offset_of!($t, $f))),*],
+        }
+    };
+}
+
+/// Every GPU struct of the crate.
+pub fn all() -> Vec<StructLayout> {
+    use crate::passes::{direct_lighting, graph_check, placeholder_tonemap};
+    use crate::scene_gpu;
+    use crate::view;
+    vec![
+        gpu_layout!(view::View, "gbuffer/draw.wgsl", [view_proj, inv_view_proj, position, viewport]),
+        gpu_layout!(scene_gpu::Vertex, "gbuffer/draw.wgsl", [position, normal]),
+        gpu_layout!(
+            scene_gpu::Instance,
+            "gbuffer/draw.wgsl",
+            [model, normal_model, base_color_roughness, metal_emissive]
+        ),
+        gpu_layout!(
+            direct_lighting::SunParams,
+            "direct_lighting/sun.wgsl",
+            [direction_lux, color, sky_zenith, sky_horizon]
+        ),
+        gpu_layout!(placeholder_tonemap::TonemapParams, "placeholder_tonemap/apply.wgsl", [exposure]),
+        gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),
+        gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),
+    ]
+}

@@ -1,0 +1,6 @@
+//! One module per technique; each owns its pipelines and adds its passes to a frame.
+
+pub mod direct_lighting;
+pub mod gbuffer;
+pub mod graph_check;
+pub mod placeholder_tonemap;

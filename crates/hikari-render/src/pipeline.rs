@@ -1,0 +1,434 @@
+//! Pipelines whose bind group layout comes from the shader itself (naga reflection).
+//!
+//! hikari binds everything a pass needs in group 0, in binding order, so a pass reads as a
+//! chain: `.read(a).write(b).constants(c)` gives bindings 0, 1, 2. The reflected layout lets the
+//! frame graph check each chain against its shader and name the pass and binding that differ.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use naga_oil::compose::ShaderDefValue;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::shader::{self, ShaderLibrary};
+
+static NEXT_PIPELINE_ID: AtomicU64 = AtomicU64::new(1);
+
+/// What a binding slot of group 0 holds, as the shader declares it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BindingKind {
+    /// `texture_2d<f32>` and friends, read with `textureLoad` or a sampler.
+    SampledTexture {
+        view: wgpu::TextureViewDimension,
+        sample: wgpu::TextureSampleType,
+    },
+    /// `texture_storage_2d<format, access>`.
+    StorageTexture {
+        view: wgpu::TextureViewDimension,
+        format: wgpu::TextureFormat,
+        access: wgpu::StorageTextureAccess,
+    },
+    Uniform,
+    Storage { read_only: bool },
+    Sampler { comparison: bool },
+}
+
+impl BindingKind {
+    /// Whether binding a resource here writes it.
+    pub fn writes(&self) -> bool {
+        match self {
+            BindingKind::StorageTexture { access, .. } => {
+                *access != wgpu::StorageTextureAccess::ReadOnly
+            }
+            BindingKind::Storage { read_only } => !read_only,
+            _ => false,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct BindingSlot {
+    pub binding: u32,
+    pub name: String,
+    pub kind: BindingKind,
+}
+
+fn storage_format(f: naga::StorageFormat) -> Option<wgpu::TextureFormat> {
+    use naga::StorageFormat as S;
+    use wgpu::TextureFormat as T;
+    Some(match f {
+        S::R8Unorm => T::R8Unorm,
+        S::R8Snorm => T::R8Snorm,
+        S::R8Uint => T::R8Uint,
+        S::R8Sint => T::R8Sint,
+        S::R16Uint => T::R16Uint,
+        S::R16Sint => T::R16Sint,
+        S::R16Float => T::R16Float,
+        S::Rg8Unorm => T::Rg8Unorm,
+        S::Rg8Snorm => T::Rg8Snorm,
+        S::Rg8Uint => T::Rg8Uint,
+        S::Rg8Sint => T::Rg8Sint,
+        S::R32Uint => T::R32Uint,
+        S::R32Sint => T::R32Sint,
+        S::R32Float => T::R32Float,
+        S::Rg16Uint => T::Rg16Uint,
+        S::Rg16Sint => T::Rg16Sint,
+        S::Rg16Float => T::Rg16Float,
+        S::Rgba8Unorm => T::Rgba8Unorm,
+        S::Rgba8Snorm => T::Rgba8Snorm,
+        S::Rgba8Uint => T::Rgba8Uint,
+        S::Rgba8Sint => T::Rgba8Sint,
+        S::Bgra8Unorm => T::Bgra8Unorm,
+        S::Rgb10a2Uint => T::Rgb10a2Uint,
+        S::Rgb10a2Unorm => T::Rgb10a2Unorm,
+        S::Rg11b10Ufloat => T::Rg11b10Ufloat,
+        S::Rg32Uint => T::Rg32Uint,
+        S::Rg32Sint => T::Rg32Sint,
+        S::Rg32Float => T::Rg32Float,
+        S::Rgba16Uint => T::Rgba16Uint,
+        S::Rgba16Sint => T::Rgba16Sint,
+        S::Rgba16Float => T::Rgba16Float,
+        S::Rgba32Uint => T::Rgba32Uint,
+        S::Rgba32Sint => T::Rgba32Sint,
+        S::Rgba32Float => T::Rgba32Float,
+        S::R16Unorm => T::R16Unorm,
+        S::R16Snorm => T::R16Snorm,
+        S::Rg16Unorm => T::Rg16Unorm,
+        S::Rg16Snorm => T::Rg16Snorm,
+        S::Rgba16Unorm => T::Rgba16Unorm,
+        S::Rgba16Snorm => T::Rgba16Snorm,
+        _ => return None,
+    })
+}
+
+fn view_dimension(dim: naga::ImageDimension, arrayed: bool) -> wgpu::TextureViewDimension {
+    use wgpu::TextureViewDimension as V;
+    match (dim, arrayed) {
+        (naga::ImageDimension::D1, _) => V::D1,
+        (naga::ImageDimension::D2, false) => V::D2,
+        (naga::ImageDimension::D2, true) => V::D2Array,
+        (naga::ImageDimension::D3, _) => V::D3,
+        (naga::ImageDimension::Cube, false) => V::Cube,
+        (naga::ImageDimension::Cube, true) => V::CubeArray,
+    }
+}
+
+/// Reads group 0 of a module. Other groups are refused: the frame graph owns all bindings.
+pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<BindingSlot>> {
+    let err = |message: String| RenderError::Shader {
+        path: path.into(),
+        message,
+    };
+    let has_filtering_sampler = module.global_variables.iter().any(|(_, g)| {
+        matches!(
+            module.types[g.ty].inner,
+            naga::TypeInner::Sampler { comparison: false }
+        )
+    });
+    let mut slots = Vec::new();
+    for (_, g) in module.global_variables.iter() {
+        let Some(rb) = &g.binding else { continue };
+        let name = g.name.clone().unwrap_or_default();
+        if rb.group != 0 {
+            return Err(err(format!(
+                "`{name}` uses @group({}); hikari binds pass resources in @group(0) only",
+                rb.group
+            )));
+        }
+        let kind = match (&module.types[g.ty].inner, g.space) {
+            (naga::TypeInner::Image { dim, arrayed, class }, _) => match class {
+                naga::ImageClass::Sampled { kind, multi: _ } => BindingKind::SampledTexture {
+                    view: view_dimension(*dim, *arrayed),
+                    sample: match kind {
+                        naga::ScalarKind::Float => wgpu::TextureSampleType::Float {
+                            // Shaders without a filtering sampler only load texels, which lets
+                            // them read unfilterable formats such as R32Float.
+                            filterable: has_filtering_sampler,
+                        },
+                        naga::ScalarKind::Sint => wgpu::TextureSampleType::Sint,
+                        naga::ScalarKind::Uint => wgpu::TextureSampleType::Uint,
+                        other => return Err(err(format!("`{name}`: texel kind {other:?}"))),
+                    },
+                },
+                naga::ImageClass::Depth { .. } => BindingKind::SampledTexture {
+                    view: view_dimension(*dim, *arrayed),
+                    sample: wgpu::TextureSampleType::Depth,
+                },
+                naga::ImageClass::Storage { format, access } => BindingKind::StorageTexture {
+                    view: view_dimension(*dim, *arrayed),
+                    format: storage_format(*format)
+                        .ok_or_else(|| err(format!("`{name}`: storage format {format:?}")))?,
+                    access: if access.contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE)
+                    {
+                        wgpu::StorageTextureAccess::ReadWrite
+                    } else if access.contains(naga::StorageAccess::STORE) {
+                        wgpu::StorageTextureAccess::WriteOnly
+                    } else {
+                        wgpu::StorageTextureAccess::ReadOnly
+                    },
+                },
+                other => return Err(err(format!("`{name}`: image class {other:?}"))),
+            },
+            (naga::TypeInner::Sampler { comparison }, _) => BindingKind::Sampler {
+                comparison: *comparison,
+            },
+            (_, naga::AddressSpace::Uniform) => BindingKind::Uniform,
+            (_, naga::AddressSpace::Storage { access }) => BindingKind::Storage {
+                read_only: !access.contains(naga::StorageAccess::STORE),
+            },
+            (other, space) => {
+                return Err(err(format!("`{name}`: unsupported binding {other:?} in {space:?}")));
+            }
+        };
+        slots.push(BindingSlot {
+            binding: rb.binding,
+            name,
+            kind,
+        });
+    }
+    slots.sort_by_key(|s| s.binding);
+    for (i, s) in slots.iter().enumerate() {
+        if s.binding != i as u32 {
+            return Err(err(format!(
+                "bindings of group 0 must be 0..n without gaps; `{}` is @binding({}) but {} was expected",
+                s.name, s.binding, i
+            )));
+        }
+    }
+    Ok(slots)
+}
+
+fn layout_entries(slots: &[BindingSlot], visibility: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
+    slots
+        .iter()
+        .map(|s| wgpu::BindGroupLayoutEntry {
+            binding: s.binding,
+            visibility,
+            ty: match &s.kind {
+                BindingKind::SampledTexture { view, sample } => wgpu::BindingType::Texture {
+                    sample_type: *sample,
+                    view_dimension: *view,
+                    multisampled: false,
+                },
+                BindingKind::StorageTexture {
+                    view,
+                    format,
+                    access,
+                } => wgpu::BindingType::StorageTexture {
+                    access: *access,
+                    format: *format,
+                    view_dimension: *view,
+                },
+                BindingKind::Uniform => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                BindingKind::Storage { read_only } => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage {
+                        read_only: *read_only,
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                BindingKind::Sampler { comparison } => wgpu::BindingType::Sampler(if *comparison {
+                    wgpu::SamplerBindingType::Comparison
+                } else {
+                    wgpu::SamplerBindingType::Filtering
+                }),
+            },
+            count: None,
+        })
+        .collect()
+}
+
+/// What every pipeline carries for the frame graph.
+pub struct PipelineInfo {
+    pub id: u64,
+    pub label: String,
+    pub slots: Vec<BindingSlot>,
+    pub bind_group_layout: wgpu::BindGroupLayout,
+}
+
+impl PipelineInfo {
+    fn new(ctx: &GpuContext, label: &str, slots: Vec<BindingSlot>, visibility: wgpu::ShaderStages) -> Self {
+        let bind_group_layout = ctx
+            .device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries: &layout_entries(&slots, visibility),
+            });
+        Self {
+            id: NEXT_PIPELINE_ID.fetch_add(1, Ordering::Relaxed),
+            label: label.into(),
+            slots,
+            bind_group_layout,
+        }
+    }
+}
+
+fn checked_module(
+    ctx: &GpuContext,
+    lib: &mut ShaderLibrary,
+    path: &str,
+    defs: &[(&str, ShaderDefValue)],
+) -> Result<(naga::Module, Vec<BindingSlot>)> {
+    let module = lib.module(path, defs)?;
+    shader::validate(path, &module, shader::capabilities_for(ctx.features))?;
+    let slots = reflect_bindings(path, &module)?;
+    Ok((module, slots))
+}
+
+fn shader_module(ctx: &GpuContext, path: &str, module: naga::Module) -> wgpu::ShaderModule {
+    ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(path),
+        source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
+    })
+}
+
+pub struct ComputePipeline {
+    pub info: PipelineInfo,
+    pub pipeline: wgpu::ComputePipeline,
+    pub workgroup_size: [u32; 3],
+}
+
+impl ComputePipeline {
+    /// Builds `entry` of the entry shader `path` (relative to `shaders/`).
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &mut ShaderLibrary,
+        path: &str,
+        entry: &str,
+        defs: &[(&str, ShaderDefValue)],
+    ) -> Result<Self> {
+        let (module, slots) = checked_module(ctx, lib, path, defs)?;
+        let workgroup_size = module
+            .entry_points
+            .iter()
+            .find(|e| e.name == entry && e.stage == naga::ShaderStage::Compute)
+            .map(|e| e.workgroup_size)
+            .ok_or_else(|| RenderError::Shader {
+                path: path.into(),
+                message: format!("no compute entry point `{entry}`"),
+            })?;
+        let label = format!("{path}:{entry}");
+        let info = PipelineInfo::new(ctx, &label, slots, wgpu::ShaderStages::COMPUTE);
+        let layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(&label),
+                bind_group_layouts: &[Some(&info.bind_group_layout)],
+                immediate_size: 0,
+            });
+        let sm = shader_module(ctx, path, module);
+        let pipeline = ctx
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(&label),
+                layout: Some(&layout),
+                module: &sm,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        Ok(Self {
+            info,
+            pipeline,
+            workgroup_size,
+        })
+    }
+
+    /// Workgroups needed to cover `threads` invocations.
+    pub fn groups_for(&self, threads: [u32; 3]) -> [u32; 3] {
+        std::array::from_fn(|i| threads[i].div_ceil(self.workgroup_size[i].max(1)))
+    }
+}
+
+/// Fixed-function state of a raster pipeline; the shader file gives the rest.
+#[derive(Clone, Debug)]
+pub struct RasterDesc<'a> {
+    pub vertex_entry: &'a str,
+    pub fragment_entry: Option<&'a str>,
+    pub color_formats: &'a [wgpu::TextureFormat],
+    pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
+    pub cull_mode: Option<wgpu::Face>,
+}
+
+pub struct RasterPipeline {
+    pub info: PipelineInfo,
+    pub pipeline: wgpu::RenderPipeline,
+}
+
+impl RasterPipeline {
+    /// Builds a pipeline that pulls its vertices from storage buffers (no vertex buffers).
+    pub fn new(
+        ctx: &GpuContext,
+        lib: &mut ShaderLibrary,
+        path: &str,
+        desc: &RasterDesc<'_>,
+        defs: &[(&str, ShaderDefValue)],
+    ) -> Result<Self> {
+        let (module, slots) = checked_module(ctx, lib, path, defs)?;
+        let label = format!("{path}:{}", desc.vertex_entry);
+        let info = PipelineInfo::new(
+            ctx,
+            &label,
+            slots,
+            wgpu::ShaderStages::VERTEX_FRAGMENT,
+        );
+        let layout = ctx
+            .device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(&label),
+                bind_group_layouts: &[Some(&info.bind_group_layout)],
+                immediate_size: 0,
+            });
+        let sm = shader_module(ctx, path, module);
+        let targets: Vec<Option<wgpu::ColorTargetState>> = desc
+            .color_formats
+            .iter()
+            .map(|f| {
+                Some(wgpu::ColorTargetState {
+                    format: *f,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })
+            })
+            .collect();
+        let pipeline = ctx
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(&label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &sm,
+                    entry_point: Some(desc.vertex_entry),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: desc.cull_mode,
+                    ..Default::default()
+                },
+                depth_stencil: desc.depth.map(|(format, compare)| wgpu::DepthStencilState {
+                    format,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: desc.fragment_entry.map(|fe| wgpu::FragmentState {
+                    module: &sm,
+                    entry_point: Some(fe),
+                    compilation_options: Default::default(),
+                    targets: &targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        Ok(Self { info, pipeline })
+    }
+}

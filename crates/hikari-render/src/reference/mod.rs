@@ -1,0 +1,5 @@
+//! CPU twins of the GPU passes, named as the passes are. Tests hold each pass to its twin.
+
+pub mod direct_lighting;
+pub mod octahedral;
+pub mod placeholder_tonemap;

@@ -1,0 +1,183 @@
+//! The shader system: WGSL files under `shaders/`, composed from shared modules by import
+//! path with naga_oil, validated by naga.
+//!
+//! A file that starts with `#define_import_path hikari::name` is a module other shaders import
+//! with `#import hikari::name`; any other file is an entry shader that pipelines are made from.
+//! All files are embedded at build time (see `build.rs`); set `HIKARI_SHADER_DIR` to the
+//! `shaders/` folder to read them from disk instead while editing.
+
+use std::collections::{HashMap, HashSet};
+
+use naga_oil::compose::{
+    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderDefValue, ShaderLanguage,
+    ShaderType,
+};
+
+use crate::error::{RenderError, Result};
+
+mod embedded {
+    include!(concat!(env!("OUT_DIR"), "/shader_files.rs"));
+}
+
+/// One WGSL file: its path relative to `shaders/` and its text.
+#[derive(Clone, Debug)]
+pub struct ShaderFile {
+    pub path: String,
+    pub source: String,
+    /// `Some("hikari::sh")` for modules, `None` for entry shaders.
+    pub import_path: Option<String>,
+    pub imports: Vec<String>,
+}
+
+/// Every shader file, embedded or read from `HIKARI_SHADER_DIR`.
+pub fn shader_files() -> Result<Vec<ShaderFile>> {
+    let raw: Vec<(String, String)> = match std::env::var_os("HIKARI_SHADER_DIR") {
+        Some(dir) => embedded::SHADER_FILES
+            .iter()
+            .map(|(p, _)| {
+                let full = std::path::Path::new(&dir).join(p);
+                std::fs::read_to_string(&full)
+                    .map(|s| (p.to_string(), s))
+                    .map_err(|e| RenderError::Shader {
+                        path: full.display().to_string(),
+                        message: e.to_string(),
+                    })
+            })
+            .collect::<Result<_>>()?,
+        None => embedded::SHADER_FILES
+            .iter()
+            .map(|(p, s)| (p.to_string(), s.to_string()))
+            .collect(),
+    };
+    Ok(raw
+        .into_iter()
+        .map(|(path, source)| {
+            let (name, imports, _) = naga_oil::compose::get_preprocessor_data(&source);
+            ShaderFile {
+                path,
+                source,
+                import_path: name,
+                imports: imports.into_iter().map(|i| i.import).collect(),
+            }
+        })
+        .collect())
+}
+
+/// Composes entry shaders into naga modules. Build one per renderer and ask it for modules.
+pub struct ShaderLibrary {
+    composer: Composer,
+    files: HashMap<String, ShaderFile>,
+}
+
+impl ShaderLibrary {
+    /// Loads all modules. `capabilities` are the naga capabilities the device offers (f16,
+    /// subgroups...), so a shader that needs one fails here with a clear message.
+    pub fn new(capabilities: naga::valid::Capabilities) -> Result<Self> {
+        let files = shader_files()?;
+        let mut composer = Composer::default().with_capabilities(capabilities);
+        // naga_oil needs a module's imports added before the module itself.
+        let modules: Vec<&ShaderFile> = files.iter().filter(|f| f.import_path.is_some()).collect();
+        let mut added: HashSet<String> = HashSet::new();
+        while added.len() < modules.len() {
+            let before = added.len();
+            for m in &modules {
+                let name = m.import_path.clone().unwrap();
+                if added.contains(&name) || !m.imports.iter().all(|i| added.contains(i)) {
+                    continue;
+                }
+                let added_module = composer.add_composable_module(ComposableModuleDescriptor {
+                    source: &m.source,
+                    file_path: &m.path,
+                    language: ShaderLanguage::Wgsl,
+                    ..Default::default()
+                });
+                if let Err(e) = added_module {
+                    return Err(RenderError::Shader {
+                        path: m.path.clone(),
+                        message: e.emit_to_string(&composer),
+                    });
+                }
+                added.insert(name);
+            }
+            if added.len() == before {
+                let stuck: Vec<String> = modules
+                    .iter()
+                    .filter(|m| !added.contains(m.import_path.as_ref().unwrap()))
+                    .map(|m| format!("{} (imports {:?})", m.path, m.imports))
+                    .collect();
+                return Err(RenderError::Shader {
+                    path: stuck.join(", "),
+                    message: "import cycle or import of a module that does not exist".into(),
+                });
+            }
+        }
+        Ok(Self {
+            composer,
+            files: files.into_iter().map(|f| (f.path.clone(), f)).collect(),
+        })
+    }
+
+    /// Paths of all entry shaders (files that are not modules), sorted.
+    pub fn entry_shaders(&self) -> Vec<String> {
+        let mut v: Vec<String> = self
+            .files
+            .values()
+            .filter(|f| f.import_path.is_none())
+            .map(|f| f.path.clone())
+            .collect();
+        v.sort();
+        v
+    }
+
+    /// Composes and validates the entry shader at `path` (relative to `shaders/`).
+    pub fn module(&mut self, path: &str, defs: &[(&str, ShaderDefValue)]) -> Result<naga::Module> {
+        let file = self.files.get(path).ok_or_else(|| RenderError::Shader {
+            path: path.into(),
+            message: "no such shader file under shaders/".into(),
+        })?;
+        self.composer
+            .make_naga_module(NagaModuleDescriptor {
+                source: &file.source,
+                file_path: &file.path,
+                shader_type: ShaderType::Wgsl,
+                shader_defs: defs.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+                additional_imports: &[],
+            })
+            .map_err(|e| RenderError::Shader {
+                path: path.into(),
+                message: e.emit_to_string(&self.composer),
+            })
+    }
+}
+
+/// Validates a composed module as the GPU would, returning its layout information.
+pub fn validate(
+    path: &str,
+    module: &naga::Module,
+    capabilities: naga::valid::Capabilities,
+) -> Result<naga::valid::ModuleInfo> {
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities)
+        .validate(module)
+        .map_err(|e| RenderError::Shader {
+            path: path.into(),
+            message: format!("{}", e.emit_to_string("")),
+        })
+}
+
+/// naga capabilities matching the features a device was given.
+pub fn capabilities_for(features: wgpu::Features) -> naga::valid::Capabilities {
+    use naga::valid::Capabilities as C;
+    let mut c = C::empty();
+    if features.contains(wgpu::Features::SHADER_F16) {
+        c |= C::SHADER_FLOAT16;
+    }
+    if features.contains(wgpu::Features::SUBGROUP) {
+        c |= C::SUBGROUP;
+    }
+    c
+}
+
+/// The name a struct or function had in its WGSL file, without naga_oil's module decoration.
+pub fn undecorated(name: &str) -> &str {
+    name.split("X_naga_oil_mod_").next().unwrap_or(name)
+}
