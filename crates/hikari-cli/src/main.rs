@@ -1,6 +1,7 @@
 //! `hikari`: render, benchmark and inspect.
 
 mod bench;
+mod constants;
 mod render;
 
 use std::process::ExitCode;
@@ -21,16 +22,33 @@ enum Command {
     /// Benchmarks that print per-pass GPU timings.
     #[command(subcommand)]
     Bench(bench::BenchCommand),
+    /// Print the derived colour, spectral and scattering constants (no GPU needed).
+    Constants(constants::ConstantsArgs),
     /// Print the GPU adapter, its features and limits.
     Info,
 }
 
+/// Mesa's drivers complain on every start when XDG_RUNTIME_DIR is unset (containers, CI);
+/// give them a private one.
+fn ensure_runtime_dir() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("hikari-runtime-{}", std::process::id()));
+    if std::fs::create_dir_all(&dir).is_ok() {
+        // SAFETY: called first thing in main, before any other thread exists.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    }
+}
+
 fn main() -> ExitCode {
+    ensure_runtime_dir();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Bench(cmd) => bench::run(cmd),
+        Command::Constants(args) => constants::run(args),
         Command::Info => info(),
     };
     match result {

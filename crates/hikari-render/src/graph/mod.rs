@@ -26,7 +26,7 @@ mod timing;
 
 pub use readback::ImageRgba32;
 pub use resources::{Buf, PoolStats, Res, Tex, TextureDesc};
-pub use runtime::{FrameResult, GraphRuntime, History};
+pub use runtime::{FrameResult, GraphRuntime, History, TimestampMode};
 pub use timing::PassTiming;
 
 use std::sync::Arc;

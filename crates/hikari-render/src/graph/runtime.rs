@@ -67,8 +67,20 @@ pub struct GraphRuntime {
     constants: Option<Arc<PhysicalBuffer>>,
     samplers: HashMap<SamplerKind, (u64, wgpu::Sampler)>,
     timer: Option<GpuTimer>,
-    timestamps: bool,
+    timestamps: TimestampMode,
     dumps: Vec<String>,
+}
+
+/// How much of the frame gets GPU timestamps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimestampMode {
+    /// None at all.
+    Off,
+    /// One at the start of the first pass and one at the end of the last: the frame's span
+    /// without the cost of timing each pass.
+    Frame,
+    /// At the start and end of every pass.
+    Pass,
 }
 
 /// Frames an imported resource is remembered after its last import.
@@ -96,14 +108,14 @@ impl GraphRuntime {
             constants: None,
             samplers: HashMap::new(),
             timer: None,
-            timestamps: true,
+            timestamps: TimestampMode::Pass,
             dumps: Vec::new(),
         }
     }
 
-    /// Turns GPU timestamps on or off (they are on when the device supports them).
-    pub fn set_timestamps(&mut self, on: bool) {
-        self.timestamps = on;
+    /// How the GPU is timed (per pass by default, when the device supports timestamps).
+    pub fn set_timestamps(&mut self, mode: TimestampMode) {
+        self.timestamps = mode;
     }
 
     /// Names of resources to read back after each frame (`--dump gbuffer.normal`). A name that
@@ -402,10 +414,19 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
 
     let timed = |k: &PassKind| !matches!(k, PassKind::Encoder { .. });
     let timed_count = passes.iter().filter(|p| timed(&p.kind)).count() as u32;
-    if rt.timestamps && rt.timer.as_ref().is_none_or(|t| t.passes() < timed_count) {
+    let mode = rt.timestamps;
+    if mode != TimestampMode::Off && rt.timer.as_ref().is_none_or(|t| t.passes() < timed_count) {
         rt.timer = GpuTimer::new(ctx, timed_count);
     }
-    let use_timer = rt.timestamps && rt.timer.is_some();
+    let use_timer = mode != TimestampMode::Off && rt.timer.is_some() && timed_count > 0;
+    // Query slots for the timed pass `slot`: its own pair, or in frame mode only the frame's
+    // first begin (query 0) and last end (query 1).
+    let queries = |slot: u32| -> (Option<u32>, Option<u32>) {
+        match mode {
+            TimestampMode::Pass => (Some(2 * slot), Some(2 * slot + 1)),
+            _ => ((slot == 0).then_some(0), (slot + 1 == timed_count).then_some(1)),
+        }
+    };
 
     // Lifetimes -> when each transient is taken from and given back to the pool.
     let mut acquire_at: Vec<Vec<Res>> = vec![Vec::new(); n + 1];
@@ -446,22 +467,50 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
         }
     };
 
+    // Without per-pass timestamps, consecutive compute passes share one wgpu compute pass:
+    // wgpu still places the barriers each dispatch needs, and the GPU skips a pass boundary.
+    let merge = mode != TimestampMode::Pass;
+    let mut run_end: Vec<usize> = (0..n).collect();
+    for i in (0..n.saturating_sub(1)).rev() {
+        let both_compute = matches!(passes[i].kind, PassKind::Compute { .. })
+            && matches!(passes[i + 1].kind, PassKind::Compute { .. });
+        if merge && both_compute {
+            run_end[i] = run_end[i + 1];
+        }
+    }
+
     let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hikari.frame") });
     let mut timings = Vec::with_capacity(n);
     let mut slot = 0u32;
+    let mut open_compute: Option<wgpu::ComputePass<'static>> = None;
     for (i, pass) in passes.into_iter().enumerate() {
         acquire(rt, &acquire_at[i], &mut textures, &mut buffers);
         let tp = Instant::now();
         let res = PassResources { textures: &textures, buffers: &buffers };
         let is_timed = timed(&pass.kind);
+        if !matches!(pass.kind, PassKind::Compute { .. }) {
+            drop(open_compute.take());
+        }
         match pass.kind {
             PassKind::Compute { pipeline, groups } => {
                 let bg = rt.bind_group(ctx, &pipeline.info, &pass.bindings, &res);
-                let timer = if use_timer { rt.timer.as_ref() } else { None };
-                let mut cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(&pass.name),
-                    timestamp_writes: timer.and_then(|t| t.compute_writes(slot)),
-                });
+                if open_compute.is_none() || !merge {
+                    // The encoder accepts a new pass only once the previous one has ended.
+                    drop(open_compute.take());
+                    let last_slot = slot + (run_end[i] - i) as u32;
+                    let q = match mode {
+                        TimestampMode::Pass => queries(slot),
+                        _ => ((slot == 0).then_some(0), (last_slot + 1 == timed_count).then_some(1)),
+                    };
+                    let timer = if use_timer { rt.timer.as_ref() } else { None };
+                    let label = if run_end[i] == i { pass.name.as_str() } else { "hikari.compute" };
+                    let cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: Some(label),
+                        timestamp_writes: timer.and_then(|t| t.compute_writes(q)),
+                    });
+                    open_compute = Some(cp.forget_lifetime());
+                }
+                let cp = open_compute.as_mut().unwrap();
                 cp.set_pipeline(&pipeline.pipeline);
                 cp.set_bind_group(0, &bg, &[]);
                 if groups.iter().all(|&g| g > 0) {
@@ -511,7 +560,7 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
                         }),
                         stencil_ops: None,
                     }),
-                    timestamp_writes: timer.and_then(|t| t.render_writes(slot)),
+                    timestamp_writes: timer.and_then(|t| t.render_writes(queries(slot))),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
@@ -527,6 +576,7 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
         }
         release(rt, &release_at[i], &textures, &buffers);
     }
+    drop(open_compute);
     // Readbacks of resources no pass touched never reach here (checked above), but a
     // persistent one could be first used at `n`: make sure it is resolved.
     acquire(rt, &acquire_at[n], &mut textures, &mut buffers);
@@ -582,14 +632,19 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
             }
         }
     }
+    let query_pairs = if mode == TimestampMode::Pass { slot } else { 1 };
     if use_timer {
-        rt.timer.as_ref().unwrap().resolve(&mut encoder, slot);
+        rt.timer.as_ref().unwrap().resolve(&mut encoder, query_pairs);
     }
     let cpu_encode_us = t_start.elapsed().as_secs_f64() * 1e6;
     ctx.queue.submit([encoder.finish()]);
 
     let (gpu, gpu_span_ms) = if use_timer {
-        rt.timer.as_ref().unwrap().read(ctx, slot)?
+        let (pairs, span) = rt.timer.as_ref().unwrap().read(ctx, query_pairs)?;
+        match mode {
+            TimestampMode::Pass => (pairs, span),
+            _ => (vec![None; slot as usize], pairs[0]),
+        }
     } else {
         (vec![None; slot as usize], None)
     };

@@ -56,19 +56,26 @@ impl GpuTimer {
         self.capacity / 2
     }
 
-    pub fn compute_writes(&self, pass: u32) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        (pass < self.passes()).then(|| wgpu::ComputePassTimestampWrites {
+    fn fits(&self, (begin, end): (Option<u32>, Option<u32>)) -> bool {
+        (begin.is_some() || end.is_some())
+            && begin.is_none_or(|q| q < self.capacity)
+            && end.is_none_or(|q| q < self.capacity)
+    }
+
+    /// Timestamp writes at the given query indices (begin, end) of a compute pass.
+    pub fn compute_writes(&self, q: (Option<u32>, Option<u32>)) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.fits(q).then(|| wgpu::ComputePassTimestampWrites {
             query_set: &self.set,
-            beginning_of_pass_write_index: Some(pass * 2),
-            end_of_pass_write_index: Some(pass * 2 + 1),
+            beginning_of_pass_write_index: q.0,
+            end_of_pass_write_index: q.1,
         })
     }
 
-    pub fn render_writes(&self, pass: u32) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        (pass < self.passes()).then(|| wgpu::RenderPassTimestampWrites {
+    pub fn render_writes(&self, q: (Option<u32>, Option<u32>)) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.fits(q).then(|| wgpu::RenderPassTimestampWrites {
             query_set: &self.set,
-            beginning_of_pass_write_index: Some(pass * 2),
-            end_of_pass_write_index: Some(pass * 2 + 1),
+            beginning_of_pass_write_index: q.0,
+            end_of_pass_write_index: q.1,
         })
     }
 

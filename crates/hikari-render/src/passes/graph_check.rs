@@ -25,8 +25,10 @@ pub struct GraphCheck {
     pub fill: ComputePipeline,
     /// `sum = a + b` on Rgba16Float textures.
     pub add: ComputePipeline,
-    /// Binds a uniform and a storage buffer and does nothing: per-pass overhead.
+    /// Binds a uniform and a read-only storage buffer and does nothing: per-pass overhead.
     pub empty: ComputePipeline,
+    /// Adds a constant to a storage buffer: each pass depends on the previous one.
+    pub chain: ComputePipeline,
 }
 
 impl GraphCheck {
@@ -35,6 +37,7 @@ impl GraphCheck {
             fill: ComputePipeline::new(ctx, lib, "graph_check/fill.wgsl", "main", &[])?,
             add: ComputePipeline::new(ctx, lib, "graph_check/add.wgsl", "main", &[])?,
             empty: ComputePipeline::new(ctx, lib, "graph_check/empty.wgsl", "main", &[])?,
+            chain: ComputePipeline::new(ctx, lib, "graph_check/chain.wgsl", "main", &[])?,
         })
     }
 }

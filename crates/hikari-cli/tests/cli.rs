@@ -1,0 +1,106 @@
+//! The `hikari` binary as a user runs it: outputs, and clean errors on bad input.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn hikari(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hikari")).args(args).output().expect("run hikari")
+}
+
+fn gpu_tests_skipped() -> bool {
+    std::env::var("HIKARI_SKIP_GPU_TESTS").is_ok_and(|v| v == "1")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hikari-cli-test-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn text(o: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+#[test]
+fn render_writes_png_exr_and_dumps() {
+    if gpu_tests_skipped() {
+        return;
+    }
+    let dir = tmp("render");
+    let png = dir.join("out.png");
+    let o = hikari(&[
+        "render", "--width", "64", "--height", "40", "-o", png.to_str().unwrap(),
+        "--dump", "gbuffer.normal", "--timings",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let img = image::open(&png).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (64, 40));
+    // Not a blank image: sky and lit boxes differ.
+    let px: Vec<_> = img.pixels().map(|p| p.0).collect();
+    assert!(px.iter().any(|p| *p != px[0]));
+    let exr = exr::prelude::read_first_rgba_layer_from_file(
+        dir.join("out.exr"),
+        |res, _| vec![[0f32; 4]; res.width() * res.height()],
+        |v, pos, (r, g, b, a): (f32, f32, f32, f32)| v[pos.y() * 64 + pos.x()] = [r, g, b, a],
+    )
+    .unwrap();
+    let hdr = exr.layer_data.channel_data.pixels;
+    assert!(hdr.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(hdr.iter().any(|p| p[0] > 100.0), "radiance in nits, not display values");
+    assert!(dir.join("gbuffer.normal.exr").exists());
+    assert!(text(&o).contains("gbuffer.draw"), "timing table: {}", text(&o));
+    // Atomic writes leave no temporary files behind.
+    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp")).collect();
+    assert!(leftovers.is_empty());
+}
+
+fn assert_clean_failure(args: &[&str], needle: &str) {
+    let o = hikari(args);
+    let t = text(&o);
+    assert!(!o.status.success(), "{args:?} should fail: {t}");
+    assert!(!t.contains("panicked"), "{args:?} panicked: {t}");
+    assert!(t.contains(needle), "{args:?}: expected `{needle}` in: {t}");
+}
+
+#[test]
+fn bad_arguments_fail_with_a_message_and_no_panic() {
+    assert_clean_failure(&["render", "--scene", "atlantis"], "unknown scene `atlantis`");
+    assert_clean_failure(&["render", "--camera", "nope"], "no camera named `nope`");
+    assert_clean_failure(&["render", "--ev100", "99"], "--ev100 99");
+    assert_clean_failure(&["render", "--width", "banana"], "invalid value");
+    assert_clean_failure(&["bench", "frame", "--frames", "0"], "--frames");
+    if gpu_tests_skipped() {
+        return;
+    }
+    let dir = tmp("bad");
+    let out = dir.join("x.png");
+    assert_clean_failure(&["render", "--width", "0", "-o", out.to_str().unwrap()], "image width");
+    assert_clean_failure(&["render", "--width", "100000", "-o", out.to_str().unwrap()], "exceeds this GPU's limit");
+    assert_clean_failure(&["render", "--width", "16", "--height", "16", "--dump", "gbuffer.nope", "-o", out.to_str().unwrap()], "gbuffer.normal");
+    assert_clean_failure(&["render", "--width", "16", "--height", "16", "-o", "/no/such/dir/x.png"], "does not exist");
+}
+
+#[test]
+fn missing_adapter_is_a_clear_error() {
+    let o = Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(["info"])
+        .env("WGPU_ADAPTER_NAME", "no-such-gpu-anywhere")
+        .output()
+        .unwrap();
+    let t = text(&o);
+    assert!(!o.status.success());
+    assert!(t.contains("no-such-gpu-anywhere") && !t.contains("panicked"), "{t}");
+
+    // No driver at all: Vulkan pointed at an empty ICD list.
+    let o = Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(["render", "--width", "8", "--height", "8"])
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .env_remove("WGPU_ADAPTER_NAME")
+        .output()
+        .unwrap();
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("mesa-vulkan-drivers") && !t.contains("panicked"), "{t}");
+}

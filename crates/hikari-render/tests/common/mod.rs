@@ -1,0 +1,49 @@
+//! Shared by the GPU tests. They run on whatever adapter the environment picks (the CPU
+//! Vulkan driver in CI); with no adapter they fail, unless HIKARI_SKIP_GPU_TESTS=1.
+
+#![allow(dead_code)]
+
+use hikari_render::{ContextOptions, GpuContext};
+
+pub fn gpu() -> Option<GpuContext> {
+    if std::env::var("HIKARI_SKIP_GPU_TESTS").is_ok_and(|v| v == "1") {
+        eprintln!("HIKARI_SKIP_GPU_TESTS=1: skipping a GPU test");
+        return None;
+    }
+    match GpuContext::new(&ContextOptions::from_env()) {
+        Ok(ctx) => Some(ctx),
+        Err(e) => panic!("GPU tests need an adapter (or HIKARI_SKIP_GPU_TESTS=1): {e}"),
+    }
+}
+
+/// A texture filled from `data` (tightly packed rows).
+pub fn texture_with_data(
+    ctx: &GpuContext,
+    format: wgpu::TextureFormat,
+    w: u32,
+    h: u32,
+    data: &[u8],
+) -> wgpu::Texture {
+    use wgpu::util::DeviceExt;
+    ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("test input"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        data,
+    )
+}

@@ -1,0 +1,79 @@
+//! Every WGSL file composes and validates with naga; no GPU needed.
+
+use hikari_render::shader::{self, ShaderLibrary};
+
+#[test]
+fn every_entry_shader_composes_and_validates() {
+    let caps = naga::valid::Capabilities::empty();
+    let mut lib = ShaderLibrary::new(caps).expect("modules load");
+    let entries = lib.entry_shaders();
+    assert!(entries.len() >= 5, "found only {entries:?}");
+    let mut failures = Vec::new();
+    for path in &entries {
+        match lib.module(path, &[]) {
+            Ok(module) => {
+                if let Err(e) = shader::validate(path, &module, caps) {
+                    failures.push(e.to_string());
+                }
+                if let Err(e) = hikari_render::pipeline::reflect_bindings(path, &module) {
+                    failures.push(e.to_string());
+                }
+            }
+            Err(e) => failures.push(e.to_string()),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n\n"));
+}
+
+#[test]
+fn every_wgsl_file_on_disk_is_embedded() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let mut on_disk = Vec::new();
+    let mut stack = vec![root.clone()];
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "wgsl") {
+                on_disk.push(p.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/"));
+            }
+        }
+    }
+    on_disk.sort();
+    let mut embedded: Vec<String> = shader::shader_files().unwrap().into_iter().map(|f| f.path).collect();
+    embedded.sort();
+    assert_eq!(on_disk, embedded);
+}
+
+#[test]
+fn a_broken_shader_is_reported_with_its_path() {
+    // The composer must turn a WGSL error into an error naming the file, not a panic.
+    let mut composer = naga_oil::compose::Composer::default();
+    let r = composer.make_naga_module(naga_oil::compose::NagaModuleDescriptor {
+        source: "fn f() -> f32 { return 1 + ; }",
+        file_path: "broken.wgsl",
+        ..Default::default()
+    });
+    let e = r.unwrap_err();
+    assert!(e.emit_to_string(&composer).contains("broken.wgsl"));
+}
+
+#[test]
+fn bindings_outside_group_zero_are_refused() {
+    let module = naga::front::wgsl::parse_str(
+        "@group(1) @binding(0) var<uniform> x: vec4<f32>;\n@compute @workgroup_size(1) fn main() { _ = x; }",
+    )
+    .unwrap();
+    let e = hikari_render::pipeline::reflect_bindings("g1.wgsl", &module).unwrap_err();
+    assert!(e.to_string().contains("@group(0)"), "{e}");
+}
+
+#[test]
+fn gaps_in_bindings_are_refused() {
+    let module = naga::front::wgsl::parse_str(
+        "@group(0) @binding(1) var<uniform> x: vec4<f32>;\n@compute @workgroup_size(1) fn main() { _ = x; }",
+    )
+    .unwrap();
+    assert!(hikari_render::pipeline::reflect_bindings("gap.wgsl", &module).is_err());
+}
