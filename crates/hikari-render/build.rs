@@ -13,7 +13,12 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<String>) {
         if p.is_dir() {
             collect(&p, root, out);
         } else if p.extension().is_some_and(|e| e == "wgsl") {
-            out.push(p.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/"));
+            out.push(
+                p.strip_prefix(root)
+                    .unwrap()
+                    .to_string_lossy()
+                    .replace('\\', "/"),
+            );
         }
     }
 }
@@ -27,8 +32,15 @@ fn main() {
     for f in &files {
         let abs = root.join(f);
         println!("cargo:rerun-if-changed={}", abs.display());
-        src += &format!("    ({f:?}, include_str!({:?})),\n", abs.display().to_string());
+        src += &format!(
+            "    ({f:?}, include_str!({:?})),\n",
+            abs.display().to_string()
+        );
     }
     src += "];\n";
-    fs::write(Path::new(&env::var("OUT_DIR").unwrap()).join("shader_files.rs"), src).unwrap();
+    fs::write(
+        Path::new(&env::var("OUT_DIR").unwrap()).join("shader_files.rs"),
+        src,
+    )
+    .unwrap();
 }

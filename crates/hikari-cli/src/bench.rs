@@ -17,6 +17,8 @@ pub enum BenchCommand {
     Frame(FrameArgs),
     /// Frame-graph overhead: frames of N near-empty passes, CPU and GPU cost per pass.
     Overhead(OverheadArgs),
+    /// BVH build times and GPU ray throughput (Grays/s) for closest and any hit.
+    Rays(crate::bench_rays::RaysArgs),
 }
 
 #[derive(Args, Debug)]
@@ -57,6 +59,7 @@ pub fn run(cmd: BenchCommand) -> anyhow::Result<()> {
     match cmd {
         BenchCommand::Frame(a) => frame(a),
         BenchCommand::Overhead(a) => overhead(a),
+        BenchCommand::Rays(a) => crate::bench_rays::run(a),
     }
 }
 
@@ -73,7 +76,11 @@ impl Stats {
             return None;
         }
         v.sort_by(|a, b| a.total_cmp(b));
-        Some(Self { median: v[v.len() / 2], min: v[0], max: v[v.len() - 1] })
+        Some(Self {
+            median: v[v.len() / 2],
+            min: v[0],
+            max: v[v.len() - 1],
+        })
     }
 
     fn json(&self) -> serde_json::Value {
@@ -116,7 +123,9 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
     for _ in 0..a.frames {
         let f = renderer.render(&settings, false)?;
         for (i, t) in f.result.timings.iter().enumerate() {
-            let e = per_pass.entry(t.name.clone()).or_insert((i, vec![], vec![]));
+            let e = per_pass
+                .entry(t.name.clone())
+                .or_insert((i, vec![], vec![]));
             e.1.extend(t.gpu_ms);
             e.2.push(t.cpu_us);
         }
@@ -134,7 +143,9 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
     if a.json {
         let passes: Vec<_> = rows
             .iter()
-            .map(|(n, g, c)| json!({ "name": n, "gpu_ms": g.map(|s| s.json()), "cpu_us": c.json() }))
+            .map(
+                |(n, g, c)| json!({ "name": n, "gpu_ms": g.map(|s| s.json()), "cpu_us": c.json() }),
+            )
             .collect();
         let out = json!({
             "benchmark": "frame",
@@ -153,19 +164,48 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     println!("adapter: {adapter}");
-    println!("startup: {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1}); pipelines + scene upload {:.1} ms",
-        ms(startup.total()), ms(startup.instance), ms(startup.adapter), ms(startup.device), setup_ms);
-    println!("scene {} ({} triangles), {}x{}, {} frames after {} warm-up", a.scene, renderer.scene().triangles, a.width, a.height, a.frames, a.warmup);
-    println!("{:<32} {:>10} {:>10} {:>10} {:>12}", "pass", "GPU med ms", "min", "max", "CPU med us");
+    println!(
+        "startup: {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1}); pipelines + scene upload {:.1} ms",
+        ms(startup.total()),
+        ms(startup.instance),
+        ms(startup.adapter),
+        ms(startup.device),
+        setup_ms
+    );
+    println!(
+        "scene {} ({} triangles), {}x{}, {} frames after {} warm-up",
+        a.scene,
+        renderer.scene().triangles,
+        a.width,
+        a.height,
+        a.frames,
+        a.warmup
+    );
+    println!(
+        "{:<32} {:>10} {:>10} {:>10} {:>12}",
+        "pass", "GPU med ms", "min", "max", "CPU med us"
+    );
     for (name, g, c) in &rows {
         match g {
-            Some(g) => println!("{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}", name, g.median, g.min, g.max, c.median),
-            None => println!("{:<32} {:>10} {:>10} {:>10} {:>12.1}", name, "n/a", "", "", c.median),
+            Some(g) => println!(
+                "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
+                name, g.median, g.min, g.max, c.median
+            ),
+            None => println!(
+                "{:<32} {:>10} {:>10} {:>10} {:>12.1}",
+                name, "n/a", "", "", c.median
+            ),
         }
     }
     match span {
-        Some(s) => println!("{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}", "frame (first to last pass)", s.median, s.min, s.max, encode.median),
-        None => println!("no GPU timestamps on this adapter; CPU encode median {:.1} us", encode.median),
+        Some(s) => println!(
+            "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
+            "frame (first to last pass)", s.median, s.min, s.max, encode.median
+        ),
+        None => println!(
+            "no GPU timestamps on this adapter; CPU encode median {:.1} us",
+            encode.median
+        ),
     }
     Ok(())
 }
@@ -192,7 +232,9 @@ fn overhead_frame(
     let mut g = rt.begin_frame(ctx);
     let (buffer, _) = g.persistent_buffer("overhead.buffer", 256)?;
     for i in 0..passes {
-        let params = EmptyParams { value: [i as f32, 0.0, 0.0, 0.0] };
+        let params = EmptyParams {
+            value: [i as f32, 0.0, 0.0, 0.0],
+        };
         match chain {
             Chain::Independent => g
                 .pass("overhead.empty")
@@ -219,7 +261,10 @@ fn overhead(a: OverheadArgs) -> anyhow::Result<()> {
     let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
     let check = GraphCheck::new(&ctx, &mut lib)?;
     let mut rt = GraphRuntime::new();
-    let mut measure = |passes: u32, chain: Chain, mode: TimestampMode| -> anyhow::Result<(Stats, Option<Stats>, Option<Stats>)> {
+    let mut measure = |passes: u32,
+                       chain: Chain,
+                       mode: TimestampMode|
+     -> anyhow::Result<(Stats, Option<Stats>, Option<Stats>)> {
         rt.set_timestamps(mode);
         for _ in 0..a.warmup {
             overhead_frame(&ctx, &mut rt, &check, passes, chain)?;
@@ -273,7 +318,16 @@ fn overhead(a: OverheadArgs) -> anyhow::Result<()> {
         "frames of 2 and {} near-empty compute passes (a uniform and a storage buffer, 1 workgroup), {} frames each; medians",
         a.passes, a.frames
     );
-    println!("{:<12} {:<11} {:>13} {:>13} {:>14} {:>14} {:>15}", "passes", "timestamps", "CPU frame us", "CPU us/pass", "GPU span ms", "GPU us/pass", "GPU us one pass");
+    println!(
+        "{:<12} {:<11} {:>13} {:>13} {:>14} {:>14} {:>15}",
+        "passes",
+        "timestamps",
+        "CPU frame us",
+        "CPU us/pass",
+        "GPU span ms",
+        "GPU us/pass",
+        "GPU us one pass"
+    );
     for (chain, mode, cpun, cpu_pp, spann, gpu_pp, each) in rows {
         let f = |v: Option<f64>, p: usize| v.map_or("n/a".to_string(), |v| format!("{v:.p$}"));
         println!(

@@ -2,7 +2,7 @@
 //! another engine. Matrices are arrays of rows acting on column vectors; linear Rec.709 is the
 //! working space.
 
-use anyhow::{bail, Context};
+use anyhow::{Context, bail};
 use clap::Args;
 use serde_json::json;
 
@@ -25,7 +25,9 @@ fn parse_white(s: &str) -> anyhow::Result<[f64; 3]> {
     }
     let mut w = [0.0; 3];
     for (i, p) in parts.iter().enumerate() {
-        w[i] = p.parse::<f64>().with_context(|| format!("--white `{s}`: `{p}` is not a number"))?;
+        w[i] = p
+            .parse::<f64>()
+            .with_context(|| format!("--white `{s}`: `{p}` is not a number"))?;
         if !w[i].is_finite() || w[i] <= 0.0 {
             bail!("--white `{s}`: each component must be finite and greater than 0");
         }
@@ -66,7 +68,12 @@ pub fn run(args: ConstantsArgs) -> anyhow::Result<()> {
             serde_json::Value::Array(rows) if rows.iter().all(|r| r.is_array()) => {
                 println!("{key}:");
                 for r in rows {
-                    let nums: Vec<String> = r.as_array().unwrap().iter().map(|x| format!("{:>14.9}", x.as_f64().unwrap_or(f64::NAN))).collect();
+                    let nums: Vec<String> = r
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| format!("{:>14.9}", x.as_f64().unwrap_or(f64::NAN)))
+                        .collect();
                     println!("  [{}]", nums.join(", "));
                 }
             }
@@ -74,8 +81,13 @@ pub fn run(args: ConstantsArgs) -> anyhow::Result<()> {
                 let nums: Vec<String> = xs.iter().map(|x| format!("{}", x)).collect();
                 println!("{key}: [{}]", nums.join(", "));
             }
-            serde_json::Value::Object(_) => println!("{key}: (see --json; {} samples)", c.smits_wavelengths_nm.len()),
-            other if key != "working_space" && key != "matrix_convention" => println!("{key}: {other}"),
+            serde_json::Value::Object(_) => println!(
+                "{key}: (see --json; {} samples)",
+                c.smits_wavelengths_nm.len()
+            ),
+            other if key != "working_space" && key != "matrix_convention" => {
+                println!("{key}: {other}")
+            }
             _ => {}
         }
     }

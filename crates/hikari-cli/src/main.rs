@@ -1,6 +1,7 @@
 //! `hikari`: render, benchmark and inspect.
 
 mod bench;
+mod bench_rays;
 mod constants;
 mod render;
 
@@ -9,7 +10,11 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "hikari", version, about = "A real-time lighting renderer: Ghost of Tsushima and Metro Exodus lighting, measured")]
+#[command(
+    name = "hikari",
+    version,
+    about = "A real-time lighting renderer: Ghost of Tsushima and Metro Exodus lighting, measured"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -63,21 +68,31 @@ fn main() -> ExitCode {
 fn info() -> anyhow::Result<()> {
     let ctx = hikari_render::GpuContext::new(&hikari_render::ContextOptions::from_env())?;
     println!("adapter:  {}", ctx.describe());
-    println!("startup:  {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1})",
+    println!(
+        "startup:  {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1})",
         ctx.startup.total().as_secs_f64() * 1e3,
         ctx.startup.instance.as_secs_f64() * 1e3,
         ctx.startup.adapter.as_secs_f64() * 1e3,
-        ctx.startup.device.as_secs_f64() * 1e3);
+        ctx.startup.device.as_secs_f64() * 1e3
+    );
     println!("features: {:?}", ctx.features);
     for f in [wgpu_fmt::RGBA16F, wgpu_fmt::RG11B10] {
-        println!("read-write storage {f:?}: {}", ctx.supports_read_write_storage(f));
+        println!(
+            "read-write storage {f:?}: {}",
+            ctx.supports_read_write_storage(f)
+        );
     }
-    println!("max 2D texture {}, max 3D texture {}, max storage buffer binding {} bytes",
-        ctx.limits.max_texture_dimension_2d, ctx.limits.max_texture_dimension_3d, ctx.limits.max_storage_buffer_binding_size);
+    println!(
+        "max 2D texture {}, max 3D texture {}, max storage buffer binding {} bytes",
+        ctx.limits.max_texture_dimension_2d,
+        ctx.limits.max_texture_dimension_3d,
+        ctx.limits.max_storage_buffer_binding_size
+    );
     Ok(())
 }
 
 mod wgpu_fmt {
     pub use hikari_render::passes::direct_lighting::RADIANCE_FORMAT as RGBA16F;
-    pub const RG11B10: hikari_render::wgpu::TextureFormat = hikari_render::wgpu::TextureFormat::Rg11b10Ufloat;
+    pub const RG11B10: hikari_render::wgpu::TextureFormat =
+        hikari_render::wgpu::TextureFormat::Rg11b10Ufloat;
 }

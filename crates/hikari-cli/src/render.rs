@@ -2,15 +2,15 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
+use anyhow::{Context, bail};
 use clap::Args;
 
 use hikari_render::graph::TimestampMode;
-use hikari_render::{output, ContextOptions, FrameSettings, GpuContext, Renderer};
+use hikari_render::{ContextOptions, FrameSettings, GpuContext, Renderer, output};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Built-in scene name (boxes).
+    /// Built-in scene (boxes, cornell, terrain) or a .gltf/.glb file.
     #[arg(long, default_value = "boxes")]
     pub scene: String,
     /// Camera name in the scene; the scene's first camera if omitted.
@@ -43,43 +43,77 @@ pub struct RenderArgs {
     pub dump_dir: Option<PathBuf>,
 }
 
+/// A built-in scene by name, or a `.gltf` / `.glb` file by path.
 pub fn load_scene(name: &str) -> anyhow::Result<hikari_scene::Scene> {
-    match hikari_scene::builtin::by_name(name) {
-        Some(s) => Ok(s),
-        None => bail!(
-            "unknown scene `{name}`; built-in scenes: {}",
-            hikari_scene::builtin::NAMES.join(", ")
-        ),
+    if let Some(s) = hikari_scene::builtin::by_name(name) {
+        return Ok(s);
     }
+    let lower = name.to_ascii_lowercase();
+    if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+        // The loader logs its warnings (ignored extensions, skipped primitives) itself.
+        return Ok(hikari_scene::gltf::load(name)?.scene);
+    }
+    bail!(
+        "unknown scene `{name}`; built-in scenes: {}, or a path to a .gltf or .glb file",
+        hikari_scene::builtin::NAMES.join(", ")
+    )
 }
 
-pub fn settings(scene: &hikari_scene::Scene, camera: Option<&str>, width: u32, height: u32, ev100: f32) -> anyhow::Result<FrameSettings> {
+pub fn settings(
+    scene: &hikari_scene::Scene,
+    camera: Option<&str>,
+    width: u32,
+    height: u32,
+    ev100: f32,
+) -> anyhow::Result<FrameSettings> {
     let camera = match camera {
         Some(name) => scene.camera(name)?.clone(),
-        None => scene.cameras.first().context("the scene has no camera")?.clone(),
+        None => scene
+            .cameras
+            .first()
+            .context("the scene has no camera")?
+            .clone(),
     };
     if !ev100.is_finite() || !(-10.0..=30.0).contains(&ev100) {
         bail!("--ev100 {ev100} is outside the range -10 to 30");
     }
-    Ok(FrameSettings { width, height, camera, ev100 })
+    Ok(FrameSettings {
+        width,
+        height,
+        camera,
+        ev100,
+    })
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let scene = load_scene(&args.scene)?;
-    let settings = settings(&scene, args.camera.as_deref(), args.width, args.height, args.ev100)?;
+    let settings = settings(
+        &scene,
+        args.camera.as_deref(),
+        args.width,
+        args.height,
+        args.ev100,
+    )?;
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
-    renderer.runtime.set_timestamps(if args.timings { TimestampMode::Pass } else { TimestampMode::Frame });
+    renderer.runtime.set_timestamps(if args.timings {
+        TimestampMode::Pass
+    } else {
+        TimestampMode::Frame
+    });
     let frame = renderer.render(&settings, true)?;
 
     let png = &args.output;
     output::write_png(png, frame.ldr.as_ref().context("no LDR image")?)?;
     println!("wrote {}", png.display());
     if !args.no_exr {
-        let exr = args.exr.clone().unwrap_or_else(|| png.with_extension("exr"));
+        let exr = args
+            .exr
+            .clone()
+            .unwrap_or_else(|| png.with_extension("exr"));
         output::write_exr(&exr, frame.hdr.as_ref().context("no HDR image")?)?;
         println!("wrote {}", exr.display());
     }

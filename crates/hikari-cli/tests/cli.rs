@@ -4,7 +4,10 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn hikari(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hikari")).args(args).output().expect("run hikari")
+    Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(args)
+        .output()
+        .expect("run hikari")
 }
 
 fn gpu_tests_skipped() -> bool {
@@ -18,7 +21,11 @@ fn tmp(name: &str) -> PathBuf {
 }
 
 fn text(o: &Output) -> String {
-    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
 }
 
 #[test]
@@ -29,8 +36,16 @@ fn render_writes_png_exr_and_dumps() {
     let dir = tmp("render");
     let png = dir.join("out.png");
     let o = hikari(&[
-        "render", "--width", "64", "--height", "40", "-o", png.to_str().unwrap(),
-        "--dump", "gbuffer.normal", "--timings",
+        "render",
+        "--width",
+        "64",
+        "--height",
+        "40",
+        "-o",
+        png.to_str().unwrap(),
+        "--dump",
+        "gbuffer.normal",
+        "--timings",
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let img = image::open(&png).unwrap().to_rgba8();
@@ -46,11 +61,27 @@ fn render_writes_png_exr_and_dumps() {
     .unwrap();
     let hdr = exr.layer_data.channel_data.pixels;
     assert!(hdr.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
-    assert!(hdr.iter().any(|p| p[0] > 100.0), "radiance in nits, not display values");
+    assert!(
+        hdr.iter().any(|p| p[0] > 100.0),
+        "radiance in nits, not display values"
+    );
     assert!(dir.join("gbuffer.normal.exr").exists());
-    assert!(text(&o).contains("gbuffer.draw"), "timing table: {}", text(&o));
+    assert!(
+        text(&o).contains("gbuffer.draw"),
+        "timing table: {}",
+        text(&o)
+    );
     // Atomic writes leave no temporary files behind.
-    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp")).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .contains(".tmp")
+        })
+        .collect();
     assert!(leftovers.is_empty());
 }
 
@@ -64,7 +95,10 @@ fn assert_clean_failure(args: &[&str], needle: &str) {
 
 #[test]
 fn bad_arguments_fail_with_a_message_and_no_panic() {
-    assert_clean_failure(&["render", "--scene", "atlantis"], "unknown scene `atlantis`");
+    assert_clean_failure(
+        &["render", "--scene", "atlantis"],
+        "unknown scene `atlantis`",
+    );
     assert_clean_failure(&["render", "--camera", "nope"], "no camera named `nope`");
     assert_clean_failure(&["render", "--ev100", "99"], "--ev100 99");
     assert_clean_failure(&["render", "--width", "banana"], "invalid value");
@@ -74,10 +108,40 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     }
     let dir = tmp("bad");
     let out = dir.join("x.png");
-    assert_clean_failure(&["render", "--width", "0", "-o", out.to_str().unwrap()], "image width");
-    assert_clean_failure(&["render", "--width", "100000", "-o", out.to_str().unwrap()], "exceeds this GPU's limit");
-    assert_clean_failure(&["render", "--width", "16", "--height", "16", "--dump", "gbuffer.nope", "-o", out.to_str().unwrap()], "gbuffer.normal");
-    assert_clean_failure(&["render", "--width", "16", "--height", "16", "-o", "/no/such/dir/x.png"], "does not exist");
+    assert_clean_failure(
+        &["render", "--width", "0", "-o", out.to_str().unwrap()],
+        "image width",
+    );
+    assert_clean_failure(
+        &["render", "--width", "100000", "-o", out.to_str().unwrap()],
+        "exceeds this GPU's limit",
+    );
+    assert_clean_failure(
+        &[
+            "render",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--dump",
+            "gbuffer.nope",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        "gbuffer.normal",
+    );
+    assert_clean_failure(
+        &[
+            "render",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "-o",
+            "/no/such/dir/x.png",
+        ],
+        "does not exist",
+    );
 }
 
 #[test]
@@ -89,7 +153,10 @@ fn missing_adapter_is_a_clear_error() {
         .unwrap();
     let t = text(&o);
     assert!(!o.status.success());
-    assert!(t.contains("no-such-gpu-anywhere") && !t.contains("panicked"), "{t}");
+    assert!(
+        t.contains("no-such-gpu-anywhere") && !t.contains("panicked"),
+        "{t}"
+    );
 
     // No driver at all: Vulkan pointed at an empty ICD list.
     let o = Command::new(env!("CARGO_BIN_EXE_hikari"))
@@ -102,5 +169,45 @@ fn missing_adapter_is_a_clear_error() {
         .unwrap();
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
-    assert!(t.contains("mesa-vulkan-drivers") && !t.contains("panicked"), "{t}");
+    assert!(
+        t.contains("mesa-vulkan-drivers") && !t.contains("panicked"),
+        "{t}"
+    );
+}
+
+#[test]
+fn constants_json_has_every_key_and_the_white_balance_maps_white() {
+    let o = hikari(&["constants", "--white", "0.8,0.9,1.2", "--json"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for key in [
+        "rec709_to_xyz",
+        "acescg_to_xyz",
+        "tonemap_to_xyz",
+        "lms_rayleigh_to_xyz",
+        "rec709_to_tonemap",
+        "tonemap_to_rec709",
+        "white_balance_rec709",
+        "lmsr_from_rec709",
+        "rgb_from_lms_gain",
+        "smits_basis",
+        "rayleigh_lms_per_km",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    // The talk's interface: the artist picks what white becomes, so W * (1,1,1) = white.
+    let m: Vec<Vec<f64>> = serde_json::from_value(v["white_balance_rec709"].clone()).unwrap();
+    let white = [0.8, 0.9, 1.2];
+    for (row, want) in m.iter().zip(white) {
+        assert!((row.iter().sum::<f64>() - want).abs() < 1e-9, "{m:?}");
+    }
+    // The talk's LMS Rayleigh coefficients, as published.
+    assert_eq!(
+        v["rayleigh_lms_per_km"],
+        serde_json::json!([0.0076224, 0.012935, 0.024845])
+    );
+    assert_eq!(v["lmsr_from_rec709"].as_array().unwrap().len(), 4);
+
+    assert_clean_failure(&["constants", "--white", "1,0,1"], "greater than 0");
+    assert_clean_failure(&["constants", "--white", "1,x,1"], "not a number");
 }

@@ -47,7 +47,9 @@ impl ContextOptions {
     pub fn from_env() -> Self {
         Self {
             backends: wgpu::Backends::from_env(),
-            adapter_name: std::env::var("WGPU_ADAPTER_NAME").ok().filter(|s| !s.is_empty()),
+            adapter_name: std::env::var("WGPU_ADAPTER_NAME")
+                .ok()
+                .filter(|s| !s.is_empty()),
             validation: std::env::var("HIKARI_GPU_VALIDATION").is_ok_and(|v| v == "1"),
         }
     }
@@ -89,7 +91,8 @@ impl GpuContext {
         let instance = wgpu::Instance::new(desc);
         let t1 = Instant::now();
 
-        let adapter = Self::pick_adapter(&instance, backends, options.adapter_name.as_deref()).await?;
+        let adapter =
+            Self::pick_adapter(&instance, backends, options.adapter_name.as_deref()).await?;
         let info = adapter.get_info();
         let t2 = Instant::now();
 

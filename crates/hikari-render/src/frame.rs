@@ -77,7 +77,9 @@ pub fn record<'r>(
     // 12. Haze and 13. TAA: their issues add them here.
 
     // 14. Exposure and tonemap (placeholder).
-    let ldr = t.placeholder_tonemap.record(g, hdr, size, &TonemapParams::from_ev100(s.ev100))?;
+    let ldr = t
+        .placeholder_tonemap
+        .record(g, hdr, size, &TonemapParams::from_ev100(s.ev100))?;
 
     Ok(FrameOutputs { hdr, ldr })
 }

@@ -17,7 +17,7 @@ pub struct StructLayout {
 macro_rules! gpu_layout {
     ($t:ty, $shader:literal, [$($f:ident),* $(,)?]) => {
         $crate::layout::StructLayout {
-            name: stringify!($t),
+            name: stringify!($t).rsplit("::").next().unwrap_or(stringify!($t)).trim(),
             shader: $shader,
             size: ::std::mem::size_of::<$t>(),
             fields: vec![$((stringify!($f), ::std::mem::offset_of!($t, $f))),*],
@@ -27,11 +27,15 @@ macro_rules! gpu_layout {
 
 /// Every GPU struct of the crate.
 pub fn all() -> Vec<StructLayout> {
-    use crate::passes::{direct_lighting, graph_check, placeholder_tonemap};
+    use crate::passes::{direct_lighting, graph_check, math_check, placeholder_tonemap};
     use crate::scene_gpu;
     use crate::view;
     vec![
-        gpu_layout!(view::View, "gbuffer/draw.wgsl", [view_proj, inv_view_proj, position, viewport]),
+        gpu_layout!(
+            view::View,
+            "gbuffer/draw.wgsl",
+            [view_proj, inv_view_proj, position, viewport]
+        ),
         gpu_layout!(scene_gpu::Vertex, "gbuffer/draw.wgsl", [position, normal]),
         gpu_layout!(
             scene_gpu::Instance,
@@ -43,8 +47,58 @@ pub fn all() -> Vec<StructLayout> {
             "direct_lighting/sun.wgsl",
             [direction_lux, color, sky_zenith, sky_horizon]
         ),
-        gpu_layout!(placeholder_tonemap::TonemapParams, "placeholder_tonemap/apply.wgsl", [exposure]),
+        gpu_layout!(
+            placeholder_tonemap::TonemapParams,
+            "placeholder_tonemap/apply.wgsl",
+            [exposure]
+        ),
         gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),
         gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),
+        gpu_layout!(
+            math_check::MathCheckParams,
+            "math_check/sh.wgsl",
+            [count, pad0, pad1, pad2]
+        ),
+        gpu_layout!(
+            math_check::MathCheckParams,
+            "math_check/ycocg.wgsl",
+            [count, pad0, pad1, pad2]
+        ),
+        gpu_layout!(
+            math_check::MathCheckParams,
+            "math_check/color.wgsl",
+            [count, pad0, pad1, pad2]
+        ),
+        gpu_layout!(
+            crate::passes::bvh_trace::TraceParams,
+            "bvh/trace.wgsl",
+            [count, pad0, pad1, pad2]
+        ),
+        gpu_layout!(
+            hikari_bvh::Ray,
+            "bvh/trace.wgsl",
+            [origin, t_min, dir, t_max]
+        ),
+        gpu_layout!(
+            hikari_bvh::Hit,
+            "bvh/trace.wgsl",
+            [t, u, v, primitive, instance, _pad]
+        ),
+        gpu_layout!(
+            hikari_bvh::TriangleRecord,
+            "bvh/trace.wgsl",
+            [v0, primitive, v1, _pad1, v2, _pad2]
+        ),
+        gpu_layout!(
+            hikari_bvh::InstanceRecord,
+            "bvh/trace.wgsl",
+            [
+                world_to_object,
+                blas_node_offset,
+                blas_triangle_offset,
+                instance_index,
+                blas_index
+            ]
+        ),
     ]
 }

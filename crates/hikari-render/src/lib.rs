@@ -17,7 +17,7 @@ pub mod shader;
 pub mod view;
 
 pub use context::{ContextOptions, GpuContext};
-pub use wgpu;
 pub use error::{RenderError, Result};
 pub use frame::FrameSettings;
 pub use renderer::{RenderedFrame, Renderer};
+pub use wgpu;

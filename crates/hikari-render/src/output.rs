@@ -15,11 +15,19 @@ fn err(path: &Path, message: impl ToString) -> RenderError {
 
 /// Runs `write` on a temporary path in the target's folder, then renames it to `path`.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     if !dir.is_dir() {
-        return Err(err(path, format!("folder {} does not exist", dir.display())));
+        return Err(err(
+            path,
+            format!("folder {} does not exist", dir.display()),
+        ));
     }
-    let file = path.file_name().ok_or_else(|| err(path, "not a file path"))?;
+    let file = path
+        .file_name()
+        .ok_or_else(|| err(path, "not a file path"))?;
     // Keep the extension last: image encoders pick the format from it.
     let tmp: PathBuf = dir.join(format!(
         ".{}.{}.tmp.{}",
@@ -53,8 +61,15 @@ pub fn write_png(path: &Path, img: &ImageRgba32) -> Result<()> {
         .flat_map(|p| p.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8))
         .collect();
     write_atomically(path, |tmp| {
-        image::save_buffer_with_format(tmp, &bytes, img.width, img.height, image::ColorType::Rgba8, image::ImageFormat::Png)
-            .map_err(|e| err(path, e))
+        image::save_buffer_with_format(
+            tmp,
+            &bytes,
+            img.width,
+            img.height,
+            image::ColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| err(path, e))
     })
 }
 

@@ -29,8 +29,12 @@ pub enum BindingKind {
         access: wgpu::StorageTextureAccess,
     },
     Uniform,
-    Storage { read_only: bool },
-    Sampler { comparison: bool },
+    Storage {
+        read_only: bool,
+    },
+    Sampler {
+        comparison: bool,
+    },
 }
 
 impl BindingKind {
@@ -136,7 +140,14 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
             )));
         }
         let kind = match (&module.types[g.ty].inner, g.space) {
-            (naga::TypeInner::Image { dim, arrayed, class }, _) => match class {
+            (
+                naga::TypeInner::Image {
+                    dim,
+                    arrayed,
+                    class,
+                },
+                _,
+            ) => match class {
                 naga::ImageClass::Sampled { kind, multi: _ } => BindingKind::SampledTexture {
                     view: view_dimension(*dim, *arrayed),
                     sample: match kind {
@@ -158,7 +169,8 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
                     view: view_dimension(*dim, *arrayed),
                     format: storage_format(*format)
                         .ok_or_else(|| err(format!("`{name}`: storage format {format:?}")))?,
-                    access: if access.contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE)
+                    access: if access
+                        .contains(naga::StorageAccess::LOAD | naga::StorageAccess::STORE)
                     {
                         wgpu::StorageTextureAccess::ReadWrite
                     } else if access.contains(naga::StorageAccess::STORE) {
@@ -177,7 +189,9 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
                 read_only: !access.contains(naga::StorageAccess::STORE),
             },
             (other, space) => {
-                return Err(err(format!("`{name}`: unsupported binding {other:?} in {space:?}")));
+                return Err(err(format!(
+                    "`{name}`: unsupported binding {other:?} in {space:?}"
+                )));
             }
         };
         slots.push(BindingSlot {
@@ -198,7 +212,10 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
     Ok(slots)
 }
 
-fn layout_entries(slots: &[BindingSlot], visibility: wgpu::ShaderStages) -> Vec<wgpu::BindGroupLayoutEntry> {
+fn layout_entries(
+    slots: &[BindingSlot],
+    visibility: wgpu::ShaderStages,
+) -> Vec<wgpu::BindGroupLayoutEntry> {
     slots
         .iter()
         .map(|s| wgpu::BindGroupLayoutEntry {
@@ -251,13 +268,18 @@ pub struct PipelineInfo {
 }
 
 impl PipelineInfo {
-    fn new(ctx: &GpuContext, label: &str, slots: Vec<BindingSlot>, visibility: wgpu::ShaderStages) -> Self {
-        let bind_group_layout = ctx
-            .device
-            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries: &layout_entries(&slots, visibility),
-            });
+    fn new(
+        ctx: &GpuContext,
+        label: &str,
+        slots: Vec<BindingSlot>,
+        visibility: wgpu::ShaderStages,
+    ) -> Self {
+        let bind_group_layout =
+            ctx.device
+                .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                    label: Some(label),
+                    entries: &layout_entries(&slots, visibility),
+                });
         Self {
             id: NEXT_PIPELINE_ID.fetch_add(1, Ordering::Relaxed),
             label: label.into(),
@@ -280,10 +302,11 @@ fn checked_module(
 }
 
 fn shader_module(ctx: &GpuContext, path: &str, module: naga::Module) -> wgpu::ShaderModule {
-    ctx.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(path),
-        source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
-    })
+    ctx.device
+        .create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(path),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
+        })
 }
 
 pub struct ComputePipeline {
@@ -370,12 +393,7 @@ impl RasterPipeline {
     ) -> Result<Self> {
         let (module, slots) = checked_module(ctx, lib, path, defs)?;
         let label = format!("{path}:{}", desc.vertex_entry);
-        let info = PipelineInfo::new(
-            ctx,
-            &label,
-            slots,
-            wgpu::ShaderStages::VERTEX_FRAGMENT,
-        );
+        let info = PipelineInfo::new(ctx, &label, slots, wgpu::ShaderStages::VERTEX_FRAGMENT);
         let layout = ctx
             .device
             .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

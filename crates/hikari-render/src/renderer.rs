@@ -62,9 +62,15 @@ impl Renderer {
         let mut result = g.execute()?;
         let (hdr, ldr) = if read_images {
             let take = |r: &mut FrameResult, name: &str| {
-                r.images.iter().position(|i| i.name == name).map(|i| r.images.remove(i))
+                r.images
+                    .iter()
+                    .position(|i| i.name == name)
+                    .map(|i| r.images.remove(i))
             };
-            (take(&mut result, "direct_lighting.radiance"), take(&mut result, "placeholder_tonemap.ldr"))
+            (
+                take(&mut result, "direct_lighting.radiance"),
+                take(&mut result, "placeholder_tonemap.ldr"),
+            )
         } else {
             (None, None)
         };

@@ -46,7 +46,9 @@ impl SceneGpu {
     /// Validates and uploads `scene`. Sizes beyond the device limits are an error that says
     /// which buffer and by how much.
     pub fn upload(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
-        scene.validate().map_err(|e| RenderError::Graph(format!("scene: {e}")))?;
+        scene
+            .validate()
+            .map_err(|e| RenderError::Graph(format!("scene: {e}")))?;
         let mut vertices = Vec::new();
         let mut indices = Vec::new();
         let mut ranges = Vec::new();
@@ -64,7 +66,8 @@ impl SceneGpu {
             .iter()
             .map(|inst| {
                 let mat = &scene.materials[inst.material];
-                let normal = Mat4::from_mat3(glam::Mat3::from_mat4(inst.transform).inverse().transpose());
+                let normal =
+                    Mat4::from_mat3(glam::Mat3::from_mat4(inst.transform).inverse().transpose());
                 Instance {
                     model: inst.transform.to_cols_array_2d(),
                     normal_model: normal.to_cols_array_2d(),
@@ -85,36 +88,56 @@ impl SceneGpu {
             .filter(|(_, inst)| ranges[inst.mesh].1 > 0)
             .map(|(i, inst)| {
                 let (first_index, index_count, base_vertex) = ranges[inst.mesh];
-                Draw { first_index, index_count, base_vertex, instance: i as u32 }
+                Draw {
+                    first_index,
+                    index_count,
+                    base_vertex,
+                    instance: i as u32,
+                }
             })
             .collect();
-        let limit = ctx.limits.max_storage_buffer_binding_size as u64;
-        let buffer = |name: &str, bytes: &[u8], usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
-            // Empty scenes still bind a buffer: wgpu refuses zero-sized bindings.
-            let padded;
-            let bytes = if bytes.is_empty() {
-                padded = [0u8; 64];
-                &padded[..]
-            } else {
-                bytes
+        let limit = ctx.limits.max_storage_buffer_binding_size;
+        let buffer =
+            |name: &str, bytes: &[u8], usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
+                // Empty scenes still bind a buffer: wgpu refuses zero-sized bindings.
+                let padded;
+                let bytes = if bytes.is_empty() {
+                    padded = [0u8; 64];
+                    &padded[..]
+                } else {
+                    bytes
+                };
+                if bytes.len() as u64 > limit {
+                    return Err(RenderError::Limit {
+                        what: format!("scene {name} buffer size in bytes"),
+                        requested: bytes.len() as u64,
+                        limit,
+                    });
+                }
+                Ok(ctx
+                    .device
+                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(name),
+                        contents: bytes,
+                        usage,
+                    }))
             };
-            if bytes.len() as u64 > limit {
-                return Err(RenderError::Limit {
-                    what: format!("scene {name} buffer size in bytes"),
-                    requested: bytes.len() as u64,
-                    limit,
-                });
-            }
-            Ok(ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(name),
-                contents: bytes,
-                usage,
-            }))
-        };
         Ok(Self {
-            vertices: buffer("vertices", bytemuck::cast_slice(&vertices), wgpu::BufferUsages::STORAGE)?,
-            indices: buffer("indices", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE)?,
-            instances: buffer("instances", bytemuck::cast_slice(&instances), wgpu::BufferUsages::STORAGE)?,
+            vertices: buffer(
+                "vertices",
+                bytemuck::cast_slice(&vertices),
+                wgpu::BufferUsages::STORAGE,
+            )?,
+            indices: buffer(
+                "indices",
+                bytemuck::cast_slice(&indices),
+                wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
+            )?,
+            instances: buffer(
+                "instances",
+                bytemuck::cast_slice(&instances),
+                wgpu::BufferUsages::STORAGE,
+            )?,
             triangles: scene.triangle_count() as u64,
             draws,
         })

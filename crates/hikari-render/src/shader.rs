@@ -160,7 +160,7 @@ pub fn validate(
         .validate(module)
         .map_err(|e| RenderError::Shader {
             path: path.into(),
-            message: format!("{}", e.emit_to_string("")),
+            message: e.emit_to_string("").to_string(),
         })
 }
 

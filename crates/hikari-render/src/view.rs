@@ -21,8 +21,13 @@ impl View {
             view_proj: vp.to_cols_array_2d(),
             inv_view_proj: vp.inverse().to_cols_array_2d(),
             position: camera.position.extend(1.0).to_array(),
-            viewport: Vec4::new(width as f32, height as f32, 1.0 / width as f32, 1.0 / height as f32)
-                .to_array(),
+            viewport: Vec4::new(
+                width as f32,
+                height as f32,
+                1.0 / width as f32,
+                1.0 / height as f32,
+            )
+            .to_array(),
         }
     }
 

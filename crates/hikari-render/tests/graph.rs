@@ -3,10 +3,10 @@
 
 mod common;
 
+use hikari_render::RenderError;
 use hikari_render::graph::{GraphRuntime, TextureDesc, TimestampMode};
 use hikari_render::passes::graph_check::{FillParams, GraphCheck};
 use hikari_render::shader::{self, ShaderLibrary};
-use hikari_render::RenderError;
 
 const F16: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
@@ -18,7 +18,9 @@ fn setup() -> Option<(hikari_render::GpuContext, GraphCheck)> {
 }
 
 fn fill(v: f32) -> FillParams {
-    FillParams { value: [v, v, v, 1.0] }
+    FillParams {
+        value: [v, v, v, 1.0],
+    }
 }
 
 #[test]
@@ -47,10 +49,28 @@ fn aliasing_is_safe(mode: TimestampMode) {
         let b = g.texture("t.b", desc).unwrap();
         let c = g.texture("t.c", desc).unwrap();
         let d = g.texture("t.d", desc).unwrap();
-        g.pass("t.fill_a").write(a).constants(&fill(1.0)).dispatch_threads(&check.fill, [16, 16, 1]).unwrap();
-        g.pass("t.fill_b").write(b).constants(&fill(2.0)).dispatch_threads(&check.fill, [16, 16, 1]).unwrap();
-        g.pass("t.c").read(a).read(b).write(c).dispatch_threads(&check.add, [16, 16, 1]).unwrap();
-        g.pass("t.d").read(c).read(c).write(d).dispatch_threads(&check.add, [16, 16, 1]).unwrap();
+        g.pass("t.fill_a")
+            .write(a)
+            .constants(&fill(1.0))
+            .dispatch_threads(&check.fill, [16, 16, 1])
+            .unwrap();
+        g.pass("t.fill_b")
+            .write(b)
+            .constants(&fill(2.0))
+            .dispatch_threads(&check.fill, [16, 16, 1])
+            .unwrap();
+        g.pass("t.c")
+            .read(a)
+            .read(b)
+            .write(c)
+            .dispatch_threads(&check.add, [16, 16, 1])
+            .unwrap();
+        g.pass("t.d")
+            .read(c)
+            .read(c)
+            .write(d)
+            .dispatch_threads(&check.add, [16, 16, 1])
+            .unwrap();
         g.readback(d);
         let r = g.execute().unwrap();
         let id = |n: &str| r.allocations.iter().find(|(name, _)| name == n).unwrap().1;
@@ -63,10 +83,17 @@ fn aliasing_is_safe(mode: TimestampMode) {
         assert_eq!(r.image("t.d").unwrap().pixel(3, 5)[0], 6.0);
         ids.push([id("t.a"), id("t.b"), id("t.c"), id("t.d")]);
         if frame > 0 {
-            assert_eq!(ids[frame], ids[0], "the pool hands the same textures back every frame");
+            assert_eq!(
+                ids[frame], ids[0],
+                "the pool hands the same textures back every frame"
+            );
         }
     }
-    assert_eq!(rt.pool_stats().textures_created, 3, "three physical textures serve four virtual ones");
+    assert_eq!(
+        rt.pool_stats().textures_created,
+        3,
+        "three physical textures serve four virtual ones"
+    );
 }
 
 #[test]
@@ -77,10 +104,19 @@ fn history_carries_the_previous_frame_and_resets_on_resize() {
         let desc = TextureDesc::d2(size, size, F16);
         let mut g = rt.begin_frame(&ctx);
         let one = g.texture("h.one", desc).unwrap();
-        g.pass("h.fill").write(one).constants(&fill(1.0)).dispatch_threads(&check.fill, [size, size, 1]).unwrap();
+        g.pass("h.fill")
+            .write(one)
+            .constants(&fill(1.0))
+            .dispatch_threads(&check.fill, [size, size, 1])
+            .unwrap();
         let h = g.history_texture("h.count", desc).unwrap();
         assert_eq!(h.valid, expect_valid);
-        g.pass("h.accumulate").read(h.prev).read(one).write(h.cur).dispatch_threads(&check.add, [size, size, 1]).unwrap();
+        g.pass("h.accumulate")
+            .read(h.prev)
+            .read(one)
+            .write(h.cur)
+            .dispatch_threads(&check.add, [size, size, 1])
+            .unwrap();
         g.readback(h.cur);
         let r = g.execute().unwrap();
         assert_eq!(r.image("h.count").unwrap().pixel(1, 1)[0], expect);
@@ -104,7 +140,11 @@ fn persistent_textures_are_created_once() {
         assert_eq!(created, frame == 0);
         g.readback(lut);
         let r = g.execute().unwrap();
-        assert_eq!(r.image("p.lut").unwrap().height, 16, "3D slices stack vertically");
+        assert_eq!(
+            r.image("p.lut").unwrap().height,
+            16,
+            "3D slices stack vertically"
+        );
     }
     let _ = check;
 }
@@ -122,19 +162,44 @@ fn binding_mistakes_name_the_pass_and_binding() {
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(&ctx);
     let a = g.texture("m.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    let wrong = g.texture("m.wrong", TextureDesc::d2(8, 8, wgpu::TextureFormat::Rgba8Unorm)).unwrap();
+    let wrong = g
+        .texture(
+            "m.wrong",
+            TextureDesc::d2(8, 8, wgpu::TextureFormat::Rgba8Unorm),
+        )
+        .unwrap();
 
-    let e = pass_error(g.pass("m.too_few").write(a).dispatch(&check.fill, [1, 1, 1]));
+    let e = pass_error(
+        g.pass("m.too_few")
+            .write(a)
+            .dispatch(&check.fill, [1, 1, 1]),
+    );
     assert!(e.contains("m.too_few") && e.contains("binds 1"), "{e}");
 
-    let e = pass_error(g.pass("m.read_as_write").read(a).constants(&fill(0.0)).dispatch(&check.fill, [1, 1, 1]));
+    let e = pass_error(
+        g.pass("m.read_as_write")
+            .read(a)
+            .constants(&fill(0.0))
+            .dispatch(&check.fill, [1, 1, 1]),
+    );
     assert!(e.contains("target_tex") && e.contains("`read`"), "{e}");
 
-    let e = pass_error(g.pass("m.format").write(wrong).constants(&fill(0.0)).dispatch(&check.fill, [1, 1, 1]));
+    let e = pass_error(
+        g.pass("m.format")
+            .write(wrong)
+            .constants(&fill(0.0))
+            .dispatch(&check.fill, [1, 1, 1]),
+    );
     assert!(e.contains("Rgba16Float") && e.contains("m.wrong"), "{e}");
 
     let b = g.texture("m.b", TextureDesc::d2(8, 8, F16)).unwrap();
-    let e = pass_error(g.pass("m.unwritten").read(b).read(b).write(a).dispatch(&check.add, [1, 1, 1]));
+    let e = pass_error(
+        g.pass("m.unwritten")
+            .read(b)
+            .read(b)
+            .write(a)
+            .dispatch(&check.add, [1, 1, 1]),
+    );
     assert!(e.contains("no earlier pass"), "{e}");
 }
 
@@ -144,21 +209,35 @@ fn limits_and_dump_names_are_checked() {
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(&ctx);
     let too_big = ctx.limits.max_texture_dimension_2d + 1;
-    assert!(matches!(g.texture("l.big", TextureDesc::d2(too_big, 4, F16)), Err(RenderError::Limit { .. })));
-    assert!(matches!(g.texture("l.zero", TextureDesc::d2(0, 4, F16)), Err(RenderError::Limit { .. })));
+    assert!(matches!(
+        g.texture("l.big", TextureDesc::d2(too_big, 4, F16)),
+        Err(RenderError::Limit { .. })
+    ));
+    assert!(matches!(
+        g.texture("l.zero", TextureDesc::d2(0, 4, F16)),
+        Err(RenderError::Limit { .. })
+    ));
     drop(g);
 
     rt.set_dumps(vec!["no.such.thing".into()]);
     let mut g = rt.begin_frame(&ctx);
     let a = g.texture("d.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    g.pass("d.fill").write(a).constants(&fill(1.0)).dispatch_threads(&check.fill, [8, 8, 1]).unwrap();
+    g.pass("d.fill")
+        .write(a)
+        .constants(&fill(1.0))
+        .dispatch_threads(&check.fill, [8, 8, 1])
+        .unwrap();
     let e = g.execute().unwrap_err().to_string();
     assert!(e.contains("no.such.thing") && e.contains("d.a"), "{e}");
 
     rt.set_dumps(vec!["d.a".into()]);
     let mut g = rt.begin_frame(&ctx);
     let a = g.texture("d.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    g.pass("d.fill").write(a).constants(&fill(0.5)).dispatch_threads(&check.fill, [8, 8, 1]).unwrap();
+    g.pass("d.fill")
+        .write(a)
+        .constants(&fill(0.5))
+        .dispatch_threads(&check.fill, [8, 8, 1])
+        .unwrap();
     let r = g.execute().unwrap();
     assert_eq!(r.image("d.a").unwrap().pixel(7, 7), [0.5, 0.5, 0.5, 1.0]);
 }
@@ -169,13 +248,25 @@ fn every_pass_gets_a_timing_row_under_its_name() {
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(&ctx);
     let a = g.texture("n.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    g.pass("n.first").write(a).constants(&fill(1.0)).dispatch_threads(&check.fill, [8, 8, 1]).unwrap();
-    g.pass("n.second").write(a).constants(&fill(2.0)).dispatch_threads(&check.fill, [8, 8, 1]).unwrap();
+    g.pass("n.first")
+        .write(a)
+        .constants(&fill(1.0))
+        .dispatch_threads(&check.fill, [8, 8, 1])
+        .unwrap();
+    g.pass("n.second")
+        .write(a)
+        .constants(&fill(2.0))
+        .dispatch_threads(&check.fill, [8, 8, 1])
+        .unwrap();
     let r = g.execute().unwrap();
     let names: Vec<&str> = r.timings.iter().map(|t| t.name.as_str()).collect();
     assert_eq!(names, ["n.first", "n.second"]);
     if ctx.has(wgpu::Features::TIMESTAMP_QUERY) {
-        assert!(r.timings.iter().all(|t| t.gpu_ms.is_some_and(|v| v >= 0.0)), "{:?}", r.timings);
+        assert!(
+            r.timings.iter().all(|t| t.gpu_ms.is_some_and(|v| v >= 0.0)),
+            "{:?}",
+            r.timings
+        );
         assert!(r.gpu_span_ms.is_some());
     }
 
@@ -183,9 +274,20 @@ fn every_pass_gets_a_timing_row_under_its_name() {
     rt.set_timestamps(TimestampMode::Frame);
     let mut g = rt.begin_frame(&ctx);
     let a = g.texture("n.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    g.pass("n.first").write(a).constants(&fill(1.0)).dispatch_threads(&check.fill, [8, 8, 1]).unwrap();
-    g.pass("n.second").write(a).constants(&fill(2.0)).dispatch_threads(&check.fill, [8, 8, 1]).unwrap();
+    g.pass("n.first")
+        .write(a)
+        .constants(&fill(1.0))
+        .dispatch_threads(&check.fill, [8, 8, 1])
+        .unwrap();
+    g.pass("n.second")
+        .write(a)
+        .constants(&fill(2.0))
+        .dispatch_threads(&check.fill, [8, 8, 1])
+        .unwrap();
     let r = g.execute().unwrap();
     assert!(r.timings.iter().all(|t| t.gpu_ms.is_none()));
-    assert_eq!(r.gpu_span_ms.is_some(), ctx.has(wgpu::Features::TIMESTAMP_QUERY));
+    assert_eq!(
+        r.gpu_span_ms.is_some(),
+        ctx.has(wgpu::Features::TIMESTAMP_QUERY)
+    );
 }

@@ -8,9 +8,12 @@
 //! cannot meet. Each `rel` is a small multiple of f32's unit roundoff (`ε = 2^-24 ≈ 6e-8`) per
 //! rounding on the path, summed over both sides (the GPU in f32; hikari-math in f32 or f64),
 //! and for the built-ins Vulkan does not round correctly (division 2.5 ulp, `inverseSqrt`
-//! 2 ulp, `pow` as `exp2(y log2 x)`), the precision Vulkan allows for them. A wrong constant
-//! beyond the 5th significant digit, a swapped component or a transposed matrix is hundreds to
+//! 2 ulp, `pow` as `exp2(y log2 x)`), the precision Vulkan allows for them. A constant wrong
+//! in its 5th significant digit, a swapped component or a transposed matrix is tens to
 //! millions of times over these bounds.
+
+// Record fields are read by index, as the WGSL writes them.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 
@@ -85,7 +88,7 @@ impl Compare {
         self.n += 1;
         let err = (got as f64 - want).abs();
         let ratio = if err == 0.0 { 0.0 } else { err / allowed };
-        if !(err <= allowed) {
+        if err.is_nan() || allowed.is_nan() || err > allowed {
             self.failed += 1;
             if self.failures.len() < 8 {
                 self.failures.push(format!(
@@ -218,6 +221,20 @@ fn dense_dirs(n: usize) -> Vec<DVec3> {
             DVec3::new(r * phi.cos(), r * phi.sin(), z)
         })
         .collect()
+}
+
+/// Smallest eigenvalue of the Hessian of `f` on the sphere at `v` (finite differences in f64
+/// along two tangents): how sharply a minimum at `v` is defined.
+fn smallest_curvature(c: &[f32; 9], v: DVec3) -> f64 {
+    let (t1, t2) = v.any_orthonormal_pair();
+    let h = 1e-3;
+    let g = |a: f64, b: f64| eval_f64(c, v + a * t1 + b * t2);
+    let f0 = g(0.0, 0.0);
+    let gaa = (g(h, 0.0) - 2.0 * f0 + g(-h, 0.0)) / (h * h);
+    let gbb = (g(0.0, h) - 2.0 * f0 + g(0.0, -h)) / (h * h);
+    let gab = (g(h, h) - g(h, -h) - g(-h, h) + g(-h, -h)) / (4.0 * h * h);
+    let (tr, det) = (gaa + gbb, gaa * gbb - gab * gab);
+    0.5 * (tr - (tr * tr - 4.0 * det).max(0.0).sqrt())
 }
 
 fn eval_f64(c: &[f32; 9], d: DVec3) -> f64 {
@@ -491,8 +508,13 @@ fn sh_find_minimum_matches_the_cpu() {
     // the search's own accuracy (~1e-4 of Σ|c_i|, hikari-math docs). 1e-5 of Σ|c_i| is 10x
     // tighter than that accuracy and ~100x above rounding.
     let mut cpu_cmp = Compare::new("sh_find_min_l2 value vs CPU", 1e-5, 0.0);
-    let mut dir_cmp = Compare::new("sh_find_min_l2 direction vs CPU", 1e-3, 0.0);
-    let (mut same_dir, mut total) = (0, 0);
+    // Directions: as close as the minimum's curvature makes them. Where the two values agree
+    // to Δf = 1e-5 of the term scale, the directions may differ by up to √(2 Δf / h), h the
+    // smallest curvature of f on the sphere at the CPU's minimum (a projected delta is zonal:
+    // its minimum is a whole ring, h = 0, and any direction on it is right). A function
+    // without band 1 is even (f(−ω) = f(ω)): its minimum is reached at opposite directions too.
+    let mut dir_cmp = Compare::new("sh_find_min_l2 direction vs CPU", 1.0, 1e-4);
+    let (mut isolated, mut total) = (0, 0);
     for (i, (f, r)) in cases.iter().zip(&out).enumerate() {
         let scale = 1.1 * sum_abs(&f.coeffs);
         let dir = DVec3::new(r[0] as f64, r[1] as f64, r[2] as f64);
@@ -500,21 +522,30 @@ fn sh_find_minimum_matches_the_cpu() {
         value_cmp.check(i, r[3], eval_f64(&f.coeffs, dir), scale);
         let (cpu_dir, cpu_value) = find_minimum(f);
         cpu_cmp.check(i, r[3], cpu_value as f64, scale);
-        // Directions agree when the minimum is well defined; a flat valley (many directions
-        // within rounding of the minimum) may legitimately end elsewhere in it.
-        total += 1;
         let cpu_dir = cpu_dir.as_dvec3();
-        if (dir - cpu_dir).length() < 1e-3 {
-            same_dir += 1;
+        let even = f.coeffs[1..4].iter().all(|&c| c == 0.0);
+        let apart = if even {
+            (dir - cpu_dir).length().min((dir + cpu_dir).length())
         } else {
-            let along = eval_f64(&f.coeffs, cpu_dir);
-            dir_cmp.check(i, r[3], along, scale);
+            (dir - cpu_dir).length()
+        };
+        let h = smallest_curvature(&f.coeffs, cpu_dir);
+        let spread = if h > 0.0 {
+            (2.0 * cpu_cmp.rel * scale / h).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        total += 1;
+        if spread < 0.05 {
+            isolated += 1;
         }
+        dir_cmp.check(i, apart as f32, 0.0, spread.min(2.0));
     }
-    // Sanity of the inputs: most minima are well defined and found at the same direction.
+    // Most minima are isolated, so the direction comparison is not vacuous.
+    eprintln!("find_min: {isolated} of {total} minima isolated (direction spread < 0.05)");
     assert!(
-        same_dir * 10 >= total * 9,
-        "only {same_dir} of {total} minimum directions agree"
+        isolated * 2 >= total,
+        "only {isolated} of {total} minima are isolated"
     );
     report(&[unit_cmp, value_cmp, cpu_cmp, dir_cmp]);
 }
@@ -541,8 +572,7 @@ fn dering_cases(rng: &mut SmallRng, n: usize) -> Vec<ShL2Rgb> {
                 ShL2Rgb::new(c).scale(decades(rng, -2.0, 2.0))
             }
             3..5 => {
-                // A projected light: a delta or a narrow lobe's worth of ringing, tinted, on
-                // a weak ambient.
+                // A projected delta light (the strongest ringing), tinted, on a weak ambient.
                 let colour = Vec3::new(
                     rng.random_range(0.1..1.0),
                     rng.random_range(0.1..1.0),
@@ -599,8 +629,8 @@ fn sh_dering_matches_the_cpu_and_is_non_negative() {
     // The true minimum, scanned densely (512 directions on the GPU with sh_eval_l2_rgb,
     // 4000 on the CPU in f64): the search estimates the minimum to ~1e-4 of the term scale and
     // a projected delta's minimum sits in a sharp trough, so a scan may find a value below the
-    // estimate by that much; 1e-3 of the channel's term scale leaves room for it, while an
-    // input that ringed and was not deringed goes negative by ~1e-1 of it.
+    // estimate by that much; 1e-3 of the channel's term scale leaves room for it, while a
+    // projected delta left ringing goes below zero by a few percent of it (~50x the bound).
     let mut scan_gpu = Compare::new("deringed minimum, GPU scan", 1e-3, 0.0);
     let mut scan_cpu = Compare::new("deringed minimum, CPU scan of GPU coefficients", 1e-3, 0.0);
     let dirs = dense_dirs(4000);
@@ -640,8 +670,10 @@ fn sh_dering_matches_the_cpu_and_is_non_negative() {
             untouched += 1;
         }
         let gpu = read_rgb(&r[1..28]);
-        let want = if f.coeffs[0].min_element() < 0.0 {
-            ShL2Rgb::zero()
+        // At the CPU's strength this is `dering(f).sh` itself; at a tie, the same windowing
+        // at the GPU's strength.
+        let want = if gpu_strength == cpu.strength {
+            cpu.sh
         } else {
             f.scale_bands(dering_window(gpu_strength))
         };
@@ -668,7 +700,10 @@ fn sh_dering_matches_the_cpu_and_is_non_negative() {
             scan_cpu.check(i, lowest.min(0.0) as f32, 0.0, s);
         }
     }
-    eprintln!("dering: {deringed} inputs windowed, {untouched} left alone, {ties} strength ties");
+    eprintln!(
+        "dering: {deringed} inputs windowed, {untouched} left alone, {ties} strength mismatches"
+    );
+    report(&[strength_cmp, coeff_cmp, self_min, scan_gpu, scan_cpu]);
     // The inputs exercise both outcomes, and ties stay rare: a twin whose search differs
     // (a wrong λ scale, a different start set) disagrees on many inputs, not on a few ties.
     assert!(
@@ -680,7 +715,6 @@ fn sh_dering_matches_the_cpu_and_is_non_negative() {
         "{ties} strength mismatches in {} cases",
         cases.len()
     );
-    report(&[strength_cmp, coeff_cmp, self_min, scan_gpu, scan_cpu]);
 }
 
 /// Linear-maximum direction and directionality boost.

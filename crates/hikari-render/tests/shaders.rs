@@ -36,12 +36,21 @@ fn every_wgsl_file_on_disk_is_embedded() {
             if p.is_dir() {
                 stack.push(p);
             } else if p.extension().is_some_and(|x| x == "wgsl") {
-                on_disk.push(p.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/"));
+                on_disk.push(
+                    p.strip_prefix(&root)
+                        .unwrap()
+                        .to_string_lossy()
+                        .replace('\\', "/"),
+                );
             }
         }
     }
     on_disk.sort();
-    let mut embedded: Vec<String> = shader::shader_files().unwrap().into_iter().map(|f| f.path).collect();
+    let mut embedded: Vec<String> = shader::shader_files()
+        .unwrap()
+        .into_iter()
+        .map(|f| f.path)
+        .collect();
     embedded.sort();
     assert_eq!(on_disk, embedded);
 }

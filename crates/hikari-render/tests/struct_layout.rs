@@ -20,22 +20,34 @@ fn rust_structs_match_wgsl_layouts() {
             failures.push(format!("{}: no WGSL struct `{}`", l.shader, l.name));
             continue;
         };
-        let naga::TypeInner::Struct { members, span } = &ty.inner else { unreachable!() };
+        let naga::TypeInner::Struct { members, span } = &ty.inner else {
+            unreachable!()
+        };
         let wgsl: Vec<(String, usize)> = members
             .iter()
             .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
             .collect();
-        let rust: Vec<(String, usize)> = l.fields.iter().map(|(n, o)| (n.to_string(), *o)).collect();
+        let rust: Vec<(String, usize)> =
+            l.fields.iter().map(|(n, o)| (n.to_string(), *o)).collect();
         if wgsl != rust {
-            failures.push(format!("{}: fields differ\n  WGSL {wgsl:?}\n  Rust {rust:?}", l.name));
+            failures.push(format!(
+                "{}: fields differ\n  WGSL {wgsl:?}\n  Rust {rust:?}",
+                l.name
+            ));
         }
         if *span as usize != l.size {
-            failures.push(format!("{}: WGSL size {} but Rust size {}", l.name, span, l.size));
+            failures.push(format!(
+                "{}: WGSL size {} but Rust size {}",
+                l.name, span, l.size
+            ));
         }
         // A uniform's size must be a multiple of its alignment for arrays and bindings.
         let align = layouter[handle].alignment.round_up(1) as usize;
         if l.size % align != 0 {
-            failures.push(format!("{}: size {} not a multiple of alignment {align}", l.name, l.size));
+            failures.push(format!(
+                "{}: size {} not a multiple of alignment {align}",
+                l.name, l.size
+            ));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

@@ -1,15 +1,19 @@
-//! Built-in scenes, generated in code.
+//! Built-in scenes, generated in code (deterministic: no randomness, no assets).
+//!
+//! Units as everywhere in the crate: metres, lux, candela, nits.
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 
-use crate::{shapes, Camera, Instance, Material, Scene, Sun};
+use crate::{Camera, Instance, Material, Mesh, Scene, Sun, shapes};
 
 /// Names of the built-in scenes, for the CLI.
-pub const NAMES: &[&str] = &["boxes"];
+pub const NAMES: &[&str] = &["boxes", "cornell", "terrain"];
 
 pub fn by_name(name: &str) -> Option<Scene> {
     match name {
         "boxes" => Some(boxes()),
+        "cornell" => Some(cornell()),
+        "terrain" => Some(terrain()),
         _ => None,
     }
 }
@@ -24,10 +28,24 @@ pub fn boxes() -> Scene {
         Material::diffuse("gold leaves", Vec3::new(0.75, 0.55, 0.08)),
     ];
     let meshes = vec![shapes::plane(40.0), shapes::cube()];
-    let mut instances = vec![Instance { mesh: 0, material: 0, transform: Mat4::IDENTITY }];
+    let mut instances = vec![Instance {
+        mesh: 0,
+        material: 0,
+        transform: Mat4::IDENTITY,
+    }];
     let boxes = [
-        (Vec3::new(-3.0, 1.0, 0.0), Vec3::new(2.0, 2.0, 2.0), 20.0f32, 1),
-        (Vec3::new(1.5, 0.75, -1.5), Vec3::new(1.5, 1.5, 1.5), -35.0, 2),
+        (
+            Vec3::new(-3.0, 1.0, 0.0),
+            Vec3::new(2.0, 2.0, 2.0),
+            20.0f32,
+            1,
+        ),
+        (
+            Vec3::new(1.5, 0.75, -1.5),
+            Vec3::new(1.5, 1.5, 1.5),
+            -35.0,
+            2,
+        ),
         (Vec3::new(2.5, 2.0, 2.5), Vec3::new(1.0, 4.0, 1.0), 10.0, 3),
         (Vec3::new(-0.5, 0.4, 3.0), Vec3::new(0.8, 0.8, 0.8), 45.0, 4),
     ];
@@ -35,7 +53,11 @@ pub fn boxes() -> Scene {
         instances.push(Instance {
             mesh: 1,
             material,
-            transform: Mat4::from_scale_rotation_translation(size, Quat::from_rotation_y(yaw.to_radians()), pos),
+            transform: Mat4::from_scale_rotation_translation(
+                size,
+                Quat::from_rotation_y(yaw.to_radians()),
+                pos,
+            ),
         });
     }
     Scene {
@@ -49,6 +71,7 @@ pub fn boxes() -> Scene {
                 target: Vec3::new(0.0, 1.0, 0.0),
                 vfov_deg: 45.0,
                 near: 0.1,
+                up: Vec3::Y,
             },
             Camera {
                 name: "top".into(),
@@ -56,13 +79,359 @@ pub fn boxes() -> Scene {
                 target: Vec3::ZERO,
                 vfov_deg: 50.0,
                 near: 0.1,
+                up: Vec3::Y,
             },
         ],
-        sun: Some(Sun {
-            direction: Vec3::new(-0.45, 0.75, 0.35).normalize(),
-            illuminance_lux: 100_000.0,
-            color: Vec3::ONE,
-        }),
+        sun: Some(Sun::default()),
+        ..Default::default()
+    }
+}
+
+/// The Cornell box's published geometry ("Cornell Box Data", Cornell University Program of
+/// Computer Graphics, <https://www.graphics.cornell.edu/online/box/data.html>), in millimetres:
+/// x from the right (green) wall at 0 to the left (red) wall at about 556, y up, z from the
+/// open front at 0 to the back wall at 559.2. Quads are listed as published.
+mod cornell_data {
+    pub const FLOOR: [[f32; 3]; 4] = [
+        [552.8, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [0.0, 0.0, 559.2],
+        [549.6, 0.0, 559.2],
+    ];
+    pub const CEILING: [[f32; 3]; 4] = [
+        [556.0, 548.8, 0.0],
+        [556.0, 548.8, 559.2],
+        [0.0, 548.8, 559.2],
+        [0.0, 548.8, 0.0],
+    ];
+    pub const BACK: [[f32; 3]; 4] = [
+        [549.6, 0.0, 559.2],
+        [0.0, 0.0, 559.2],
+        [0.0, 548.8, 559.2],
+        [556.0, 548.8, 559.2],
+    ];
+    pub const RIGHT_GREEN: [[f32; 3]; 4] = [
+        [0.0, 0.0, 559.2],
+        [0.0, 0.0, 0.0],
+        [0.0, 548.8, 0.0],
+        [0.0, 548.8, 559.2],
+    ];
+    pub const LEFT_RED: [[f32; 3]; 4] = [
+        [552.8, 0.0, 0.0],
+        [549.6, 0.0, 559.2],
+        [556.0, 548.8, 559.2],
+        [556.0, 548.8, 0.0],
+    ];
+    pub const LIGHT: [[f32; 3]; 4] = [
+        [343.0, 548.8, 227.0],
+        [343.0, 548.8, 332.0],
+        [213.0, 548.8, 332.0],
+        [213.0, 548.8, 227.0],
+    ];
+    /// Top face then the four sides of each block (the published lists omit the bottoms).
+    pub const SHORT_BLOCK: [[[f32; 3]; 4]; 5] = [
+        [
+            [130.0, 165.0, 65.0],
+            [82.0, 165.0, 225.0],
+            [240.0, 165.0, 272.0],
+            [290.0, 165.0, 114.0],
+        ],
+        [
+            [290.0, 0.0, 114.0],
+            [290.0, 165.0, 114.0],
+            [240.0, 165.0, 272.0],
+            [240.0, 0.0, 272.0],
+        ],
+        [
+            [130.0, 0.0, 65.0],
+            [130.0, 165.0, 65.0],
+            [290.0, 165.0, 114.0],
+            [290.0, 0.0, 114.0],
+        ],
+        [
+            [82.0, 0.0, 225.0],
+            [82.0, 165.0, 225.0],
+            [130.0, 165.0, 65.0],
+            [130.0, 0.0, 65.0],
+        ],
+        [
+            [240.0, 0.0, 272.0],
+            [240.0, 165.0, 272.0],
+            [82.0, 165.0, 225.0],
+            [82.0, 0.0, 225.0],
+        ],
+    ];
+    pub const TALL_BLOCK: [[[f32; 3]; 4]; 5] = [
+        [
+            [423.0, 330.0, 247.0],
+            [265.0, 330.0, 296.0],
+            [314.0, 330.0, 456.0],
+            [472.0, 330.0, 406.0],
+        ],
+        [
+            [423.0, 0.0, 247.0],
+            [423.0, 330.0, 247.0],
+            [472.0, 330.0, 406.0],
+            [472.0, 0.0, 406.0],
+        ],
+        [
+            [472.0, 0.0, 406.0],
+            [472.0, 330.0, 406.0],
+            [314.0, 330.0, 456.0],
+            [314.0, 0.0, 456.0],
+        ],
+        [
+            [314.0, 0.0, 456.0],
+            [314.0, 330.0, 456.0],
+            [265.0, 330.0, 296.0],
+            [265.0, 0.0, 296.0],
+        ],
+        [
+            [265.0, 0.0, 296.0],
+            [265.0, 330.0, 296.0],
+            [423.0, 330.0, 247.0],
+            [423.0, 0.0, 247.0],
+        ],
+    ];
+    /// Camera: position (278, 273, -800), looking along +z, up +y; focal length 35 mm onto a
+    /// 25 mm x 25 mm film.
+    pub const CAMERA_POSITION: [f32; 3] = [278.0, 273.0, -800.0];
+    pub const FOCAL_LENGTH: f32 = 35.0;
+    pub const FILM_SIZE: f32 = 25.0;
+}
+
+/// Appends the quad `q` (millimetres) to `mesh` in metres, wound counter-clockwise seen from
+/// the side `facing` points to, with the flat normal.
+fn push_quad(mesh: &mut Mesh, q: [[f32; 3]; 4], facing: Vec3) {
+    let mut p = q.map(|c| Vec3::from(c) * 1e-3);
+    let n = (p[1] - p[0]).cross(p[2] - p[0]) + (p[2] - p[0]).cross(p[3] - p[0]);
+    if n.dot(facing) < 0.0 {
+        p.reverse();
+    }
+    let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+    let u = (p[1] - p[0]).normalize();
+    // +v runs from corner 3 (v = 0) to corner 0 (v = 1), per the UV table below.
+    let w = if n.cross(u).dot(p[0] - p[3]) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let base = mesh.positions.len() as u32;
+    for (corner, uv) in p.iter().zip([
+        Vec2::new(0.0, 1.0),
+        Vec2::new(1.0, 1.0),
+        Vec2::new(1.0, 0.0),
+        Vec2::new(0.0, 0.0),
+    ]) {
+        mesh.positions.push(*corner);
+        mesh.normals.push(n);
+        mesh.uvs.push(uv);
+        mesh.tangents.push(u.extend(w));
+    }
+    mesh.indices
+        .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+}
+
+/// Luminance of the Cornell box light, nits. The published emission is a spectrum without
+/// an absolute scale that matters for rendering; this value puts the floor under the light at
+/// about 50 nits (E ≈ L A / d² with A = 0.0137 m², d = 0.549 m, then albedo 0.72 / π), an
+/// interior exposure of about EV 7.
+pub const CORNELL_LIGHT_NITS: f32 = 5000.0;
+
+/// The Cornell box with its published dimensions, in metres (see `cornell_data`), seen from
+/// the published camera. The interior mask is 1 everywhere: it is a closed room.
+///
+/// Colours: the published data give spectral reflectances (400-700 nm); these are the
+/// approximate linear RGB albedos derived from them that reference renderers commonly use
+/// (for example the Mitsuba and Tungsten Cornell box scenes): white (0.725, 0.71, 0.68), red
+/// (0.63, 0.065, 0.05), green (0.14, 0.45, 0.091). The light is the commonly used RGB
+/// emission (17, 12, 4) (the published spectrum's shape: more red than blue), scaled to a
+/// luminance of [`CORNELL_LIGHT_NITS`]. It is lowered by 0.5 mm below the ceiling, which it
+/// would otherwise coincide with (the published light is a patch of the ceiling).
+pub fn cornell() -> Scene {
+    use cornell_data::*;
+    let room_center = Vec3::new(0.278, 0.274, 0.280);
+    let white = Vec3::new(0.725, 0.71, 0.68);
+    let emission_rgb = Vec3::new(17.0, 12.0, 4.0);
+    let luminance = emission_rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let indoor = |m: Material| Material {
+        interior: Some(1.0),
+        roughness: 1.0,
+        ..m
+    };
+    let materials = vec![
+        indoor(Material::diffuse("white", white)),
+        indoor(Material::diffuse("red", Vec3::new(0.63, 0.065, 0.05))),
+        indoor(Material::diffuse("green", Vec3::new(0.14, 0.45, 0.091))),
+        indoor(Material::emissive(
+            "light",
+            emission_rgb * (CORNELL_LIGHT_NITS / luminance),
+        )),
+    ];
+    let inward = |q: [[f32; 3]; 4]| {
+        let c = q.iter().map(|p| Vec3::from(*p) * 1e-3).sum::<Vec3>() / 4.0;
+        room_center - c
+    };
+    let mut walls = Mesh {
+        name: "cornell white walls".into(),
+        ..Default::default()
+    };
+    for q in [FLOOR, CEILING, BACK] {
+        push_quad(&mut walls, q, inward(q));
+    }
+    let mut red = Mesh {
+        name: "cornell red wall".into(),
+        ..Default::default()
+    };
+    push_quad(&mut red, LEFT_RED, inward(LEFT_RED));
+    let mut green = Mesh {
+        name: "cornell green wall".into(),
+        ..Default::default()
+    };
+    push_quad(&mut green, RIGHT_GREEN, inward(RIGHT_GREEN));
+    let mut blocks = Mesh {
+        name: "cornell blocks".into(),
+        ..Default::default()
+    };
+    for block in [SHORT_BLOCK, TALL_BLOCK] {
+        let centre = block
+            .iter()
+            .flatten()
+            .map(|p| Vec3::from(*p) * 1e-3)
+            .sum::<Vec3>()
+            / 20.0;
+        let centre = Vec3::new(centre.x, 0.0, centre.z);
+        for q in block {
+            let c = q.iter().map(|p| Vec3::from(*p) * 1e-3).sum::<Vec3>() / 4.0;
+            let out = if q.iter().all(|p| p[1] == q[0][1]) {
+                Vec3::Y
+            } else {
+                c - centre.with_y(c.y)
+            };
+            push_quad(&mut blocks, q, out);
+        }
+    }
+    let mut light = Mesh {
+        name: "cornell light".into(),
+        ..Default::default()
+    };
+    push_quad(
+        &mut light,
+        LIGHT.map(|[x, y, z]| [x, y - 0.5, z]),
+        Vec3::NEG_Y,
+    );
+    let meshes = vec![walls, red, green, blocks, light];
+    let instances = [(0, 0), (1, 1), (2, 2), (3, 0), (4, 3)]
+        .map(|(mesh, material)| Instance {
+            mesh,
+            material,
+            transform: Mat4::IDENTITY,
+        })
+        .to_vec();
+    let position = Vec3::from(CAMERA_POSITION) * 1e-3;
+    Scene {
+        meshes,
+        materials,
+        instances,
+        cameras: vec![Camera {
+            name: "main".into(),
+            position,
+            target: position + Vec3::Z,
+            vfov_deg: (2.0 * (0.5 * FILM_SIZE / FOCAL_LENGTH).atan()).to_degrees(),
+            near: 0.01,
+            up: Vec3::Y,
+        }],
+        sun: None,
+        ..Default::default()
+    }
+}
+
+/// Side of the terrain grid in vertices.
+pub const TERRAIN_GRID: usize = 708;
+/// Half the side of the terrain in metres: it spans [-100, 100] in x and z.
+pub const TERRAIN_HALF_SIZE: f32 = 100.0;
+
+/// The terrain benchmark's height field, metres. Evaluated in f64: in f32 the rounding of
+/// 0.7x + 0.3z (up to 100) alone moves the result by about 1e-5.
+pub fn terrain_height(x: f32, z: f32) -> f32 {
+    let (x, z) = (x as f64, z as f64);
+    (5.0 * (0.1 * x).sin() * (0.13 * z).cos() + 2.0 * (0.7 * x + 0.3 * z).sin()) as f32
+}
+
+/// (dy/dx, dy/dz) of [`terrain_height`].
+pub fn terrain_gradient(x: f32, z: f32) -> Vec2 {
+    let (x, z) = (x as f64, z as f64);
+    let s = 0.7 * x + 0.3 * z;
+    glam::DVec2::new(
+        0.5 * (0.1 * x).cos() * (0.13 * z).cos() + 1.4 * s.cos(),
+        -0.65 * (0.1 * x).sin() * (0.13 * z).sin() + 0.6 * s.cos(),
+    )
+    .as_vec2()
+}
+
+/// The ray-tracing benchmark height field: a [`TERRAIN_GRID`]² vertex grid over x, z in
+/// [-100, 100] m, y = 5 sin(0.1x) cos(0.13z) + 2 sin(0.7x + 0.3z), two triangles per cell
+/// (2 x 707² = 999 698 triangles), analytic normals, UVs spanning the grid once; the camera at
+/// (0, 40, -120) looking along normalize(0, -0.5, 1) with a vertical field of view of
+/// 2 atan(0.4) (an image plane at distance 1 spanning ±0.4 vertically); the default sun.
+pub fn terrain() -> Scene {
+    let n = TERRAIN_GRID;
+    let step = 2.0 * TERRAIN_HALF_SIZE / (n - 1) as f32;
+    let mut m = Mesh {
+        name: "terrain".into(),
+        ..Default::default()
+    };
+    m.positions.reserve(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            // Coordinates from the index, not by accumulating `step`, so the grid edges land
+            // exactly on ±100.
+            let x = -TERRAIN_HALF_SIZE + i as f32 * step;
+            let z = -TERRAIN_HALF_SIZE + j as f32 * step;
+            let g = terrain_gradient(x, z);
+            m.positions.push(Vec3::new(x, terrain_height(x, z), z));
+            m.normals.push(
+                glam::DVec3::new(-g.x as f64, 1.0, -g.y as f64)
+                    .normalize()
+                    .as_vec3(),
+            );
+            m.uvs.push(Vec2::new(i as f32, j as f32) / (n - 1) as f32);
+            // u along +x: dp/du ∝ (1, dy/dx, 0); v along +z, which is -cross(normal, +x), so w = -1.
+            m.tangents
+                .push(Vec3::new(1.0, g.x, 0.0).normalize().extend(-1.0));
+        }
+    }
+    m.indices.reserve(6 * (n - 1) * (n - 1));
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let v00 = (j * n + i) as u32;
+            let (v10, v01, v11) = (v00 + 1, v00 + n as u32, v00 + n as u32 + 1);
+            // Counter-clockwise seen from above (+y).
+            m.indices.extend([v00, v01, v11, v00, v11, v10]);
+        }
+    }
+    let position = Vec3::new(0.0, 40.0, -120.0);
+    Scene {
+        meshes: vec![m],
+        materials: vec![Material {
+            interior: Some(0.0),
+            ..Material::diffuse("ground", Vec3::new(0.30, 0.28, 0.25))
+        }],
+        instances: vec![Instance {
+            mesh: 0,
+            material: 0,
+            transform: Mat4::IDENTITY,
+        }],
+        cameras: vec![Camera {
+            name: "main".into(),
+            position,
+            target: position + Vec3::new(0.0, -0.5, 1.0).normalize(),
+            vfov_deg: (2.0 * 0.4f32.atan()).to_degrees(),
+            near: 0.1,
+            up: Vec3::Y,
+        }],
+        sun: Some(Sun::default()),
+        ..Default::default()
     }
 }
 

@@ -1,11 +1,64 @@
-//! hikari-scene: the scene model (meshes, materials, instances, cameras, the sun) and the
-//! built-in scenes. Lights are in physical units: the sun in lux, emission in nits.
+//! hikari-scene: the scene model (meshes, materials, textures, instances, cameras, lights),
+//! glTF 2.0 loading and the built-in scenes.
 //!
-//! This is the first cut that the engine skeleton needs; glTF loading and the procedural
-//! village come with the scenes issue.
+//! # Units
+//!
+//! Lengths are in metres, angles of cameras in degrees (vertical field of view) and of spot
+//! cones in radians. Colours are linear Rec.709. Light is photometric: the sun ([`Sun`]) in
+//! lux, point and spot lights ([`Light`]) in candela (with constructors from lumens), emissive
+//! surfaces ([`Material::emissive_nits`]) in nits (cd/m²).
+//!
+//! # glTF 2.0 support ([`gltf::load`])
+//!
+//! Read:
+//! - `.gltf` with buffers and images in external files (relative paths, `file:` URIs) or
+//!   embedded as base64 `data:` URIs, and `.glb` (its BIN chunk); PNG and JPEG images, decoded
+//!   to RGBA8 (16-bit and float images are reduced to 8 bits).
+//! - Meshes: triangle-list primitives, one [`Mesh`] each, with POSITION, NORMAL, TANGENT,
+//!   TEXCOORD_0 (float or normalised u8/u16), COLOR_0 (RGB or RGBA) and u8/u16/u32 indices;
+//!   sparse accessors. Primitives without normals get flat normals (as the glTF spec asks).
+//!   Missing tangents are generated from the UVs only when the material has a normal map (not
+//!   MikkTSpace; see [`gltf::generate_tangents`]); otherwise they stay absent.
+//! - The node hierarchy of the default scene (else the first scene), flattened into
+//!   [`Instance`]s with world transforms; a mesh used by several nodes is shared.
+//! - Metallic-roughness materials with all five textures (base colour, metallic-roughness,
+//!   normal with scale, emissive, occlusion with strength), texture samplers' wrap modes,
+//!   `doubleSided`, base colour alpha.
+//! - Perspective cameras, with their names (the camera's, else the node's, else `cameraN`),
+//!   world position, view direction (-Z) and up (+Y) of the node, `yfov` and `znear`.
+//! - `KHR_lights_punctual`: point and spot lights with their intensity in candela, as the
+//!   extension defines it; the first directional light becomes the [`Sun`], its intensity
+//!   taken as lux (also the extension's unit).
+//! - `KHR_materials_emissive_strength`: emission in nits = `emissiveFactor` x
+//!   `emissiveStrength` x [`gltf::GltfOptions::emissive_nits_per_unit`] (default 1), i.e. the
+//!   product is read as cd/m², which is what that extension says to do where a physical unit
+//!   is needed. Files written for display-referred viewers, where emissive 1 means "white",
+//!   look dim under daylight exposure unless that option is raised.
+//!
+//! Ignored, with a warning in [`gltf::Loaded::warnings`] (also logged with `log::warn!`):
+//! non-triangle primitives (points, lines, strips, fans), orthographic cameras, further
+//! directional lights, animations, skins, morph targets, texture coordinate sets other than 0,
+//! alpha modes other than opaque (drawn opaque), scenes other than the default one, and any
+//! extension other than the two above listed in `extensionsUsed`. An extension in
+//! `extensionsRequired` that is not supported is an error. Also ignored silently: `zfar` and
+//! `aspectRatio` of cameras (the renderer uses an infinite far plane and the image's aspect
+//! ratio), texture filters (the renderer chooses its own), `extras`.
+//!
+//! A file without cameras gets one named `auto` framing the bounds of the whole scene
+//! ([`Camera::framing`]); a file without any light gets [`Sun::default`] (100 000 lux).
+//!
+//! Malformed files give a [`gltf::GltfError`] naming the file and what is wrong, never a
+//! panic: unreadable or truncated files, bad JSON, glTF validation failures (indices of
+//! missing objects, unsupported required extensions), missing or short buffers and images,
+//! buffer views and accessors reading out of range, attributes of the wrong type or count,
+//! indices out of range, non-finite numbers (through [`Scene::validate`]).
 
 pub mod builtin;
+pub mod gltf;
 pub mod model;
 pub mod shapes;
 
-pub use model::{Camera, Instance, Material, Mesh, Scene, SceneError, Sun};
+pub use model::{
+    Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh, Scene,
+    SceneError, Sun, Texture, TextureRef, Wrap,
+};

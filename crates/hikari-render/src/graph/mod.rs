@@ -93,12 +93,19 @@ pub struct PassResources<'a> {
 
 impl PassResources<'_> {
     pub fn texture(&self, t: Tex) -> &wgpu::Texture {
-        &self.textures[t.0 as usize].physical.as_ref().expect("declared by the pass").texture
+        &self.textures[t.0 as usize]
+            .physical
+            .as_ref()
+            .expect("declared by the pass")
+            .texture
     }
 
     /// The whole texture as its natural view (2D, 2D array or 3D).
     pub fn view(&self, t: Tex) -> wgpu::TextureView {
-        let p = self.textures[t.0 as usize].physical.as_ref().expect("declared by the pass");
+        let p = self.textures[t.0 as usize]
+            .physical
+            .as_ref()
+            .expect("declared by the pass");
         p.view(resources::ViewKey {
             dimension: p.default_dimension(),
             single_mip: false,
@@ -106,12 +113,18 @@ impl PassResources<'_> {
     }
 
     pub fn buffer(&self, b: Buf) -> &wgpu::Buffer {
-        &self.buffers[b.0 as usize].physical.as_ref().expect("declared by the pass").buffer
+        &self.buffers[b.0 as usize]
+            .physical
+            .as_ref()
+            .expect("declared by the pass")
+            .buffer
     }
 }
 
-pub(crate) type RasterRecord<'r> = Box<dyn FnOnce(&mut wgpu::RenderPass<'_>, &PassResources<'_>) + 'r>;
-pub(crate) type EncoderRecord<'r> = Box<dyn FnOnce(&mut wgpu::CommandEncoder, &PassResources<'_>) + 'r>;
+pub(crate) type RasterRecord<'r> =
+    Box<dyn FnOnce(&mut wgpu::RenderPass<'_>, &PassResources<'_>) + 'r>;
+pub(crate) type EncoderRecord<'r> =
+    Box<dyn FnOnce(&mut wgpu::CommandEncoder, &PassResources<'_>) + 'r>;
 
 pub(crate) enum PassKind<'r> {
     Compute {
@@ -157,7 +170,13 @@ impl<'r> FrameGraph<'r> {
         self.rt.frame
     }
 
-    fn add_texture(&mut self, name: &str, desc: TextureDesc, source: TexSource, physical: Option<Arc<PhysicalTexture>>) -> Tex {
+    fn add_texture(
+        &mut self,
+        name: &str,
+        desc: TextureDesc,
+        source: TexSource,
+        physical: Option<Arc<PhysicalTexture>>,
+    ) -> Tex {
         let written = !matches!(source, TexSource::Transient);
         self.textures.push(VirtualTexture {
             name: name.into(),
@@ -184,7 +203,10 @@ impl<'r> FrameGraph<'r> {
     pub fn persistent_texture(&mut self, name: &str, desc: TextureDesc) -> Result<(Tex, bool)> {
         desc.check(self.ctx, name)?;
         let (p, created) = self.rt.persistent_texture(self.ctx, name, desc);
-        Ok((self.add_texture(name, desc, TexSource::Persistent, Some(p)), created))
+        Ok((
+            self.add_texture(name, desc, TexSource::Persistent, Some(p)),
+            created,
+        ))
     }
 
     /// A pair of textures for temporal techniques: `prev` holds what `cur` held last frame.
@@ -193,7 +215,12 @@ impl<'r> FrameGraph<'r> {
     pub fn history_texture(&mut self, name: &str, desc: TextureDesc) -> Result<History> {
         desc.check(self.ctx, name)?;
         let (prev, cur, valid) = self.rt.history_texture(self.ctx, name, desc);
-        let prev = self.add_texture(&format!("{name}.prev"), desc, TexSource::HistoryPrev, Some(prev));
+        let prev = self.add_texture(
+            &format!("{name}.prev"),
+            desc,
+            TexSource::HistoryPrev,
+            Some(prev),
+        );
         let cur = self.add_texture(name, desc, TexSource::HistoryCur, Some(cur));
         Ok(History { prev, cur, valid })
     }
@@ -201,7 +228,11 @@ impl<'r> FrameGraph<'r> {
     /// A texture made outside the graph (e.g. a baked probe atlas).
     pub fn import_texture(&mut self, name: &str, texture: &wgpu::Texture) -> Tex {
         let desc = TextureDesc {
-            size: [texture.width(), texture.height(), texture.depth_or_array_layers()],
+            size: [
+                texture.width(),
+                texture.height(),
+                texture.depth_or_array_layers(),
+            ],
             dimension: texture.dimension(),
             format: texture.format(),
             mip_levels: texture.mip_level_count(),
@@ -210,7 +241,13 @@ impl<'r> FrameGraph<'r> {
         self.add_texture(name, desc, TexSource::Imported, Some(p))
     }
 
-    fn add_buffer(&mut self, name: &str, size: u64, transient: bool, physical: Option<Arc<PhysicalBuffer>>) -> Buf {
+    fn add_buffer(
+        &mut self,
+        name: &str,
+        size: u64,
+        transient: bool,
+        physical: Option<Arc<PhysicalBuffer>>,
+    ) -> Buf {
         self.buffers.push(VirtualBuffer {
             name: name.into(),
             size,
@@ -224,7 +261,7 @@ impl<'r> FrameGraph<'r> {
     }
 
     fn check_buffer_size(&self, name: &str, size: u64) -> Result<()> {
-        let limit = self.ctx.limits.max_storage_buffer_binding_size as u64;
+        let limit = self.ctx.limits.max_storage_buffer_binding_size;
         if size == 0 || size > limit {
             return Err(RenderError::Limit {
                 what: format!("size in bytes of buffer `{name}`"),
@@ -278,15 +315,23 @@ impl<'r> FrameGraph<'r> {
     fn touch(&mut self, res: Res, pass: usize, write: bool, pass_name: &str) -> Result<()> {
         let (first, last, written, name) = match res {
             Res::Tex(t) => {
-                let v = self.textures.get_mut(t.0 as usize).ok_or_else(|| {
-                    RenderError::Pass { pass: pass_name.into(), message: "texture handle from another frame".into() }
-                })?;
+                let v = self
+                    .textures
+                    .get_mut(t.0 as usize)
+                    .ok_or_else(|| RenderError::Pass {
+                        pass: pass_name.into(),
+                        message: "texture handle from another frame".into(),
+                    })?;
                 (&mut v.first, &mut v.last, &mut v.written, v.name.clone())
             }
             Res::Buf(b) => {
-                let v = self.buffers.get_mut(b.0 as usize).ok_or_else(|| {
-                    RenderError::Pass { pass: pass_name.into(), message: "buffer handle from another frame".into() }
-                })?;
+                let v = self
+                    .buffers
+                    .get_mut(b.0 as usize)
+                    .ok_or_else(|| RenderError::Pass {
+                        pass: pass_name.into(),
+                        message: "buffer handle from another frame".into(),
+                    })?;
                 (&mut v.first, &mut v.last, &mut v.written, v.name.clone())
             }
         };
@@ -340,8 +385,13 @@ impl<'r> FrameGraph<'r> {
                 .unwrap_or(expect_write[i] == Some(true));
             let reads = !writes
                 || info.is_some_and(|inf| {
-                    matches!(inf.slots[i].kind,
-                        BindingKind::StorageTexture { access: wgpu::StorageTextureAccess::ReadWrite, .. })
+                    matches!(
+                        inf.slots[i].kind,
+                        BindingKind::StorageTexture {
+                            access: wgpu::StorageTextureAccess::ReadWrite,
+                            ..
+                        }
+                    )
                 });
             touched.push((res, !reads));
             if reads && writes {
@@ -360,37 +410,70 @@ impl<'r> FrameGraph<'r> {
         for (res, write) in touched {
             self.touch(res, index, write, &name)?;
         }
-        self.passes.push(PassNode { name, kind, bindings });
+        self.passes.push(PassNode {
+            name,
+            kind,
+            bindings,
+        });
         Ok(())
     }
 
-    fn check_bindings(&self, pass: &str, info: &PipelineInfo, bindings: &[Binding], expect_write: &[Option<bool>]) -> Result<()> {
-        let err = |message: String| RenderError::Pass { pass: pass.into(), message };
+    fn check_bindings(
+        &self,
+        pass: &str,
+        info: &PipelineInfo,
+        bindings: &[Binding],
+        expect_write: &[Option<bool>],
+    ) -> Result<()> {
+        let err = |message: String| RenderError::Pass {
+            pass: pass.into(),
+            message,
+        };
         if bindings.len() != info.slots.len() {
-            let wanted: Vec<String> = info.slots.iter().map(|s| format!("{}: {}", s.binding, s.name)).collect();
+            let wanted: Vec<String> = info
+                .slots
+                .iter()
+                .map(|s| format!("{}: {}", s.binding, s.name))
+                .collect();
             return Err(err(format!(
                 "binds {} resources but `{}` declares {} ({})",
-                bindings.len(), info.label, info.slots.len(), wanted.join(", ")
+                bindings.len(),
+                info.label,
+                info.slots.len(),
+                wanted.join(", ")
             )));
         }
         for ((b, slot), ew) in bindings.iter().zip(&info.slots).zip(expect_write) {
-            let here = format!("@binding({}) `{}` of `{}`", slot.binding, slot.name, info.label);
+            let here = format!(
+                "@binding({}) `{}` of `{}`",
+                slot.binding, slot.name, info.label
+            );
             match (b, &slot.kind) {
                 (Binding::Texture(t), BindingKind::SampledTexture { view, .. })
                 | (Binding::Texture(t), BindingKind::StorageTexture { view, .. }) => {
                     let v = &self.textures[t.0 as usize];
                     let ok_dim = match view {
-                        wgpu::TextureViewDimension::D3 => v.desc.dimension == wgpu::TextureDimension::D3,
-                        wgpu::TextureViewDimension::D1 => v.desc.dimension == wgpu::TextureDimension::D1,
+                        wgpu::TextureViewDimension::D3 => {
+                            v.desc.dimension == wgpu::TextureDimension::D3
+                        }
+                        wgpu::TextureViewDimension::D1 => {
+                            v.desc.dimension == wgpu::TextureDimension::D1
+                        }
                         _ => v.desc.dimension == wgpu::TextureDimension::D2,
                     };
                     if !ok_dim {
-                        return Err(err(format!("{here} is a {view:?} view but `{}` is {:?}", v.name, v.desc.dimension)));
+                        return Err(err(format!(
+                            "{here} is a {view:?} view but `{}` is {:?}",
+                            v.name, v.desc.dimension
+                        )));
                     }
                     if let BindingKind::StorageTexture { format, .. } = &slot.kind
                         && *format != v.desc.format
                     {
-                        return Err(err(format!("{here} wants format {format:?} but `{}` is {:?}", v.name, v.desc.format)));
+                        return Err(err(format!(
+                            "{here} wants format {format:?} but `{}` is {:?}",
+                            v.name, v.desc.format
+                        )));
                     }
                 }
                 (Binding::Buffer(_), BindingKind::Storage { .. } | BindingKind::Uniform) => {}
@@ -401,7 +484,11 @@ impl<'r> FrameGraph<'r> {
             if let Some(w) = ew
                 && *w != slot.kind.writes()
             {
-                let (said, is) = if *w { ("write", "read-only") } else { ("read", "writable") };
+                let (said, is) = if *w {
+                    ("write", "read-only")
+                } else {
+                    ("read", "writable")
+                };
                 return Err(err(format!("{here} is {is} but the pass says `{said}`")));
             }
         }
@@ -489,7 +576,14 @@ impl<'r> PassBuilder<'_, 'r> {
             });
         }
         let kind = PassKind::Compute { pipeline, groups };
-        self.g.add_pass(self.name, kind, self.bindings, self.expect_write, self.uses, Some(&pipeline.info))
+        self.g.add_pass(
+            self.name,
+            kind,
+            self.bindings,
+            self.expect_write,
+            self.uses,
+            Some(&pipeline.info),
+        )
     }
 
     /// Dispatches enough workgroups to cover `threads` invocations.
@@ -510,7 +604,14 @@ impl<'r> PassBuilder<'_, 'r> {
             depth: self.depth,
             record: Box::new(record),
         };
-        self.g.add_pass(self.name, kind, self.bindings, self.expect_write, self.uses, Some(&pipeline.info))
+        self.g.add_pass(
+            self.name,
+            kind,
+            self.bindings,
+            self.expect_write,
+            self.uses,
+            Some(&pipeline.info),
+        )
     }
 
     /// A pass that records commands itself (copies, clears); it declares its resources with
@@ -525,7 +626,10 @@ impl<'r> PassBuilder<'_, 'r> {
                 message: "an encoder pass binds nothing; declare resources with `uses`".into(),
             });
         }
-        let kind = PassKind::Encoder { record: Box::new(record) };
-        self.g.add_pass(self.name, kind, vec![], vec![], self.uses, None)
+        let kind = PassKind::Encoder {
+            record: Box::new(record),
+        };
+        self.g
+            .add_pass(self.name, kind, vec![], vec![], self.uses, None)
     }
 }

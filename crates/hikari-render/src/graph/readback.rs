@@ -60,7 +60,13 @@ fn f11(bits: u32) -> f32 {
     let (e, m) = ((bits >> 6) & 0x1f, bits & 0x3f);
     match e {
         0 => (m as f32 / 64.0) * 2f32.powi(-14),
-        31 => if m == 0 { f32::INFINITY } else { f32::NAN },
+        31 => {
+            if m == 0 {
+                f32::INFINITY
+            } else {
+                f32::NAN
+            }
+        }
         _ => (1.0 + m as f32 / 64.0) * 2f32.powi(e as i32 - 15),
     }
 }
@@ -69,7 +75,13 @@ fn f10(bits: u32) -> f32 {
     let (e, m) = ((bits >> 5) & 0x1f, bits & 0x1f);
     match e {
         0 => (m as f32 / 32.0) * 2f32.powi(-14),
-        31 => if m == 0 { f32::INFINITY } else { f32::NAN },
+        31 => {
+            if m == 0 {
+                f32::INFINITY
+            } else {
+                f32::NAN
+            }
+        }
         _ => (1.0 + m as f32 / 32.0) * 2f32.powi(e as i32 - 15),
     }
 }
@@ -94,7 +106,12 @@ fn decode(format: wgpu::TextureFormat, t: &[u8]) -> [f32; 4] {
         F::R16Float => [h(0), 0.0, 0.0, 1.0],
         F::R16Uint => [u16_at(0) as f32, 0.0, 0.0, 1.0],
         F::Rg16Float => [h(0), h(2), 0.0, 1.0],
-        F::Rg16Unorm => [u16_at(0) as f32 / 65535.0, u16_at(2) as f32 / 65535.0, 0.0, 1.0],
+        F::Rg16Unorm => [
+            u16_at(0) as f32 / 65535.0,
+            u16_at(2) as f32 / 65535.0,
+            0.0,
+            1.0,
+        ],
         F::Rg16Snorm => {
             let s = |i| (i16::from_le_bytes([t[i], t[i + 1]]) as f32 / 32767.0).max(-1.0);
             [s(0), s(2), 0.0, 1.0]
@@ -131,7 +148,10 @@ fn decode(format: wgpu::TextureFormat, t: &[u8]) -> [f32; 4] {
 /// Turns the padded rows of a texture copy into an image.
 pub(crate) fn decode_image(name: &str, desc: &TextureDesc, data: &[u8]) -> Result<ImageRgba32> {
     let tb = texel_bytes(desc.format).ok_or_else(|| {
-        RenderError::Graph(format!("cannot read back `{name}`: format {:?}", desc.format))
+        RenderError::Graph(format!(
+            "cannot read back `{name}`: format {:?}",
+            desc.format
+        ))
     })? as usize;
     let row = padded_row_bytes(desc).unwrap() as usize;
     let [w, h, d] = desc.size;

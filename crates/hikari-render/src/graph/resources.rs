@@ -73,7 +73,11 @@ impl TextureDesc {
             wgpu::TextureDimension::D2 => ("2D texture", lim.max_texture_dimension_2d),
             wgpu::TextureDimension::D1 => ("1D texture", lim.max_texture_dimension_1d),
         };
-        let dims = if self.dimension == wgpu::TextureDimension::D3 { 3 } else { 2 };
+        let dims = if self.dimension == wgpu::TextureDimension::D3 {
+            3
+        } else {
+            2
+        };
         for (axis, &v) in self.size.iter().enumerate().take(dims) {
             if v == 0 || v > max {
                 return Err(crate::RenderError::Limit {
@@ -83,7 +87,9 @@ impl TextureDesc {
                 });
             }
         }
-        if self.dimension == wgpu::TextureDimension::D2 && self.size[2] > lim.max_texture_array_layers {
+        if self.dimension == wgpu::TextureDimension::D2
+            && self.size[2] > lim.max_texture_array_layers
+        {
             return Err(crate::RenderError::Limit {
                 what: format!("array layers of `{name}`"),
                 requested: self.size[2] as u64,
@@ -123,7 +129,10 @@ impl From<Buf> for Res {
 
 /// Every usage the format allows, so that one pooled texture serves any pass.
 pub(crate) fn texture_usage(ctx: &GpuContext, format: wgpu::TextureFormat) -> wgpu::TextureUsages {
-    let allowed = ctx.adapter.get_texture_format_features(format).allowed_usages;
+    let allowed = ctx
+        .adapter
+        .get_texture_format_features(format)
+        .allowed_usages;
     let mut usage = wgpu::TextureUsages::TEXTURE_BINDING
         | wgpu::TextureUsages::COPY_SRC
         | wgpu::TextureUsages::COPY_DST;
@@ -298,7 +307,13 @@ impl Pool {
         }
     }
 
-    pub fn acquire_buffer(&mut self, ctx: &GpuContext, name: &str, size: u64, frame: u64) -> Arc<PhysicalBuffer> {
+    pub fn acquire_buffer(
+        &mut self,
+        ctx: &GpuContext,
+        name: &str,
+        size: u64,
+        frame: u64,
+    ) -> Arc<PhysicalBuffer> {
         if let Some(p) = self
             .buffers
             .iter_mut()

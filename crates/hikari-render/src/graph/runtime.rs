@@ -6,7 +6,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::readback::{self, ImageRgba32};
-use super::resources::{next_id, PhysicalBuffer, PhysicalTexture, Pool, PoolStats, TextureDesc, ViewKey};
+use super::resources::{
+    PhysicalBuffer, PhysicalTexture, Pool, PoolStats, TextureDesc, ViewKey, next_id,
+};
 use super::timing::{GpuTimer, PassTiming};
 use super::{Binding, FrameGraph, PassKind, PassResources, Res, SamplerKind, Tex, TexSource};
 use crate::context::GpuContext;
@@ -140,7 +142,12 @@ impl GraphRuntime {
         }
     }
 
-    pub(crate) fn persistent_texture(&mut self, ctx: &GpuContext, name: &str, desc: TextureDesc) -> (Arc<PhysicalTexture>, bool) {
+    pub(crate) fn persistent_texture(
+        &mut self,
+        ctx: &GpuContext,
+        name: &str,
+        desc: TextureDesc,
+    ) -> (Arc<PhysicalTexture>, bool) {
         if let Some(p) = self.persistent_textures.get(name)
             && p.desc == desc
         {
@@ -152,7 +159,12 @@ impl GraphRuntime {
         (p, true)
     }
 
-    pub(crate) fn persistent_buffer(&mut self, ctx: &GpuContext, name: &str, size: u64) -> (Arc<PhysicalBuffer>, bool) {
+    pub(crate) fn persistent_buffer(
+        &mut self,
+        ctx: &GpuContext,
+        name: &str,
+        size: u64,
+    ) -> (Arc<PhysicalBuffer>, bool) {
         if let Some(p) = self.persistent_buffers.get(name)
             && p.size == size
         {
@@ -164,20 +176,28 @@ impl GraphRuntime {
         (p, true)
     }
 
-    pub(crate) fn history_texture(&mut self, ctx: &GpuContext, name: &str, desc: TextureDesc) -> (Arc<PhysicalTexture>, Arc<PhysicalTexture>, bool) {
+    pub(crate) fn history_texture(
+        &mut self,
+        ctx: &GpuContext,
+        name: &str,
+        desc: TextureDesc,
+    ) -> (Arc<PhysicalTexture>, Arc<PhysicalTexture>, bool) {
         let fresh = self.history.get(name).is_none_or(|h| h.desc != desc);
         if fresh {
             self.bind_groups.clear();
-            self.history.insert(name.into(), HistoryEntry {
-                desc,
-                textures: [
-                    PhysicalTexture::create(ctx, &format!("{name}.a"), desc),
-                    PhysicalTexture::create(ctx, &format!("{name}.b"), desc),
-                ],
-                parity: 0,
-                frames_written: 0,
-                used: false,
-            });
+            self.history.insert(
+                name.into(),
+                HistoryEntry {
+                    desc,
+                    textures: [
+                        PhysicalTexture::create(ctx, &format!("{name}.a"), desc),
+                        PhysicalTexture::create(ctx, &format!("{name}.b"), desc),
+                    ],
+                    parity: 0,
+                    frames_written: 0,
+                    used: false,
+                },
+            );
         }
         let h = self.history.get_mut(name).unwrap();
         h.used = true;
@@ -188,7 +208,11 @@ impl GraphRuntime {
         )
     }
 
-    pub(crate) fn imported_texture(&mut self, texture: &wgpu::Texture, desc: TextureDesc) -> Arc<PhysicalTexture> {
+    pub(crate) fn imported_texture(
+        &mut self,
+        texture: &wgpu::Texture,
+        desc: TextureDesc,
+    ) -> Arc<PhysicalTexture> {
         let frame = self.frame;
         let e = self
             .imported_textures
@@ -200,16 +224,19 @@ impl GraphRuntime {
 
     pub(crate) fn imported_buffer(&mut self, buffer: &wgpu::Buffer) -> Arc<PhysicalBuffer> {
         let frame = self.frame;
-        let e = self.imported_buffers.entry(buffer.clone()).or_insert_with(|| {
-            (
-                Arc::new(PhysicalBuffer {
-                    id: next_id(),
-                    size: buffer.size(),
-                    buffer: buffer.clone(),
-                }),
-                frame,
-            )
-        });
+        let e = self
+            .imported_buffers
+            .entry(buffer.clone())
+            .or_insert_with(|| {
+                (
+                    Arc::new(PhysicalBuffer {
+                        id: next_id(),
+                        size: buffer.size(),
+                        buffer: buffer.clone(),
+                    }),
+                    frame,
+                )
+            });
         e.1 = frame;
         e.0.clone()
     }
@@ -219,9 +246,19 @@ impl GraphRuntime {
             .entry(kind)
             .or_insert_with(|| {
                 let (filter, address, compare) = match kind {
-                    SamplerKind::LinearClamp => (wgpu::FilterMode::Linear, wgpu::AddressMode::ClampToEdge, None),
-                    SamplerKind::NearestClamp => (wgpu::FilterMode::Nearest, wgpu::AddressMode::ClampToEdge, None),
-                    SamplerKind::LinearRepeat => (wgpu::FilterMode::Linear, wgpu::AddressMode::Repeat, None),
+                    SamplerKind::LinearClamp => (
+                        wgpu::FilterMode::Linear,
+                        wgpu::AddressMode::ClampToEdge,
+                        None,
+                    ),
+                    SamplerKind::NearestClamp => (
+                        wgpu::FilterMode::Nearest,
+                        wgpu::AddressMode::ClampToEdge,
+                        None,
+                    ),
+                    SamplerKind::LinearRepeat => {
+                        (wgpu::FilterMode::Linear, wgpu::AddressMode::Repeat, None)
+                    }
                     SamplerKind::ShadowCompare => (
                         wgpu::FilterMode::Linear,
                         wgpu::AddressMode::ClampToEdge,
@@ -264,7 +301,9 @@ impl GraphRuntime {
                     key.push(res.textures[t.0 as usize].physical.as_ref().unwrap().id);
                     key.push(matches!(slot.kind, BindingKind::StorageTexture { .. }) as u64);
                 }
-                Binding::Buffer(bf) => key.push(res.buffers[bf.0 as usize].physical.as_ref().unwrap().id),
+                Binding::Buffer(bf) => {
+                    key.push(res.buffers[bf.0 as usize].physical.as_ref().unwrap().id)
+                }
                 Binding::Constants { offset, .. } => {
                     key.push(constants.as_ref().unwrap().id);
                     key.push(*offset);
@@ -284,11 +323,17 @@ impl GraphRuntime {
             match (b, &slot.kind) {
                 (Binding::Texture(t), BindingKind::SampledTexture { view, .. }) => {
                     let p = res.textures[t.0 as usize].physical.as_ref().unwrap();
-                    views.push(p.view(ViewKey { dimension: *view, single_mip: false }));
+                    views.push(p.view(ViewKey {
+                        dimension: *view,
+                        single_mip: false,
+                    }));
                 }
                 (Binding::Texture(t), BindingKind::StorageTexture { view, .. }) => {
                     let p = res.textures[t.0 as usize].physical.as_ref().unwrap();
-                    views.push(p.view(ViewKey { dimension: *view, single_mip: true }));
+                    views.push(p.view(ViewKey {
+                        dimension: *view,
+                        single_mip: true,
+                    }));
                 }
                 (Binding::Sampler(s), _) => samplers.push(self.sampler(ctx, *s).1),
                 _ => {}
@@ -311,11 +356,13 @@ impl GraphRuntime {
                         .unwrap()
                         .buffer
                         .as_entire_binding(),
-                    Binding::Constants { offset, size } => wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &constants.as_ref().unwrap().buffer,
-                        offset: *offset,
-                        size: std::num::NonZeroU64::new(*size),
-                    }),
+                    Binding::Constants { offset, size } => {
+                        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &constants.as_ref().unwrap().buffer,
+                            offset: *offset,
+                            size: std::num::NonZeroU64::new(*size),
+                        })
+                    }
                     Binding::Sampler(_) => {
                         si += 1;
                         wgpu::BindingResource::Sampler(&samplers[si - 1])
@@ -337,8 +384,14 @@ impl GraphRuntime {
 fn dump_requests(g: &FrameGraph<'_>) -> Result<Vec<Res>> {
     let mut out = Vec::new();
     for want in &g.rt.dumps {
-        let t = g.textures.iter().position(|t| &t.name == want && t.first.is_some());
-        let b = g.buffers.iter().position(|b| &b.name == want && b.first.is_some());
+        let t = g
+            .textures
+            .iter()
+            .position(|t| &t.name == want && t.first.is_some());
+        let b = g
+            .buffers
+            .iter()
+            .position(|b| &b.name == want && b.first.is_some());
         match (t, b) {
             (Some(t), _) => out.push(Res::Tex(Tex(t as u32))),
             (None, Some(b)) => out.push(Res::Buf(super::Buf(b as u32))),
@@ -348,7 +401,12 @@ fn dump_requests(g: &FrameGraph<'_>) -> Result<Vec<Res>> {
                     .iter()
                     .filter(|t| t.first.is_some())
                     .map(|t| t.name.as_str())
-                    .chain(g.buffers.iter().filter(|b| b.first.is_some()).map(|b| b.name.as_str()))
+                    .chain(
+                        g.buffers
+                            .iter()
+                            .filter(|b| b.first.is_some())
+                            .map(|b| b.name.as_str()),
+                    )
                     .collect();
                 names.sort();
                 names.dedup();
@@ -382,7 +440,9 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
             }
         };
         if !written {
-            return Err(RenderError::Graph(format!("read back of `{name}`, which no pass wrote")));
+            return Err(RenderError::Graph(format!(
+                "read back of `{name}`, which no pass wrote"
+            )));
         }
         // Keep it alive to the end of the frame so nothing else is placed in its memory.
         first.get_or_insert(n);
@@ -400,7 +460,14 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
         }
     }
 
-    let FrameGraph { rt, mut textures, mut buffers, passes, constants, .. } = g;
+    let FrameGraph {
+        rt,
+        mut textures,
+        mut buffers,
+        passes,
+        constants,
+        ..
+    } = g;
 
     // Pass constants go up in one write before the frame's commands.
     if !constants.is_empty() {
@@ -409,7 +476,8 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
             rt.constants = Some(PhysicalBuffer::create(ctx, "hikari.constants", need));
             rt.bind_groups.clear();
         }
-        ctx.queue.write_buffer(&rt.constants.as_ref().unwrap().buffer, 0, &constants);
+        ctx.queue
+            .write_buffer(&rt.constants.as_ref().unwrap().buffer, 0, &constants);
     }
 
     let timed = |k: &PassKind| !matches!(k, PassKind::Encoder { .. });
@@ -424,7 +492,10 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
     let queries = |slot: u32| -> (Option<u32>, Option<u32>) {
         match mode {
             TimestampMode::Pass => (Some(2 * slot), Some(2 * slot + 1)),
-            _ => ((slot == 0).then_some(0), (slot + 1 == timed_count).then_some(1)),
+            _ => (
+                (slot == 0).then_some(0),
+                (slot + 1 == timed_count).then_some(1),
+            ),
         }
     };
 
@@ -444,7 +515,10 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
         }
     }
     let frame = rt.frame;
-    let acquire = |rt: &mut GraphRuntime, list: &[Res], textures: &mut [super::VirtualTexture], buffers: &mut [super::VirtualBuffer]| {
+    let acquire = |rt: &mut GraphRuntime,
+                   list: &[Res],
+                   textures: &mut [super::VirtualTexture],
+                   buffers: &mut [super::VirtualBuffer]| {
         for r in list {
             match *r {
                 Res::Tex(t) => {
@@ -458,11 +532,18 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
             }
         }
     };
-    let release = |rt: &mut GraphRuntime, list: &[Res], textures: &[super::VirtualTexture], buffers: &[super::VirtualBuffer]| {
+    let release = |rt: &mut GraphRuntime,
+                   list: &[Res],
+                   textures: &[super::VirtualTexture],
+                   buffers: &[super::VirtualBuffer]| {
         for r in list {
             match *r {
-                Res::Tex(t) => rt.pool.release_texture(textures[t.0 as usize].physical.as_ref().unwrap().id),
-                Res::Buf(b) => rt.pool.release_buffer(buffers[b.0 as usize].physical.as_ref().unwrap().id),
+                Res::Tex(t) => rt
+                    .pool
+                    .release_texture(textures[t.0 as usize].physical.as_ref().unwrap().id),
+                Res::Buf(b) => rt
+                    .pool
+                    .release_buffer(buffers[b.0 as usize].physical.as_ref().unwrap().id),
             }
         }
     };
@@ -479,14 +560,21 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
         }
     }
 
-    let mut encoder = ctx.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hikari.frame") });
+    let mut encoder = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("hikari.frame"),
+        });
     let mut timings = Vec::with_capacity(n);
     let mut slot = 0u32;
     let mut open_compute: Option<wgpu::ComputePass<'static>> = None;
     for (i, pass) in passes.into_iter().enumerate() {
         acquire(rt, &acquire_at[i], &mut textures, &mut buffers);
         let tp = Instant::now();
-        let res = PassResources { textures: &textures, buffers: &buffers };
+        let res = PassResources {
+            textures: &textures,
+            buffers: &buffers,
+        };
         let is_timed = timed(&pass.kind);
         if !matches!(pass.kind, PassKind::Compute { .. }) {
             drop(open_compute.take());
@@ -500,10 +588,17 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
                     let last_slot = slot + (run_end[i] - i) as u32;
                     let q = match mode {
                         TimestampMode::Pass => queries(slot),
-                        _ => ((slot == 0).then_some(0), (last_slot + 1 == timed_count).then_some(1)),
+                        _ => (
+                            (slot == 0).then_some(0),
+                            (last_slot + 1 == timed_count).then_some(1),
+                        ),
                     };
                     let timer = if use_timer { rt.timer.as_ref() } else { None };
-                    let label = if run_end[i] == i { pass.name.as_str() } else { "hikari.compute" };
+                    let label = if run_end[i] == i {
+                        pass.name.as_str()
+                    } else {
+                        "hikari.compute"
+                    };
                     let cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                         label: Some(label),
                         timestamp_writes: timer.and_then(|t| t.compute_writes(q)),
@@ -517,14 +612,23 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
                     cp.dispatch_workgroups(groups[0], groups[1], groups[2]);
                 }
             }
-            PassKind::Raster { pipeline, colors, depth, record } => {
+            PassKind::Raster {
+                pipeline,
+                colors,
+                depth,
+                record,
+            } => {
                 let bg = rt.bind_group(ctx, &pipeline.info, &pass.bindings, &res);
                 let timer = if use_timer { rt.timer.as_ref() } else { None };
                 let attach = |t: Tex| {
-                    res.textures[t.0 as usize].physical.as_ref().unwrap().view(ViewKey {
-                        dimension: wgpu::TextureViewDimension::D2,
-                        single_mip: true,
-                    })
+                    res.textures[t.0 as usize]
+                        .physical
+                        .as_ref()
+                        .unwrap()
+                        .view(ViewKey {
+                            dimension: wgpu::TextureViewDimension::D2,
+                            single_mip: true,
+                        })
                 };
                 let color_views: Vec<(wgpu::TextureView, Option<[f64; 4]>)> =
                     colors.iter().map(|(t, c)| (attach(*t), *c)).collect();
@@ -538,7 +642,12 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
                             resolve_target: None,
                             ops: wgpu::Operations {
                                 load: match clear {
-                                    Some([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color { r: *r, g: *g, b: *b, a: *a }),
+                                    Some([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color {
+                                        r: *r,
+                                        g: *g,
+                                        b: *b,
+                                        a: *a,
+                                    }),
                                     None => wgpu::LoadOp::Load,
                                 },
                                 store: wgpu::StoreOp::Store,
@@ -549,16 +658,18 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
                 let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some(&pass.name),
                     color_attachments: &color_attachments,
-                    depth_stencil_attachment: depth_view.as_ref().map(|(v, clear)| wgpu::RenderPassDepthStencilAttachment {
-                        view: v,
-                        depth_ops: Some(wgpu::Operations {
-                            load: match clear {
-                                Some(d) => wgpu::LoadOp::Clear(*d),
-                                None => wgpu::LoadOp::Load,
-                            },
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
+                    depth_stencil_attachment: depth_view.as_ref().map(|(v, clear)| {
+                        wgpu::RenderPassDepthStencilAttachment {
+                            view: v,
+                            depth_ops: Some(wgpu::Operations {
+                                load: match clear {
+                                    Some(d) => wgpu::LoadOp::Clear(*d),
+                                    None => wgpu::LoadOp::Load,
+                                },
+                                store: wgpu::StoreOp::Store,
+                            }),
+                            stencil_ops: None,
+                        }
                     }),
                     timestamp_writes: timer.and_then(|t| t.render_writes(queries(slot))),
                     occlusion_query_set: None,
@@ -570,7 +681,11 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
             }
             PassKind::Encoder { record } => record(&mut encoder, &res),
         }
-        timings.push((pass.name, is_timed.then_some(slot), tp.elapsed().as_secs_f64() * 1e6));
+        timings.push((
+            pass.name,
+            is_timed.then_some(slot),
+            tp.elapsed().as_secs_f64() * 1e6,
+        ));
         if is_timed {
             slot += 1;
         }
@@ -634,7 +749,10 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
     }
     let query_pairs = if mode == TimestampMode::Pass { slot } else { 1 };
     if use_timer {
-        rt.timer.as_ref().unwrap().resolve(&mut encoder, query_pairs);
+        rt.timer
+            .as_ref()
+            .unwrap()
+            .resolve(&mut encoder, query_pairs);
     }
     let cpu_encode_us = t_start.elapsed().as_secs_f64() * 1e6;
     ctx.queue.submit([encoder.finish()]);
@@ -650,7 +768,11 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
     };
     let timings = timings
         .into_iter()
-        .map(|(name, s, cpu_us)| PassTiming { name, gpu_ms: s.and_then(|s| gpu[s as usize]), cpu_us })
+        .map(|(name, s, cpu_us)| PassTiming {
+            name,
+            gpu_ms: s.and_then(|s| gpu[s as usize]),
+            cpu_us,
+        })
         .collect();
 
     for (_, buf) in &staging {
@@ -665,7 +787,10 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
         let data = buf
             .slice(..)
             .get_mapped_range()
-            .map_err(|e| RenderError::Gpu { during: "read back".into(), message: e.to_string() })?
+            .map_err(|e| RenderError::Gpu {
+                during: "read back".into(),
+                message: e.to_string(),
+            })?
             .to_vec();
         match r {
             Res::Tex(t) => {
@@ -699,8 +824,10 @@ pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
     rt.frame += 1;
     let f = rt.frame;
     let before = rt.imported_buffers.len() + rt.imported_textures.len();
-    rt.imported_buffers.retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
-    rt.imported_textures.retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
+    rt.imported_buffers
+        .retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
+    rt.imported_textures
+        .retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
     let pruned = before != rt.imported_buffers.len() + rt.imported_textures.len();
     if rt.pool.trim(f) || pruned {
         // Cached bind groups hold their resources alive; start over so freed memory goes.

@@ -27,7 +27,9 @@ impl GpuTimer {
         if !ctx.has(wgpu::Features::TIMESTAMP_QUERY) {
             return None;
         }
-        let capacity = (passes.max(16) * 2).next_power_of_two().min(wgpu::QUERY_SET_MAX_QUERIES);
+        let capacity = (passes.max(16) * 2)
+            .next_power_of_two()
+            .min(wgpu::QUERY_SET_MAX_QUERIES);
         let bytes = capacity as u64 * 8;
         Some(Self {
             set: ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -63,16 +65,22 @@ impl GpuTimer {
     }
 
     /// Timestamp writes at the given query indices (begin, end) of a compute pass.
-    pub fn compute_writes(&self, q: (Option<u32>, Option<u32>)) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        self.fits(q).then(|| wgpu::ComputePassTimestampWrites {
+    pub fn compute_writes(
+        &self,
+        q: (Option<u32>, Option<u32>),
+    ) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        self.fits(q).then_some(wgpu::ComputePassTimestampWrites {
             query_set: &self.set,
             beginning_of_pass_write_index: q.0,
             end_of_pass_write_index: q.1,
         })
     }
 
-    pub fn render_writes(&self, q: (Option<u32>, Option<u32>)) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
-        self.fits(q).then(|| wgpu::RenderPassTimestampWrites {
+    pub fn render_writes(
+        &self,
+        q: (Option<u32>, Option<u32>),
+    ) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        self.fits(q).then_some(wgpu::RenderPassTimestampWrites {
             query_set: &self.set,
             beginning_of_pass_write_index: q.0,
             end_of_pass_write_index: q.1,
@@ -87,17 +95,23 @@ impl GpuTimer {
 
     /// Maps the readback buffer (after the frame was submitted) and returns per-pass
     /// milliseconds and the span from the first pass's begin to the last pass's end.
-    pub fn read(&self, ctx: &GpuContext, passes: u32) -> crate::Result<(Vec<Option<f64>>, Option<f64>)> {
+    pub fn read(
+        &self,
+        ctx: &GpuContext,
+        passes: u32,
+    ) -> crate::Result<(Vec<Option<f64>>, Option<f64>)> {
         let n = passes.min(self.passes()) as usize;
         let bytes = (n.max(1) * 16) as u64;
         let slice = self.readback.slice(0..bytes);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         ctx.wait_idle()?;
         let ticks: Vec<u64> = {
-            let data = slice.get_mapped_range().map_err(|e| crate::RenderError::Gpu {
-                during: "timestamp read back".into(),
-                message: e.to_string(),
-            })?;
+            let data = slice
+                .get_mapped_range()
+                .map_err(|e| crate::RenderError::Gpu {
+                    during: "timestamp read back".into(),
+                    message: e.to_string(),
+                })?;
             bytemuck::cast_slice::<u8, u64>(&data).to_vec()
         };
         self.readback.unmap();

@@ -57,9 +57,18 @@ impl DirectLighting {
     }
 
     /// Radiance in nits of every pixel: lit surfaces, or the placeholder sky where depth is 0.
-    pub fn record<'r>(&'r self, g: &mut FrameGraph<'r>, gb: &GBuffer, view: &View, params: &SunParams) -> Result<Tex> {
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        gb: &GBuffer,
+        view: &View,
+        params: &SunParams,
+    ) -> Result<Tex> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
-        let radiance = g.texture("direct_lighting.radiance", TextureDesc::d2(w, h, RADIANCE_FORMAT))?;
+        let radiance = g.texture(
+            "direct_lighting.radiance",
+            TextureDesc::d2(w, h, RADIANCE_FORMAT),
+        )?;
         g.pass("direct_lighting.sun")
             .constants(view)
             .read(gb.depth)

@@ -50,9 +50,18 @@ impl GBufferPass {
         [width, height]: [u32; 2],
     ) -> Result<GBuffer> {
         let gb = GBuffer {
-            depth: g.texture("gbuffer.depth", TextureDesc::d2(width, height, DEPTH_FORMAT))?,
-            normal: g.texture("gbuffer.normal", TextureDesc::d2(width, height, NORMAL_FORMAT))?,
-            albedo: g.texture("gbuffer.albedo", TextureDesc::d2(width, height, ALBEDO_FORMAT))?,
+            depth: g.texture(
+                "gbuffer.depth",
+                TextureDesc::d2(width, height, DEPTH_FORMAT),
+            )?,
+            normal: g.texture(
+                "gbuffer.normal",
+                TextureDesc::d2(width, height, NORMAL_FORMAT),
+            )?,
+            albedo: g.texture(
+                "gbuffer.albedo",
+                TextureDesc::d2(width, height, ALBEDO_FORMAT),
+            )?,
         };
         let vertices = g.import_buffer("scene.vertices", &scene.vertices);
         let instances = g.import_buffer("scene.instances", &scene.instances);

@@ -20,7 +20,12 @@ pub struct TonemapParams {
 impl TonemapParams {
     pub fn from_ev100(ev100: f32) -> Self {
         Self {
-            exposure: [crate::reference::placeholder_tonemap::exposure_from_ev100(ev100), 0.0, 0.0, 0.0],
+            exposure: [
+                crate::reference::placeholder_tonemap::exposure_from_ev100(ev100),
+                0.0,
+                0.0,
+                0.0,
+            ],
         }
     }
 }
@@ -37,8 +42,17 @@ impl PlaceholderTonemap {
     }
 
     /// sRGB-encoded 8-bit image of `hdr` (radiance in nits).
-    pub fn record<'r>(&'r self, g: &mut FrameGraph<'r>, hdr: Tex, size: [u32; 2], params: &TonemapParams) -> Result<Tex> {
-        let ldr = g.texture("placeholder_tonemap.ldr", TextureDesc::d2(size[0], size[1], LDR_FORMAT))?;
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        hdr: Tex,
+        size: [u32; 2],
+        params: &TonemapParams,
+    ) -> Result<Tex> {
+        let ldr = g.texture(
+            "placeholder_tonemap.ldr",
+            TextureDesc::d2(size[0], size[1], LDR_FORMAT),
+        )?;
         g.pass("placeholder_tonemap.apply")
             .read(hdr)
             .write(ldr)

@@ -30,5 +30,8 @@ pub fn surface(p: &SunParams, normal_oct: Vec2, albedo: Vec3) -> Vec3 {
 }
 
 pub fn clamp(r: Vec3) -> Vec3 {
-    Vec3::from_array(r.to_array().map(|c| if c >= 0.0 { c.min(MAX_RADIANCE) } else { 0.0 }))
+    Vec3::from_array(
+        r.to_array()
+            .map(|c| if c >= 0.0 { c.min(MAX_RADIANCE) } else { 0.0 }),
+    )
 }

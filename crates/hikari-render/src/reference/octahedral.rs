@@ -3,7 +3,10 @@
 use glam::{Vec2, Vec3};
 
 fn sign_not_zero(v: Vec2) -> Vec2 {
-    Vec2::new(if v.x >= 0.0 { 1.0 } else { -1.0 }, if v.y >= 0.0 { 1.0 } else { -1.0 })
+    Vec2::new(
+        if v.x >= 0.0 { 1.0 } else { -1.0 },
+        if v.y >= 0.0 { 1.0 } else { -1.0 },
+    )
 }
 
 pub fn encode(n: Vec3) -> Vec2 {

@@ -1,0 +1,253 @@
+//! Bottom-level acceleration structure: one mesh, object space.
+
+use crate::aabb::Aabb;
+use crate::build_sah::{self, PrimRef, SahParams};
+use crate::error::BvhError;
+use crate::layout::{Hit, Ray, TriangleRecord, WideNode};
+use crate::traverse::Stack;
+use crate::triangle::is_degenerate;
+use crate::wide;
+use glam::{Vec3, Vec3A};
+
+/// What to do with a triangle the builder cannot use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BadTriangle {
+    /// Leave it out and count it in [`BlasStats`].
+    #[default]
+    Skip,
+    /// Fail the build with an error naming the mesh and the triangle.
+    Reject,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct BuildOptions {
+    /// Zero-area triangles can never be hit by the watertight test; skipping them is harmless.
+    pub degenerate: BadTriangle,
+    /// Triangles with a NaN or infinite vertex, or a vertex index out of range.
+    pub invalid: BadTriangle,
+    /// Most triangles per leaf child (1..=3).
+    pub max_leaf: usize,
+    /// Build threads; 0 = all available cores.
+    pub threads: usize,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        Self {
+            degenerate: BadTriangle::Skip,
+            invalid: BadTriangle::Reject,
+            max_leaf: 3,
+            threads: 0,
+        }
+    }
+}
+
+pub(crate) fn thread_count(requested: usize) -> usize {
+    if requested > 0 {
+        requested
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    }
+}
+
+/// Wall time of each build phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BuildTimings {
+    /// Validation and primitive boxes.
+    pub validate: std::time::Duration,
+    /// Binary SAH build.
+    pub binary: std::time::Duration,
+    /// Collapse to the wide layout and quantization.
+    pub collapse: std::time::Duration,
+    /// Triangle records in leaf order.
+    pub triangles: std::time::Duration,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BlasStats {
+    pub input_triangles: usize,
+    pub triangles: usize,
+    pub skipped_degenerate: usize,
+    pub skipped_non_finite: usize,
+    pub skipped_bad_index: usize,
+    pub nodes: usize,
+    /// Nodes on the longest root-to-leaf path; the kernel's stack needs this many entries
+    /// (plus the TLAS depth).
+    pub depth: u32,
+    pub timings: BuildTimings,
+}
+
+impl BlasStats {
+    pub fn skipped(&self) -> usize {
+        self.skipped_degenerate + self.skipped_non_finite + self.skipped_bad_index
+    }
+}
+
+/// A BLAS: compressed wide nodes and leaf-ordered triangles, plus the index buffer kept for refit.
+#[derive(Clone, Debug)]
+pub struct Blas {
+    pub name: String,
+    /// Root at index 0; `child_base` and `prim_base` are relative to this BLAS.
+    pub nodes: Vec<WideNode>,
+    pub triangles: Vec<TriangleRecord>,
+    pub(crate) indices: Vec<[u32; 3]>,
+    pub(crate) vertex_count: usize,
+    pub bounds: Aabb,
+    pub stats: BlasStats,
+}
+
+impl Blas {
+    /// Builds a BLAS from an indexed triangle mesh. `name` appears in every error message.
+    pub fn build(
+        name: &str,
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+        options: &BuildOptions,
+    ) -> Result<Blas, BvhError> {
+        if indices.is_empty() {
+            return Err(BvhError::EmptyMesh { mesh: name.into() });
+        }
+        if indices.len() > build_sah::MAX_PRIMS {
+            return Err(BvhError::TooManyTriangles {
+                mesh: name.into(),
+                triangles: indices.len(),
+                max: build_sah::MAX_PRIMS,
+            });
+        }
+        let mut stats = BlasStats {
+            input_triangles: indices.len(),
+            ..Default::default()
+        };
+        let t_validate = std::time::Instant::now();
+        let mut prims = Vec::with_capacity(indices.len());
+        for (t, tri) in indices.iter().enumerate() {
+            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= positions.len()) {
+                if options.invalid == BadTriangle::Reject {
+                    return Err(BvhError::IndexOutOfRange {
+                        mesh: name.into(),
+                        triangle: t,
+                        index: bad,
+                        vertex_count: positions.len(),
+                    });
+                }
+                stats.skipped_bad_index += 1;
+                continue;
+            }
+            let v = tri.map(|i| Vec3A::from(positions[i as usize]));
+            if let Some(k) = (0..3).find(|&k| !v[k].is_finite()) {
+                if options.invalid == BadTriangle::Reject {
+                    return Err(BvhError::NonFiniteVertex {
+                        mesh: name.into(),
+                        triangle: t,
+                        vertex: tri[k],
+                        value: v[k].into(),
+                    });
+                }
+                stats.skipped_non_finite += 1;
+                continue;
+            }
+            if is_degenerate(v[0], v[1], v[2]) {
+                if options.degenerate == BadTriangle::Reject {
+                    return Err(BvhError::DegenerateTriangle {
+                        mesh: name.into(),
+                        triangle: t,
+                    });
+                }
+                stats.skipped_degenerate += 1;
+                continue;
+            }
+            let b = Aabb::new(v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+            prims.push(PrimRef::new(&b, t as u32));
+        }
+        if prims.is_empty() {
+            return Err(BvhError::NoValidTriangles {
+                mesh: name.into(),
+                total: indices.len(),
+                degenerate: stats.skipped_degenerate,
+                non_finite: stats.skipped_non_finite,
+                out_of_range: stats.skipped_bad_index,
+            });
+        }
+        let max_leaf = options.max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
+        stats.timings.validate = t_validate.elapsed();
+        let t_binary = std::time::Instant::now();
+        let binary = build_sah::build(
+            prims,
+            &SahParams {
+                max_leaf,
+                threads: thread_count(options.threads),
+            },
+        );
+        stats.timings.binary = t_binary.elapsed();
+        let t_collapse = std::time::Instant::now();
+        let bounds = binary.nodes[0].bounds;
+        let wide = wide::collapse(&binary, max_leaf, thread_count(options.threads));
+        stats.timings.collapse = t_collapse.elapsed();
+        let t_triangles = std::time::Instant::now();
+        let triangles: Vec<TriangleRecord> = wide
+            .leaf_prims
+            .iter()
+            .map(|&p| {
+                let id = binary.prims[p as usize].id();
+                let tri = indices[id as usize];
+                TriangleRecord {
+                    v0: positions[tri[0] as usize].into(),
+                    primitive: id,
+                    v1: positions[tri[1] as usize].into(),
+                    _pad1: 0,
+                    v2: positions[tri[2] as usize].into(),
+                    _pad2: 0,
+                }
+            })
+            .collect();
+        stats.timings.triangles = t_triangles.elapsed();
+        stats.triangles = triangles.len();
+        stats.nodes = wide.nodes.len();
+        stats.depth = wide.depth;
+        Ok(Blas {
+            name: name.into(),
+            nodes: wide.nodes,
+            triangles,
+            indices: indices.to_vec(),
+            vertex_count: positions.len(),
+            bounds,
+            stats,
+        })
+    }
+
+    /// Bytes the kernel reads: nodes plus triangles.
+    pub fn gpu_bytes(&self) -> usize {
+        std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.triangles.as_slice())
+    }
+
+    /// Closest hit in object space (`instance` is reported as 0).
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_with(ray, &mut Stack::default())
+    }
+
+    /// [`Blas::intersect`] reusing a stack, which also counts the work done.
+    pub fn intersect_with(&self, ray: &Ray, stack: &mut Stack) -> Option<Hit> {
+        crate::traverse::closest_hit_blas(&self.nodes, &self.triangles, ray, 0, stack)
+    }
+
+    /// True if anything is hit with `t_min < t < t_max`.
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.occluded_with(ray, &mut Stack::default())
+    }
+
+    pub fn occluded_with(&self, ray: &Ray, stack: &mut Stack) -> bool {
+        crate::traverse::any_hit_blas(&self.nodes, &self.triangles, ray, stack)
+    }
+}
+
+impl Blas {
+    /// [`Blas::build`] from a [`crate::Mesh`].
+    pub fn from_mesh(
+        name: &str,
+        mesh: &crate::Mesh,
+        options: &BuildOptions,
+    ) -> Result<Blas, BvhError> {
+        Blas::build(name, &mesh.positions, &mesh.indices, options)
+    }
+}

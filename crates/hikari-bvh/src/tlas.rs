@@ -1,0 +1,262 @@
+//! Top-level acceleration structure over instances, rebuilt from scratch every frame from the
+//! instances that survive culling (Metro's recipe: TLAS rebuild only, BLAS update only).
+
+use crate::aabb::Aabb;
+use crate::blas::Blas;
+use crate::build_sah::{self, PrimRef, SahParams};
+use crate::error::BvhError;
+use crate::layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
+use crate::traverse::{self, TraversalStacks};
+use crate::wide;
+use glam::Affine3A;
+
+/// One placement of a BLAS in the world.
+#[derive(Clone, Copy, Debug)]
+pub struct Instance {
+    /// Object-to-world affine transform (any invertible 3x4: rotation, scale, shear, mirror).
+    pub transform: Affine3A,
+    /// Index into the BLAS list; many instances may share one BLAS.
+    pub blas: u32,
+    /// Logical (game) visibility: a hidden instance never enters the TLAS.
+    pub visible: bool,
+}
+
+impl Instance {
+    pub fn new(transform: Affine3A, blas: u32) -> Self {
+        Self {
+            transform,
+            blas,
+            visible: true,
+        }
+    }
+    /// World-space box of the instance.
+    pub fn world_bounds(&self, blases: &[Blas]) -> Aabb {
+        blases
+            .get(self.blas as usize)
+            .map_or(Aabb::EMPTY, |b| b.bounds.transformed(&self.transform))
+    }
+}
+
+/// Row-major 3x4 world-to-object matrix, or `None` if the transform is not invertible/finite.
+pub fn world_to_object(transform: &Affine3A) -> Option<[[f32; 4]; 3]> {
+    let det = transform.matrix3.determinant();
+    if !(det.is_finite() && det != 0.0 && transform.translation.is_finite()) {
+        return None;
+    }
+    let inv = transform.inverse();
+    let m = inv.matrix3;
+    let t = inv.translation;
+    let rows = [
+        [m.x_axis.x, m.y_axis.x, m.z_axis.x, t.x],
+        [m.x_axis.y, m.y_axis.y, m.z_axis.y, t.y],
+        [m.x_axis.z, m.y_axis.z, m.z_axis.z, t.z],
+    ];
+    rows.iter()
+        .all(|r| r.iter().all(|v| v.is_finite()))
+        .then_some(rows)
+}
+
+/// Where each BLAS starts in the packed GPU buffers (see [`PackedBlases`]).
+pub fn blas_offsets(blases: &[Blas]) -> Vec<(u32, u32)> {
+    let mut nodes = 0u32;
+    let mut tris = 0u32;
+    blases
+        .iter()
+        .map(|b| {
+            let o = (nodes, tris);
+            nodes += b.nodes.len() as u32;
+            tris += b.triangles.len() as u32;
+            o
+        })
+        .collect()
+}
+
+/// All BLAS concatenated for upload: node and triangle buffers the kernel indexes with the
+/// offsets stored in each [`InstanceRecord`].
+pub struct PackedBlases {
+    pub nodes: Vec<WideNode>,
+    pub triangles: Vec<TriangleRecord>,
+    pub offsets: Vec<(u32, u32)>,
+}
+
+impl PackedBlases {
+    pub fn new(blases: &[Blas]) -> Self {
+        Self {
+            nodes: blases
+                .iter()
+                .flat_map(|b| b.nodes.iter().copied())
+                .collect(),
+            triangles: blases
+                .iter()
+                .flat_map(|b| b.triangles.iter().copied())
+                .collect(),
+            offsets: blas_offsets(blases),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TlasStats {
+    /// Instances in the TLAS.
+    pub instances: usize,
+    /// Selected instances left out because their transform is singular or not finite, or their
+    /// BLAS box is empty.
+    pub skipped_invalid: usize,
+    pub nodes: usize,
+    pub depth: u32,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Tlas {
+    pub nodes: Vec<WideNode>,
+    /// Leaf-ordered instance records (the TLAS's "triangles").
+    pub instances: Vec<InstanceRecord>,
+    pub bounds: Aabb,
+    pub stats: TlasStats,
+}
+
+impl Tlas {
+    /// Builds the TLAS over `selected` (indices into `instances`, e.g. from
+    /// [`crate::cull::cull_instances`]); hits report the index into `instances`.
+    pub fn build(
+        instances: &[Instance],
+        selected: &[u32],
+        blases: &[Blas],
+    ) -> Result<Tlas, BvhError> {
+        let offsets = blas_offsets(blases);
+        let mut records = Vec::with_capacity(selected.len());
+        let mut prims = Vec::with_capacity(selected.len());
+        let mut stats = TlasStats::default();
+        for &i in selected {
+            let Some(inst) = instances.get(i as usize) else {
+                stats.skipped_invalid += 1;
+                continue;
+            };
+            let Some(blas) = blases.get(inst.blas as usize) else {
+                return Err(BvhError::BadBlasIndex {
+                    instance: i as usize,
+                    blas: inst.blas,
+                    blas_count: blases.len(),
+                });
+            };
+            let bounds = blas.bounds.transformed(&inst.transform);
+            let Some(w2o) = world_to_object(&inst.transform) else {
+                stats.skipped_invalid += 1;
+                continue;
+            };
+            if bounds.is_empty() || !bounds.is_finite() {
+                stats.skipped_invalid += 1;
+                continue;
+            }
+            let (node_off, tri_off) = offsets[inst.blas as usize];
+            prims.push(PrimRef::new(&bounds, records.len() as u32));
+            records.push(InstanceRecord {
+                world_to_object: w2o,
+                blas_node_offset: node_off,
+                blas_triangle_offset: tri_off,
+                instance_index: i,
+                blas_index: inst.blas,
+            });
+        }
+        if prims.is_empty() {
+            return Ok(Tlas {
+                stats,
+                ..Default::default()
+            });
+        }
+        // One instance per leaf slot: entering an instance costs a transform and a BLAS root
+        // visit, so the tightest possible TLAS boxes pay off. The binary build stops at 8
+        // instances, which the collapse turns into one node of single-instance leaves; splitting
+        // further would only decide slot order, at most of the TLAS build's cost.
+        let binary = build_sah::build(
+            prims,
+            &SahParams {
+                max_leaf: crate::layout::WIDTH,
+                threads: 1,
+            },
+        );
+        let bounds = binary.nodes[0].bounds;
+        let wide = wide::collapse(&binary, 1, 1);
+        let leaf_records: Vec<InstanceRecord> = wide
+            .leaf_prims
+            .iter()
+            .map(|&p| records[binary.prims[p as usize].id() as usize])
+            .collect();
+        stats.instances = leaf_records.len();
+        stats.nodes = wide.nodes.len();
+        stats.depth = wide.depth;
+        Ok(Tlas {
+            nodes: wide.nodes,
+            instances: leaf_records,
+            bounds,
+            stats,
+        })
+    }
+
+    pub fn closest_hit(&self, blases: &[Blas], ray: &Ray) -> Option<Hit> {
+        traverse::closest_hit(
+            &self.nodes,
+            &self.instances,
+            blases,
+            ray,
+            &mut TraversalStacks::default(),
+        )
+    }
+
+    pub fn any_hit(&self, blases: &[Blas], ray: &Ray) -> bool {
+        traverse::any_hit(
+            &self.nodes,
+            &self.instances,
+            blases,
+            ray,
+            &mut TraversalStacks::default(),
+        )
+    }
+
+    /// Closest hits for a batch of rays on `threads` threads (0 = all cores), reusing traversal
+    /// stacks; what the offline bake uses when no GPU is wanted. Misses are [`Hit::NONE`].
+    pub fn closest_hits(&self, blases: &[Blas], rays: &[Ray], threads: usize) -> Vec<Hit> {
+        let mut out = vec![Hit::NONE; rays.len()];
+        for_each_chunk(rays, &mut out, threads, |ray, hit, stacks| {
+            *hit = traverse::closest_hit(&self.nodes, &self.instances, blases, ray, stacks)
+                .unwrap_or(Hit::NONE);
+        });
+        out
+    }
+
+    /// Any-hit results for a batch of rays (true = occluded within `t_max`).
+    pub fn any_hits(&self, blases: &[Blas], rays: &[Ray], threads: usize) -> Vec<bool> {
+        let mut out = vec![false; rays.len()];
+        for_each_chunk(rays, &mut out, threads, |ray, hit, stacks| {
+            *hit = traverse::any_hit(&self.nodes, &self.instances, blases, ray, stacks);
+        });
+        out
+    }
+
+    /// Bytes the kernel reads for the TLAS: nodes plus instance records.
+    pub fn gpu_bytes(&self) -> usize {
+        std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.instances.as_slice())
+    }
+}
+
+fn for_each_chunk<T: Send>(
+    rays: &[Ray],
+    out: &mut [T],
+    threads: usize,
+    f: impl Fn(&Ray, &mut T, &mut TraversalStacks) + Sync,
+) {
+    let threads = crate::blas::thread_count(threads).max(1);
+    let chunk = rays.len().div_ceil(threads).max(1);
+    std::thread::scope(|scope| {
+        for (rays, out) in rays.chunks(chunk).zip(out.chunks_mut(chunk)) {
+            let f = &f;
+            scope.spawn(move || {
+                let mut stacks = TraversalStacks::default();
+                for (ray, o) in rays.iter().zip(out) {
+                    f(ray, o, &mut stacks);
+                }
+            });
+        }
+    });
+}

@@ -1,0 +1,418 @@
+//! Collapse of a binary BVH into the compressed 8-wide layout, and the child-box quantization
+//! shared by build and refit.
+
+use crate::aabb::Aabb;
+use crate::build_sah::BinaryBvh;
+use crate::layout::{META_INTERNAL, WIDTH, WideNode, leaf_meta};
+use glam::Vec3A;
+
+/// Result of a collapse: nodes in depth-first order of their allocation (every child index is
+/// larger than its parent's, which refit relies on) and, in leaf order, positions into `BinaryBvh::prims`.
+pub struct WideBvh {
+    pub nodes: Vec<WideNode>,
+    pub leaf_prims: Vec<u32>,
+    /// Number of nodes on the longest root-to-leaf path.
+    pub depth: u32,
+}
+
+/// Subtrees of at most this many primitives are collapsed as independent jobs (in parallel when
+/// threads are available) and appended in a fixed order, so the layout never depends on the
+/// thread count.
+const JOB_PRIMS: u32 = 32 * 1024;
+
+/// A pending wide node: binary node, wide node index, depth.
+type Pending = (u32, u32, u32);
+
+pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
+    let max_leaf = max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
+    let bn = &bin.nodes;
+    // Subtree primitive counts; children always follow their parent in the binary array.
+    let mut counts = vec![0u32; bn.len()];
+    for i in (0..bn.len()).rev() {
+        let n = &bn[i];
+        counts[i] = if n.is_leaf() {
+            n.count
+        } else {
+            counts[n.first as usize] + counts[n.first as usize + 1]
+        };
+    }
+    let counts = &counts;
+
+    let mut nodes = vec![WideNode::default()];
+    let mut leaf_prims = Vec::with_capacity(bin.prims.len());
+    let mut jobs = Vec::new();
+    // Small trees are not worth splitting into jobs (nor spawning threads for).
+    let split_into_jobs = counts[0] > 2 * JOB_PRIMS;
+    let mut depth = emit(
+        bin,
+        counts,
+        max_leaf,
+        vec![(0, 0, 1)],
+        &mut nodes,
+        &mut leaf_prims,
+        split_into_jobs.then_some(&mut jobs),
+    );
+    if jobs.is_empty() {
+        return WideBvh {
+            nodes,
+            leaf_prims,
+            depth,
+        };
+    }
+
+    // Each job collapses into its own arrays with its root at local index 0.
+    let run = |job: &Pending| {
+        let mut n = vec![WideNode::default()];
+        let mut p = Vec::new();
+        let d = emit(
+            bin,
+            counts,
+            max_leaf,
+            vec![(job.0, 0, job.2)],
+            &mut n,
+            &mut p,
+            None,
+        );
+        (n, p, d)
+    };
+    let threads = threads.clamp(1, jobs.len());
+    let results: Vec<(Vec<WideNode>, Vec<u32>, u32)> = if threads == 1 {
+        jobs.iter().map(run).collect()
+    } else {
+        let per = jobs.len().div_ceil(threads);
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = jobs
+                .chunks(per)
+                .map(|chunk| scope.spawn(|| chunk.iter().map(run).collect::<Vec<_>>()))
+                .collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().expect("BVH collapse thread panicked"))
+                .collect()
+        })
+    };
+    for (job, (sub_nodes, sub_prims, sub_depth)) in jobs.iter().zip(results) {
+        depth = depth.max(sub_depth);
+        // Local node i >= 1 moves to node_base + i - 1; the local root replaces the placeholder.
+        let node_base = nodes.len() as u32;
+        let prim_base = leaf_prims.len() as u32;
+        let remap = |mut n: WideNode| {
+            n.child_base = node_base + n.child_base - 1;
+            n.prim_base += prim_base;
+            n
+        };
+        nodes[job.1 as usize] = remap(sub_nodes[0]);
+        nodes.extend(sub_nodes[1..].iter().map(|&n| remap(n)));
+        leaf_prims.extend_from_slice(&sub_prims);
+    }
+    WideBvh {
+        nodes,
+        leaf_prims,
+        depth,
+    }
+}
+
+/// Emits wide nodes depth-first from `todo`; pending nodes whose subtree is small enough go to
+/// `jobs` instead when given. Returns the deepest level emitted.
+fn emit(
+    bin: &BinaryBvh,
+    counts: &[u32],
+    max_leaf: usize,
+    mut todo: Vec<Pending>,
+    nodes: &mut Vec<WideNode>,
+    leaf_prims: &mut Vec<u32>,
+    mut jobs: Option<&mut Vec<Pending>>,
+) -> u32 {
+    let bn = &bin.nodes;
+    // Depth-first: the binary nodes were laid out depth-first, so this order walks them almost
+    // sequentially (breadth-first order made every binary node read a cache miss). Children are
+    // still allocated, contiguously, when their parent is emitted, so every child index is
+    // larger than its parent's.
+    let mut depth = 1;
+    while let Some((b, w, d)) = todo.pop() {
+        if let Some(jobs) = jobs.as_mut()
+            && w != 0
+            && counts[b as usize] <= JOB_PRIMS
+        {
+            jobs.push((b, w, d));
+            continue;
+        }
+        depth = depth.max(d);
+        let bnode = &bn[b as usize];
+        if bnode.is_leaf() && bnode.count as usize > max_leaf {
+            nodes[w as usize] = leaf_bundle(bin, bnode, max_leaf, leaf_prims);
+            continue;
+        }
+        // Open the binary subtree: repeatedly replace the internal child with the largest box
+        // by its two children, which removes the most expected traversal work per slot.
+        let mut open = [0u32; WIDTH];
+        let mut n_open;
+        if bn[b as usize].is_leaf() {
+            open[0] = b;
+            n_open = 1;
+        } else {
+            let f = bn[b as usize].first;
+            open[0] = f;
+            open[1] = f + 1;
+            n_open = 2;
+        }
+        while n_open < WIDTH {
+            let mut best = usize::MAX;
+            let mut best_area = -1.0;
+            for (i, &c) in open[..n_open].iter().enumerate() {
+                let n = &bn[c as usize];
+                if !n.is_leaf() && n.bounds.half_area() > best_area {
+                    best_area = n.bounds.half_area();
+                    best = i;
+                }
+            }
+            if best == usize::MAX {
+                break;
+            }
+            let f = bn[open[best] as usize].first;
+            open[best] = f;
+            open[n_open] = f + 1;
+            n_open += 1;
+        }
+        let open = &open[..n_open];
+
+        let parent_center = bn[b as usize].bounds.center();
+        let mut centers = [Vec3A::ZERO; WIDTH];
+        for (c, &o) in centers.iter_mut().zip(open) {
+            *c = bn[o as usize].bounds.center();
+        }
+        let slots = assign_slots(parent_center, &centers[..n_open]);
+
+        let mut node = WideNode::default();
+        let mut boxes = [None; WIDTH];
+        let mut imask = 0u8;
+        node.child_base = nodes.len() as u32;
+        node.prim_base = leaf_prims.len() as u32;
+        let mut leaf_offset = 0u32;
+        let todo_start = todo.len();
+        for slot in 0..WIDTH {
+            let Some(ci) = slots[slot] else { continue };
+            let c = open[ci];
+            boxes[slot] = Some(bn[c as usize].bounds);
+            if counts[c as usize] as usize > max_leaf {
+                imask |= 1 << slot;
+                node.set_meta(slot, META_INTERNAL | slot as u8);
+                let child_w = nodes.len() as u32;
+                nodes.push(WideNode::default());
+                todo.push((c, child_w, d + 1));
+            } else {
+                let before = leaf_prims.len();
+                gather_prims(bin, c, leaf_prims);
+                let count = (leaf_prims.len() - before) as u32;
+                node.set_meta(slot, leaf_meta(leaf_offset, count));
+                leaf_offset += count;
+            }
+        }
+        // Reversed so the lowest slot is popped, and emitted, first.
+        todo[todo_start..].reverse();
+        encode_boxes(&mut node, &boxes, imask);
+        nodes[w as usize] = node;
+    }
+    depth
+}
+
+/// A node for a binary leaf holding more primitives than one leaf slot may (the TLAS builds
+/// binary leaves of up to 8 instances): each slot takes a chunk of at most `max_leaf`.
+fn leaf_bundle(
+    bin: &BinaryBvh,
+    leaf: &crate::build_sah::BinNode,
+    max_leaf: usize,
+    leaf_prims: &mut Vec<u32>,
+) -> WideNode {
+    let first = leaf.first as usize;
+    let count = leaf.count as usize;
+    debug_assert!(count <= WIDTH * max_leaf);
+    // Chunks are runs along the leaf's widest axis, so each chunk stays compact.
+    let mut order = [0u32; WIDTH * crate::layout::MAX_LEAF_TRIANGLES];
+    let order = &mut order[..count];
+    for (i, o) in order.iter_mut().enumerate() {
+        *o = (first + i) as u32;
+    }
+    if max_leaf > 1 {
+        let ext = leaf.bounds.extent();
+        let axis = if ext.x >= ext.y && ext.x >= ext.z {
+            0
+        } else if ext.y >= ext.z {
+            1
+        } else {
+            2
+        };
+        let key = |i: &u32| {
+            let p = &bin.prims[*i as usize];
+            (p.lo3() + p.hi3())[axis]
+        };
+        order.sort_by(|a, b| key(a).total_cmp(&key(b)));
+    }
+    let mut chunk_boxes = [Aabb::EMPTY; WIDTH];
+    let mut centers = [Vec3A::ZERO; WIDTH];
+    let chunks = count.div_ceil(max_leaf).min(WIDTH);
+    for (k, b) in chunk_boxes[..chunks].iter_mut().enumerate() {
+        for &i in &order[k * max_leaf..((k + 1) * max_leaf).min(count)] {
+            let p = &bin.prims[i as usize];
+            b.grow(&Aabb::new(p.lo3(), p.hi3()));
+        }
+        centers[k] = b.center();
+    }
+    let slots = assign_slots(leaf.bounds.center(), &centers[..chunks]);
+    let mut node = WideNode {
+        prim_base: leaf_prims.len() as u32,
+        ..Default::default()
+    };
+    let mut boxes = [None; WIDTH];
+    let mut offset = 0u32;
+    for (slot, k) in slots.iter().enumerate() {
+        let Some(k) = *k else { continue };
+        let chunk = &order[k * max_leaf..((k + 1) * max_leaf).min(count)];
+        leaf_prims.extend_from_slice(chunk);
+        node.set_meta(slot, leaf_meta(offset, chunk.len() as u32));
+        offset += chunk.len() as u32;
+        boxes[slot] = Some(chunk_boxes[k]);
+    }
+    encode_boxes(&mut node, &boxes, 0);
+    node
+}
+
+fn gather_prims(bin: &BinaryBvh, root: u32, out: &mut Vec<u32>) {
+    // A subtree gathered here holds at most MAX_LEAF_TRIANGLES primitives, so its depth is tiny.
+    let mut stack = [0u32; 2 * crate::layout::MAX_LEAF_TRIANGLES + 2];
+    stack[0] = root;
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        let i = stack[sp];
+        let n = &bin.nodes[i as usize];
+        if n.is_leaf() {
+            out.extend(n.first..n.first + n.count);
+        } else {
+            stack[sp] = n.first + 1;
+            stack[sp + 1] = n.first;
+            sp += 2;
+        }
+    }
+}
+
+/// Places each child in the slot whose octant corner its centre points to, relative to the
+/// parent's centre. Traversal visits slots in the order `slot ^ ray_octant`, so a ray meets
+/// children roughly front to back without sorting. Children with the strongest preference (the
+/// largest centre offset) choose first, each taking the free slot whose corner direction best
+/// matches its offset; returns, per slot, the child index.
+pub(crate) fn assign_slots(parent_center: Vec3A, centers: &[Vec3A]) -> [Option<usize>; WIDTH] {
+    let n = centers.len().min(WIDTH);
+    let mut offsets = [Vec3A::ZERO; WIDTH];
+    let mut order = [0usize; WIDTH];
+    let mut strength = [0.0f32; WIDTH];
+    for c in 0..n {
+        let off = centers[c] - parent_center;
+        offsets[c] = if off.is_finite() { off } else { Vec3A::ZERO };
+        strength[c] = offsets[c].abs().element_sum();
+        order[c] = c;
+    }
+    // Stable insertion sort by decreasing strength keeps ties in child order (deterministic).
+    for i in 1..n {
+        let mut j = i;
+        while j > 0 && strength[order[j - 1]] < strength[order[j]] {
+            order.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+    let mut slots = [None; WIDTH];
+    for &c in &order[..n] {
+        let o = offsets[c];
+        // Branch-free argmax over the free slots: the comparisons are unpredictable, and this
+        // runs for every node of every TLAS rebuild.
+        let mut best_score = f32::NEG_INFINITY;
+        let mut best_slot = usize::MAX;
+        for (s, slot) in slots.iter().enumerate() {
+            // Dot product with the corner direction (+1 on axes whose bit is set, -1 otherwise).
+            let score = (if s & 1 != 0 { o.x } else { -o.x })
+                + (if s & 2 != 0 { o.y } else { -o.y })
+                + (if s & 4 != 0 { o.z } else { -o.z });
+            let take = slot.is_none() & ((score > best_score) | (best_slot == usize::MAX));
+            best_score = if take { score } else { best_score };
+            best_slot = if take { s } else { best_slot };
+        }
+        slots[best_slot] = Some(c);
+    }
+    slots
+}
+
+/// Smallest power-of-two step `2^(e-127)` with `255 * step >= extent`, as the biased exponent.
+fn step_exponent(extent: f32) -> u32 {
+    let x = extent / 255.0;
+    // Also catches NaN: a zero or invalid extent gets the finest step.
+    if x.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return 1;
+    }
+    let bits = x.to_bits();
+    let mut e = (bits >> 23) & 0xFF;
+    if bits & 0x7F_FFFF != 0 {
+        e += 1;
+    }
+    e.clamp(1, 254)
+}
+
+/// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
+/// (`origin + q * step`, evaluated in f32 as the kernel does) contains the exact child box.
+pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], imask: u8) {
+    let mut all = Aabb::EMPTY;
+    for b in boxes.iter().flatten() {
+        all.grow(b);
+    }
+    if all.is_empty() {
+        node.origin = [0.0; 3];
+        node.set_exponents_imask([127; 3], imask);
+        return;
+    }
+    let origin = all.min;
+    let mut exps = [0u8; 3];
+    let mut q = [([0u8; 3], [0u8; 3]); WIDTH];
+    for a in 0..3 {
+        let mut e = step_exponent(all.max[a] - origin[a]);
+        'retry: loop {
+            let step = f32::from_bits(e << 23);
+            let decode = |k: u32| origin[a] + k as f32 * step;
+            for (slot, b) in boxes.iter().enumerate() {
+                let Some(b) = b else { continue };
+                // Offsets are >= 0 (the origin is the minimum), so truncation is floor; the
+                // saturating casts clamp to 255 below.
+                let mut lo = (((b.min[a] - origin[a]) / step) as u32).min(255);
+                while lo > 0 && decode(lo) > b.min[a] {
+                    lo -= 1;
+                }
+                let f = (b.max[a] - origin[a]) / step;
+                let mut hi = f as u32;
+                if (hi as f32) < f {
+                    hi += 1;
+                }
+                hi = hi.min(255);
+                while hi < 255 && decode(hi) < b.max[a] {
+                    hi += 1;
+                }
+                // Rounding of the origin addition left the top unreachable: coarser step. At the
+                // largest finite step the decoded planes already reach +-inf, so stop there.
+                if (decode(hi) < b.max[a] || decode(lo) > b.min[a]) && e < 254 {
+                    e += 1;
+                    continue 'retry;
+                }
+                q[slot].0[a] = lo as u8;
+                q[slot].1[a] = hi as u8;
+            }
+            break;
+        }
+        exps[a] = e as u8;
+    }
+    node.origin = origin.into();
+    node.set_exponents_imask(exps, imask);
+    for (slot, b) in boxes.iter().enumerate() {
+        if b.is_some() {
+            node.set_quantized(slot, q[slot].0, q[slot].1);
+        } else {
+            node.set_quantized(slot, [0; 3], [0; 3]);
+        }
+    }
+}

@@ -1,0 +1,481 @@
+//! The WGSL traversal (`shaders/bvh/traverse.wgsl`) against its CPU twin (hikari-bvh's
+//! traversal of the same buffers) against brute force over every triangle, on small scenes:
+//! random triangle soups, instances with rotations, scales and mirrors, and a terrain.
+
+mod common;
+
+use glam::{Affine3A, Quat, Vec3};
+use hikari_bvh::reference::{any_hit_instances, closest_hit_instances};
+use hikari_bvh::rng::SplitMix64;
+use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
+use hikari_render::GpuContext;
+use hikari_render::graph::GraphRuntime;
+use hikari_render::passes::bvh_trace::{BvhTrace, HIT_BYTES, TraceMode};
+use hikari_render::shader::{self, ShaderLibrary};
+use wgpu::util::DeviceExt;
+
+struct Scene {
+    meshes: Vec<Mesh>,
+    blases: Vec<Blas>,
+    instances: Vec<Instance>,
+    tlas: Tlas,
+}
+
+impl Scene {
+    fn new(meshes: Vec<Mesh>, instances: Vec<Instance>) -> Self {
+        let blases: Vec<Blas> = meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                Blas::from_mesh(&format!("mesh{i}"), m, &BuildOptions::default()).unwrap()
+            })
+            .collect();
+        let all: Vec<u32> = (0..instances.len() as u32).collect();
+        let tlas = Tlas::build(&instances, &all, &blases).unwrap();
+        Self {
+            meshes,
+            blases,
+            instances,
+            tlas,
+        }
+    }
+
+    fn single(mesh: Mesh) -> Self {
+        Self::new(vec![mesh], vec![Instance::new(Affine3A::IDENTITY, 0)])
+    }
+}
+
+struct Gpu {
+    ctx: GpuContext,
+    lib: ShaderLibrary,
+}
+
+impl Gpu {
+    fn new() -> Option<Self> {
+        let ctx = common::gpu()?;
+        let lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+        Some(Self { ctx, lib })
+    }
+
+    /// Hits of both modes for `rays`, traced in one frame.
+    fn trace(&mut self, scene: &Scene, rays: &[Ray]) -> (Vec<Hit>, Vec<Hit>) {
+        let ctx = &self.ctx;
+        let mut trace = BvhTrace::new(ctx, &mut self.lib).unwrap();
+        trace.upload_blases(ctx, &scene.blases).unwrap();
+        trace.upload_tlas(ctx, &scene.tlas).unwrap();
+        let ray_buffer = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("test.rays"),
+                contents: bytemuck::cast_slice(rays),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        let n = rays.len() as u32;
+        let mut rt = GraphRuntime::new();
+        let mut g = rt.begin_frame(ctx);
+        let rays_buf = g.import_buffer("test.rays", &ray_buffer);
+        let closest = g.buffer("test.closest", n as u64 * HIT_BYTES).unwrap();
+        let any = g.buffer("test.any", n as u64 * HIT_BYTES).unwrap();
+        trace
+            .record(&mut g, rays_buf, closest, n, TraceMode::Closest)
+            .unwrap();
+        trace
+            .record(&mut g, rays_buf, any, n, TraceMode::Any)
+            .unwrap();
+        g.readback(closest);
+        g.readback(any);
+        let r = g.execute().unwrap();
+        let get = |name: &str| -> Vec<Hit> {
+            let bytes = &r.buffers.iter().find(|(b, _)| b == name).unwrap().1;
+            bytemuck::pod_collect_to_vec(&bytes[..rays.len() * HIT_BYTES as usize])
+        };
+        (get("test.closest"), get("test.any"))
+    }
+}
+
+/// Same primitive and instance with t (and barycentrics) within 1e-4 relative, or an exact
+/// tie: another primitive at the same distance within 1e-6 relative (hikari-bvh's rule).
+fn same_hit(got: Option<Hit>, want: Option<Hit>) -> Result<(), String> {
+    match (got, want) {
+        (None, None) => Ok(()),
+        (Some(g), None) => Err(format!("hit {g:?}, expected a miss")),
+        (None, Some(w)) => Err(format!("missed, expected {w:?}")),
+        (Some(g), Some(w)) => {
+            let scale = w.t.abs().max(1e-6);
+            if g.primitive == w.primitive && g.instance == w.instance {
+                if (g.t - w.t).abs() <= 1e-4 * scale
+                    && (g.u - w.u).abs() <= 1e-4
+                    && (g.v - w.v).abs() <= 1e-4
+                {
+                    Ok(())
+                } else {
+                    Err(format!("same primitive, different hit: {g:?} vs {w:?}"))
+                }
+            } else if (g.t - w.t).abs() <= 1e-6 * scale {
+                Ok(())
+            } else {
+                Err(format!("different primitive: {g:?} vs {w:?}"))
+            }
+        }
+    }
+}
+
+fn as_option(h: Hit) -> Option<Hit> {
+    h.is_hit().then_some(h)
+}
+
+/// GPU vs CPU twin vs brute force, closest and any hit; returns the number of hits.
+fn check(gpu: &mut Gpu, name: &str, scene: &Scene, rays: &[Ray]) -> usize {
+    let (closest, any) = gpu.trace(scene, rays);
+    let mut hits = 0;
+    let mut failures = Vec::new();
+    for (i, ray) in rays.iter().enumerate() {
+        let cpu = scene.tlas.closest_hit(&scene.blases, ray);
+        let brute = closest_hit_instances(&scene.meshes, &scene.instances, None, ray);
+        if let Err(e) = same_hit(cpu, brute) {
+            failures.push(format!("ray {i} {ray:?}: CPU vs brute force: {e}"));
+        }
+        if let Err(e) = same_hit(as_option(closest[i]), cpu) {
+            failures.push(format!("ray {i} {ray:?}: GPU vs CPU: {e}"));
+        }
+        if !closest[i].is_hit()
+            && (closest[i].t != f32::INFINITY || closest[i].instance != Hit::MISS)
+        {
+            failures.push(format!(
+                "ray {i}: a miss must have t = inf and no instance: {:?}",
+                closest[i]
+            ));
+        }
+        let cpu_any = scene.tlas.any_hit(&scene.blases, ray);
+        let brute_any = any_hit_instances(&scene.meshes, &scene.instances, None, ray);
+        if cpu_any != brute_any {
+            failures.push(format!(
+                "ray {i} {ray:?}: CPU any-hit {cpu_any}, brute force {brute_any}"
+            ));
+        }
+        if any[i].is_hit() != cpu_any {
+            failures.push(format!(
+                "ray {i} {ray:?}: GPU any-hit {:?}, CPU {cpu_any}",
+                any[i]
+            ));
+        } else if any[i].is_hit() && !(any[i].t > ray.t_min && any[i].t < ray.t_max) {
+            failures.push(format!(
+                "ray {i} {ray:?}: any-hit outside (t_min, t_max): {:?}",
+                any[i]
+            ));
+        }
+        hits += closest[i].is_hit() as usize;
+    }
+    assert!(
+        failures.is_empty(),
+        "{name}: {} of {} rays disagree; first ones:\n{}",
+        failures.len(),
+        rays.len(),
+        failures[..failures.len().min(12)].join("\n")
+    );
+    hits
+}
+
+fn random_dir(rng: &mut SplitMix64) -> Vec3 {
+    loop {
+        let v = Vec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        );
+        let l = v.length_squared();
+        if l > 1e-4 && l <= 1.0 {
+            return v / l.sqrt();
+        }
+    }
+}
+
+/// Rays from random points in a cube, in random directions; some axis-aligned (zero direction
+/// components exercise the reciprocal clamp), some of other lengths, some with finite t ranges.
+fn random_rays(rng: &mut SplitMix64, count: usize, extent: f32) -> Vec<Ray> {
+    (0..count)
+        .map(|i| {
+            let o = Vec3::new(
+                rng.range(-extent, extent),
+                rng.range(-extent, extent),
+                rng.range(-extent, extent),
+            );
+            let d = match i % 7 {
+                0 => [Vec3::X, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_X][rng.below(4)],
+                1 => random_dir(rng) * rng.range(0.1, 10.0),
+                _ => random_dir(rng),
+            };
+            let (t_min, t_max) = if i % 5 == 0 {
+                (rng.range(0.0, extent), rng.range(0.0, 3.0 * extent))
+            } else {
+                (0.0, f32::INFINITY)
+            };
+            Ray::new(o, d, t_min, t_max)
+        })
+        .collect()
+}
+
+#[test]
+fn random_soups_match_cpu_and_brute_force() {
+    let Some(mut gpu) = Gpu::new() else { return };
+    for (seed, count) in [(1u64, 1usize), (2, 7), (3, 60), (4, 700), (5, 5000)] {
+        let scene = Scene::single(Mesh::random_soup(seed, count, 10.0, 3.0));
+        let mut rng = SplitMix64::new(seed * 31);
+        let rays = random_rays(&mut rng, 700, 12.0);
+        let hits = check(
+            &mut gpu,
+            &format!("soup {seed} ({count} triangles)"),
+            &scene,
+            &rays,
+        );
+        if count >= 700 {
+            assert!(hits > 100, "test rays should hit something ({hits})");
+        }
+    }
+}
+
+#[test]
+fn mixed_scale_soup_matches() {
+    // Tiny triangles next to long slivers: wide boxes beside small ones stress quantization.
+    let Some(mut gpu) = Gpu::new() else { return };
+    let mut mesh = Mesh::random_soup(11, 1500, 10.0, 0.05);
+    let slivers = Mesh::random_soup(12, 500, 10.0, 20.0);
+    let base = mesh.positions.len() as u32;
+    mesh.positions.extend(&slivers.positions);
+    mesh.indices
+        .extend(slivers.indices.iter().map(|t| t.map(|i| i + base)));
+    let mut rng = SplitMix64::new(13);
+    let rays = random_rays(&mut rng, 1000, 12.0);
+    check(&mut gpu, "mixed", &Scene::single(mesh), &rays);
+}
+
+#[test]
+fn instanced_scene_matches() {
+    let Some(mut gpu) = Gpu::new() else { return };
+    let meshes = vec![
+        Mesh::random_soup(3, 300, 3.0, 1.5),
+        Mesh::terrain(17),
+        Mesh::random_soup(4, 30, 1.0, 2.0),
+    ];
+    let mut rng = SplitMix64::new(21);
+    let instances: Vec<Instance> = (0..48)
+        .map(|i| {
+            let axis = random_dir(&mut rng);
+            let rot = Quat::from_axis_angle(axis, rng.range(0.0, std::f32::consts::TAU));
+            let mut scale = Vec3::new(
+                rng.range(0.5, 2.0),
+                rng.range(0.5, 2.0),
+                rng.range(0.5, 2.0),
+            );
+            if i % 5 == 0 {
+                scale.x = -scale.x;
+            }
+            let blas = (i % 3) as u32;
+            if blas == 1 {
+                scale *= 0.1;
+            }
+            let t = Vec3::new(
+                rng.range(-30.0, 30.0),
+                rng.range(-30.0, 30.0),
+                rng.range(-30.0, 30.0),
+            );
+            Instance::new(
+                Affine3A::from_scale_rotation_translation(scale, rot, t),
+                blas,
+            )
+        })
+        .collect();
+    let scene = Scene::new(meshes, instances);
+    assert!(
+        scene.tlas.stats.depth >= 2,
+        "the TLAS should have more than one level"
+    );
+    let mut rng = SplitMix64::new(22);
+    let rays = random_rays(&mut rng, 1500, 35.0);
+    let hits = check(&mut gpu, "instances", &scene, &rays);
+    assert!(hits > 100, "{hits} hits");
+    // The instance reported is the index in the caller's list, not the TLAS leaf order.
+    let (closest, _) = gpu.trace(&scene, &rays);
+    let seen: std::collections::HashSet<u32> = closest
+        .iter()
+        .filter(|h| h.is_hit())
+        .map(|h| h.instance)
+        .collect();
+    assert!(seen.len() > 10, "hits spread over instances: {seen:?}");
+}
+
+fn terrain_rays(rng: &mut SplitMix64, count: usize) -> Vec<Ray> {
+    (0..count)
+        .map(|i| {
+            let x = rng.range(-90.0, 90.0);
+            let z = rng.range(-90.0, 90.0);
+            let y = hikari_bvh::mesh::terrain_height(x, z);
+            match i % 3 {
+                0 => Ray::new(
+                    Vec3::new(x, 30.0, z),
+                    random_dir(rng) - Vec3::Y * 1.5,
+                    0.0,
+                    f32::INFINITY,
+                ),
+                1 => {
+                    let d = random_dir(rng);
+                    Ray::new(
+                        Vec3::new(x, y + 0.5, z),
+                        Vec3::new(d.x, 0.02 * d.y, d.z),
+                        0.0,
+                        f32::INFINITY,
+                    )
+                }
+                _ => {
+                    let mut d = random_dir(rng);
+                    d.y = d.y.abs();
+                    Ray::new(Vec3::new(x, y + 0.01, z), d, 0.0, 5.0)
+                }
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn terrain_matches() {
+    let Some(mut gpu) = Gpu::new() else { return };
+    // 64 x 64 cells, 8192 triangles.
+    let scene = Scene::single(Mesh::terrain(65));
+    let mut rng = SplitMix64::new(5);
+    let rays = terrain_rays(&mut rng, 2400);
+    let hits = check(&mut gpu, "terrain", &scene, &rays);
+    assert!(hits > 800, "{hits} hits");
+}
+
+#[test]
+fn rays_through_shared_edges_and_vertices_never_leak() {
+    // Straight down and slanted through grid vertices and cell edges of the terrain: the
+    // watertight test must report a hit for every one.
+    let Some(mut gpu) = Gpu::new() else { return };
+    let n = 33;
+    let mesh = Mesh::terrain(n);
+    let v = |i: usize, j: usize| mesh.positions[j * n + i];
+    let mut rays = Vec::new();
+    for j in 2..n - 2 {
+        for i in 2..n - 2 {
+            // A vertex, the midpoints of two cell edges, and the midpoint of the cell's diagonal
+            // (Mesh::terrain splits cells along (i+1, j)-(i, j+1)), all on the surface.
+            let targets = [
+                v(i, j),
+                (v(i, j) + v(i + 1, j)) * 0.5,
+                (v(i, j) + v(i, j + 1)) * 0.5,
+                (v(i + 1, j) + v(i, j + 1)) * 0.5,
+            ];
+            for p in targets {
+                for d in [
+                    Vec3::NEG_Y,
+                    Vec3::new(0.3, -1.0, -0.2),
+                    Vec3::new(-0.05, -0.3, 0.1),
+                ] {
+                    rays.push(Ray::new(p - d * 40.0, d, 0.0, f32::INFINITY));
+                }
+            }
+        }
+    }
+    let scene = Scene::single(mesh);
+    let (closest, any) = gpu.trace(&scene, &rays);
+    // Named on failure: what the CPU twin makes of a leaking ray tells a kernel bug from a
+    // test-geometry mistake.
+    for i in (0..rays.len()).filter(|&i| !closest[i].is_hit()).take(8) {
+        eprintln!(
+            "leak ray {i} {:?}: CPU {:?}, GPU any hit {:?}",
+            rays[i],
+            scene.tlas.closest_hit(&scene.blases, &rays[i]),
+            any[i]
+        );
+    }
+    let leaks = closest.iter().filter(|h| !h.is_hit()).count();
+    let any_leaks = any.iter().filter(|h| !h.is_hit()).count();
+    assert_eq!((leaks, any_leaks), (0, 0), "of {} rays", rays.len());
+    check(&mut gpu, "edges", &scene, &rays);
+}
+
+#[test]
+fn nan_and_degenerate_rays_miss_and_terminate() {
+    let Some(mut gpu) = Gpu::new() else { return };
+    let scene = Scene::single(Mesh::random_soup(8, 400, 5.0, 2.0));
+    let nan = f32::NAN;
+    let inf = f32::INFINITY;
+    let rays = vec![
+        Ray::new(Vec3::new(nan, 0.0, 0.0), Vec3::X, 0.0, inf),
+        Ray::new(Vec3::ZERO, Vec3::new(nan, 1.0, 0.0), 0.0, inf),
+        Ray::new(Vec3::ZERO, Vec3::splat(nan), 0.0, inf),
+        Ray::new(Vec3::splat(nan), Vec3::splat(nan), nan, nan),
+        Ray::new(Vec3::ZERO, Vec3::X, nan, inf),
+        Ray::new(Vec3::ZERO, Vec3::X, 0.0, nan),
+        Ray::new(Vec3::ZERO, Vec3::ZERO, 0.0, inf),
+        Ray::new(Vec3::new(inf, 0.0, 0.0), Vec3::NEG_X, 0.0, inf),
+        Ray::new(Vec3::ZERO, Vec3::new(inf, 0.0, 0.0), 0.0, inf),
+        // Empty t range, reversed t range.
+        Ray::new(Vec3::ZERO, Vec3::X, 3.0, 3.0),
+        Ray::new(Vec3::ZERO, Vec3::X, 5.0, 1.0),
+    ];
+    let (closest, any) = gpu.trace(&scene, &rays);
+    for (i, (c, a)) in closest.iter().zip(&any).enumerate() {
+        assert!(
+            !c.is_hit() && !a.is_hit(),
+            "ray {i} {:?} hit: {c:?} / {a:?}",
+            rays[i]
+        );
+        assert!(
+            scene.tlas.closest_hit(&scene.blases, &rays[i]).is_none(),
+            "the CPU twin agrees"
+        );
+    }
+}
+
+#[test]
+fn empty_scene_misses() {
+    let Some(mut gpu) = Gpu::new() else { return };
+    let scene = Scene::new(vec![], vec![]);
+    let rays = vec![Ray::new(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY); 5];
+    let (closest, any) = gpu.trace(&scene, &rays);
+    assert!(closest.iter().chain(&any).all(|h| !h.is_hit()));
+}
+
+#[test]
+fn any_hit_respects_t_max_and_closest_reports_the_nearest() {
+    // Two parallel triangles at z = 1 and z = 2 (two instances of one BLAS).
+    let Some(mut gpu) = Gpu::new() else { return };
+    let mesh = Mesh::new(
+        vec![
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(2.0, -1.0, 0.0),
+            Vec3::new(-1.0, 2.0, 0.0),
+        ],
+        vec![[0, 1, 2]],
+    );
+    let instances = vec![
+        Instance::new(Affine3A::from_translation(Vec3::Z * 2.0), 0),
+        Instance::new(Affine3A::from_translation(Vec3::Z), 0),
+    ];
+    let scene = Scene::new(vec![mesh], instances);
+    let o = Vec3::new(0.1, 0.2, 0.0);
+    let rays = vec![
+        Ray::new(o, Vec3::Z, 0.0, f32::INFINITY),
+        Ray::new(o, Vec3::Z, 0.0, 1.5),
+        Ray::new(o, Vec3::Z, 0.0, 0.999),
+        Ray::new(o, Vec3::Z, 1.5, f32::INFINITY),
+        Ray::new(o, Vec3::Z * 2.0, 0.0, f32::INFINITY),
+    ];
+    let (closest, any) = gpu.trace(&scene, &rays);
+    assert_eq!(closest[0].instance, 1);
+    assert!((closest[0].t - 1.0).abs() < 1e-6);
+    assert!(
+        (closest[0].u - 0.1 / 3.0 - 1.0 / 3.0).abs() < 1e-5,
+        "{:?}",
+        closest[0]
+    );
+    assert!(any[1].is_hit() && any[1].instance == 1);
+    assert!(!any[2].is_hit() && !closest[2].is_hit());
+    assert_eq!(closest[3].instance, 0);
+    assert!((closest[3].t - 2.0).abs() < 1e-6);
+    // t is in units of the direction, in world and object space alike.
+    assert!((closest[4].t - 0.5).abs() < 1e-6);
+    check(&mut gpu, "two planes", &scene, &rays);
+}

@@ -1,0 +1,1024 @@
+//! glTF 2.0 loading (`.gltf` with external or data-URI buffers and images, and `.glb`).
+//!
+//! See the crate documentation for what is read, what is ignored and the unit conventions.
+//! Every problem with the file is an [`GltfError`] naming the file; nothing in here panics on
+//! bad input: byte ranges are checked before they are sliced, and the parts of the `gltf`
+//! crate that would slice unchecked (its accessor readers) are not used.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use gltf::accessor::{DataType, Dimensions};
+use thiserror::Error;
+
+use crate::{
+    Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef, Wrap,
+};
+
+/// Extensions whose content is read. Others in `extensionsUsed` give a warning; others in
+/// `extensionsRequired` are an error.
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+
+/// A glTF file that cannot be loaded: the file and what is wrong with it.
+#[derive(Debug, Error)]
+#[error("{}: {what}", path.display())]
+pub struct GltfError {
+    pub path: PathBuf,
+    pub what: String,
+}
+
+/// Loader settings.
+#[derive(Clone, Debug)]
+pub struct GltfOptions {
+    /// Nits per unit of `emissiveFactor x emissiveStrength x emissiveTexture`. The default 1
+    /// follows KHR_materials_emissive_strength, which says that where a physical unit is
+    /// needed the product is in cd/m².
+    pub emissive_nits_per_unit: f32,
+}
+
+impl Default for GltfOptions {
+    fn default() -> Self {
+        Self {
+            emissive_nits_per_unit: 1.0,
+        }
+    }
+}
+
+/// A loaded file: the scene and what was skipped or approximated on the way.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    pub scene: Scene,
+    /// One line per ignored feature; also logged with `log::warn!`.
+    pub warnings: Vec<String>,
+}
+
+/// Loads `path` (`.gltf` or `.glb`) with the default [`GltfOptions`].
+pub fn load(path: impl AsRef<Path>) -> Result<Loaded, GltfError> {
+    load_with(path, &GltfOptions::default())
+}
+
+pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded, GltfError> {
+    let path = path.as_ref();
+    let err = |what: String| GltfError {
+        path: path.to_path_buf(),
+        what,
+    };
+    // A last line of defence: the checks below should leave nothing for a dependency to panic
+    // on, but a malformed file must never take the process down.
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        Loader::new(path, options).and_then(Loader::run)
+    }));
+    match result {
+        Ok(Ok(loaded)) => {
+            for w in &loaded.warnings {
+                log::warn!("{}: {w}", path.display());
+            }
+            Ok(loaded)
+        }
+        Ok(Err(what)) => Err(err(what)),
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("unknown");
+            Err(err(format!("malformed file (the reader failed: {msg})")))
+        }
+    }
+}
+
+type Res<T> = Result<T, String>;
+
+/// Largest element count accepted for an accessor without a buffer view.
+const MAX_VIEWLESS_ELEMENTS: usize = 1 << 24;
+
+struct Loader<'o> {
+    base: PathBuf,
+    options: &'o GltfOptions,
+    doc: gltf::Document,
+    buffers: Vec<gltf::buffer::Data>,
+    warnings: std::cell::RefCell<Vec<String>>,
+}
+
+/// Checks a .glb header before `gltf` reads it: its length arithmetic underflows on a
+/// header claiming fewer than 12 bytes.
+fn check_glb_header(bytes: &[u8]) -> Res<()> {
+    if bytes.len() < 12 {
+        return Err(format!(
+            "truncated .glb: {} bytes, but the header alone is 12",
+            bytes.len()
+        ));
+    }
+    let word = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    let (version, length) = (word(4), word(8) as usize);
+    if version != 2 {
+        return Err(format!(
+            ".glb container version {version}; only glTF 2.0 is supported"
+        ));
+    }
+    if length < 20 {
+        return Err(format!(
+            "malformed .glb: header gives a total length of {length} bytes"
+        ));
+    }
+    if length > bytes.len() {
+        return Err(format!(
+            "truncated .glb: the header says {length} bytes but the file has {}",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
+/// `%XX` decoding of a relative URI, as glTF asks; an error if the result is not UTF-8.
+fn percent_decode(uri: &str) -> Res<String> {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%'
+            && let (Some(h), Some(l)) = (
+                b.get(i + 1).and_then(|&c| hex(c)),
+                b.get(i + 2).and_then(|&c| hex(c)),
+            )
+        {
+            out.push((h * 16 + l) as u8);
+            i += 3;
+        } else {
+            out.push(b[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).map_err(|_| format!("URI `{uri}` does not decode to UTF-8"))
+}
+
+/// Checks a URI so that `gltf`'s importer only sees ones it handles without panicking; returns
+/// the local file it names, if any, for messages.
+fn check_uri(base: &Path, uri: &str) -> Res<Option<PathBuf>> {
+    if uri.starts_with("data:") {
+        return Ok(None);
+    }
+    if let Some(rest) = uri
+        .strip_prefix("file://")
+        .or_else(|| uri.strip_prefix("file:"))
+    {
+        return Ok(Some(PathBuf::from(rest)));
+    }
+    if uri.contains(':') {
+        return Err(format!(
+            "URI `{uri}` has an unsupported scheme (only data: and relative paths)"
+        ));
+    }
+    Ok(Some(base.join(percent_decode(uri)?)))
+}
+
+/// The `gltf` crate's validation indexes the POSITION accessor before checking it exists.
+fn check_position_accessors(root: &gltf::json::Root) -> Res<()> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "invalid glTF: meshes[{m}].primitives[{p}].attributes[\"{}\"] is accessor {} but the file has {}",
+                        semantic.to_string(),
+                        index.value(),
+                        root.accessors.len()
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+fn describe(e: &gltf::Error) -> String {
+    match e {
+        gltf::Error::Deserialize(e) => format!("bad JSON: {e}"),
+        gltf::Error::Validation(list) => {
+            let items: Vec<String> = list
+                .iter()
+                .map(|(path, e)| format!("{path}: {e}"))
+                .collect();
+            format!("invalid glTF: {}", items.join("; "))
+        }
+        gltf::Error::Binary(e) => format!("malformed .glb: {e:?}"),
+        other => other.to_string(),
+    }
+}
+
+impl<'o> Loader<'o> {
+    fn new(path: &Path, options: &'o GltfOptions) -> Res<Self> {
+        let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
+        if bytes.starts_with(b"glTF") {
+            check_glb_header(&bytes)?;
+        }
+        let gltf::Gltf { document, blob } =
+            gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| describe(&e))?;
+        let root = document.into_json();
+        check_position_accessors(&root)?;
+        let doc = gltf::Document::from_json(root).map_err(|e| describe(&e))?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let mut loader = Loader {
+            base,
+            options,
+            doc,
+            buffers: Vec::new(),
+            warnings: Default::default(),
+        };
+        loader.load_buffers(blob)?;
+        Ok(loader)
+    }
+
+    fn warn(&self, w: String) {
+        self.warnings.borrow_mut().push(w);
+    }
+
+    fn load_buffers(&mut self, blob: Option<Vec<u8>>) -> Res<()> {
+        let mut blob = blob;
+        for buffer in self.doc.buffers() {
+            let i = buffer.index();
+            let data = match buffer.source() {
+                gltf::buffer::Source::Bin => {
+                    let bin = blob.take();
+                    bin.ok_or_else(|| {
+                        format!("buffer {i} refers to the .glb BIN chunk, which is missing")
+                    })?
+                }
+                gltf::buffer::Source::Uri(uri) => {
+                    let file =
+                        check_uri(&self.base, uri).map_err(|e| format!("buffer {i}: {e}"))?;
+                    let data = gltf::buffer::Data::from_source(buffer.source(), Some(&self.base));
+                    match (data, file) {
+                        (Ok(d), _) => d.0,
+                        (Err(gltf::Error::Io(e)), Some(file)) => {
+                            return Err(format!(
+                                "buffer {i}: cannot read `{}`: {e}",
+                                file.display()
+                            ));
+                        }
+                        (Err(e), _) => return Err(format!("buffer {i}: {}", describe(&e))),
+                    }
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(format!(
+                    "buffer {i} has {} bytes but declares byteLength {}",
+                    data.len(),
+                    buffer.length()
+                ));
+            }
+            self.buffers.push(gltf::buffer::Data(data));
+        }
+        for view in self.doc.views() {
+            let b = view.buffer().index();
+            let end = view.offset().checked_add(view.length());
+            if end.is_none_or(|end| end > self.buffers[b].len()) {
+                return Err(format!(
+                    "buffer view {} spans bytes {}..{} of buffer {b}, which has {}",
+                    view.index(),
+                    view.offset(),
+                    view.offset() as u128 + view.length() as u128,
+                    self.buffers[b].len()
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn view_bytes(&self, view: &gltf::buffer::View) -> &[u8] {
+        // In range: checked in load_buffers.
+        &self.buffers[view.buffer().index()][view.offset()..view.offset() + view.length()]
+    }
+
+    /// Every component of every element of `acc` as f64 (exact for all glTF component types),
+    /// normalised integers mapped to [0, 1] or [-1, 1]; sparse substitution applied.
+    fn read_accessor(&self, acc: &gltf::Accessor) -> Res<Vec<f64>> {
+        let what = |msg: String| format!("accessor {}: {msg}", acc.index());
+        let comps = acc.dimensions().multiplicity();
+        let ty = acc.data_type();
+        let csize = ty.size();
+        let count = acc.count();
+        let total = count
+            .checked_mul(comps)
+            .ok_or_else(|| what(format!("count {count} is too large")))?;
+        let normalized = acc.normalized();
+        let decode = |b: &[u8]| -> f64 {
+            let v = match ty {
+                DataType::I8 => b[0] as i8 as f64,
+                DataType::U8 => b[0] as f64,
+                DataType::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+                DataType::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+                DataType::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+                DataType::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            };
+            if !normalized {
+                return v;
+            }
+            match ty {
+                DataType::I8 => (v / 127.0).max(-1.0),
+                DataType::U8 => v / 255.0,
+                DataType::I16 => (v / 32767.0).max(-1.0),
+                DataType::U16 => v / 65535.0,
+                _ => v,
+            }
+        };
+        // Elements of `size` bytes, `stride` apart, from `offset` in `bytes`, checked.
+        let gather = |bytes: &[u8],
+                      offset: usize,
+                      stride: usize,
+                      n: usize,
+                      size: usize,
+                      label: &str|
+         -> Res<Vec<usize>> {
+            if n == 0 {
+                return Ok(Vec::new());
+            }
+            if stride < size {
+                return Err(what(format!(
+                    "{label}: byte stride {stride} is smaller than the element size {size}"
+                )));
+            }
+            let end = (n - 1)
+                .checked_mul(stride)
+                .and_then(|x| x.checked_add(offset))
+                .and_then(|x| x.checked_add(size));
+            match end {
+                Some(end) if end <= bytes.len() => {
+                    Ok((0..n).map(|e| offset + e * stride).collect())
+                }
+                _ => Err(what(format!(
+                    "{label} out of range: {n} elements of {size} bytes from byte offset {offset} (stride {stride}) need {} bytes but the buffer view has {}",
+                    offset as u128 + (n as u128).saturating_sub(1) * stride as u128 + size as u128,
+                    bytes.len()
+                ))),
+            }
+        };
+        let elem = comps * csize;
+        // Bytes behind a view were checked against the file; a view-less (all-zero or purely
+        // sparse) accessor is not, so bound what it may allocate.
+        if acc.view().is_none() && count > MAX_VIEWLESS_ELEMENTS {
+            return Err(what(format!(
+                "has no buffer view and {count} elements; at most {MAX_VIEWLESS_ELEMENTS} are supported"
+            )));
+        }
+        let mut out = vec![0.0f64; total];
+        if let Some(view) = acc.view() {
+            let bytes = self.view_bytes(&view);
+            let stride = view.stride().unwrap_or(elem);
+            for (e, start) in gather(bytes, acc.offset(), stride, count, elem, "data")?
+                .into_iter()
+                .enumerate()
+            {
+                for c in 0..comps {
+                    out[e * comps + c] = decode(&bytes[start + c * csize..]);
+                }
+            }
+        }
+        if let Some(sparse) = acc.sparse() {
+            let n = sparse.count();
+            let iv = sparse.indices().view();
+            let it = sparse.indices().index_type();
+            let isize = it.size();
+            let ibytes = self.view_bytes(&iv);
+            let idx = gather(
+                ibytes,
+                sparse.indices().offset(),
+                isize,
+                n,
+                isize,
+                "sparse indices",
+            )?;
+            let vv = sparse.values().view();
+            let vbytes = self.view_bytes(&vv);
+            let vals = gather(
+                vbytes,
+                sparse.values().offset(),
+                elem,
+                n,
+                elem,
+                "sparse values",
+            )?;
+            for (ipos, vpos) in idx.into_iter().zip(vals) {
+                let b = &ibytes[ipos..];
+                let target = match isize {
+                    1 => b[0] as usize,
+                    2 => u16::from_le_bytes([b[0], b[1]]) as usize,
+                    _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
+                };
+                if target >= count {
+                    return Err(what(format!(
+                        "sparse index {target} is out of range for {count} elements"
+                    )));
+                }
+                for c in 0..comps {
+                    out[target * comps + c] = decode(&vbytes[vpos + c * csize..]);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Reads a float attribute of `dims` components; `ints` allows normalised integer types.
+    fn read_floats(
+        &self,
+        acc: &gltf::Accessor,
+        label: &str,
+        dims: &[Dimensions],
+        ints: bool,
+    ) -> Res<(usize, Vec<f32>)> {
+        let ok_type = acc.data_type() == DataType::F32
+            || (ints
+                && acc.normalized()
+                && matches!(acc.data_type(), DataType::U8 | DataType::U16));
+        if !dims.contains(&acc.dimensions()) || !ok_type {
+            return Err(format!(
+                "{label}: accessor {} is {:?} {:?}{}, expected {:?} of float{}",
+                acc.index(),
+                acc.dimensions(),
+                acc.data_type(),
+                if acc.normalized() { " normalized" } else { "" },
+                dims,
+                if ints { " or normalized u8/u16" } else { "" }
+            ));
+        }
+        let v = self
+            .read_accessor(acc)
+            .map_err(|e| format!("{label}: {e}"))?;
+        Ok((
+            acc.dimensions().multiplicity(),
+            v.into_iter().map(|x| x as f32).collect(),
+        ))
+    }
+
+    fn run(self) -> Res<Loaded> {
+        for ext in self.doc.extensions_used() {
+            if !SUPPORTED_EXTENSIONS.contains(&ext) {
+                self.warn(format!("extension {ext} is not supported and is ignored"));
+            }
+        }
+        if self.doc.animations().next().is_some() {
+            self.warn("animations are ignored".into());
+        }
+        if self.doc.skins().next().is_some() {
+            self.warn("skins are ignored: skinned meshes are drawn in their bind pose".into());
+        }
+        let mut scene = Scene {
+            textures: self.load_textures()?,
+            ..Default::default()
+        };
+        scene.materials = self.load_materials(scene.textures.len());
+        let meshes = self.load_meshes(&mut scene)?;
+        self.load_nodes(&mut scene, &meshes)?;
+        if scene.cameras.is_empty() {
+            if let Some((lo, hi)) = scene.bounds() {
+                scene.cameras.push(Camera::framing("auto", lo, hi));
+            } else {
+                scene.cameras.push(Camera {
+                    name: "auto".into(),
+                    ..Default::default()
+                });
+            }
+        }
+        if scene.sun.is_none() && scene.lights.is_empty() {
+            scene.sun = Some(Sun::default());
+        }
+        scene.validate().map_err(|e| e.to_string())?;
+        Ok(Loaded {
+            scene,
+            warnings: self.warnings.into_inner(),
+        })
+    }
+
+    fn load_textures(&self) -> Res<Vec<Texture>> {
+        let mut images = Vec::new();
+        for image in self.doc.images() {
+            let i = image.index();
+            if let gltf::image::Source::Uri { uri, .. } = image.source() {
+                check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
+            }
+            let data =
+                gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
+                    .map_err(|e| match (&e, image.source()) {
+                        (gltf::Error::Io(io), gltf::image::Source::Uri { uri, .. }) => {
+                            format!(
+                                "image {i}: cannot read `{}`: {io}",
+                                self.base.join(uri).display()
+                            )
+                        }
+                        _ => format!("image {i}: {}", describe(&e)),
+                    })?;
+            images.push(
+                to_rgba8(&data)
+                    .ok_or_else(|| format!("image {i}: decoded pixel data has the wrong size"))?,
+            );
+        }
+        let mut textures = Vec::new();
+        for t in self.doc.textures() {
+            let (width, height, data) = images[t.source().index()].clone();
+            let sampler = t.sampler();
+            let wrap = |w: gltf::texture::WrappingMode| match w {
+                gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+                gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+                gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            };
+            textures.push(Texture {
+                name: t
+                    .name()
+                    .or(t.source().name())
+                    .map_or_else(|| format!("texture{}", t.index()), str::to_owned),
+                width,
+                height,
+                data,
+                wrap_s: wrap(sampler.wrap_s()),
+                wrap_t: wrap(sampler.wrap_t()),
+            });
+        }
+        Ok(textures)
+    }
+
+    fn load_materials(&self, texture_count: usize) -> Vec<Material> {
+        let mut out = Vec::new();
+        let docs: Vec<_> = self.doc.materials().collect();
+        for m in docs {
+            let name = m.name().map_or_else(
+                || format!("material{}", m.index().unwrap_or(0)),
+                str::to_owned,
+            );
+            let tex = |info: Option<(gltf::texture::Texture, u32)>,
+                       what: &str|
+             -> Option<TextureRef> {
+                let (t, set) = info?;
+                if set != 0 {
+                    self.warn(format!(
+                        "material `{name}`: {what} texture uses TEXCOORD_{set}; only TEXCOORD_0 is loaded, so it is used instead"
+                    ));
+                }
+                (t.index() < texture_count).then(|| TextureRef::new(t.index()))
+            };
+            let pbr = m.pbr_metallic_roughness();
+            let [r, g, b, a] = pbr.base_color_factor();
+            let strength = m.emissive_strength().unwrap_or(1.0);
+            let normal = m.normal_texture();
+            let occlusion = m.occlusion_texture();
+            let mat = Material {
+                base_color: Vec3::new(r, g, b),
+                alpha: a.clamp(0.0, 1.0),
+                roughness: pbr.roughness_factor().clamp(0.0, 1.0),
+                metalness: pbr.metallic_factor().clamp(0.0, 1.0),
+                emissive_nits: Vec3::from(m.emissive_factor())
+                    * strength
+                    * self.options.emissive_nits_per_unit,
+                double_sided: m.double_sided(),
+                base_color_texture: tex(
+                    pbr.base_color_texture()
+                        .map(|i| (i.texture(), i.tex_coord())),
+                    "base colour",
+                ),
+                metallic_roughness_texture: tex(
+                    pbr.metallic_roughness_texture()
+                        .map(|i| (i.texture(), i.tex_coord())),
+                    "metallic-roughness",
+                ),
+                normal_texture: tex(
+                    normal.as_ref().map(|i| (i.texture(), i.tex_coord())),
+                    "normal",
+                ),
+                normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
+                emissive_texture: tex(
+                    m.emissive_texture().map(|i| (i.texture(), i.tex_coord())),
+                    "emissive",
+                ),
+                occlusion_texture: tex(
+                    occlusion.as_ref().map(|i| (i.texture(), i.tex_coord())),
+                    "occlusion",
+                ),
+                occlusion_strength: occlusion
+                    .as_ref()
+                    .map_or(1.0, |o| o.strength())
+                    .clamp(0.0, 1.0),
+                name,
+                ..Default::default()
+            };
+            if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+                self.warn(format!(
+                    "material `{}`: alpha mode {:?} is drawn opaque",
+                    mat.name,
+                    m.alpha_mode()
+                ));
+            }
+            out.push(mat);
+        }
+        out
+    }
+
+    /// Loads every primitive; returns, per glTF mesh, its (scene mesh, scene material) pairs.
+    fn load_meshes(&self, scene: &mut Scene) -> Res<Vec<Vec<(usize, usize)>>> {
+        let mut default_material = None;
+        let mut out = Vec::new();
+        let meshes: Vec<_> = self.doc.meshes().collect();
+        for mesh in meshes {
+            let mut prims = Vec::new();
+            let mesh_name = mesh
+                .name()
+                .map_or_else(|| format!("mesh{}", mesh.index()), str::to_owned);
+            for prim in mesh.primitives() {
+                let label = format!("mesh `{mesh_name}` primitive {}", prim.index());
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    self.warn(format!(
+                        "{label}: mode {:?} skipped; only triangle lists are drawn",
+                        prim.mode()
+                    ));
+                    continue;
+                }
+                if prim.morph_targets().next().is_some() {
+                    self.warn(format!("{label}: morph targets are ignored"));
+                }
+                let material = match prim.material().index() {
+                    Some(i) => i,
+                    None => *default_material.get_or_insert_with(|| {
+                        scene.materials.push(Material {
+                            name: "gltf default".into(),
+                            base_color: Vec3::ONE,
+                            metalness: 1.0,
+                            roughness: 1.0,
+                            ..Default::default()
+                        });
+                        scene.materials.len() - 1
+                    }),
+                };
+                let wants_tangents = scene.materials[material].normal_texture.is_some();
+                let Some(m) = self.load_primitive(&prim, &label, wants_tangents)? else {
+                    continue;
+                };
+                scene.meshes.push(m);
+                prims.push((scene.meshes.len() - 1, material));
+            }
+            out.push(prims);
+        }
+        Ok(out)
+    }
+
+    fn load_primitive(
+        &self,
+        prim: &gltf::Primitive,
+        label: &str,
+        wants_tangents: bool,
+    ) -> Res<Option<Mesh>> {
+        let err = |e: String| format!("{label}: {e}");
+        let Some(pos) = prim.get(&gltf::Semantic::Positions) else {
+            self.warn(format!("{label}: no POSITION attribute; skipped"));
+            return Ok(None);
+        };
+        let (_, p) = self
+            .read_floats(&pos, "POSITION", &[Dimensions::Vec3], false)
+            .map_err(err)?;
+        let positions: Vec<Vec3> = p.chunks_exact(3).map(Vec3::from_slice).collect();
+        let n = positions.len();
+        let per_vertex = |what: &str, len: usize| -> Res<()> {
+            if len != n {
+                return Err(err(format!(
+                    "{what} has {len} elements but POSITION has {n}"
+                )));
+            }
+            Ok(())
+        };
+        let mut mesh = Mesh {
+            name: label.replace("mesh `", "").replace("` primitive ", "/"),
+            positions,
+            ..Default::default()
+        };
+        if let Some(a) = prim.get(&gltf::Semantic::Normals) {
+            let (_, v) = self
+                .read_floats(&a, "NORMAL", &[Dimensions::Vec3], false)
+                .map_err(err)?;
+            mesh.normals = v.chunks_exact(3).map(Vec3::from_slice).collect();
+            per_vertex("NORMAL", mesh.normals.len())?;
+        }
+        if let Some(a) = prim.get(&gltf::Semantic::Tangents) {
+            let (_, v) = self
+                .read_floats(&a, "TANGENT", &[Dimensions::Vec4], false)
+                .map_err(err)?;
+            mesh.tangents = v.chunks_exact(4).map(Vec4::from_slice).collect();
+            per_vertex("TANGENT", mesh.tangents.len())?;
+        }
+        if let Some(a) = prim.get(&gltf::Semantic::TexCoords(0)) {
+            let (_, v) = self
+                .read_floats(&a, "TEXCOORD_0", &[Dimensions::Vec2], true)
+                .map_err(err)?;
+            mesh.uvs = v.chunks_exact(2).map(Vec2::from_slice).collect();
+            per_vertex("TEXCOORD_0", mesh.uvs.len())?;
+        }
+        if let Some(a) = prim.get(&gltf::Semantic::Colors(0)) {
+            let (dims, v) = self
+                .read_floats(&a, "COLOR_0", &[Dimensions::Vec3, Dimensions::Vec4], true)
+                .map_err(err)?;
+            let c: Vec<Vec4> = v
+                .chunks_exact(dims)
+                .map(|c| {
+                    if dims == 3 {
+                        Vec3::from_slice(c).extend(1.0)
+                    } else {
+                        Vec4::from_slice(c)
+                    }
+                })
+                .collect();
+            per_vertex("COLOR_0", c.len())?;
+            mesh.colors = Some(c);
+        }
+        mesh.indices = match prim.indices() {
+            Some(a) => {
+                if a.dimensions() != Dimensions::Scalar
+                    || !matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+                    || a.normalized()
+                {
+                    return Err(err(format!(
+                        "indices: accessor {} is {:?} {:?}, expected an unsigned integer scalar",
+                        a.index(),
+                        a.dimensions(),
+                        a.data_type()
+                    )));
+                }
+                let v = self
+                    .read_accessor(&a)
+                    .map_err(|e| err(format!("indices: {e}")))?;
+                v.into_iter().map(|x| x as u32).collect()
+            }
+            None => (0..n as u32).collect(),
+        };
+        if !mesh.indices.len().is_multiple_of(3) {
+            return Err(err(format!(
+                "{} indices is not a whole number of triangles",
+                mesh.indices.len()
+            )));
+        }
+        if let Some(i) = mesh.indices.iter().position(|&ix| ix as usize >= n) {
+            return Err(err(format!(
+                "index {i} is {} but there are only {n} vertices",
+                mesh.indices[i]
+            )));
+        }
+        if mesh.normals.is_empty() {
+            // glTF asks for flat normals when none are given: unweld so each triangle has its own.
+            flat_normals(&mut mesh);
+        }
+        if mesh.tangents.is_empty() && wants_tangents && !mesh.uvs.is_empty() {
+            mesh.tangents = generate_tangents(&mesh);
+        }
+        Ok(Some(mesh))
+    }
+
+    fn load_nodes(&self, scene: &mut Scene, meshes: &[Vec<(usize, usize)>]) -> Res<()> {
+        let roots: Vec<gltf::Node> = match self
+            .doc
+            .default_scene()
+            .or_else(|| self.doc.scenes().next())
+        {
+            Some(s) => s.nodes().collect(),
+            None => {
+                // No scene: every node that is nobody's child is a root.
+                let children: std::collections::HashSet<usize> = self
+                    .doc
+                    .nodes()
+                    .flat_map(|n| n.children().map(|c| c.index()))
+                    .collect();
+                self.doc
+                    .nodes()
+                    .filter(|n| !children.contains(&n.index()))
+                    .collect()
+            }
+        };
+        if self.doc.scenes().len() > 1 {
+            self.warn("the file has several scenes; only the default one is loaded".into());
+        }
+        let node_count = self.doc.nodes().len();
+        let mut visits = vec![0usize; node_count];
+        // Depth first in file order, so instances, cameras and lights keep the file's order.
+        let mut stack: Vec<(gltf::Node, Mat4, usize)> = roots
+            .into_iter()
+            .rev()
+            .map(|n| (n, Mat4::IDENTITY, 0))
+            .collect();
+        while let Some((node, parent, depth)) = stack.pop() {
+            if depth > node_count {
+                return Err(format!(
+                    "node {} is its own ancestor: the node hierarchy has a cycle",
+                    node.index()
+                ));
+            }
+            visits[node.index()] += 1;
+            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if !world.is_finite() {
+                return Err(format!("node {}: transform is not finite", node.index()));
+            }
+            if let Some(mesh) = node.mesh() {
+                for &(m, material) in &meshes[mesh.index()] {
+                    scene.instances.push(Instance {
+                        mesh: m,
+                        material,
+                        transform: world,
+                    });
+                }
+            }
+            let node_name = node.name().map(str::to_owned);
+            if let Some(cam) = node.camera() {
+                let name = cam
+                    .name()
+                    .map(str::to_owned)
+                    .or(node_name.clone())
+                    .unwrap_or_else(|| format!("camera{}", cam.index()));
+                match cam.projection() {
+                    gltf::camera::Projection::Perspective(p) => {
+                        let position = world.transform_point3(Vec3::ZERO);
+                        let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+                        if forward == Vec3::ZERO || up == Vec3::ZERO {
+                            return Err(format!(
+                                "camera `{name}`: node {} transform is degenerate",
+                                node.index()
+                            ));
+                        }
+                        scene.cameras.push(Camera {
+                            name,
+                            position,
+                            target: position + forward,
+                            vfov_deg: p.yfov().to_degrees(),
+                            near: p.znear(),
+                            up,
+                        });
+                    }
+                    gltf::camera::Projection::Orthographic(_) => {
+                        self.warn(format!(
+                            "camera `{name}`: orthographic cameras are not supported; skipped"
+                        ));
+                    }
+                }
+            }
+            if let Some(light) = node.light() {
+                let name = light
+                    .name()
+                    .map(str::to_owned)
+                    .or(node_name)
+                    .unwrap_or_else(|| format!("light{}", light.index()));
+                let color = Vec3::from(light.color());
+                let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+                let position = world.transform_point3(Vec3::ZERO);
+                match light.kind() {
+                    gltf::khr_lights_punctual::Kind::Directional => {
+                        if scene.sun.is_some() {
+                            self.warn(format!("light `{name}`: only the first directional light is used as the sun"));
+                        } else {
+                            scene.sun = Some(Sun {
+                                direction: -direction,
+                                illuminance_lux: light.intensity(),
+                                color,
+                            });
+                        }
+                    }
+                    kind => {
+                        let kind = match kind {
+                            gltf::khr_lights_punctual::Kind::Spot {
+                                inner_cone_angle,
+                                outer_cone_angle,
+                            } => LightKind::Spot {
+                                inner_cone: inner_cone_angle,
+                                outer_cone: outer_cone_angle,
+                            },
+                            _ => LightKind::Point,
+                        };
+                        scene.lights.push(Light {
+                            name,
+                            kind,
+                            position,
+                            direction,
+                            intensity_cd: light.intensity(),
+                            color,
+                            range: light.range(),
+                        });
+                    }
+                }
+            }
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child, world, depth + 1));
+            }
+        }
+        // Validation of the `gltf` crate does not reject a node with two parents; it would be
+        // drawn twice here, which is what such a file asks for, but say so.
+        if let Some(n) = visits.iter().position(|&v| v > 1) {
+            self.warn(format!(
+                "node {n} is reached through more than one parent and appears {} times",
+                visits[n]
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn to_rgba8(d: &gltf::image::Data) -> Option<(u32, u32, Vec<u8>)> {
+    use gltf::image::Format as F;
+    let (channels, bytes_per) = match d.format {
+        F::R8 => (1, 1),
+        F::R8G8 => (2, 1),
+        F::R8G8B8 => (3, 1),
+        F::R8G8B8A8 => (4, 1),
+        F::R16 => (1, 2),
+        F::R16G16 => (2, 2),
+        F::R16G16B16 => (3, 2),
+        F::R16G16B16A16 => (4, 2),
+        F::R32G32B32FLOAT => (3, 4),
+        F::R32G32B32A32FLOAT => (4, 4),
+    };
+    let texels = d.width as usize * d.height as usize;
+    if d.pixels.len() != texels * channels * bytes_per {
+        return None;
+    }
+    let channel = |b: &[u8]| -> u8 {
+        match bytes_per {
+            1 => b[0],
+            2 => (u16::from_ne_bytes([b[0], b[1]]) >> 8) as u8,
+            _ => (f32::from_ne_bytes([b[0], b[1], b[2], b[3]]).clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
+        }
+    };
+    if d.format == F::R8G8B8A8 {
+        return Some((d.width, d.height, d.pixels.clone()));
+    }
+    let mut out = Vec::with_capacity(texels * 4);
+    for px in d.pixels.chunks_exact(channels * bytes_per) {
+        let mut c = [0u8; 4];
+        for (k, ch) in px.chunks_exact(bytes_per).enumerate() {
+            c[k] = channel(ch);
+        }
+        out.extend_from_slice(&match channels {
+            1 => [c[0], c[0], c[0], 255],
+            2 => [c[0], c[1], 0, 255],
+            3 => [c[0], c[1], c[2], 255],
+            _ => [c[0], c[1], c[2], c[3]],
+        });
+    }
+    Some((d.width, d.height, out))
+}
+
+/// Unwelds `mesh` so each triangle has its own three vertices with the face normal.
+fn flat_normals(mesh: &mut Mesh) {
+    let old = std::mem::take(mesh);
+    let pick = |i: u32| old.positions[i as usize];
+    mesh.name = old.name.clone();
+    for t in old.indices.chunks_exact(3) {
+        let [a, b, c] = [pick(t[0]), pick(t[1]), pick(t[2])];
+        let n = (b - a).cross(c - a).normalize_or(Vec3::Y);
+        for &i in t {
+            let i = i as usize;
+            mesh.indices.push(mesh.positions.len() as u32);
+            mesh.positions.push(old.positions[i]);
+            mesh.normals.push(n);
+            if let Some(t) = old.tangents.get(i) {
+                mesh.tangents.push(*t);
+            }
+            if let Some(uv) = old.uvs.get(i) {
+                mesh.uvs.push(*uv);
+            }
+            if let Some(c) = old.colors.as_ref().and_then(|c| c.get(i)) {
+                mesh.colors.get_or_insert_with(Vec::new).push(*c);
+            }
+        }
+    }
+}
+
+/// Per-vertex tangents from the UV gradients of the surrounding triangles, Gram-Schmidt
+/// orthogonalised against the normal. This is not MikkTSpace (which glTF recommends), so normal
+/// maps baked for MikkTSpace can show small seams where the two disagree.
+pub fn generate_tangents(mesh: &Mesh) -> Vec<Vec4> {
+    let n = mesh.positions.len();
+    let (mut tan, mut bit) = (vec![Vec3::ZERO; n], vec![Vec3::ZERO; n]);
+    for t in mesh.indices.chunks_exact(3) {
+        let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
+        let (e1, e2) = (
+            mesh.positions[b] - mesh.positions[a],
+            mesh.positions[c] - mesh.positions[a],
+        );
+        let (d1, d2) = (mesh.uvs[b] - mesh.uvs[a], mesh.uvs[c] - mesh.uvs[a]);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if det.abs() < 1e-20 {
+            continue;
+        }
+        let dpdu = (e1 * d2.y - e2 * d1.y) / det;
+        let dpdv = (e2 * d1.x - e1 * d2.x) / det;
+        for v in [a, b, c] {
+            tan[v] += dpdu;
+            bit[v] += dpdv;
+        }
+    }
+    (0..n)
+        .map(|i| {
+            let nrm = mesh.normals[i];
+            let t = (tan[i] - nrm * nrm.dot(tan[i])).normalize_or(nrm.any_orthonormal_vector());
+            let w = if nrm.cross(t).dot(bit[i]) < 0.0 {
+                -1.0
+            } else {
+                1.0
+            };
+            t.extend(w)
+        })
+        .collect()
+}
