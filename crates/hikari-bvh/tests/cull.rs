@@ -1,7 +1,7 @@
 //! Instance culling never drops an instance that a ray starting inside the view frustum can hit
 //! within the frustum margin; hidden and tiny distant instances are dropped.
 
-mod common;
+use hikari_bvh::reference as common;
 
 use glam::{Affine3A, Mat4, Quat, Vec3, Vec4};
 use hikari_bvh::reference::closest_hit_instances;

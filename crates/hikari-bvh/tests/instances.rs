@@ -1,11 +1,11 @@
 //! Two-level traversal (TLAS over instances sharing BLAS) against brute force over every
 //! triangle of every instance.
 
-mod common;
+use hikari_bvh::reference as common;
 
-use common::{random_rays, same_hit};
 use glam::{Affine3A, Quat, Vec3};
 use hikari_bvh::reference::{any_hit_instances, closest_hit_instances};
+use hikari_bvh::reference::{random_rays, same_hit};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Instance, Mesh, Ray, Tlas};
 

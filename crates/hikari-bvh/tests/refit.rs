@@ -1,10 +1,9 @@
 //! Refit keeps the hits of a full rebuild on the deformed mesh.
 
-mod common;
 
-use common::{random_rays, same_hit};
 use glam::Vec3;
 use hikari_bvh::reference::closest_hit_mesh;
+use hikari_bvh::reference::{random_rays, same_hit};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, BvhError, Mesh};
 

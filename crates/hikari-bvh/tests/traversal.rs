@@ -1,10 +1,10 @@
 //! BLAS traversal over the GPU layout against brute force over every triangle.
 
-mod common;
+use hikari_bvh::reference as common;
 
-use common::{random_rays, same_hit};
 use glam::Vec3;
 use hikari_bvh::reference::{any_hit_mesh, closest_hit_mesh};
+use hikari_bvh::reference::{random_rays, same_hit};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Mesh, Ray};
 

@@ -706,11 +706,7 @@ fn specular_sampling_consistent() {
 // The WGSL twin
 
 fn brdf_wgsl() -> String {
-    let path = format!(
-        "{}/../hikari-render/shaders/common/brdf.wgsl",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    std::fs::read_to_string(path).expect("brdf.wgsl present")
+    common::wgsl_module("brdf.wgsl")
 }
 
 /// `brdf.wgsl` parses and validates with naga (the `#define_import_path` line is naga_oil's,
@@ -719,19 +715,7 @@ fn brdf_wgsl() -> String {
 fn wgsl_twin_validates() {
     let src = brdf_wgsl();
     assert!(src.starts_with("#define_import_path hikari::brdf"));
-    let body: String = src
-        .lines()
-        .filter(|l| !l.starts_with("#define_import_path"))
-        .collect::<Vec<_>>()
-        .join("\n");
-    let module = naga::front::wgsl::parse_str(&body)
-        .unwrap_or_else(|e| panic!("brdf.wgsl: {}", e.emit_to_string(&body)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::empty(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("brdf.wgsl: {e:?}"));
+    common::validate_wgsl(&src, "brdf.wgsl");
 }
 
 /// The twin has every CPU function under its `brdf_` name, and the same constants.

@@ -2,34 +2,12 @@
 //! color.wgsl must equal the exact f64 derivations rounded to f32.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
+use common::{validate_wgsl as validate, wgsl_module as shader};
 use hikari_math::color::Mat3Rows;
 use hikari_math::color::primaries::{ACESCG, LMS_RAYLEIGH, REC709, TONEMAP, rgb_to_rgb};
 use hikari_math::color::purkinje::PurkinjeMatrices;
-
-fn shader(name: &str) -> String {
-    let path = format!(
-        "{}/../hikari-render/shaders/common/{name}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    std::fs::read_to_string(path).expect("shader present")
-}
-
-/// naga_oil's `#define_import_path` is not WGSL; drop it to validate the module on its own.
-fn validate(src: &str, name: &str) {
-    let body: String = src
-        .lines()
-        .filter(|l| !l.starts_with("#define_import_path"))
-        .collect::<Vec<_>>()
-        .join("\n");
-    let module = naga::front::wgsl::parse_str(&body)
-        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&body)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::empty(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("{name}: {e:?}"));
-}
 
 #[test]
 fn wgsl_twins_validate() {

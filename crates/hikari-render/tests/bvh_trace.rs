@@ -5,7 +5,9 @@
 mod common;
 
 use glam::{Affine3A, Quat, Vec3};
-use hikari_bvh::reference::{any_hit_instances, closest_hit_instances};
+use hikari_bvh::reference::{
+    any_hit_instances, closest_hit_instances, random_dir, random_rays, same_hit,
+};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
 use hikari_render::GpuContext;
@@ -93,33 +95,6 @@ impl Gpu {
     }
 }
 
-/// Same primitive and instance with t (and barycentrics) within 1e-4 relative, or an exact
-/// tie: another primitive at the same distance within 1e-6 relative (hikari-bvh's rule).
-fn same_hit(got: Option<Hit>, want: Option<Hit>) -> Result<(), String> {
-    match (got, want) {
-        (None, None) => Ok(()),
-        (Some(g), None) => Err(format!("hit {g:?}, expected a miss")),
-        (None, Some(w)) => Err(format!("missed, expected {w:?}")),
-        (Some(g), Some(w)) => {
-            let scale = w.t.abs().max(1e-6);
-            if g.primitive == w.primitive && g.instance == w.instance {
-                if (g.t - w.t).abs() <= 1e-4 * scale
-                    && (g.u - w.u).abs() <= 1e-4
-                    && (g.v - w.v).abs() <= 1e-4
-                {
-                    Ok(())
-                } else {
-                    Err(format!("same primitive, different hit: {g:?} vs {w:?}"))
-                }
-            } else if (g.t - w.t).abs() <= 1e-6 * scale {
-                Ok(())
-            } else {
-                Err(format!("different primitive: {g:?} vs {w:?}"))
-            }
-        }
-    }
-}
-
 fn as_option(h: Hit) -> Option<Hit> {
     h.is_hit().then_some(h)
 }
@@ -174,45 +149,6 @@ fn check(gpu: &mut Gpu, name: &str, scene: &Scene, rays: &[Ray]) -> usize {
         failures[..failures.len().min(12)].join("\n")
     );
     hits
-}
-
-fn random_dir(rng: &mut SplitMix64) -> Vec3 {
-    loop {
-        let v = Vec3::new(
-            rng.range(-1.0, 1.0),
-            rng.range(-1.0, 1.0),
-            rng.range(-1.0, 1.0),
-        );
-        let l = v.length_squared();
-        if l > 1e-4 && l <= 1.0 {
-            return v / l.sqrt();
-        }
-    }
-}
-
-/// Rays from random points in a cube, in random directions; some axis-aligned (zero direction
-/// components exercise the reciprocal clamp), some of other lengths, some with finite t ranges.
-fn random_rays(rng: &mut SplitMix64, count: usize, extent: f32) -> Vec<Ray> {
-    (0..count)
-        .map(|i| {
-            let o = Vec3::new(
-                rng.range(-extent, extent),
-                rng.range(-extent, extent),
-                rng.range(-extent, extent),
-            );
-            let d = match i % 7 {
-                0 => [Vec3::X, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_X][rng.below(4)],
-                1 => random_dir(rng) * rng.range(0.1, 10.0),
-                _ => random_dir(rng),
-            };
-            let (t_min, t_max) = if i % 5 == 0 {
-                (rng.range(0.0, extent), rng.range(0.0, 3.0 * extent))
-            } else {
-                (0.0, f32::INFINITY)
-            };
-            Ray::new(o, d, t_min, t_max)
-        })
-        .collect()
 }
 
 #[test]

@@ -96,3 +96,29 @@ pub fn dense_dirs(n: usize) -> Vec<Vec3> {
         })
         .collect()
 }
+
+/// A WGSL module of `hikari-render/shaders/common/` (the twins of this crate).
+pub fn wgsl_module(name: &str) -> String {
+    let path = format!(
+        "{}/../hikari-render/shaders/common/{name}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    std::fs::read_to_string(path).expect("shader present")
+}
+
+/// naga_oil's `#define_import_path` is not WGSL; drop it to validate the module on its own.
+pub fn validate_wgsl(src: &str, name: &str) {
+    let body: String = src
+        .lines()
+        .filter(|l| !l.starts_with("#define_import_path"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let module = naga::front::wgsl::parse_str(&body)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&body)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::empty(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+}
