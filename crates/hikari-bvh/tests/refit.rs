@@ -1,6 +1,5 @@
 //! Refit keeps the hits of a full rebuild on the deformed mesh.
 
-
 use glam::Vec3;
 use hikari_bvh::reference::closest_hit_mesh;
 use hikari_bvh::reference::{random_rays, same_hit};
