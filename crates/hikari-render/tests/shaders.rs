@@ -86,3 +86,29 @@ fn gaps_in_bindings_are_refused() {
     .unwrap();
     assert!(hikari_render::pipeline::reflect_bindings("gap.wgsl", &module).is_err());
 }
+
+#[test]
+fn bvh_stack_size_matches_the_kernel() {
+    // The Rust side refuses scenes deeper than the kernel's stack; the two must agree. naga
+    // folds the constant into the array type, so read it from the module's source.
+    let files = shader::shader_files().unwrap();
+    let src = &files
+        .iter()
+        .find(|f| f.path == "bvh/traverse.wgsl")
+        .unwrap()
+        .source;
+    let line = src
+        .lines()
+        .find(|l| l.starts_with("const BVH_STACK_SIZE: u32 ="))
+        .expect("BVH_STACK_SIZE in hikari::bvh");
+    let value: u32 = line
+        .split('=')
+        .nth(1)
+        .unwrap()
+        .trim()
+        .trim_end_matches(';')
+        .trim_end_matches('u')
+        .parse()
+        .unwrap();
+    assert_eq!(value, hikari_render::passes::bvh_trace::STACK_SIZE);
+}

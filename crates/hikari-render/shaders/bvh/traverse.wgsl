@@ -50,7 +50,7 @@ struct InstanceRecord {
 const BVH_MISS: u32 = 0xffffffffu;
 // One entry per tree level below the root, TLAS and BLAS together; hikari-render refuses a
 // scene whose depths need more (`bvh_trace::STACK_SIZE` mirrors this).
-const BVH_STACK_SIZE: u32 = 64u;
+const BVH_STACK_SIZE: u32 = 24u;
 const BVH_NODE_BITS: u32 = 0xff000000u;
 // 1 + 2^-20: absorbs the rounding of the reassociated slab formula (see hikari-bvh).
 const BVH_BOX_FAR_SCALE: f32 = 1.00000095367431640625;

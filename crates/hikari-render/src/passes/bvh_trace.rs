@@ -25,7 +25,7 @@ use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
 
 /// Stack entries of the kernel (`BVH_STACK_SIZE` in `shaders/bvh/traverse.wgsl`).
-pub const STACK_SIZE: u32 = 64;
+pub const STACK_SIZE: u32 = 24;
 
 /// Bytes per ray and per hit in the buffers [`BvhTrace::record`] binds.
 pub const RAY_BYTES: u64 = std::mem::size_of::<hikari_bvh::Ray>() as u64;
