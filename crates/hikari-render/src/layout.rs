@@ -56,18 +56,8 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),
         gpu_layout!(
             math_check::MathCheckParams,
-            "math_check/sh.wgsl",
-            [count, pad0, pad1, pad2]
-        ),
-        gpu_layout!(
-            math_check::MathCheckParams,
-            "math_check/ycocg.wgsl",
-            [count, pad0, pad1, pad2]
-        ),
-        gpu_layout!(
-            math_check::MathCheckParams,
             "math_check/color.wgsl",
-            [count, pad0, pad1, pad2]
+            [count, pad_a, pad_b, pad_c]
         ),
         gpu_layout!(
             crate::passes::bvh_trace::TraceParams,

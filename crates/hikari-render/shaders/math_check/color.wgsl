@@ -10,26 +10,7 @@
     srgb_decode3, purkinje_shift,
 }
 
-struct MathCheckParams {
-    count: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> params: MathCheckParams;
-@group(0) @binding(1) var<storage, read> inputs: array<f32>;
-@group(0) @binding(2) var<storage, read_write> outputs: array<f32>;
-
-fn in_vec3(i: u32) -> vec3<f32> {
-    return vec3<f32>(inputs[i], inputs[i + 1u], inputs[i + 2u]);
-}
-
-fn out_vec3(i: u32, v: vec3<f32>) {
-    outputs[i] = v.x;
-    outputs[i + 1u] = v.y;
-    outputs[i + 2u] = v.z;
-}
+#import hikari::math_check_io::{params, inputs, outputs, in_vec3, out_vec3}
 
 // In: linear x (1), encoded e (1), colour (3).
 // Out: srgb_encode(x), srgb_decode(e), srgb_encode3(colour) (3), srgb_decode3(colour) (3),

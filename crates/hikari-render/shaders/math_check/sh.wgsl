@@ -12,20 +12,7 @@
     sh_dering_strength_rgb, sh_dering_l2_rgb, sh_linear_max_dir_rgb, sh_directionality_boost_rgb,
 }
 
-struct MathCheckParams {
-    count: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> params: MathCheckParams;
-@group(0) @binding(1) var<storage, read> inputs: array<f32>;
-@group(0) @binding(2) var<storage, read_write> outputs: array<f32>;
-
-fn in_vec3(i: u32) -> vec3<f32> {
-    return vec3<f32>(inputs[i], inputs[i + 1u], inputs[i + 2u]);
-}
+#import hikari::math_check_io::{params, inputs, outputs, in_vec3, out_vec3}
 
 fn in_l2(i: u32) -> ShL2 {
     var s: ShL2;
@@ -41,12 +28,6 @@ fn in_l2_rgb(i: u32) -> ShL2Rgb {
         s.c[k] = in_vec3(i + 3u * k);
     }
     return s;
-}
-
-fn out_vec3(i: u32, v: vec3<f32>) {
-    outputs[i] = v.x;
-    outputs[i + 1u] = v.y;
-    outputs[i + 2u] = v.z;
 }
 
 fn out_vec4(i: u32, v: vec4<f32>) {

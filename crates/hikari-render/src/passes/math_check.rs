@@ -21,9 +21,9 @@ use crate::shader::ShaderLibrary;
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct MathCheckParams {
     pub count: u32,
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
+    pub pad_a: u32,
+    pub pad_b: u32,
+    pub pad_c: u32,
 }
 
 /// One verification kernel: its shader entry point and the sizes of its records.
