@@ -242,23 +242,29 @@ fn limits_and_dump_names_are_checked() {
     assert_eq!(r.image("d.a").unwrap().pixel(7, 7), [0.5, 0.5, 0.5, 1.0]);
 }
 
+/// A frame of two passes, `n.first` and `n.second`, both filling one texture.
+fn two_fills(
+    ctx: &hikari_render::GpuContext,
+    check: &GraphCheck,
+    rt: &mut GraphRuntime,
+) -> hikari_render::graph::FrameResult {
+    let mut g = rt.begin_frame(ctx);
+    let a = g.texture("n.a", TextureDesc::d2(8, 8, F16)).unwrap();
+    for (name, v) in [("n.first", 1.0), ("n.second", 2.0)] {
+        g.pass(name)
+            .write(a)
+            .constants(&fill(v))
+            .dispatch_threads(&check.fill, [8, 8, 1])
+            .unwrap();
+    }
+    g.execute().unwrap()
+}
+
 #[test]
 fn every_pass_gets_a_timing_row_under_its_name() {
     let Some((ctx, check)) = setup() else { return };
     let mut rt = GraphRuntime::new();
-    let mut g = rt.begin_frame(&ctx);
-    let a = g.texture("n.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    g.pass("n.first")
-        .write(a)
-        .constants(&fill(1.0))
-        .dispatch_threads(&check.fill, [8, 8, 1])
-        .unwrap();
-    g.pass("n.second")
-        .write(a)
-        .constants(&fill(2.0))
-        .dispatch_threads(&check.fill, [8, 8, 1])
-        .unwrap();
-    let r = g.execute().unwrap();
+    let r = two_fills(&ctx, &check, &mut rt);
     let names: Vec<&str> = r.timings.iter().map(|t| t.name.as_str()).collect();
     assert_eq!(names, ["n.first", "n.second"]);
     if ctx.has(wgpu::Features::TIMESTAMP_QUERY) {
@@ -272,19 +278,7 @@ fn every_pass_gets_a_timing_row_under_its_name() {
 
     // Frame mode: one span, no per-pass numbers.
     rt.set_timestamps(TimestampMode::Frame);
-    let mut g = rt.begin_frame(&ctx);
-    let a = g.texture("n.a", TextureDesc::d2(8, 8, F16)).unwrap();
-    g.pass("n.first")
-        .write(a)
-        .constants(&fill(1.0))
-        .dispatch_threads(&check.fill, [8, 8, 1])
-        .unwrap();
-    g.pass("n.second")
-        .write(a)
-        .constants(&fill(2.0))
-        .dispatch_threads(&check.fill, [8, 8, 1])
-        .unwrap();
-    let r = g.execute().unwrap();
+    let r = two_fills(&ctx, &check, &mut rt);
     assert!(r.timings.iter().all(|t| t.gpu_ms.is_none()));
     assert_eq!(
         r.gpu_span_ms.is_some(),
