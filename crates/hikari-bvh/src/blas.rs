@@ -1,6 +1,7 @@
 //! Bottom-level acceleration structure: one mesh, object space.
 
 use crate::aabb::Aabb;
+use crate::build_sah::parallel::{map_dynamic, ranges, split_ranges};
 use crate::build_sah::{self, PrimRef, SahParams};
 use crate::error::BvhError;
 use crate::layout::{Hit, Ray, TriangleRecord, WideNode};
@@ -59,7 +60,7 @@ pub struct BuildTimings {
     pub binary: std::time::Duration,
     /// Collapse to the wide layout and quantization.
     pub collapse: std::time::Duration,
-    /// Triangle records in leaf order.
+    /// Triangle records in leaf order, and the copy of the index buffer kept for refit.
     pub triangles: std::time::Duration,
 }
 
@@ -119,87 +120,40 @@ impl Blas {
             ..Default::default()
         };
         let t_validate = std::time::Instant::now();
-        let mut prims = Vec::with_capacity(indices.len());
-        for (t, tri) in indices.iter().enumerate() {
-            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= positions.len()) {
-                if options.invalid == BadTriangle::Reject {
-                    return Err(BvhError::IndexOutOfRange {
-                        mesh: name.into(),
-                        triangle: t,
-                        index: bad,
-                        vertex_count: positions.len(),
-                    });
-                }
-                stats.skipped_bad_index += 1;
-                continue;
-            }
-            let v = tri.map(|i| Vec3A::from(positions[i as usize]));
-            if let Some(k) = (0..3).find(|&k| !v[k].is_finite()) {
-                if options.invalid == BadTriangle::Reject {
-                    return Err(BvhError::NonFiniteVertex {
-                        mesh: name.into(),
-                        triangle: t,
-                        vertex: tri[k],
-                        value: v[k].into(),
-                    });
-                }
-                stats.skipped_non_finite += 1;
-                continue;
-            }
-            if is_degenerate(v[0], v[1], v[2]) {
-                if options.degenerate == BadTriangle::Reject {
-                    return Err(BvhError::DegenerateTriangle {
-                        mesh: name.into(),
-                        triangle: t,
-                    });
-                }
-                stats.skipped_degenerate += 1;
-                continue;
-            }
-            let b = Aabb::new(v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
-            prims.push(PrimRef::new(&b, t as u32));
-        }
-        if prims.is_empty() {
-            return Err(BvhError::NoValidTriangles {
-                mesh: name.into(),
-                total: indices.len(),
-                degenerate: stats.skipped_degenerate,
-                non_finite: stats.skipped_non_finite,
-                out_of_range: stats.skipped_bad_index,
-            });
-        }
+        let threads = thread_count(options.threads);
+        let prims = prim_refs(name, positions, indices, options, threads, &mut stats)?;
         let max_leaf = options.max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
         stats.timings.validate = t_validate.elapsed();
         let t_binary = std::time::Instant::now();
-        let binary = build_sah::build(
-            prims,
-            &SahParams {
-                max_leaf,
-                threads: thread_count(options.threads),
-            },
-        );
+        let binary = build_sah::build(prims, &SahParams { max_leaf, threads });
         stats.timings.binary = t_binary.elapsed();
         let t_collapse = std::time::Instant::now();
         let bounds = binary.nodes[0].bounds;
-        let wide = wide::collapse(&binary, max_leaf, thread_count(options.threads));
+        let wide = wide::collapse(&binary, max_leaf, threads);
         stats.timings.collapse = t_collapse.elapsed();
         let t_triangles = std::time::Instant::now();
-        let triangles: Vec<TriangleRecord> = wide
-            .leaf_prims
-            .iter()
-            .map(|&p| {
+        let mut triangles: Vec<TriangleRecord> = bytemuck::zeroed_vec(wide.leaf_prims.len());
+        let pieces = ranges(triangles.len(), threads, CHUNK);
+        let work: Vec<_> = split_ranges(&mut triangles, &pieces)
+            .into_iter()
+            .zip(&pieces)
+            .collect();
+        map_dynamic(threads, work, |(out, r)| {
+            for (rec, &p) in out.iter_mut().zip(&wide.leaf_prims[r.clone()]) {
                 let id = binary.prims[p as usize].id();
                 let tri = indices[id as usize];
-                TriangleRecord {
+                *rec = TriangleRecord {
                     v0: positions[tri[0] as usize].into(),
                     primitive: id,
                     v1: positions[tri[1] as usize].into(),
                     _pad1: 0,
                     v2: positions[tri[2] as usize].into(),
                     _pad2: 0,
-                }
-            })
-            .collect();
+                };
+            }
+        });
+        // The index buffer is kept for refit.
+        let kept_indices = copy_parallel(indices, threads);
         stats.timings.triangles = t_triangles.elapsed();
         stats.triangles = triangles.len();
         stats.nodes = wide.nodes.len();
@@ -208,7 +162,7 @@ impl Blas {
             name: name.into(),
             nodes: wide.nodes,
             triangles,
-            indices: indices.to_vec(),
+            indices: kept_indices,
             vertex_count: positions.len(),
             bounds,
             stats,
@@ -239,6 +193,110 @@ impl Blas {
     pub fn occluded_with(&self, ray: &Ray, stack: &mut Stack) -> bool {
         crate::traverse::any_hit_blas(&self.nodes, &self.triangles, ray, stack)
     }
+}
+
+/// Triangles per piece of the parallel passes over the mesh.
+const CHUNK: usize = 16 * 1024;
+
+/// Validates every triangle and returns the boxes of those kept, in triangle order; counts the
+/// skipped ones in `stats`. Pieces of the index buffer are checked in parallel; with several
+/// bad triangles, the error names the first, as a serial pass would.
+fn prim_refs(
+    name: &str,
+    positions: &[Vec3],
+    indices: &[[u32; 3]],
+    options: &BuildOptions,
+    threads: usize,
+    stats: &mut BlasStats,
+) -> Result<Vec<PrimRef>, BvhError> {
+    let mut prims: Vec<PrimRef> = bytemuck::zeroed_vec(indices.len());
+    let pieces = ranges(indices.len(), threads, CHUNK);
+    let work: Vec<_> = split_ranges(&mut prims, &pieces)
+        .into_iter()
+        .zip(&pieces)
+        .collect();
+    // Each piece writes the boxes it keeps to the front of its own range.
+    let results = map_dynamic(threads, work, |(out, r)| {
+        let mut kept = 0;
+        let mut skipped = BlasStats::default();
+        for (t, tri) in indices[r.clone()].iter().enumerate() {
+            let t = r.start + t;
+            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= positions.len()) {
+                if options.invalid == BadTriangle::Reject {
+                    return Err(BvhError::IndexOutOfRange {
+                        mesh: name.into(),
+                        triangle: t,
+                        index: bad,
+                        vertex_count: positions.len(),
+                    });
+                }
+                skipped.skipped_bad_index += 1;
+                continue;
+            }
+            let v = tri.map(|i| Vec3A::from(positions[i as usize]));
+            if let Some(k) = (0..3).find(|&k| !v[k].is_finite()) {
+                if options.invalid == BadTriangle::Reject {
+                    return Err(BvhError::NonFiniteVertex {
+                        mesh: name.into(),
+                        triangle: t,
+                        vertex: tri[k],
+                        value: v[k].into(),
+                    });
+                }
+                skipped.skipped_non_finite += 1;
+                continue;
+            }
+            if is_degenerate(v[0], v[1], v[2]) {
+                if options.degenerate == BadTriangle::Reject {
+                    return Err(BvhError::DegenerateTriangle {
+                        mesh: name.into(),
+                        triangle: t,
+                    });
+                }
+                skipped.skipped_degenerate += 1;
+                continue;
+            }
+            let b = Aabb::new(v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
+            out[kept] = PrimRef::new(&b, t as u32);
+            kept += 1;
+        }
+        Ok((kept, skipped))
+    });
+    let mut end = 0;
+    for (r, result) in pieces.iter().zip(results) {
+        // Pieces are in triangle order, so the first error met is the first bad triangle.
+        let (kept, skipped) = result?;
+        stats.skipped_bad_index += skipped.skipped_bad_index;
+        stats.skipped_non_finite += skipped.skipped_non_finite;
+        stats.skipped_degenerate += skipped.skipped_degenerate;
+        if end != r.start {
+            prims.copy_within(r.start..r.start + kept, end);
+        }
+        end += kept;
+    }
+    prims.truncate(end);
+    if prims.is_empty() {
+        return Err(BvhError::NoValidTriangles {
+            mesh: name.into(),
+            total: indices.len(),
+            degenerate: stats.skipped_degenerate,
+            non_finite: stats.skipped_non_finite,
+            out_of_range: stats.skipped_bad_index,
+        });
+    }
+    Ok(prims)
+}
+
+/// `data.to_vec()` in parallel pieces: the index buffer of a large mesh is tens of megabytes.
+fn copy_parallel<T: bytemuck::Pod + Send + Sync>(data: &[T], threads: usize) -> Vec<T> {
+    let mut out: Vec<T> = bytemuck::zeroed_vec(data.len());
+    let pieces = ranges(data.len(), threads, 4 * CHUNK);
+    let work: Vec<_> = split_ranges(&mut out, &pieces)
+        .into_iter()
+        .zip(&pieces)
+        .collect();
+    map_dynamic(threads, work, |(o, r)| o.copy_from_slice(&data[r.clone()]));
+    out
 }
 
 impl Blas {

@@ -1,12 +1,22 @@
 //! Binary BVH over primitive boxes by binned SAH, the first stage of every build (BLAS and TLAS).
 //!
-//! Primitives travel as 32-byte [`PrimRef`]s (box plus id) that the partition moves in place, so
-//! every pass over a node reads memory sequentially. The top of the tree is built on one thread
-//! until enough independent subtrees exist; those are then built on scoped threads into their own
-//! node arrays and stitched in a fixed order, so the result is identical for any thread count.
+//! Primitives travel as 32-byte [`PrimRef`]s that every split reorders with a stable partition
+//! (left side first, each side in its previous order), so every pass over a node reads memory
+//! sequentially. A large build runs in two parallel phases: the top levels are split level by
+//! level with every thread binning and scattering a share of every node's primitives
+//! ([`top_levels`]), then the remaining subtrees are built one per task into node ranges reserved
+//! for them. Bins merge exactly (minima, maxima, counts) and a stable partition does not depend
+//! on who moved which primitive, so the tree is identical for any thread count.
+
+mod bins;
+pub(crate) mod parallel;
+mod top_levels;
 
 use crate::aabb::Aabb;
+use bins::Bins;
 use glam::{Vec3A, Vec4};
+use parallel::{map_dynamic, map_largest_first, ranges, split_ranges};
+use top_levels::Subtree;
 
 /// Tag that makes an id (< `MAX_PRIMS`) a normal float between 2 and 2^65.
 const ID_TAG: u32 = 0x4000_0000;
@@ -20,13 +30,13 @@ const BINS: usize = 16;
 const MEDIAN_SPLIT_DEPTH: u32 = 40;
 /// Nodes up to this size use an exact sweep instead of bins.
 const SMALL_NODE: usize = 12;
-/// Subtrees smaller than this are never handed to another thread.
+/// Nodes smaller than this are never split by several threads together.
 const MIN_PARALLEL_PRIMS: usize = 16 * 1024;
 
 /// A primitive's box; `lo.w` holds the primitive id as the bits of a normal float (`ID_TAG | id`):
 /// the SIMD box arithmetic also runs on the w lane, and a raw small integer there would be a
 /// denormal, which costs a microcode assist on every operation.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct PrimRef {
     pub lo: Vec4,
@@ -67,7 +77,13 @@ pub struct BinNode {
     pub first: u32,
     /// Number of primitives of a leaf; 0 for an internal node.
     pub count: u32,
+    /// Number of primitives in the subtree.
+    pub prims: u32,
 }
+
+// SAFETY: every field is an f32 or u32 (through `Aabb`'s `Vec3A`s), for which all-zero bits are
+// a valid value; the padding after `prims` needs no value.
+unsafe impl bytemuck::Zeroable for BinNode {}
 
 impl BinNode {
     #[inline]
@@ -77,6 +93,8 @@ impl BinNode {
 }
 
 pub struct BinaryBvh {
+    /// Root at index 0, siblings next to each other. A parallel build leaves unused entries
+    /// between subtrees: walk the tree from the root rather than the array.
     pub nodes: Vec<BinNode>,
     /// Primitives in leaf order.
     pub prims: Vec<PrimRef>,
@@ -111,167 +129,155 @@ struct Split {
 /// Builds a binary BVH. `prims` must be non-empty.
 pub fn build(mut prims: Vec<PrimRef>, params: &SahParams) -> BinaryBvh {
     assert!(!prims.is_empty());
-    let mut bounds = Aabb::EMPTY;
-    let mut cbounds = Aabb::EMPTY;
-    for p in &prims {
-        bounds.grow(&Aabb::new(p.lo3(), p.hi3()));
-        cbounds.grow_point(p.c2());
-    }
-    // A binary tree over n primitives has at most 2n - 1 nodes.
-    let mut nodes = Vec::with_capacity(2 * prims.len());
-    nodes.push(BinNode {
-        bounds,
-        first: 0,
-        count: 0,
-    });
+    let n = prims.len();
+    let threads = params.threads.max(1);
+    let (bounds, cbounds) = root_bounds(&prims, threads);
     let root = Task {
         node: 0,
         begin: 0,
-        end: prims.len(),
+        end: n,
         cbounds,
         depth: 0,
     };
-    let threads = params.threads.max(1);
-    if threads == 1 || prims.len() < 2 * MIN_PARALLEL_PRIMS {
-        build_tasks(&mut prims, 0, &mut nodes, vec![root], params, None);
-        return BinaryBvh { nodes, prims };
-    }
+    let mut top = vec![BinNode {
+        bounds,
+        first: 0,
+        count: 0,
+        prims: n as u32,
+    }];
+    // Stable partitions move one side through this buffer; the parallel top levels move whole
+    // nodes back and forth between it and `prims`.
+    let mut scratch: Vec<PrimRef> = bytemuck::zeroed_vec(n);
+    let mut subtrees = if threads > 1 && n >= 2 * MIN_PARALLEL_PRIMS {
+        // Small enough subtrees that a thread that draws a large one last does not hold up the
+        // others for long; the level-parallel top costs a few barriers per level.
+        let threshold = (n / (threads * 8)).max(MIN_PARALLEL_PRIMS);
+        top_levels::split(&mut prims, &mut scratch, root, &mut top, threshold, threads)
+    } else {
+        vec![Subtree {
+            task: root,
+            in_scratch: false,
+        }]
+    };
+    subtrees.sort_by_key(|s| s.task.begin);
 
-    // Split the top sequentially until there are several subtrees per thread, so the threads
-    // stay busy even when SAH splits are uneven.
-    let threshold = (prims.len() / (threads * 4)).max(MIN_PARALLEL_PRIMS);
-    let mut deferred = Vec::new();
-    build_tasks(
-        &mut prims,
-        0,
-        &mut nodes,
-        vec![root],
-        params,
-        Some((threshold, &mut deferred)),
+    // Each subtree of m primitives gets at most 2m - 2 nodes below its root (which already
+    // sits in `top`), in a range of its own: subtrees fill them independently, and the unused
+    // tails are never referenced (zeroed pages that are never touched cost no memory).
+    let mut reserve = Vec::with_capacity(subtrees.len());
+    let mut total = top.len();
+    for s in &subtrees {
+        let m = s.task.end - s.task.begin;
+        reserve.push(total..total + 2 * m.max(1) - 2);
+        total += 2 * m.max(1) - 2;
+    }
+    let mut nodes: Vec<BinNode> = bytemuck::zeroed_vec(total);
+    nodes[..top.len()].copy_from_slice(&top);
+    let prim_ranges: Vec<_> = subtrees.iter().map(|s| s.task.begin..s.task.end).collect();
+    let jobs: Vec<_> = split_ranges(&mut nodes, &reserve)
+        .into_iter()
+        .zip(split_ranges(&mut prims, &prim_ranges))
+        .zip(split_ranges(&mut scratch, &prim_ranges))
+        .zip(subtrees.iter().zip(&reserve))
+        .map(|(((arena, prims), scratch), (s, r))| (s, r.start, arena, prims, scratch))
+        .collect();
+    let roots = map_largest_first(
+        threads,
+        jobs,
+        |job| job.3.len(),
+        |(s, base, arena, prims, scratch)| {
+            if s.in_scratch {
+                prims.copy_from_slice(scratch);
+            }
+            let mut arena = Arena {
+                root: top[s.task.node as usize],
+                root_index: s.task.node,
+                nodes: arena,
+                base: base as u32,
+                used: 0,
+            };
+            let local = Task {
+                begin: 0,
+                end: prims.len(),
+                ..s.task
+            };
+            build_tasks(prims, scratch, s.task.begin, &mut arena, local, params);
+            (arena.root, arena.used)
+        },
     );
-    deferred.sort_by_key(|t: &Task| t.begin);
-
-    // Hand out disjoint slices of the primitive array, one per deferred subtree.
-    let mut slices: Vec<(Task, &mut [PrimRef])> = Vec::with_capacity(deferred.len());
-    let mut rest: &mut [PrimRef] = &mut prims;
-    let mut consumed = 0;
-    for t in &deferred {
-        let (_, tail) = rest.split_at_mut(t.begin - consumed);
-        let (mine, tail) = tail.split_at_mut(t.end - t.begin);
-        slices.push((*t, mine));
-        rest = tail;
-        consumed = t.end;
+    let mut used_end = top.len();
+    for ((s, r), (root, used)) in subtrees.iter().zip(&reserve).zip(roots) {
+        nodes[s.task.node as usize] = root;
+        used_end = used_end.max(r.start + used);
     }
-    // Largest subtrees first, each to the least loaded thread: a fixed assignment, so the
-    // work split (though not the result, which never depends on it) is reproducible too.
-    let mut order: Vec<usize> = (0..slices.len()).collect();
-    order.sort_by_key(|&i| std::cmp::Reverse(slices[i].1.len()));
-    let mut groups: Vec<(usize, Vec<usize>)> = (0..threads).map(|_| (0, Vec::new())).collect();
-    for i in order {
-        let g = groups.iter_mut().min_by_key(|g| g.0).unwrap();
-        g.0 += slices[i].1.len();
-        g.1.push(i);
-    }
-    let mut work: Vec<Vec<(usize, Task, &mut [PrimRef])>> = Vec::new();
-    let mut taken: Vec<Option<(Task, &mut [PrimRef])>> = slices.into_iter().map(Some).collect();
-    for (_, members) in &groups {
-        work.push(
-            members
-                .iter()
-                .map(|&i| {
-                    let (t, s) = taken[i].take().unwrap();
-                    (i, t, s)
-                })
-                .collect(),
-        );
-    }
-    let top: &[BinNode] = &nodes;
-    let mut results: Vec<(usize, Vec<BinNode>)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = work
-            .into_iter()
-            .map(|jobs| {
-                scope.spawn(move || {
-                    jobs.into_iter()
-                        .map(|(i, task, slice)| (i, build_subtree(slice, task, top, params)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("BVH build thread panicked"))
-            .collect()
-    });
-    results.sort_by_key(|r| r.0);
-    for (task, (_, sub)) in deferred.iter().zip(results) {
-        stitch(&mut nodes, task.node, sub);
-    }
+    // The serial path has one subtree: drop its unused tail. With several, gaps remain between
+    // their ranges.
+    nodes.truncate(used_end);
     BinaryBvh { nodes, prims }
 }
 
-/// Builds one deferred subtree into its own array, root at index 0, primitive indices global.
-fn build_subtree(
-    slice: &mut [PrimRef],
-    task: Task,
-    top: &[BinNode],
-    params: &SahParams,
-) -> Vec<BinNode> {
-    let mut nodes = Vec::with_capacity(slice.len() * 2 / params.max_leaf.max(1) + 8);
-    nodes.push(top[task.node as usize]);
-    let local = Task {
-        node: 0,
-        begin: 0,
-        end: slice.len(),
-        ..task
-    };
-    build_tasks(slice, task.begin, &mut nodes, vec![local], params, None);
-    nodes
-}
-
-/// Appends a subtree built with its root at local index 0, replacing the placeholder `at`.
-fn stitch(nodes: &mut Vec<BinNode>, at: u32, sub: Vec<BinNode>) {
-    // Local index i >= 1 moves to base + i - 1.
-    fn remap(n: &BinNode, base: u32) -> BinNode {
-        let mut n = *n;
-        if !n.is_leaf() {
-            n.first = base + n.first - 1;
-        }
-        n
+/// Box of all primitives and box of their doubled centroids.
+fn root_bounds(prims: &[PrimRef], threads: usize) -> (Aabb, Aabb) {
+    let pieces = ranges(prims.len(), threads, MIN_PARALLEL_PRIMS);
+    let parts = map_dynamic(threads, pieces, |r| side_bounds(&prims[r]));
+    let mut b = Aabb::EMPTY;
+    let mut c = Aabb::EMPTY;
+    for (pb, pc) in parts {
+        b.grow(&pb);
+        c.grow(&pc);
     }
-    let base = nodes.len() as u32;
-    nodes[at as usize] = remap(&sub[0], base);
-    nodes.extend(sub[1..].iter().map(|n| remap(n, base)));
+    (b, c)
 }
 
+/// Where the nodes of one subtree go: its root (kept aside, as it lives in the top part of the
+/// node array) and the range reserved for everything below it, filled from the front.
+struct Arena<'a> {
+    root: BinNode,
+    root_index: u32,
+    nodes: &'a mut [BinNode],
+    /// Global index of `nodes[0]`.
+    base: u32,
+    used: usize,
+}
+
+impl Arena<'_> {
+    #[inline]
+    fn get_mut(&mut self, i: u32) -> &mut BinNode {
+        if i == self.root_index {
+            &mut self.root
+        } else {
+            &mut self.nodes[(i - self.base) as usize]
+        }
+    }
+
+    /// Appends two siblings; returns the global index of the first.
+    #[inline]
+    fn push_pair(&mut self, pair: [BinNode; 2]) -> u32 {
+        self.nodes[self.used..self.used + 2].copy_from_slice(&pair);
+        self.used += 2;
+        self.base + self.used as u32 - 2
+    }
+}
+
+/// Builds the subtree below `root` (whose range is all of `prims`); `scratch` is as long as
+/// `prims`, and `prim_offset` is the global index of `prims[0]`.
 fn build_tasks(
     prims: &mut [PrimRef],
+    scratch: &mut [PrimRef],
     prim_offset: usize,
-    nodes: &mut Vec<BinNode>,
-    mut stack: Vec<Task>,
+    nodes: &mut Arena,
+    root: Task,
     params: &SahParams,
-    mut defer: Option<(usize, &mut Vec<Task>)>,
 ) {
+    let mut stack = vec![root];
     while let Some(task) = stack.pop() {
         let n = task.end - task.begin;
-        if let Some((threshold, deferred)) = defer.as_mut()
-            && n <= *threshold
-        {
-            deferred.push(Task {
-                begin: task.begin + prim_offset,
-                end: task.end + prim_offset,
-                ..task
-            });
-            continue;
-        }
-        let make_leaf = |nodes: &mut Vec<BinNode>| {
-            let node = &mut nodes[task.node as usize];
-            node.first = (task.begin + prim_offset) as u32;
-            node.count = n as u32;
-        };
         // The wide collapse turns every subtree of at most `max_leaf` primitives into one leaf
         // child anyway, so splitting it here would only cost time.
         if n <= params.max_leaf.max(1) {
-            make_leaf(nodes);
+            let node = nodes.get_mut(task.node);
+            node.first = (task.begin + prim_offset) as u32;
+            node.count = n as u32;
             continue;
         }
         let range = &mut prims[task.begin..task.end];
@@ -295,7 +301,8 @@ fn build_tasks(
         };
         let (mid, left_box, right_box, left_cb, right_cb) = match split {
             Some(s) => {
-                let (mid, lcb, rcb) = partition(range, &task.cbounds, &s);
+                let (mid, lcb, rcb) =
+                    partition(range, &mut scratch[task.begin..task.end], &task.cbounds, &s);
                 (mid, s.left, s.right, lcb, rcb)
             }
             None => median_split(range, &task.cbounds),
@@ -312,22 +319,24 @@ fn build_tasks(
 }
 
 fn push_children(
-    nodes: &mut Vec<BinNode>,
+    nodes: &mut Arena,
     stack: &mut Vec<Task>,
     task: &Task,
     split_at: usize,
     boxes: [Aabb; 2],
     cbounds: [Aabb; 2],
 ) {
-    let left = nodes.len() as u32;
-    for b in boxes {
-        nodes.push(BinNode {
-            bounds: b,
-            first: 0,
-            count: 0,
-        });
-    }
-    let node = &mut nodes[task.node as usize];
+    let child = |bounds, prims: usize| BinNode {
+        bounds,
+        first: 0,
+        count: 0,
+        prims: prims as u32,
+    };
+    let left = nodes.push_pair([
+        child(boxes[0], split_at - task.begin),
+        child(boxes[1], task.end - split_at),
+    ]);
+    let node = nodes.get_mut(task.node);
     node.first = left;
     node.count = 0;
     // Right first so the left subtree is built (and laid out) next.
@@ -480,128 +489,47 @@ fn find_split(prims: &[PrimRef], cb: &Aabb) -> Option<Split> {
 }
 
 fn find_split_n<const NB: usize>(prims: &[PrimRef], cb: &Aabb) -> Option<Split> {
-    let nb = NB;
-    let k = bin_scale(cb, nb);
+    let k = bin_scale(cb, NB);
     if k.cmpeq(Vec3A::ZERO).all() {
         return None;
     }
-    // Two interleaved sets of bins: neighbouring primitives usually fall into the same bin, and
-    // with one set every update would wait on the store of the previous one.
-    let mut lo = [[[Vec3A::INFINITY; NB]; 3]; 2];
-    let mut hi = [[[Vec3A::NEG_INFINITY; NB]; 3]; 2];
-    let mut count = [[[0u32; NB]; 3]; 2];
-    let mut pairs = prims.chunks_exact(2);
-    for pair in &mut pairs {
-        for (set, p) in pair.iter().enumerate() {
-            let l = p.lo3();
-            let h = p.hi3();
-            let b = bin_index(l + h, cb.min, k, nb);
-            for a in 0..3 {
-                lo[set][a][b[a]] = lo[set][a][b[a]].min(l);
-                hi[set][a][b[a]] = hi[set][a][b[a]].max(h);
-                count[set][a][b[a]] += 1;
-            }
-        }
-    }
-    for p in pairs.remainder() {
-        let l = p.lo3();
-        let h = p.hi3();
-        let b = bin_index(l + h, cb.min, k, nb);
-        for a in 0..3 {
-            lo[0][a][b[a]] = lo[0][a][b[a]].min(l);
-            hi[0][a][b[a]] = hi[0][a][b[a]].max(h);
-            count[0][a][b[a]] += 1;
-        }
-    }
-    let [mut lo, lo1] = lo;
-    let [mut hi, hi1] = hi;
-    let [mut count, count1] = count;
-    for a in 0..3 {
-        for i in 0..nb {
-            lo[a][i] = lo[a][i].min(lo1[a][i]);
-            hi[a][i] = hi[a][i].max(hi1[a][i]);
-            count[a][i] += count1[a][i];
-        }
-    }
-    let mut best: Option<(f32, usize, usize)> = None;
-    for a in 0..3 {
-        if k[a] == 0.0 {
-            continue;
-        }
-        // Right-to-left sweep: cost of the right side of each split plane.
-        let mut right_cost = [0.0f32; NB];
-        let mut l = Vec3A::INFINITY;
-        let mut h = Vec3A::NEG_INFINITY;
-        let mut cnt = 0;
-        for i in (1..nb).rev() {
-            cnt += count[a][i];
-            if cnt > 0 {
-                l = l.min(lo[a][i]);
-                h = h.max(hi[a][i]);
-                right_cost[i] = half_area(l, h) * cnt as f32;
-            }
-        }
-        let mut l = Vec3A::INFINITY;
-        let mut h = Vec3A::NEG_INFINITY;
-        let mut cnt = 0;
-        for i in 0..nb - 1 {
-            cnt += count[a][i];
-            if cnt == 0 {
-                continue;
-            }
-            l = l.min(lo[a][i]);
-            h = h.max(hi[a][i]);
-            if cnt as usize == prims.len() {
-                break;
-            }
-            let cost = half_area(l, h) * cnt as f32 + right_cost[i + 1];
-            if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, a, i));
-            }
-        }
-    }
-    let (_, axis, bin) = best?;
-    let mut left = Aabb::EMPTY;
-    let mut right = Aabb::EMPTY;
-    for i in 0..nb {
-        if count[axis][i] == 0 {
-            continue;
-        }
-        let side = if i <= bin { &mut left } else { &mut right };
-        side.grow(&Aabb::new(lo[axis][i], hi[axis][i]));
-    }
-    Some(Split {
-        axis,
-        bin,
-        bins: nb,
-        left,
-        right,
-    })
+    Bins::<NB>::accumulate(prims, cb.min, k).best_split(k, prims.len())
 }
 
-/// Moves primitives whose centroid bin is `<= bin` to the front; returns the split point and
-/// the centroid boxes of both sides.
-fn partition(prims: &mut [PrimRef], cb: &Aabb, s: &Split) -> (usize, Aabb, Aabb) {
+/// Stable partition: primitives whose centroid bin is `<= bin` first, each side in its previous
+/// order (the parallel top levels produce exactly this order). Returns the split point and the
+/// doubled-centroid boxes of both sides. `scratch` is as long as `prims`.
+fn partition(
+    prims: &mut [PrimRef],
+    scratch: &mut [PrimRef],
+    cb: &Aabb,
+    s: &Split,
+) -> (usize, Aabb, Aabb) {
     let (axis, bin, bins) = (s.axis, s.bin, s.bins);
     let k = bin_scale(cb, bins);
     let (mut lmin, mut lmax) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
     let (mut rmin, mut rmax) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-    // Branch-free Lomuto: a side decision per primitive is a coin flip for the branch
-    // predictor, so swap unconditionally and advance the boundary by the decision instead.
+    // Branch-free: a side decision per primitive is a coin flip for the branch predictor, so
+    // every primitive is written to both places and only the cursor of its side advances. Left
+    // ones compact in place (the write cursor never passes the read cursor), right ones wait in
+    // `scratch`.
     let mut l = 0;
+    let mut r = 0;
     for i in 0..prims.len() {
         let p = prims[i];
         let c2 = p.c2();
         let left = bin_index(c2, cb.min, k, bins)[axis] <= bin;
-        prims[i] = prims[l];
         prims[l] = p;
+        scratch[r] = p;
         l += left as usize;
+        r += !left as usize;
         let m = glam::BVec3A::splat(left);
         lmin = lmin.min(Vec3A::select(m, c2, Vec3A::INFINITY));
         lmax = lmax.max(Vec3A::select(m, c2, Vec3A::NEG_INFINITY));
         rmin = rmin.min(Vec3A::select(m, Vec3A::INFINITY, c2));
         rmax = rmax.max(Vec3A::select(m, Vec3A::NEG_INFINITY, c2));
     }
+    prims[l..].copy_from_slice(&scratch[..r]);
     (l, Aabb::new(lmin, lmax), Aabb::new(rmin, rmax))
 }
 

@@ -3,6 +3,7 @@
 
 use crate::aabb::Aabb;
 use crate::build_sah::BinaryBvh;
+use crate::build_sah::parallel::{map_dynamic, map_largest_first, split_ranges};
 use crate::layout::{META_INTERNAL, WIDTH, WideNode, leaf_meta};
 use glam::Vec3A;
 
@@ -25,27 +26,16 @@ type Pending = (u32, u32, u32);
 
 pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
     let max_leaf = max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
-    let bn = &bin.nodes;
-    // Subtree primitive counts; children always follow their parent in the binary array.
-    let mut counts = vec![0u32; bn.len()];
-    for i in (0..bn.len()).rev() {
-        let n = &bn[i];
-        counts[i] = if n.is_leaf() {
-            n.count
-        } else {
-            counts[n.first as usize] + counts[n.first as usize + 1]
-        };
-    }
-    let counts = &counts;
-
     let mut nodes = vec![WideNode::default()];
-    let mut leaf_prims = Vec::with_capacity(bin.prims.len());
+    let mut leaf_prims = Vec::new();
     let mut jobs = Vec::new();
     // Small trees are not worth splitting into jobs (nor spawning threads for).
-    let split_into_jobs = counts[0] > 2 * JOB_PRIMS;
+    let split_into_jobs = bin.nodes[0].prims > 2 * JOB_PRIMS;
+    if !split_into_jobs {
+        leaf_prims.reserve(bin.prims.len());
+    }
     let mut depth = emit(
         bin,
-        counts,
         max_leaf,
         vec![(0, 0, 1)],
         &mut nodes,
@@ -61,53 +51,62 @@ pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
     }
 
     // Each job collapses into its own arrays with its root at local index 0.
-    let run = |job: &Pending| {
-        let mut n = vec![WideNode::default()];
-        let mut p = Vec::new();
-        let d = emit(
-            bin,
-            counts,
-            max_leaf,
-            vec![(job.0, 0, job.2)],
-            &mut n,
-            &mut p,
-            None,
-        );
-        (n, p, d)
-    };
-    let threads = threads.clamp(1, jobs.len());
-    let results: Vec<(Vec<WideNode>, Vec<u32>, u32)> = if threads == 1 {
-        jobs.iter().map(run).collect()
-    } else {
-        let per = jobs.len().div_ceil(threads);
-        std::thread::scope(|scope| {
-            let handles: Vec<_> = jobs
-                .chunks(per)
-                .map(|chunk| scope.spawn(|| chunk.iter().map(run).collect::<Vec<_>>()))
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().expect("BVH collapse thread panicked"))
-                .collect()
-        })
-    };
-    for (job, (sub_nodes, sub_prims, sub_depth)) in jobs.iter().zip(results) {
-        depth = depth.max(sub_depth);
-        // Local node i >= 1 moves to node_base + i - 1; the local root replaces the placeholder.
-        let node_base = nodes.len() as u32;
-        let prim_base = leaf_prims.len() as u32;
-        let remap = |mut n: WideNode| {
-            n.child_base = node_base + n.child_base - 1;
-            n.prim_base += prim_base;
-            n
-        };
-        nodes[job.1 as usize] = remap(sub_nodes[0]);
-        nodes.extend(sub_nodes[1..].iter().map(|&n| remap(n)));
-        leaf_prims.extend_from_slice(&sub_prims);
+    let results = map_largest_first(
+        threads,
+        jobs.clone(),
+        |job| bin.nodes[job.0 as usize].prims as usize,
+        |job| {
+            let mut n = vec![WideNode::default()];
+            let mut p = Vec::with_capacity(bin.nodes[job.0 as usize].prims as usize);
+            let d = emit(bin, max_leaf, vec![(job.0, 0, job.2)], &mut n, &mut p, None);
+            (n, p, d)
+        },
+    );
+
+    // Appended in job order: local node i >= 1 moves to node_base + i - 1, and the local root
+    // replaces the job's placeholder. The copies run in parallel into preallocated arrays.
+    let mut node_ranges = Vec::with_capacity(jobs.len());
+    let mut prim_ranges = Vec::with_capacity(jobs.len());
+    let (mut node_end, mut prim_end) = (nodes.len(), leaf_prims.len());
+    for (sub_nodes, sub_prims, sub_depth) in &results {
+        depth = depth.max(*sub_depth);
+        node_ranges.push(node_end..node_end + sub_nodes.len() - 1);
+        prim_ranges.push(prim_end..prim_end + sub_prims.len());
+        node_end += sub_nodes.len() - 1;
+        prim_end += sub_prims.len();
     }
+    let top_nodes = nodes.len();
+    let top_prims = leaf_prims.len();
+    let mut all_nodes: Vec<WideNode> = bytemuck::zeroed_vec(node_end);
+    let mut all_prims: Vec<u32> = bytemuck::zeroed_vec(prim_end);
+    all_nodes[..top_nodes].copy_from_slice(&nodes);
+    all_prims[..top_prims].copy_from_slice(&leaf_prims);
+    let remap = |mut n: WideNode, node_base: usize, prim_base: usize| {
+        n.child_base = node_base as u32 + n.child_base - 1;
+        n.prim_base += prim_base as u32;
+        n
+    };
+    for (i, (job, (sub_nodes, _, _))) in jobs.iter().zip(&results).enumerate() {
+        all_nodes[job.1 as usize] = remap(sub_nodes[0], node_ranges[i].start, prim_ranges[i].start);
+    }
+    let copies: Vec<_> = split_ranges(&mut all_nodes, &node_ranges)
+        .into_iter()
+        .zip(split_ranges(&mut all_prims, &prim_ranges))
+        .zip(results.iter().zip(node_ranges.iter().zip(&prim_ranges)))
+        .collect();
+    map_dynamic(
+        threads,
+        copies,
+        |((dst_nodes, dst_prims), ((sub_nodes, sub_prims, _), (nr, pr)))| {
+            for (d, &n) in dst_nodes.iter_mut().zip(&sub_nodes[1..]) {
+                *d = remap(n, nr.start, pr.start);
+            }
+            dst_prims.copy_from_slice(sub_prims);
+        },
+    );
     WideBvh {
-        nodes,
-        leaf_prims,
+        nodes: all_nodes,
+        leaf_prims: all_prims,
         depth,
     }
 }
@@ -116,7 +115,6 @@ pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
 /// `jobs` instead when given. Returns the deepest level emitted.
 fn emit(
     bin: &BinaryBvh,
-    counts: &[u32],
     max_leaf: usize,
     mut todo: Vec<Pending>,
     nodes: &mut Vec<WideNode>,
@@ -132,7 +130,7 @@ fn emit(
     while let Some((b, w, d)) = todo.pop() {
         if let Some(jobs) = jobs.as_mut()
             && w != 0
-            && counts[b as usize] <= JOB_PRIMS
+            && bn[b as usize].prims <= JOB_PRIMS
         {
             jobs.push((b, w, d));
             continue;
@@ -194,7 +192,7 @@ fn emit(
             let Some(ci) = slots[slot] else { continue };
             let c = open[ci];
             boxes[slot] = Some(bn[c as usize].bounds);
-            if counts[c as usize] as usize > max_leaf {
+            if bn[c as usize].prims as usize > max_leaf {
                 imask |= 1 << slot;
                 node.set_meta(slot, META_INTERNAL | slot as u8);
                 let child_w = nodes.len() as u32;
