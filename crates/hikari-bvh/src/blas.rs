@@ -28,7 +28,8 @@ pub struct BuildOptions {
     pub invalid: BadTriangle,
     /// Most triangles per leaf child (1..=3).
     pub max_leaf: usize,
-    /// Build threads; 0 = all available cores.
+    /// Build threads; 0 = all available cores (at most 256 are used). The BVH is the same for
+    /// any count.
     pub threads: usize,
 }
 
@@ -120,7 +121,9 @@ impl Blas {
             ..Default::default()
         };
         let t_validate = std::time::Instant::now();
-        let threads = thread_count(options.threads);
+        // More threads than this only add start-up and barrier costs (and an absurd request
+        // could fail to start them all).
+        let threads = thread_count(options.threads).min(MAX_BUILD_THREADS);
         let prims = prim_refs(name, positions, indices, options, threads, &mut stats)?;
         let max_leaf = options.max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
         stats.timings.validate = t_validate.elapsed();
@@ -194,6 +197,9 @@ impl Blas {
         crate::traverse::any_hit_blas(&self.nodes, &self.triangles, ray, stack)
     }
 }
+
+/// Most threads one build uses, whatever [`BuildOptions::threads`] asks for.
+const MAX_BUILD_THREADS: usize = 256;
 
 /// Triangles per piece of the parallel passes over the mesh.
 const CHUNK: usize = 16 * 1024;

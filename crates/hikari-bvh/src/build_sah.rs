@@ -32,6 +32,8 @@ const MEDIAN_SPLIT_DEPTH: u32 = 40;
 const SMALL_NODE: usize = 12;
 /// Nodes smaller than this are never split by several threads together.
 const MIN_PARALLEL_PRIMS: usize = 16 * 1024;
+/// Nodes larger than this are split level by level (see [`top_levels`]), even on one thread.
+const MAX_SUBTREE_PRIMS: usize = 64 * 1024;
 
 /// A primitive's box; `lo.w` holds the primitive id as the bits of a normal float (`ID_TAG | id`):
 /// the SIMD box arithmetic also runs on the w lane, and a raw small integer there would be a
@@ -127,7 +129,24 @@ struct Split {
 }
 
 /// Builds a binary BVH. `prims` must be non-empty.
-pub fn build(mut prims: Vec<PrimRef>, params: &SahParams) -> BinaryBvh {
+pub fn build(prims: Vec<PrimRef>, params: &SahParams) -> BinaryBvh {
+    let n = prims.len();
+    // Enough subtrees that a thread drawing a large one last does not hold up the others for
+    // long, each small enough to stay in a core's cache. The level-by-level top pays a few
+    // barriers per level, but even on one thread it beats splitting the large nodes in place:
+    // its scatter to the other buffer needs no copy back.
+    let top = (n >= 2 * MIN_PARALLEL_PRIMS)
+        .then(|| (n / (params.threads.max(1) * 8)).clamp(MIN_PARALLEL_PRIMS, MAX_SUBTREE_PRIMS));
+    build_with(prims, params, top)
+}
+
+/// [`build`], with the top split level by level until no node holds more than
+/// `top_threshold` primitives, if given. The tree does not depend on it.
+fn build_with(
+    mut prims: Vec<PrimRef>,
+    params: &SahParams,
+    top_threshold: Option<usize>,
+) -> BinaryBvh {
     assert!(!prims.is_empty());
     let n = prims.len();
     let threads = params.threads.max(1);
@@ -148,16 +167,14 @@ pub fn build(mut prims: Vec<PrimRef>, params: &SahParams) -> BinaryBvh {
     // Stable partitions move one side through this buffer; the parallel top levels move whole
     // nodes back and forth between it and `prims`.
     let mut scratch: Vec<PrimRef> = bytemuck::zeroed_vec(n);
-    let mut subtrees = if threads > 1 && n >= 2 * MIN_PARALLEL_PRIMS {
-        // Small enough subtrees that a thread that draws a large one last does not hold up the
-        // others for long; the level-parallel top costs a few barriers per level.
-        let threshold = (n / (threads * 8)).max(MIN_PARALLEL_PRIMS);
-        top_levels::split(&mut prims, &mut scratch, root, &mut top, threshold, threads)
-    } else {
-        vec![Subtree {
+    let mut subtrees = match top_threshold {
+        Some(threshold) => {
+            top_levels::split(&mut prims, &mut scratch, root, &mut top, threshold, threads)
+        }
+        None => vec![Subtree {
             task: root,
             in_scratch: false,
-        }]
+        }],
     };
     subtrees.sort_by_key(|s| s.task.begin);
 
@@ -507,8 +524,6 @@ fn partition(
 ) -> (usize, Aabb, Aabb) {
     let (axis, bin, bins) = (s.axis, s.bin, s.bins);
     let k = bin_scale(cb, bins);
-    let (mut lmin, mut lmax) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
-    let (mut rmin, mut rmax) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
     // Branch-free: a side decision per primitive is a coin flip for the branch predictor, so
     // every primitive is written to both places and only the cursor of its side advances. Left
     // ones compact in place (the write cursor never passes the read cursor), right ones wait in
@@ -517,19 +532,27 @@ fn partition(
     let mut r = 0;
     for i in 0..prims.len() {
         let p = prims[i];
-        let c2 = p.c2();
-        let left = bin_index(c2, cb.min, k, bins)[axis] <= bin;
+        let left = bin_index(p.c2(), cb.min, k, bins)[axis] <= bin;
         prims[l] = p;
         scratch[r] = p;
         l += left as usize;
         r += !left as usize;
-        let m = glam::BVec3A::splat(left);
-        lmin = lmin.min(Vec3A::select(m, c2, Vec3A::INFINITY));
-        lmax = lmax.max(Vec3A::select(m, c2, Vec3A::NEG_INFINITY));
-        rmin = rmin.min(Vec3A::select(m, Vec3A::INFINITY, c2));
-        rmax = rmax.max(Vec3A::select(m, Vec3A::NEG_INFINITY, c2));
     }
-    prims[l..].copy_from_slice(&scratch[..r]);
+    // Centroid boxes of the two sides in separate passes over each side (the left one still in
+    // cache): cheaper than selecting a side per primitive above.
+    let (mut lmin, mut lmax) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for p in &prims[..l] {
+        let c2 = p.c2();
+        lmin = lmin.min(c2);
+        lmax = lmax.max(c2);
+    }
+    let (mut rmin, mut rmax) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for (dst, p) in prims[l..].iter_mut().zip(&scratch[..r]) {
+        *dst = *p;
+        let c2 = p.c2();
+        rmin = rmin.min(c2);
+        rmax = rmax.max(c2);
+    }
     (l, Aabb::new(lmin, lmax), Aabb::new(rmin, rmax))
 }
 
@@ -551,4 +574,96 @@ fn median_split(prims: &mut [PrimRef], cb: &Aabb) -> (usize, Aabb, Aabb, Aabb, A
     let (lb, lcb) = side_bounds(&prims[..mid]);
     let (rb, rcb) = side_bounds(&prims[mid..]);
     (mid, lb, rb, lcb, rcb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::SplitMix64;
+
+    /// The tree as a sequence of (box, leaf primitive ids) in depth-first order: what every
+    /// later stage reads, independent of where nodes sit in the array.
+    fn canonical(b: &BinaryBvh) -> Vec<([u32; 6], Vec<u32>)> {
+        let mut out = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let n = &b.nodes[i as usize];
+            let bx = [n.bounds.min, n.bounds.max].map(|v| v.to_array().map(f32::to_bits));
+            let key = [bx[0][0], bx[0][1], bx[0][2], bx[1][0], bx[1][1], bx[1][2]];
+            if n.is_leaf() {
+                let ids = b.prims[n.first as usize..(n.first + n.count) as usize]
+                    .iter()
+                    .map(PrimRef::id)
+                    .collect();
+                out.push((key, ids));
+            } else {
+                out.push((key, Vec::new()));
+                stack.push(n.first + 1);
+                stack.push(n.first);
+            }
+        }
+        out
+    }
+
+    /// Boxes in clumps of different density, with many equal coordinates (a grid) so that ties
+    /// in the exact small-node sweep depend on primitive order.
+    fn boxes(seed: u64, count: usize) -> Vec<PrimRef> {
+        let mut rng = SplitMix64::new(seed);
+        (0..count)
+            .map(|i| {
+                let c = if i % 3 == 0 {
+                    Vec3A::new(
+                        rng.range(-50.0, 50.0),
+                        rng.range(-50.0, 50.0),
+                        rng.range(-50.0, 50.0),
+                    )
+                } else {
+                    Vec3A::new(rng.below(40) as f32, (i % 5) as f32, rng.below(40) as f32) * 0.25
+                };
+                let e = Vec3A::new(
+                    rng.range(0.0, 0.5),
+                    rng.range(0.0, 0.5),
+                    rng.range(0.0, 0.5),
+                );
+                PrimRef::new(&Aabb::new(c - e, c + e), i as u32)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn top_levels_give_the_tree_of_a_serial_build() {
+        for (seed, count) in [(1, 20_000), (2, 3_001)] {
+            let prims = boxes(seed, count);
+            let params = |threads| SahParams {
+                max_leaf: 3,
+                threads,
+            };
+            let serial = canonical(&build_with(prims.clone(), &params(1), None));
+            for (threads, threshold) in [(1, 1000), (3, 700), (8, 64), (16, 5000)] {
+                let got = canonical(&build_with(
+                    prims.clone(),
+                    &params(threads),
+                    Some(threshold),
+                ));
+                assert!(
+                    got == serial,
+                    "{count} boxes, {threads} threads, top down to {threshold}: tree differs"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn top_levels_median_split_gives_the_tree_of_a_serial_build() {
+        // Equal centroids: no SAH plane anywhere, every node is split at the median.
+        let b = Aabb::new(Vec3A::ZERO, Vec3A::ONE);
+        let prims: Vec<PrimRef> = (0..5000).map(|i| PrimRef::new(&b, i)).collect();
+        let params = SahParams {
+            max_leaf: 3,
+            threads: 4,
+        };
+        let serial = canonical(&build_with(prims.clone(), &params, None));
+        let top = canonical(&build_with(prims, &params, Some(300)));
+        assert!(top == serial);
+    }
 }

@@ -19,7 +19,7 @@ pub struct WideBvh {
 /// Subtrees of at most this many primitives are collapsed as independent jobs (in parallel when
 /// threads are available) and appended in a fixed order, so the layout never depends on the
 /// thread count.
-const JOB_PRIMS: u32 = 32 * 1024;
+const JOB_PRIMS: u32 = 8 * 1024;
 
 /// A pending wide node: binary node, wide node index, depth.
 type Pending = (u32, u32, u32);
@@ -144,6 +144,16 @@ fn emit(
         // Open the binary subtree: repeatedly replace the internal child with the largest box
         // by its two children, which removes the most expected traversal work per slot.
         let mut open = [0u32; WIDTH];
+        // Surface area of each open internal child; -1 for leaves, which are never opened.
+        let mut area = [-1.0f32; WIDTH];
+        let area_of = |c: u32| {
+            let n = &bn[c as usize];
+            if n.is_leaf() {
+                -1.0
+            } else {
+                n.bounds.half_area()
+            }
+        };
         let mut n_open;
         if bn[b as usize].is_leaf() {
             open[0] = b;
@@ -152,15 +162,16 @@ fn emit(
             let f = bn[b as usize].first;
             open[0] = f;
             open[1] = f + 1;
+            area[0] = area_of(f);
+            area[1] = area_of(f + 1);
             n_open = 2;
         }
         while n_open < WIDTH {
             let mut best = usize::MAX;
             let mut best_area = -1.0;
-            for (i, &c) in open[..n_open].iter().enumerate() {
-                let n = &bn[c as usize];
-                if !n.is_leaf() && n.bounds.half_area() > best_area {
-                    best_area = n.bounds.half_area();
+            for (i, &a) in area[..n_open].iter().enumerate() {
+                if a > best_area {
+                    best_area = a;
                     best = i;
                 }
             }
@@ -170,6 +181,8 @@ fn emit(
             let f = bn[open[best] as usize].first;
             open[best] = f;
             open[n_open] = f + 1;
+            area[best] = area_of(f);
+            area[n_open] = area_of(f + 1);
             n_open += 1;
         }
         let open = &open[..n_open];
@@ -373,16 +386,23 @@ pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], i
         let mut e = step_exponent(all.max[a] - origin[a]);
         'retry: loop {
             let step = f32::from_bits(e << 23);
+            // 1 / step, exact (a power of two; 2^-127 is the denormal 1 << 22), so multiplying
+            // by it rounds exactly as dividing by `step` would, at a fraction of the latency.
+            let inv_step = if e <= 253 {
+                f32::from_bits((254 - e) << 23)
+            } else {
+                f32::from_bits(1 << 22)
+            };
             let decode = |k: u32| origin[a] + k as f32 * step;
             for (slot, b) in boxes.iter().enumerate() {
                 let Some(b) = b else { continue };
                 // Offsets are >= 0 (the origin is the minimum), so truncation is floor; the
                 // saturating casts clamp to 255 below.
-                let mut lo = (((b.min[a] - origin[a]) / step) as u32).min(255);
+                let mut lo = (((b.min[a] - origin[a]) * inv_step) as u32).min(255);
                 while lo > 0 && decode(lo) > b.min[a] {
                     lo -= 1;
                 }
-                let f = (b.max[a] - origin[a]) / step;
+                let f = (b.max[a] - origin[a]) * inv_step;
                 let mut hi = f as u32;
                 if (hi as f32) < f {
                     hi += 1;
@@ -411,6 +431,34 @@ pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], i
             node.set_quantized(slot, q[slot].0, q[slot].1);
         } else {
             node.set_quantized(slot, [0; 3], [0; 3]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::rng::SplitMix64;
+
+    #[test]
+    fn multiplying_by_the_inverse_step_rounds_like_dividing() {
+        let mut rng = SplitMix64::new(4);
+        for e in 1u32..=254 {
+            let step = f32::from_bits(e << 23);
+            let inv = if e <= 253 {
+                f32::from_bits((254 - e) << 23)
+            } else {
+                f32::from_bits(1 << 22)
+            };
+            assert_eq!(step * inv, 1.0, "e = {e}");
+            for _ in 0..200 {
+                // Offsets over the whole f32 range, denormals included.
+                let x = f32::from_bits(rng.below(0x7F00_0000) as u32);
+                assert_eq!(
+                    (x * inv).to_bits(),
+                    (x / step).to_bits(),
+                    "e = {e}, x = {x:e}"
+                );
+            }
         }
     }
 }
