@@ -1,7 +1,7 @@
 //! Bottom-level acceleration structure: one mesh, object space.
 
 use crate::aabb::Aabb;
-use crate::build_sah::parallel::{map_dynamic, ranges, split_ranges};
+use crate::build_sah::parallel::{collect_pieces, map_dynamic, ranges, split_ranges};
 use crate::build_sah::{self, PrimRef, SahParams};
 use crate::error::BvhError;
 use crate::layout::{Hit, Ray, TriangleRecord, WideNode};
@@ -9,6 +9,7 @@ use crate::traverse::Stack;
 use crate::triangle::is_degenerate;
 use crate::wide;
 use glam::{Vec3, Vec3A};
+use std::sync::Mutex;
 
 /// What to do with a triangle the builder cannot use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -128,14 +129,21 @@ impl Blas {
         let max_leaf = options.max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
         stats.timings.validate = t_validate.elapsed();
         let t_binary = std::time::Instant::now();
-        let binary = build_sah::build(prims, &SahParams { max_leaf, threads });
+        // The triangle records' buffer is as large as the binary build's scratch space needs
+        // (48 bytes per triangle against 32), so it is lent to the build first: its pages are
+        // faulted in once, by the build's threads.
+        let mut triangles: Vec<TriangleRecord> = bytemuck::zeroed_vec(prims.len());
+        let scratch_bytes = std::mem::size_of::<PrimRef>() * prims.len();
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut triangles);
+        let scratch: &mut [PrimRef] = bytemuck::cast_slice_mut(&mut bytes[..scratch_bytes]);
+        let binary = build_sah::build_in(prims, scratch, &SahParams { max_leaf, threads });
         stats.timings.binary = t_binary.elapsed();
         let t_collapse = std::time::Instant::now();
         let bounds = binary.nodes[0].bounds;
         let wide = wide::collapse(&binary, max_leaf, threads);
         stats.timings.collapse = t_collapse.elapsed();
         let t_triangles = std::time::Instant::now();
-        let mut triangles: Vec<TriangleRecord> = bytemuck::zeroed_vec(wide.leaf_prims.len());
+        debug_assert_eq!(triangles.len(), wide.leaf_prims.len());
         let pieces = ranges(triangles.len(), threads, CHUNK);
         let work: Vec<_> = split_ranges(&mut triangles, &pieces)
             .into_iter()
@@ -204,6 +212,16 @@ const MAX_BUILD_THREADS: usize = 256;
 /// Triangles per piece of the parallel passes over the mesh.
 const CHUNK: usize = 16 * 1024;
 
+/// Bad triangles met by one piece of the validation pass.
+#[derive(Default)]
+struct Rejects {
+    /// Skipped triangles, in order.
+    skipped: Vec<u32>,
+    counts: BlasStats,
+    /// The piece's first error (with `BadTriangle::Reject`).
+    error: Option<BvhError>,
+}
+
 /// Validates every triangle and returns the boxes of those kept, in triangle order; counts the
 /// skipped ones in `stats`. Pieces of the index buffer are checked in parallel; with several
 /// bad triangles, the error names the first, as a serial pass would.
@@ -215,72 +233,62 @@ fn prim_refs(
     threads: usize,
     stats: &mut BlasStats,
 ) -> Result<Vec<PrimRef>, BvhError> {
-    let mut prims: Vec<PrimRef> = bytemuck::zeroed_vec(indices.len());
     let pieces = ranges(indices.len(), threads, CHUNK);
-    let work: Vec<_> = split_ranges(&mut prims, &pieces)
-        .into_iter()
-        .zip(&pieces)
-        .collect();
-    // Each piece writes the boxes it keeps to the front of its own range.
-    let results = map_dynamic(threads, work, |(out, r)| {
-        let mut kept = 0;
-        let mut skipped = BlasStats::default();
-        for (t, tri) in indices[r.clone()].iter().enumerate() {
-            let t = r.start + t;
-            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= positions.len()) {
-                if options.invalid == BadTriangle::Reject {
-                    return Err(BvhError::IndexOutOfRange {
-                        mesh: name.into(),
-                        triangle: t,
-                        index: bad,
-                        vertex_count: positions.len(),
-                    });
+    let rejects: Vec<Mutex<Rejects>> = pieces.iter().map(|_| Mutex::default()).collect();
+    // One box per triangle, so that the common case (nothing to skip) writes every box once,
+    // straight into place; bad triangles get a placeholder, removed below.
+    let mut prims = collect_pieces(threads, indices.len(), &pieces, |k| {
+        let mut failed = false;
+        let rejects = &rejects[k];
+        pieces[k].clone().map(move |t| {
+            let bad = if failed {
+                None
+            } else {
+                match check_triangle(name, positions, indices[t], t, options) {
+                    Ok(b) => return PrimRef::new(&b, t as u32),
+                    Err(bad) => Some(bad),
                 }
-                skipped.skipped_bad_index += 1;
-                continue;
-            }
-            let v = tri.map(|i| Vec3A::from(positions[i as usize]));
-            if let Some(k) = (0..3).find(|&k| !v[k].is_finite()) {
-                if options.invalid == BadTriangle::Reject {
-                    return Err(BvhError::NonFiniteVertex {
-                        mesh: name.into(),
-                        triangle: t,
-                        vertex: tri[k],
-                        value: v[k].into(),
-                    });
+            };
+            if let Some(bad) = bad {
+                let mut r = rejects.lock().unwrap_or_else(|e| e.into_inner());
+                match bad {
+                    Bad::Error(e) => {
+                        r.error = Some(e);
+                        failed = true;
+                    }
+                    Bad::Skip(count) => {
+                        r.skipped.push(t as u32);
+                        count(&mut r.counts);
+                    }
                 }
-                skipped.skipped_non_finite += 1;
-                continue;
             }
-            if is_degenerate(v[0], v[1], v[2]) {
-                if options.degenerate == BadTriangle::Reject {
-                    return Err(BvhError::DegenerateTriangle {
-                        mesh: name.into(),
-                        triangle: t,
-                    });
-                }
-                skipped.skipped_degenerate += 1;
-                continue;
-            }
-            let b = Aabb::new(v[0].min(v[1]).min(v[2]), v[0].max(v[1]).max(v[2]));
-            out[kept] = PrimRef::new(&b, t as u32);
-            kept += 1;
-        }
-        Ok((kept, skipped))
+            PrimRef::new(&Aabb::new(Vec3A::ZERO, Vec3A::ZERO), t as u32)
+        })
     });
-    let mut end = 0;
-    for (r, result) in pieces.iter().zip(results) {
+    let mut skipped = Vec::new();
+    for r in rejects {
+        let r = r.into_inner().unwrap_or_else(|e| e.into_inner());
         // Pieces are in triangle order, so the first error met is the first bad triangle.
-        let (kept, skipped) = result?;
-        stats.skipped_bad_index += skipped.skipped_bad_index;
-        stats.skipped_non_finite += skipped.skipped_non_finite;
-        stats.skipped_degenerate += skipped.skipped_degenerate;
-        if end != r.start {
-            prims.copy_within(r.start..r.start + kept, end);
+        if let Some(e) = r.error {
+            return Err(e);
         }
-        end += kept;
+        stats.skipped_bad_index += r.counts.skipped_bad_index;
+        stats.skipped_non_finite += r.counts.skipped_non_finite;
+        stats.skipped_degenerate += r.counts.skipped_degenerate;
+        skipped.extend(r.skipped);
     }
-    prims.truncate(end);
+    if !skipped.is_empty() {
+        // Rare (bad input): drop the placeholders. `skipped` is sorted.
+        let mut next = skipped.iter().peekable();
+        prims.retain(|p| {
+            if next.peek() == Some(&&p.id()) {
+                next.next();
+                false
+            } else {
+                true
+            }
+        });
+    }
     if prims.is_empty() {
         return Err(BvhError::NoValidTriangles {
             mesh: name.into(),
@@ -293,16 +301,64 @@ fn prim_refs(
     Ok(prims)
 }
 
+/// Why a triangle is left out: an error, or a skip with the counter it adds to.
+enum Bad {
+    Error(BvhError),
+    Skip(fn(&mut BlasStats)),
+}
+
+/// The box of triangle `t`, or why it cannot be used.
+fn check_triangle(
+    name: &str,
+    positions: &[Vec3],
+    tri: [u32; 3],
+    t: usize,
+    options: &BuildOptions,
+) -> Result<Aabb, Bad> {
+    if let Some(&bad) = tri.iter().find(|&&i| i as usize >= positions.len()) {
+        if options.invalid == BadTriangle::Reject {
+            return Err(Bad::Error(BvhError::IndexOutOfRange {
+                mesh: name.into(),
+                triangle: t,
+                index: bad,
+                vertex_count: positions.len(),
+            }));
+        }
+        return Err(Bad::Skip(|s| s.skipped_bad_index += 1));
+    }
+    let v = tri.map(|i| Vec3A::from(positions[i as usize]));
+    if let Some(k) = (0..3).find(|&k| !v[k].is_finite()) {
+        if options.invalid == BadTriangle::Reject {
+            return Err(Bad::Error(BvhError::NonFiniteVertex {
+                mesh: name.into(),
+                triangle: t,
+                vertex: tri[k],
+                value: v[k].into(),
+            }));
+        }
+        return Err(Bad::Skip(|s| s.skipped_non_finite += 1));
+    }
+    if is_degenerate(v[0], v[1], v[2]) {
+        if options.degenerate == BadTriangle::Reject {
+            return Err(Bad::Error(BvhError::DegenerateTriangle {
+                mesh: name.into(),
+                triangle: t,
+            }));
+        }
+        return Err(Bad::Skip(|s| s.skipped_degenerate += 1));
+    }
+    Ok(Aabb::new(
+        v[0].min(v[1]).min(v[2]),
+        v[0].max(v[1]).max(v[2]),
+    ))
+}
+
 /// `data.to_vec()` in parallel pieces: the index buffer of a large mesh is tens of megabytes.
-fn copy_parallel<T: bytemuck::Pod + Send + Sync>(data: &[T], threads: usize) -> Vec<T> {
-    let mut out: Vec<T> = bytemuck::zeroed_vec(data.len());
+fn copy_parallel<T: Copy + Send + Sync>(data: &[T], threads: usize) -> Vec<T> {
     let pieces = ranges(data.len(), threads, 4 * CHUNK);
-    let work: Vec<_> = split_ranges(&mut out, &pieces)
-        .into_iter()
-        .zip(&pieces)
-        .collect();
-    map_dynamic(threads, work, |(o, r)| o.copy_from_slice(&data[r.clone()]));
-    out
+    collect_pieces(threads, data.len(), &pieces, |k| {
+        data[pieces[k].clone()].iter().copied()
+    })
 }
 
 impl Blas {

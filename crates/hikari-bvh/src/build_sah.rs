@@ -38,7 +38,7 @@ const MAX_SUBTREE_PRIMS: usize = 64 * 1024;
 /// A primitive's box; `lo.w` holds the primitive id as the bits of a normal float (`ID_TAG | id`):
 /// the SIMD box arithmetic also runs on the w lane, and a raw small integer there would be a
 /// denormal, which costs a microcode assist on every operation.
-#[derive(Clone, Copy, Debug, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(16))]
 pub struct PrimRef {
     pub lo: Vec4,
@@ -130,6 +130,18 @@ struct Split {
 
 /// Builds a binary BVH. `prims` must be non-empty.
 pub fn build(prims: Vec<PrimRef>, params: &SahParams) -> BinaryBvh {
+    let mut scratch: Vec<PrimRef> = bytemuck::zeroed_vec(prims.len());
+    build_in(prims, &mut scratch, params)
+}
+
+/// [`build`] with the caller's scratch space, at least as long as `prims`; its contents are
+/// overwritten. A caller that needs a buffer of that size afterwards anyway can lend it here,
+/// so that its pages are faulted in once.
+pub(crate) fn build_in(
+    prims: Vec<PrimRef>,
+    scratch: &mut [PrimRef],
+    params: &SahParams,
+) -> BinaryBvh {
     let n = prims.len();
     // Enough subtrees that a thread drawing a large one last does not hold up the others for
     // long, each small enough to stay in a core's cache. The level-by-level top pays a few
@@ -137,13 +149,15 @@ pub fn build(prims: Vec<PrimRef>, params: &SahParams) -> BinaryBvh {
     // its scatter to the other buffer needs no copy back.
     let top = (n >= 2 * MIN_PARALLEL_PRIMS)
         .then(|| (n / (params.threads.max(1) * 8)).clamp(MIN_PARALLEL_PRIMS, MAX_SUBTREE_PRIMS));
-    build_with(prims, params, top)
+    build_with(prims, &mut scratch[..n], params, top)
 }
 
-/// [`build`], with the top split level by level until no node holds more than
-/// `top_threshold` primitives, if given. The tree does not depend on it.
+/// [`build_in`], with the top split level by level until no node holds more than
+/// `top_threshold` primitives, if given. The tree does not depend on it. `scratch` is as long
+/// as `prims`.
 fn build_with(
     mut prims: Vec<PrimRef>,
+    scratch: &mut [PrimRef],
     params: &SahParams,
     top_threshold: Option<usize>,
 ) -> BinaryBvh {
@@ -164,12 +178,11 @@ fn build_with(
         count: 0,
         prims: n as u32,
     }];
-    // Stable partitions move one side through this buffer; the parallel top levels move whole
+    // Stable partitions move one side through `scratch`; the level-by-level top moves whole
     // nodes back and forth between it and `prims`.
-    let mut scratch: Vec<PrimRef> = bytemuck::zeroed_vec(n);
     let mut subtrees = match top_threshold {
         Some(threshold) => {
-            top_levels::split(&mut prims, &mut scratch, root, &mut top, threshold, threads)
+            top_levels::split(&mut prims, scratch, root, &mut top, threshold, threads)
         }
         None => vec![Subtree {
             task: root,
@@ -194,7 +207,7 @@ fn build_with(
     let jobs: Vec<_> = split_ranges(&mut nodes, &reserve)
         .into_iter()
         .zip(split_ranges(&mut prims, &prim_ranges))
-        .zip(split_ranges(&mut scratch, &prim_ranges))
+        .zip(split_ranges(scratch, &prim_ranges))
         .zip(subtrees.iter().zip(&reserve))
         .map(|(((arena, prims), scratch), (s, r))| (s, r.start, arena, prims, scratch))
         .collect();
@@ -638,10 +651,12 @@ mod tests {
                 max_leaf: 3,
                 threads,
             };
-            let serial = canonical(&build_with(prims.clone(), &params(1), None));
+            let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
+            let serial = canonical(&build_with(prims.clone(), &mut scratch, &params(1), None));
             for (threads, threshold) in [(1, 1000), (3, 700), (8, 64), (16, 5000)] {
                 let got = canonical(&build_with(
                     prims.clone(),
+                    &mut scratch,
                     &params(threads),
                     Some(threshold),
                 ));
@@ -662,8 +677,9 @@ mod tests {
             max_leaf: 3,
             threads: 4,
         };
-        let serial = canonical(&build_with(prims.clone(), &params, None));
-        let top = canonical(&build_with(prims, &params, Some(300)));
+        let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
+        let serial = canonical(&build_with(prims.clone(), &mut scratch, &params, None));
+        let top = canonical(&build_with(prims, &mut scratch, &params, Some(300)));
         assert!(top == serial);
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::aabb::Aabb;
 use crate::build_sah::BinaryBvh;
-use crate::build_sah::parallel::{map_dynamic, map_largest_first, split_ranges};
+use crate::build_sah::parallel::{collect_pieces, map_largest_first};
 use crate::layout::{META_INTERNAL, WIDTH, WideNode, leaf_meta};
 use glam::Vec3A;
 
@@ -56,8 +56,11 @@ pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
         jobs.clone(),
         |job| bin.nodes[job.0 as usize].prims as usize,
         |job| {
-            let mut n = vec![WideNode::default()];
-            let mut p = Vec::with_capacity(bin.nodes[job.0 as usize].prims as usize);
+            let prims = bin.nodes[job.0 as usize].prims as usize;
+            // Wide nodes hold 5 to 6 primitives on average: room enough not to grow.
+            let mut n = Vec::with_capacity(prims / 4 + 1);
+            n.push(WideNode::default());
+            let mut p = Vec::with_capacity(prims);
             let d = emit(bin, max_leaf, vec![(job.0, 0, job.2)], &mut n, &mut p, None);
             (n, p, d)
         },
@@ -75,35 +78,38 @@ pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
         node_end += sub_nodes.len() - 1;
         prim_end += sub_prims.len();
     }
-    let top_nodes = nodes.len();
-    let top_prims = leaf_prims.len();
-    let mut all_nodes: Vec<WideNode> = bytemuck::zeroed_vec(node_end);
-    let mut all_prims: Vec<u32> = bytemuck::zeroed_vec(prim_end);
-    all_nodes[..top_nodes].copy_from_slice(&nodes);
-    all_prims[..top_prims].copy_from_slice(&leaf_prims);
     let remap = |mut n: WideNode, node_base: usize, prim_base: usize| {
         n.child_base = node_base as u32 + n.child_base - 1;
         n.prim_base += prim_base as u32;
         n
     };
     for (i, (job, (sub_nodes, _, _))) in jobs.iter().zip(&results).enumerate() {
-        all_nodes[job.1 as usize] = remap(sub_nodes[0], node_ranges[i].start, prim_ranges[i].start);
+        nodes[job.1 as usize] = remap(sub_nodes[0], node_ranges[i].start, prim_ranges[i].start);
     }
-    let copies: Vec<_> = split_ranges(&mut all_nodes, &node_ranges)
-        .into_iter()
-        .zip(split_ranges(&mut all_prims, &prim_ranges))
-        .zip(results.iter().zip(node_ranges.iter().zip(&prim_ranges)))
-        .collect();
-    map_dynamic(
-        threads,
-        copies,
-        |((dst_nodes, dst_prims), ((sub_nodes, sub_prims, _), (nr, pr)))| {
-            for (d, &n) in dst_nodes.iter_mut().zip(&sub_nodes[1..]) {
-                *d = remap(n, nr.start, pr.start);
-            }
-            dst_prims.copy_from_slice(sub_prims);
-        },
-    );
+    // Piece 0 is the top part; piece i + 1 is job i.
+    node_ranges.insert(0, 0..nodes.len());
+    prim_ranges.insert(0, 0..leaf_prims.len());
+    let all_nodes = collect_pieces(threads, node_end, &node_ranges, |k| {
+        let (src, bases) = if k == 0 {
+            (&nodes[..], None)
+        } else {
+            let bases = (node_ranges[k].start, prim_ranges[k].start);
+            (&results[k - 1].0[1..], Some(bases))
+        };
+        src.iter().map(move |&n| match bases {
+            Some((nb, pb)) => remap(n, nb, pb),
+            None => n,
+        })
+    });
+    let all_prims = collect_pieces(threads, prim_end, &prim_ranges, |k| {
+        if k == 0 {
+            &leaf_prims
+        } else {
+            &results[k - 1].1
+        }
+        .iter()
+        .copied()
+    });
     WideBvh {
         nodes: all_nodes,
         leaf_prims: all_prims,

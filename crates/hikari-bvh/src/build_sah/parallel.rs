@@ -2,6 +2,9 @@
 //! build, collapse, triangle records). Each call starts its threads afresh (tens of microseconds
 //! for 16 threads), which a build of a million triangles does only a handful of times.
 
+use std::mem::MaybeUninit;
+use std::ops::Range;
+
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -73,9 +76,54 @@ pub(crate) fn map_largest_first<T: Send, R: Send>(
         .collect()
 }
 
+/// A vector of `len` elements written in parallel: piece `k` of `pieces` (ascending ranges that
+/// cover `0..len`) is filled from the iterator `fill(k)`, which must yield exactly as many
+/// elements as the piece holds.
+///
+/// Unlike filling a zeroed vector, nothing writes the memory twice: the allocator hands out
+/// recycled memory for all but the largest vectors, and zeroing tens of megabytes on the calling
+/// thread would cost more than the parallel fill itself.
+pub(crate) fn collect_pieces<T: Send, I: Iterator<Item = T>>(
+    threads: usize,
+    len: usize,
+    pieces: &[Range<usize>],
+    fill: impl Fn(usize) -> I + Sync,
+) -> Vec<T> {
+    let mut covered = 0;
+    for r in pieces {
+        assert_eq!(r.start, covered, "pieces must cover 0..len in order");
+        covered = r.end;
+    }
+    assert_eq!(covered, len, "pieces must cover 0..len");
+    let mut v: Vec<T> = Vec::with_capacity(len);
+    let parts: Vec<(usize, &mut [MaybeUninit<T>])> =
+        split_ranges(&mut v.spare_capacity_mut()[..len], pieces)
+            .into_iter()
+            .enumerate()
+            .collect();
+    map_dynamic(threads, parts, |(k, out)| {
+        let mut items = fill(k);
+        for slot in out.iter_mut() {
+            slot.write(
+                items
+                    .next()
+                    .expect("a piece's iterator yields one element per slot"),
+            );
+        }
+        assert!(
+            items.next().is_none(),
+            "a piece's iterator yields one element per slot"
+        );
+    });
+    // SAFETY: the pieces cover 0..len (asserted above), and every slot of every piece was
+    // written (a short iterator panics before this point, a long one too).
+    unsafe { v.set_len(len) };
+    v
+}
+
 /// Splits `0..len` into about `4 * threads` contiguous ranges of at least `min_len` (fewer when
 /// `len` is small): enough pieces that an unlucky thread does not hold up the rest.
-pub(crate) fn ranges(len: usize, threads: usize, min_len: usize) -> Vec<std::ops::Range<usize>> {
+pub(crate) fn ranges(len: usize, threads: usize, min_len: usize) -> Vec<Range<usize>> {
     let pieces = (4 * threads).min(len / min_len.max(1)).max(1);
     let per = len.div_ceil(pieces).max(1);
     (0..len)
@@ -87,7 +135,7 @@ pub(crate) fn ranges(len: usize, threads: usize, min_len: usize) -> Vec<std::ops
 /// Splits `data` into the given ascending, contiguous ranges that cover it.
 pub(crate) fn split_ranges<'a, T>(
     mut data: &'a mut [T],
-    ranges: &[std::ops::Range<usize>],
+    ranges: &[Range<usize>],
 ) -> Vec<&'a mut [T]> {
     let mut out = Vec::with_capacity(ranges.len());
     let mut at = 0;
