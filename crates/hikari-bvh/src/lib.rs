@@ -195,17 +195,18 @@
 //!    records; 16 centroid bins per axis (8 below 64 primitives), an exact object-split sweep
 //!    for nodes of at most 12, leaves of at most 3 primitives, and a median split as the
 //!    fallback when no plane separates the centroids or the depth passes 40 (so every input
-//!    terminates with bounded depth). The top is split on one thread until there are a few
-//!    subtrees per thread; those are built on scoped threads and stitched in a fixed order, so
-//!    the tree is identical for any thread count.
+//!    terminates with bounded depth). The top levels are split level by level by all threads
+//!    together (each bins its share of the triangles, the bins merge exactly, and a stable
+//!    partition scatters the shares), then subtrees of at most 16K-64K primitives are built as
+//!    tasks into node ranges reserved for them, so the tree is identical for any thread count.
 //! 3. Collapse to the wide layout ([`wide`]): starting from a binary node, repeatedly open the
 //!    child with the largest surface area until there are 8 children; any child with at most 3
 //!    triangles becomes a leaf. Children are assigned to octant slots greedily by how well their
 //!    centre offset aligns with each slot's corner, then quantized: the grid step per axis is
 //!    the smallest power of two with `255 * step >= extent`; lower planes round down and upper
 //!    planes up, checked by decoding in f32. Nodes are emitted depth-first (the order the
-//!    binary nodes lie in memory); subtrees of at most 32K primitives are collapsed as separate
-//!    jobs, on threads when available, and appended in a fixed order.
+//!    binary nodes lie in memory); subtrees of at most 8K primitives are collapsed as separate
+//!    jobs, scheduled dynamically on threads, and assembled in a fixed order.
 //!
 //! The TLAS uses the same builder with one instance per leaf slot; its binary build stops at
 //! 8 instances, and each such group becomes one node of single-instance leaves.

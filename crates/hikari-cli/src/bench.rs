@@ -23,14 +23,8 @@ pub enum BenchCommand {
 
 #[derive(Args, Debug)]
 pub struct FrameArgs {
-    #[arg(long, default_value = "boxes")]
-    scene: String,
-    #[arg(long)]
-    camera: Option<String>,
-    #[arg(long, default_value_t = 1920)]
-    width: u32,
-    #[arg(long, default_value_t = 1080)]
-    height: u32,
+    #[command(flatten)]
+    frame: crate::render::FrameArgs,
     /// Frames measured.
     #[arg(long, default_value_t = 100)]
     frames: u32,
@@ -40,6 +34,10 @@ pub struct FrameArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     json: bool,
+    /// Time the whole frame only: untimed compute passes merge, as in normal rendering, so
+    /// the frame span is the real cost (timing each pass adds about 10 us a pass).
+    #[arg(long)]
+    frame_only: bool,
 }
 
 #[derive(Args, Debug)]
@@ -105,8 +103,8 @@ pub fn print_single_frame(r: &FrameResult) {
 }
 
 fn frame(a: FrameArgs) -> anyhow::Result<()> {
-    let scene = crate::render::load_scene(&a.scene)?;
-    let settings = crate::render::settings(&scene, a.camera.as_deref(), a.width, a.height, 14.0)?;
+    let (scene, settings) = a.frame.resolve()?;
+    let scene_name = a.frame.scene.clone().unwrap_or_else(|| "village".into());
     anyhow::ensure!(a.frames > 0, "--frames must be at least 1");
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     let adapter = ctx.describe();
@@ -114,6 +112,11 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
     let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);
     let t0 = Instant::now();
     let mut renderer = Renderer::new(ctx, &scene)?;
+    renderer.runtime.set_timestamps(if a.frame_only {
+        TimestampMode::Frame
+    } else {
+        TimestampMode::Pass
+    });
     let setup_ms = ms(t0.elapsed());
     for _ in 0..a.warmup {
         renderer.render(&settings, false)?;
@@ -150,8 +153,9 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
         let out = json!({
             "benchmark": "frame",
             "adapter": adapter,
-            "scene": a.scene,
-            "width": a.width, "height": a.height, "frames": a.frames,
+            "scene": scene_name,
+            "camera": settings.camera.name,
+            "width": settings.width, "height": settings.height, "frames": a.frames,
             "triangles": renderer.scene().triangles,
             "startup_ms": { "instance": ms(startup.instance), "adapter": ms(startup.adapter), "device": ms(startup.device), "total": ms(startup.total()) },
             "pipelines_and_upload_ms": setup_ms,
@@ -174,10 +178,10 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
     );
     println!(
         "scene {} ({} triangles), {}x{}, {} frames after {} warm-up",
-        a.scene,
+        scene_name,
         renderer.scene().triangles,
-        a.width,
-        a.height,
+        settings.width,
+        settings.height,
         a.frames,
         a.warmup
     );
@@ -196,6 +200,19 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
                 name, "n/a", "", "", c.median
             ),
         }
+    }
+    // Per technique: the sum of its passes' medians (technique = name before the first dot).
+    let mut techniques: Vec<(String, f64)> = Vec::new();
+    for (name, g, _) in &rows {
+        let t = name.split('.').next().unwrap_or(name).to_string();
+        let ms = g.as_ref().map_or(0.0, |g| g.median);
+        match techniques.iter_mut().find(|(n, _)| *n == t) {
+            Some(e) => e.1 += ms,
+            None => techniques.push((t, ms)),
+        }
+    }
+    for (t, ms) in &techniques {
+        println!("{:<32} {:>10.4}", format!("{t} (sum of medians)"), ms);
     }
     match span {
         Some(s) => println!(

@@ -2,6 +2,7 @@
 
 mod bench;
 mod bench_rays;
+mod config;
 mod constants;
 mod render;
 

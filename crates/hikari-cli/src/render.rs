@@ -8,18 +8,85 @@ use clap::Args;
 use hikari_render::graph::TimestampMode;
 use hikari_render::{ContextOptions, FrameSettings, GpuContext, Renderer, output};
 
-#[derive(Args, Debug)]
-pub struct RenderArgs {
-    /// Built-in scene (boxes, cornell, terrain) or a .gltf/.glb file.
-    #[arg(long, default_value = "boxes")]
-    pub scene: String,
+/// What to render and how: shared by `render` and `bench frame`.
+#[derive(Args, Debug, Clone, Default)]
+pub struct FrameArgs {
+    /// Built-in scene (village, cornell, terrain, boxes) or a .gltf/.glb file [default: village].
+    #[arg(long)]
+    pub scene: Option<String>,
     /// Camera name in the scene; the scene's first camera if omitted.
     #[arg(long)]
     pub camera: Option<String>,
-    #[arg(long, default_value_t = 1280)]
-    pub width: u32,
-    #[arg(long, default_value_t = 720)]
-    pub height: u32,
+    /// Time of day, HH:MM: sets the sun (or moon) by a simple model until the atmosphere
+    /// issue [default: the scene's own sun].
+    #[arg(long)]
+    pub time: Option<String>,
+    /// Image width in pixels [default: 1280].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: 720].
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// TOML settings file (docs/config.md); flags win over it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Placeholder exposure: EV at ISO 100 (sunny day about 15, overcast 12, interior 7)
+    /// [default: metered from the sun].
+    #[arg(long, allow_negative_numbers = true)]
+    pub ev100: Option<f32>,
+}
+
+impl FrameArgs {
+    /// The scene and the frame settings, from the flags, then the config file, then defaults.
+    pub fn resolve(&self) -> anyhow::Result<(hikari_scene::Scene, FrameSettings)> {
+        let file = match &self.config {
+            Some(p) => crate::config::load(p)?,
+            None => crate::config::ConfigFile::default(),
+        };
+        let scene_name = self
+            .scene
+            .clone()
+            .or(file.scene.clone())
+            .unwrap_or_else(|| "village".into());
+        let scene = load_scene(&scene_name)?;
+        let camera = self.camera.as_deref().or(file.camera.as_deref());
+        let camera = match camera {
+            Some(name) => scene.camera(name)?.clone(),
+            None => scene
+                .cameras
+                .first()
+                .context("the scene has no camera")?
+                .clone(),
+        };
+        let sun = match self.time.as_deref().or(file.time.as_deref()) {
+            Some(t) => Some(hikari_scene::time_of_day::sun_at(
+                hikari_scene::time_of_day::parse_time(t).context("--time")?,
+            )),
+            None => scene.sun.clone(),
+        };
+        let mut settings = file.settings;
+        if let Some(ev) = self.ev100 {
+            settings.exposure.ev100 = Some(ev);
+        }
+        settings.validate().context("settings")?;
+        Ok((
+            scene,
+            FrameSettings {
+                width: self.width.or(file.width).unwrap_or(1280),
+                height: self.height.or(file.height).unwrap_or(720),
+                camera,
+                prev_camera: None,
+                sun,
+                settings,
+            },
+        ))
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    pub frame: FrameArgs,
     /// PNG output (display-encoded sRGB).
     #[arg(short, long, default_value = "hikari.png")]
     pub output: PathBuf,
@@ -29,9 +96,6 @@ pub struct RenderArgs {
     /// Do not write the EXR.
     #[arg(long)]
     pub no_exr: bool,
-    /// Placeholder exposure: EV at ISO 100 (sunny day about 15, overcast 12, interior 7).
-    #[arg(long, default_value_t = 14.0, allow_negative_numbers = true)]
-    pub ev100: f32,
     /// Print a per-pass GPU timing table.
     #[arg(long)]
     pub timings: bool,
@@ -59,41 +123,8 @@ pub fn load_scene(name: &str) -> anyhow::Result<hikari_scene::Scene> {
     )
 }
 
-pub fn settings(
-    scene: &hikari_scene::Scene,
-    camera: Option<&str>,
-    width: u32,
-    height: u32,
-    ev100: f32,
-) -> anyhow::Result<FrameSettings> {
-    let camera = match camera {
-        Some(name) => scene.camera(name)?.clone(),
-        None => scene
-            .cameras
-            .first()
-            .context("the scene has no camera")?
-            .clone(),
-    };
-    if !ev100.is_finite() || !(-10.0..=30.0).contains(&ev100) {
-        bail!("--ev100 {ev100} is outside the range -10 to 30");
-    }
-    Ok(FrameSettings {
-        width,
-        height,
-        camera,
-        ev100,
-    })
-}
-
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    let scene = load_scene(&args.scene)?;
-    let settings = settings(
-        &scene,
-        args.camera.as_deref(),
-        args.width,
-        args.height,
-        args.ev100,
-    )?;
+    let (scene, settings) = args.frame.resolve()?;
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;

@@ -15,7 +15,14 @@ pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
     .union(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES)
     .union(wgpu::Features::SHADER_F16)
     .union(wgpu::Features::SUBGROUP)
-    .union(wgpu::Features::FLOAT32_FILTERABLE);
+    .union(wgpu::Features::FLOAT32_FILTERABLE)
+    .union(wgpu::Features::SHADER_INT64)
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+
+/// What the renderer cannot run without beyond WebGPU's core: the software rasteriser of the
+/// G-buffer and shadow maps resolves visibility with 64-bit `atomicMax` on depth and id.
+pub const REQUIRED_FEATURES: wgpu::Features =
+    wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
 
 /// How long each step of start-up took; `hikari bench` reports it.
 #[derive(Clone, Copy, Debug, Default)]

@@ -1,15 +1,18 @@
 //! One frame, top to bottom. Each numbered step is the step of the same number in
 //! ARCHITECTURE.md; the steps not yet built say which issue brings them.
 
-use hikari_scene::Camera;
+use hikari_scene::{Camera, Sun};
 
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{FrameGraph, Tex};
-use crate::passes::direct_lighting::{DirectLighting, SunParams};
-use crate::passes::gbuffer::GBufferPass;
+use crate::passes::direct_lighting::{DirectLighting, LightingParams};
+use crate::passes::gbuffer::{GBuffer, GBufferPass};
 use crate::passes::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
+use crate::passes::raster::Rasterizer;
+use crate::passes::sun_shadows::{self, SunShadowMaps};
 use crate::scene_gpu::SceneGpu;
+use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::view::View;
 
@@ -19,12 +22,28 @@ pub struct FrameSettings {
     pub width: u32,
     pub height: u32,
     pub camera: Camera,
-    /// Exposure value at ISO 100 of the placeholder exposure.
-    pub ev100: f32,
+    /// The camera of the previous frame, for motion vectors; `None`: it did not move.
+    pub prev_camera: Option<Camera>,
+    /// The sun or moon; `None`: no directional light.
+    pub sun: Option<Sun>,
+    pub settings: Settings,
+}
+
+impl FrameSettings {
+    /// Exposure of the placeholder tonemap: the configured EV100, else the incident-light
+    /// meter rule EV100 = log2(E * 100 / C) with C = 250 (ISO 2720) on the sun's illuminance,
+    /// floored at 20 lux so that nights are exposed for their lamps, not for the moon.
+    pub fn ev100(&self) -> f32 {
+        self.settings.exposure.ev100.unwrap_or_else(|| {
+            let lux = self.sun.as_ref().map_or(0.0, |s| s.illuminance_lux);
+            (lux.max(20.0) * 100.0 / 250.0).log2()
+        })
+    }
 }
 
 /// Every technique's pipelines, built once.
 pub struct Techniques {
+    pub raster: Rasterizer,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
     pub placeholder_tonemap: PlaceholderTonemap,
@@ -34,6 +53,7 @@ impl Techniques {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
         Ok(Self {
+            raster: Rasterizer::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
@@ -41,9 +61,11 @@ impl Techniques {
     }
 }
 
-/// The frame's final images.
+/// The frame's images.
 #[derive(Clone, Copy, Debug)]
 pub struct FrameOutputs {
+    pub gbuffer: GBuffer,
+    pub shadows: SunShadowMaps,
     /// Linear radiance in nits (Rgba16Float), for the EXR.
     pub hdr: Tex,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
@@ -54,32 +76,57 @@ pub fn record<'r>(
     g: &mut FrameGraph<'r>,
     t: &'r Techniques,
     scene: &'r SceneGpu,
-    sun: &SunParams,
     s: &FrameSettings,
 ) -> Result<FrameOutputs> {
     let size = [s.width, s.height];
+    let aspect = s.width as f32 / s.height as f32;
 
-    // 1. Update: camera; the sun comes from the scene until the atmosphere issue derives it
-    //    from time and date.
-    let view = View::new(&s.camera, s.width, s.height);
+    // 1. Update: camera and sun. The sun comes from the scene or a simple time-of-day model
+    //    until the atmosphere issue derives it from time and date.
+    let view = View::with_previous(
+        &s.camera,
+        s.prev_camera.as_ref().unwrap_or(&s.camera),
+        s.width,
+        s.height,
+    );
+    let to_sun = s.sun.as_ref().map_or(glam::Vec3::ZERO, |sun| sun.direction);
 
-    // 2. Atmosphere LUTs, 3. sky SH, 4. irradiance probes, 5. reflection probes, 6. clouds,
-    //    7. shadow maps: their issues add them here.
+    // 2. Atmosphere LUTs, 3. sky SH, 4. irradiance probes, 5. reflection probes, 6. clouds:
+    //    their issues add them here.
+
+    // 7. Sun shadow maps.
+    let shadows = sun_shadows::record(
+        g,
+        &t.raster,
+        scene,
+        &s.camera,
+        aspect,
+        to_sun,
+        &s.settings.shadows,
+    )?;
 
     // 8. G-buffer.
-    let gbuffer = t.gbuffer.record(g, scene, &view, size)?;
+    let gbuffer = t.gbuffer.record(g, &t.raster, scene, &view, size)?;
 
     // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
 
-    // 11. Deferred lighting (sun, placeholder sky and ambient).
-    let hdr = t.direct_lighting.record(g, &gbuffer, &view, sun)?;
+    // 11. Deferred direct lighting (sun, lights, emissive; placeholder sky and ambient).
+    let lighting = LightingParams::new(s.sun.as_ref(), scene.light_count, &s.settings.lighting);
+    let hdr = t
+        .direct_lighting
+        .record(g, &gbuffer, &shadows, scene, &view, &lighting)?;
 
     // 12. Haze and 13. TAA: their issues add them here.
 
     // 14. Exposure and tonemap (placeholder).
     let ldr = t
         .placeholder_tonemap
-        .record(g, hdr, size, &TonemapParams::from_ev100(s.ev100))?;
+        .record(g, hdr, size, &TonemapParams::from_ev100(s.ev100()))?;
 
-    Ok(FrameOutputs { hdr, ldr })
+    Ok(FrameOutputs {
+        gbuffer,
+        shadows,
+        hdr,
+        ldr,
+    })
 }

@@ -27,25 +27,63 @@ macro_rules! gpu_layout {
 
 /// Every GPU struct of the crate.
 pub fn all() -> Vec<StructLayout> {
-    use crate::passes::{direct_lighting, graph_check, math_check, placeholder_tonemap};
+    use crate::passes::{
+        direct_lighting, graph_check, math_check, placeholder_tonemap, raster, sun_shadows,
+    };
     use crate::scene_gpu;
     use crate::view;
     vec![
         gpu_layout!(
             view::View,
-            "gbuffer/draw.wgsl",
-            [view_proj, inv_view_proj, position, viewport]
+            "gbuffer/resolve.wgsl",
+            [
+                view_proj,
+                inv_view_proj,
+                position,
+                viewport,
+                prev_view_proj,
+                forward_near
+            ]
         ),
-        gpu_layout!(scene_gpu::Vertex, "gbuffer/draw.wgsl", [position, normal]),
         gpu_layout!(
-            scene_gpu::Instance,
-            "gbuffer/draw.wgsl",
-            [model, normal_model, base_color_roughness, metal_emissive]
+            scene_gpu::VertexAttr,
+            "gbuffer/resolve.wgsl",
+            [uv, normal, tangent, color, extra, pad]
         ),
         gpu_layout!(
-            direct_lighting::SunParams,
-            "direct_lighting/sun.wgsl",
-            [direction_lux, color, sky_zenith, sky_horizon]
+            scene_gpu::InstanceGpu,
+            "gbuffer/resolve.wgsl",
+            [model, normal_model, prev_model, material, flags, pad]
+        ),
+        gpu_layout!(
+            scene_gpu::MaterialGpu,
+            "gbuffer/resolve.wgsl",
+            [base_color, emissive, params, extra, textures, more_textures]
+        ),
+        gpu_layout!(
+            scene_gpu::Chunk,
+            "gbuffer/resolve.wgsl",
+            [instance, first_triangle, count, pad]
+        ),
+        gpu_layout!(
+            scene_gpu::LightGpu,
+            "direct_lighting/shade.wgsl",
+            [position_range, direction_kind, intensity, spot]
+        ),
+        gpu_layout!(
+            raster::RasterParams,
+            "raster/triangles.wgsl",
+            [view_proj, viewport, config]
+        ),
+        gpu_layout!(
+            sun_shadows::ShadowParams,
+            "direct_lighting/shade.wgsl",
+            [light_view_proj, texel_world, config, depth_bias]
+        ),
+        gpu_layout!(
+            direct_lighting::LightingParams,
+            "direct_lighting/shade.wgsl",
+            [direction_lux, color, sky_zenith, sky_horizon, config]
         ),
         gpu_layout!(
             placeholder_tonemap::TonemapParams,

@@ -13,11 +13,14 @@ pub mod pipeline;
 pub mod reference;
 pub mod renderer;
 pub mod scene_gpu;
+pub mod scene_textures;
+pub mod settings;
 pub mod shader;
 pub mod view;
 
 pub use context::{ContextOptions, GpuContext};
 pub use error::{RenderError, Result};
 pub use frame::FrameSettings;
+pub use settings::Settings;
 pub use renderer::{RenderedFrame, Renderer};
 pub use wgpu;

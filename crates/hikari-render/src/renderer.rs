@@ -4,9 +4,8 @@ use hikari_scene::Scene;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::frame::{self, FrameSettings, Techniques};
-use crate::graph::{FrameResult, GraphRuntime, ImageRgba32};
-use crate::passes::direct_lighting::SunParams;
+use crate::frame::{self, FrameOutputs, FrameSettings, Techniques};
+use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
 use crate::scene_gpu::SceneGpu;
 
 /// A rendered frame: timings, and the images if they were asked for.
@@ -21,7 +20,6 @@ pub struct Renderer {
     pub runtime: GraphRuntime,
     techniques: Techniques,
     scene: SceneGpu,
-    sun: SunParams,
 }
 
 impl Renderer {
@@ -29,7 +27,6 @@ impl Renderer {
         let techniques = Techniques::new(&ctx)?;
         let scene_gpu = SceneGpu::upload(&ctx, scene)?;
         Ok(Self {
-            sun: SunParams::new(scene.sun.as_ref()),
             runtime: GraphRuntime::new(),
             techniques,
             scene: scene_gpu,
@@ -43,6 +40,29 @@ impl Renderer {
 
     /// Renders one frame; with `read_images`, copies the HDR and LDR results back.
     pub fn render(&mut self, settings: &FrameSettings, read_images: bool) -> Result<RenderedFrame> {
+        let mut result = self.render_reading(settings, |out| {
+            if read_images {
+                vec![out.hdr.into(), out.ldr.into()]
+            } else {
+                vec![]
+            }
+        })?;
+        let hdr = result.take_image("direct_lighting.radiance");
+        let ldr = result.take_image("placeholder_tonemap.ldr");
+        Ok(RenderedFrame { result, hdr, ldr })
+    }
+
+    /// Renders one frame and copies back whatever `pick` names of its resources (G-buffer
+    /// textures, shadow maps...); they appear in the result under their graph names.
+    pub fn render_reading(
+        &mut self,
+        settings: &FrameSettings,
+        pick: impl FnOnce(&FrameOutputs) -> Vec<Res>,
+    ) -> Result<FrameResult> {
+        settings
+            .settings
+            .validate()
+            .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
         let limit = self.ctx.limits.max_texture_dimension_2d;
         for (what, v) in [("width", settings.width), ("height", settings.height)] {
             if v == 0 || v > limit {
@@ -54,26 +74,10 @@ impl Renderer {
             }
         }
         let mut g = self.runtime.begin_frame(&self.ctx);
-        let out = frame::record(&mut g, &self.techniques, &self.scene, &self.sun, settings)?;
-        if read_images {
-            g.readback(out.hdr);
-            g.readback(out.ldr);
+        let out = frame::record(&mut g, &self.techniques, &self.scene, settings)?;
+        for r in pick(&out) {
+            g.readback(r);
         }
-        let mut result = g.execute()?;
-        let (hdr, ldr) = if read_images {
-            let take = |r: &mut FrameResult, name: &str| {
-                r.images
-                    .iter()
-                    .position(|i| i.name == name)
-                    .map(|i| r.images.remove(i))
-            };
-            (
-                take(&mut result, "direct_lighting.radiance"),
-                take(&mut result, "placeholder_tonemap.ldr"),
-            )
-        } else {
-            (None, None)
-        };
-        Ok(RenderedFrame { result, hdr, ldr })
+        g.execute()
     }
 }

@@ -1,45 +1,303 @@
-//! The scene uploaded for rasterisation: one vertex buffer, one index buffer, one instance
-//! buffer, and a draw per instance.
+//! The scene as the compute rasteriser and the G-buffer resolve read it.
+//!
+//! One buffer per stream, shared by every instance of a mesh: positions (what the rasteriser
+//! reads, 16 bytes a vertex), the other vertex attributes (what the resolve reads), indices with
+//! each mesh's base vertex already added, instances, materials, and the chunk table. A chunk is
+//! up to [`CHUNK_TRIANGLES`] consecutive triangles of one instance: the rasteriser runs one
+//! workgroup per chunk, and a pixel's visibility id is `chunk * CHUNK_TRIANGLES + lane`.
+//! Textures go into two 2D arrays, one sRGB (base colour, emissive) and one linear (the rest).
 
 use bytemuck::{Pod, Zeroable};
-use glam::Mat4;
+use glam::{Mat3, Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
-use hikari_scene::Scene;
+use hikari_scene::{Scene, Wrap};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
+use crate::scene_textures::{self, TextureArrays};
 
+/// Triangles per chunk; the rasteriser's workgroup size.
+pub const CHUNK_TRIANGLES: u32 = 64;
+/// Material texture slot with no texture.
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// Per-vertex attributes other than the position.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct Vertex {
-    pub position: [f32; 4],
-    pub normal: [f32; 4],
+pub struct VertexAttr {
+    pub uv: [f32; 2],
+    /// Octahedral normal, snorm16x2.
+    pub normal: u32,
+    /// Octahedral tangent, snorm16x2.
+    pub tangent: u32,
+    /// Linear RGBA vertex colour in [0, 1], unorm16x4.
+    pub color: [u32; 2],
+    /// Interior mask as unorm16 in the low bits; bit 16: bitangent = -cross(n, t); bit 17: the
+    /// mesh has tangents.
+    pub extra: u32,
+    pub pad: u32,
 }
 
+pub const EXTRA_BITANGENT_NEGATIVE: u32 = 1 << 16;
+pub const EXTRA_HAS_TANGENT: u32 = 1 << 17;
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct Instance {
+pub struct InstanceGpu {
     pub model: [[f32; 4]; 4],
+    /// Inverse transpose of the model matrix's upper 3x3, in a mat4 for alignment.
     pub normal_model: [[f32; 4]; 4],
-    pub base_color_roughness: [f32; 4],
-    pub metal_emissive: [f32; 4],
+    /// Last frame's model matrix, for motion vectors.
+    pub prev_model: [[f32; 4]; 4],
+    pub material: u32,
+    /// Bit 0: double-sided.
+    pub flags: u32,
+    pub pad: [u32; 2],
 }
 
-#[derive(Clone, Copy, Debug)]
-pub struct Draw {
-    pub first_index: u32,
-    pub index_count: u32,
-    pub base_vertex: i32,
+pub const INSTANCE_DOUBLE_SIDED: u32 = 1;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct MaterialGpu {
+    /// rgb: linear base colour; a: alpha (ignored: every surface is opaque).
+    pub base_color: [f32; 4],
+    /// rgb: emitted luminance in nits; a: normal map scale.
+    pub emissive: [f32; 4],
+    /// Perceptual roughness, metalness, anisotropy strength, anisotropy rotation (radians).
+    pub params: [f32; 4],
+    /// Occlusion strength, interior mask (negative: none, use the vertex's), 0, 0.
+    pub extra: [f32; 4],
+    /// Texture layers: base colour and emissive in the sRGB array, metallic-roughness and
+    /// normal in the linear array; [`NO_TEXTURE`] where absent.
+    pub textures: [u32; 4],
+    /// Occlusion layer (linear array), wrap modes (4 bits a slot: s in bits 0-1, t in 2-3, slots
+    /// in the order base colour, metallic-roughness, normal, emissive, occlusion), 0, 0.
+    pub more_textures: [u32; 4],
+}
+
+/// `instance`, first triangle (global, into the index buffer / 3), triangle count, 0.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct Chunk {
     pub instance: u32,
+    pub first_triangle: u32,
+    pub count: u32,
+    pub pad: u32,
 }
 
 pub struct SceneGpu {
-    pub vertices: wgpu::Buffer,
+    pub positions: wgpu::Buffer,
+    pub attributes: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub instances: wgpu::Buffer,
-    pub draws: Vec<Draw>,
+    pub materials: wgpu::Buffer,
+    pub chunks: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    pub textures: TextureArrays,
+    pub chunk_count: u32,
+    pub light_count: u32,
     pub triangles: u64,
+    /// World-space bounds of every instance, `None` for an empty scene.
+    pub bounds: Option<(Vec3, Vec3)>,
+    /// The CPU copies the twins and tests read.
+    pub cpu: SceneCpu,
+}
+
+/// What was uploaded, kept on the CPU for the CPU twins.
+#[derive(Clone, Debug, Default)]
+pub struct SceneCpu {
+    pub positions: Vec<[f32; 4]>,
+    pub attributes: Vec<VertexAttr>,
+    pub indices: Vec<u32>,
+    pub instances: Vec<InstanceGpu>,
+    pub materials: Vec<MaterialGpu>,
+    pub chunks: Vec<Chunk>,
+    pub lights: Vec<LightGpu>,
+}
+
+/// A point or spot light.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LightGpu {
+    /// xyz: world position; w: range in metres (the light is exactly 0 beyond it).
+    pub position_range: [f32; 4],
+    /// xyz: unit direction the spot points along; w: 0 point, 1 spot.
+    pub direction_kind: [f32; 4],
+    /// rgb: colour (luminance 1) times intensity in candela; a unused.
+    pub intensity: [f32; 4],
+    /// Spot cone: scale and offset such that the angular factor is
+    /// `saturate(cos_angle * scale + offset)^2`; zw unused.
+    pub spot: [f32; 4],
+}
+
+pub const LIGHT_POINT: f32 = 0.0;
+pub const LIGHT_SPOT: f32 = 1.0;
+
+/// Illuminance below which a punctual light is cut off (its range, when the scene gives none):
+/// a hundredth of a lux is far below moonlight, so the cut is invisible at any exposure that
+/// shows the scene.
+pub const LIGHT_CUTOFF_LUX: f32 = 0.01;
+
+pub fn snorm16x2(v: glam::Vec2) -> u32 {
+    let q = |x: f32| ((x.clamp(-1.0, 1.0) * 32767.0).round() as i16) as u16 as u32;
+    q(v.x) | (q(v.y) << 16)
+}
+
+pub fn unpack_snorm16x2(p: u32) -> glam::Vec2 {
+    let f = |b: u32| ((b as u16 as i16) as f32 / 32767.0).max(-1.0);
+    glam::Vec2::new(f(p & 0xffff), f(p >> 16))
+}
+
+pub fn unorm16x2(a: f32, b: f32) -> u32 {
+    let q = |x: f32| (x.clamp(0.0, 1.0) * 65535.0).round() as u32;
+    q(a) | (q(b) << 16)
+}
+
+fn wrap_bits(w: Wrap) -> u32 {
+    match w {
+        Wrap::Repeat => 0,
+        Wrap::MirroredRepeat => 1,
+        Wrap::ClampToEdge => 2,
+    }
+}
+
+/// Any unit vector perpendicular to `n` (Duff et al. 2017), for meshes without tangents; the
+/// WGSL twin is `orthonormal_tangent` in `gbuffer/resolve.wgsl`.
+pub fn orthonormal_tangent(n: Vec3) -> Vec3 {
+    let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x)
+}
+
+pub fn light_range(intensity_cd: f32, range: Option<f32>) -> f32 {
+    let cutoff = (intensity_cd.max(0.0) / LIGHT_CUTOFF_LUX).sqrt();
+    range.map_or(cutoff, |r| r.min(cutoff)).max(1e-3)
+}
+
+impl SceneCpu {
+    pub fn build(scene: &Scene, layers: &scene_textures::LayerMap) -> Self {
+        let mut cpu = SceneCpu::default();
+        let mut mesh_first_triangle = Vec::new();
+        for m in &scene.meshes {
+            let base = cpu.positions.len() as u32;
+            mesh_first_triangle.push(cpu.indices.len() as u32 / 3);
+            cpu.indices.extend(m.indices.iter().map(|i| i + base));
+            cpu.positions
+                .extend(m.positions.iter().map(|p| p.extend(1.0).to_array()));
+            for v in 0..m.positions.len() {
+                let n = m.normals[v].normalize_or(Vec3::Y);
+                let (t, negative, has) = match m.tangents.get(v) {
+                    Some(t) => (t.truncate().normalize_or(orthonormal_tangent(n)), t.w < 0.0, true),
+                    None => (orthonormal_tangent(n), false, false),
+                };
+                let c = m
+                    .colors
+                    .as_ref()
+                    .and_then(|c| c.get(v).copied())
+                    .unwrap_or(Vec4::ONE);
+                let interior = m.interior.get(v).copied().unwrap_or(hikari_scene::DEFAULT_INTERIOR);
+                let mut extra = (interior.clamp(0.0, 1.0) * 65535.0).round() as u32;
+                if negative {
+                    extra |= EXTRA_BITANGENT_NEGATIVE;
+                }
+                if has {
+                    extra |= EXTRA_HAS_TANGENT;
+                }
+                cpu.attributes.push(VertexAttr {
+                    uv: m.uvs.get(v).copied().unwrap_or_default().to_array(),
+                    normal: snorm16x2(crate::reference::octahedral::encode(n)),
+                    tangent: snorm16x2(crate::reference::octahedral::encode(t)),
+                    color: [unorm16x2(c.x, c.y), unorm16x2(c.z, c.w)],
+                    extra,
+                    pad: 0,
+                });
+            }
+        }
+        for (i, inst) in scene.instances.iter().enumerate() {
+            let mat = &scene.materials[inst.material];
+            let normal = Mat4::from_mat3(Mat3::from_mat4(inst.transform).inverse().transpose());
+            cpu.instances.push(InstanceGpu {
+                model: inst.transform.to_cols_array_2d(),
+                normal_model: normal.to_cols_array_2d(),
+                prev_model: inst.transform.to_cols_array_2d(),
+                material: inst.material as u32,
+                flags: if mat.double_sided {
+                    INSTANCE_DOUBLE_SIDED
+                } else {
+                    0
+                },
+                pad: [0; 2],
+            });
+            let triangles = scene.meshes[inst.mesh].indices.len() as u32 / 3;
+            let first = mesh_first_triangle[inst.mesh];
+            let mut t = 0;
+            while t < triangles {
+                let count = (triangles - t).min(CHUNK_TRIANGLES);
+                cpu.chunks.push(Chunk {
+                    instance: i as u32,
+                    first_triangle: first + t,
+                    count,
+                    pad: 0,
+                });
+                t += count;
+            }
+        }
+        for m in &scene.materials {
+            let slot = |t: &Option<hikari_scene::TextureRef>, array: &[Option<u32>]| {
+                t.map_or((NO_TEXTURE, 0), |r| {
+                    let tex = &scene.textures[r.texture];
+                    (
+                        array[r.texture].unwrap_or(NO_TEXTURE),
+                        wrap_bits(tex.wrap_s) | (wrap_bits(tex.wrap_t) << 2),
+                    )
+                })
+            };
+            let slots = [
+                slot(&m.base_color_texture, &layers.color),
+                slot(&m.metallic_roughness_texture, &layers.data),
+                slot(&m.normal_texture, &layers.data),
+                slot(&m.emissive_texture, &layers.color),
+                slot(&m.occlusion_texture, &layers.data),
+            ];
+            let wraps = slots
+                .iter()
+                .enumerate()
+                .fold(0, |acc, (k, s)| acc | (s.1 << (4 * k)));
+            let (aniso, rotation) = m.anisotropy.map_or((0.0, 0.0), |a| (a.strength, a.rotation));
+            cpu.materials.push(MaterialGpu {
+                base_color: m.base_color.extend(m.alpha).to_array(),
+                emissive: m.emissive_nits.extend(m.normal_scale).to_array(),
+                params: [m.roughness, m.metalness, aniso, rotation],
+                extra: [m.occlusion_strength, m.interior.unwrap_or(-1.0), 0.0, 0.0],
+                textures: [slots[0].0, slots[1].0, slots[2].0, slots[3].0],
+                more_textures: [slots[4].0, wraps, 0, 0],
+            });
+        }
+        for l in &scene.lights {
+            let (kind, dir, spot) = match l.kind {
+                hikari_scene::LightKind::Point => (LIGHT_POINT, Vec3::NEG_Z, [0.0, 1.0, 0.0, 0.0]),
+                hikari_scene::LightKind::Spot {
+                    inner_cone,
+                    outer_cone,
+                } => {
+                    // KHR_lights_punctual's smooth cone: linear in cos between the cones.
+                    let (ci, co) = (inner_cone.cos(), outer_cone.cos());
+                    let scale = 1.0 / (ci - co).max(1e-4);
+                    (LIGHT_SPOT, l.direction.normalize(), [scale, -co * scale, 0.0, 0.0])
+                }
+            };
+            cpu.lights.push(LightGpu {
+                position_range: l.position.extend(light_range(l.intensity_cd, l.range)).to_array(),
+                direction_kind: dir.extend(kind).to_array(),
+                intensity: (l.color * l.intensity_cd).extend(0.0).to_array(),
+                spot,
+            });
+        }
+        cpu
+    }
 }
 
 impl SceneGpu {
@@ -49,97 +307,63 @@ impl SceneGpu {
         scene
             .validate()
             .map_err(|e| RenderError::Graph(format!("scene: {e}")))?;
-        let mut vertices = Vec::new();
-        let mut indices = Vec::new();
-        let mut ranges = Vec::new();
-        for m in &scene.meshes {
-            let (first_index, base_vertex) = (indices.len() as u32, vertices.len() as i32);
-            vertices.extend(m.positions.iter().zip(&m.normals).map(|(p, n)| Vertex {
-                position: p.extend(1.0).to_array(),
-                normal: n.extend(0.0).to_array(),
-            }));
-            indices.extend_from_slice(&m.indices);
-            ranges.push((first_index, m.indices.len() as u32, base_vertex));
-        }
-        let instances: Vec<Instance> = scene
-            .instances
-            .iter()
-            .map(|inst| {
-                let mat = &scene.materials[inst.material];
-                let normal =
-                    Mat4::from_mat3(glam::Mat3::from_mat4(inst.transform).inverse().transpose());
-                Instance {
-                    model: inst.transform.to_cols_array_2d(),
-                    normal_model: normal.to_cols_array_2d(),
-                    base_color_roughness: mat.base_color.extend(mat.roughness).to_array(),
-                    metal_emissive: [
-                        mat.metalness,
-                        mat.emissive_nits.x,
-                        mat.emissive_nits.y,
-                        mat.emissive_nits.z,
-                    ],
-                }
-            })
-            .collect();
-        let draws: Vec<Draw> = scene
-            .instances
-            .iter()
-            .enumerate()
-            .filter(|(_, inst)| ranges[inst.mesh].1 > 0)
-            .map(|(i, inst)| {
-                let (first_index, index_count, base_vertex) = ranges[inst.mesh];
-                Draw {
-                    first_index,
-                    index_count,
-                    base_vertex,
-                    instance: i as u32,
-                }
-            })
-            .collect();
+        let (textures, layers) = TextureArrays::upload(ctx, scene)?;
+        let cpu = SceneCpu::build(scene, &layers);
         let limit = ctx.limits.max_storage_buffer_binding_size;
-        let buffer =
-            |name: &str, bytes: &[u8], usage: wgpu::BufferUsages| -> Result<wgpu::Buffer> {
-                // Empty scenes still bind a buffer: wgpu refuses zero-sized bindings.
-                let padded;
-                let bytes = if bytes.is_empty() {
-                    padded = [0u8; 64];
-                    &padded[..]
-                } else {
-                    bytes
-                };
-                if bytes.len() as u64 > limit {
-                    return Err(RenderError::Limit {
-                        what: format!("scene {name} buffer size in bytes"),
-                        requested: bytes.len() as u64,
-                        limit,
-                    });
-                }
-                Ok(ctx
-                    .device
-                    .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                        label: Some(name),
-                        contents: bytes,
-                        usage,
-                    }))
+        let buffer = |name: &str, bytes: &[u8]| -> Result<wgpu::Buffer> {
+            // Empty scenes still bind a buffer: wgpu refuses zero-sized bindings.
+            let padded;
+            let bytes = if bytes.is_empty() {
+                padded = [0u8; 256];
+                &padded[..]
+            } else {
+                bytes
             };
+            if bytes.len() as u64 > limit {
+                return Err(RenderError::Limit {
+                    what: format!("scene {name} buffer size in bytes"),
+                    requested: bytes.len() as u64,
+                    limit,
+                });
+            }
+            Ok(ctx
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(name),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                }))
+        };
+        let bounds = scene.instances.iter().fold(None, |acc: Option<(Vec3, Vec3)>, inst| {
+            let Some((lo, hi)) = scene.meshes[inst.mesh].bounds() else {
+                return acc;
+            };
+            let corners = (0..8).map(|i| {
+                let c = Vec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                );
+                inst.transform.transform_point3(c)
+            });
+            Some(corners.fold(acc.unwrap_or((Vec3::INFINITY, Vec3::NEG_INFINITY)), |(a, b), c| {
+                (a.min(c), b.max(c))
+            }))
+        });
         Ok(Self {
-            vertices: buffer(
-                "vertices",
-                bytemuck::cast_slice(&vertices),
-                wgpu::BufferUsages::STORAGE,
-            )?,
-            indices: buffer(
-                "indices",
-                bytemuck::cast_slice(&indices),
-                wgpu::BufferUsages::INDEX | wgpu::BufferUsages::STORAGE,
-            )?,
-            instances: buffer(
-                "instances",
-                bytemuck::cast_slice(&instances),
-                wgpu::BufferUsages::STORAGE,
-            )?,
+            positions: buffer("positions", bytemuck::cast_slice(&cpu.positions))?,
+            attributes: buffer("vertex attributes", bytemuck::cast_slice(&cpu.attributes))?,
+            indices: buffer("indices", bytemuck::cast_slice(&cpu.indices))?,
+            instances: buffer("instances", bytemuck::cast_slice(&cpu.instances))?,
+            materials: buffer("materials", bytemuck::cast_slice(&cpu.materials))?,
+            chunks: buffer("chunks", bytemuck::cast_slice(&cpu.chunks))?,
+            lights: buffer("lights", bytemuck::cast_slice(&cpu.lights))?,
+            textures,
+            chunk_count: cpu.chunks.len() as u32,
+            light_count: cpu.lights.len() as u32,
             triangles: scene.triangle_count() as u64,
-            draws,
+            bounds,
+            cpu,
         })
     }
 }

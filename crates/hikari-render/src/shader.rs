@@ -174,6 +174,12 @@ pub fn capabilities_for(features: wgpu::Features) -> naga::valid::Capabilities {
     if features.contains(wgpu::Features::SUBGROUP) {
         c |= C::SUBGROUP;
     }
+    if features.contains(wgpu::Features::SHADER_INT64) {
+        c |= C::SHADER_INT64;
+    }
+    if features.contains(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX) {
+        c |= C::SHADER_INT64_ATOMIC_MIN_MAX;
+    }
     c
 }
 

@@ -12,12 +12,25 @@ pub struct View {
     pub inv_view_proj: [[f32; 4]; 4],
     pub position: [f32; 4],
     pub viewport: [f32; 4],
+    /// Last frame's view-projection, for motion vectors (this frame's on the first frame).
+    pub prev_view_proj: [[f32; 4]; 4],
+    /// xyz: unit forward; w: near plane distance in metres.
+    pub forward_near: [f32; 4],
 }
 
 impl View {
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
-        let vp = camera.projection(width as f32 / height as f32) * camera.view();
+        Self::with_previous(camera, camera, width, height)
+    }
+
+    /// The view of `camera` whose previous frame was seen from `previous`.
+    pub fn with_previous(camera: &Camera, previous: &Camera, width: u32, height: u32) -> Self {
+        let aspect = width as f32 / height as f32;
+        let vp = camera.projection(aspect) * camera.view();
+        let prev = previous.projection(aspect) * previous.view();
         Self {
+            prev_view_proj: prev.to_cols_array_2d(),
+            forward_near: camera.forward().extend(camera.near).to_array(),
             view_proj: vp.to_cols_array_2d(),
             inv_view_proj: vp.inverse().to_cols_array_2d(),
             position: camera.position.extend(1.0).to_array(),

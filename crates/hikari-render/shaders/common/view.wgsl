@@ -9,6 +9,10 @@ struct View {
     position: vec4<f32>,
     // width, height, 1 / width, 1 / height in pixels.
     viewport: vec4<f32>,
+    // Last frame's view-projection, for motion vectors.
+    prev_view_proj: mat4x4<f32>,
+    // xyz: unit forward; w: near plane distance in metres.
+    forward_near: vec4<f32>,
 }
 
 // World position of the pixel centre `pixel` at reverse-Z depth `depth`.

@@ -43,6 +43,22 @@ pub struct FrameResult {
 }
 
 impl FrameResult {
+    /// Removes and returns the read-back image of the resource named `name`.
+    pub fn take_image(&mut self, name: &str) -> Option<ImageRgba32> {
+        let i = self.images.iter().position(|i| i.name == name)?;
+        Some(self.images.remove(i))
+    }
+
+    /// The read-back bytes of the buffer named `name`.
+    pub fn buffer(&self, name: &str) -> Option<&[u8]> {
+        self.buffers
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, b)| b.as_slice())
+    }
+}
+
+impl FrameResult {
     pub fn image(&self, name: &str) -> Option<&ImageRgba32> {
         self.images.iter().find(|i| i.name == name)
     }

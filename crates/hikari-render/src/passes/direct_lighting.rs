@@ -1,5 +1,6 @@
-//! Deferred direct light from the sun, with placeholder sky and ambient light.
-//! CPU twin: [`crate::reference::direct_lighting`].
+//! Deferred direct lighting: sun with cascaded shadows, point and spot lights, emissive
+//! surfaces, and placeholder sky and ambient light. CPU twin:
+//! [`crate::reference::direct_lighting`].
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -7,52 +8,74 @@ use glam::Vec3;
 use hikari_scene::Sun;
 
 use super::gbuffer::GBuffer;
+use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
+use crate::scene_gpu::SceneGpu;
+use crate::settings::LightingSettings;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
+pub const LIGHTING_SUN: u32 = 1;
+pub const LIGHTING_PUNCTUAL: u32 = 2;
+pub const LIGHTING_EMISSIVE: u32 = 4;
+pub const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8;
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct SunParams {
+pub struct LightingParams {
     pub direction_lux: [f32; 4],
     pub color: [f32; 4],
     pub sky_zenith: [f32; 4],
     pub sky_horizon: [f32; 4],
+    /// Number of lights, `LIGHTING_*` flags, 0, 0.
+    pub config: [u32; 4],
 }
 
-/// Placeholder sky radiance (nits) until the atmosphere issue: a clear-day blue zenith and a
-/// paler horizon, of the order of a real clear sky (a few thousand nits).
+/// Placeholder sky radiance (nits) under the default 100000 lux sun, until the atmosphere
+/// issue: a clear-day blue zenith and a paler horizon, of the order of a real clear sky (a
+/// few thousand nits). It scales with the sun's illuminance, so night skies are dark.
 pub const PLACEHOLDER_SKY_ZENITH: Vec3 = Vec3::new(1800.0, 3200.0, 6500.0);
 pub const PLACEHOLDER_SKY_HORIZON: Vec3 = Vec3::new(6000.0, 7000.0, 8000.0);
 
-impl SunParams {
-    pub fn new(sun: Option<&Sun>) -> Self {
+impl LightingParams {
+    pub fn new(sun: Option<&Sun>, light_count: u32, s: &LightingSettings) -> Self {
         let (dir, lux, color) = match sun {
             Some(s) => (s.direction.normalize(), s.illuminance_lux, s.color),
             None => (Vec3::Y, 0.0, Vec3::ONE),
         };
+        let sky = lux / Sun::DEFAULT_LUX;
+        let flags = [
+            (s.sun, LIGHTING_SUN),
+            (s.punctual, LIGHTING_PUNCTUAL),
+            (s.emissive, LIGHTING_EMISSIVE),
+            (s.placeholder_ambient, LIGHTING_PLACEHOLDER_AMBIENT),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .fold(0, |acc, (_, bit)| acc | bit);
         Self {
             direction_lux: dir.extend(lux).to_array(),
             color: color.extend(1.0).to_array(),
-            sky_zenith: PLACEHOLDER_SKY_ZENITH.extend(0.0).to_array(),
-            sky_horizon: PLACEHOLDER_SKY_HORIZON.extend(0.0).to_array(),
+            sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky).extend(0.0).to_array(),
+            sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky).extend(0.0).to_array(),
+            config: [light_count, flags, 0, 0],
         }
     }
 }
 
 pub struct DirectLighting {
-    sun: ComputePipeline,
+    shade: ComputePipeline,
 }
 
 impl DirectLighting {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
-            sun: ComputePipeline::new(ctx, lib, "direct_lighting/sun.wgsl", "main", &[])?,
+            shade: ComputePipeline::new(ctx, lib, "direct_lighting/shade.wgsl", "main", &[])?,
         })
     }
 
@@ -61,22 +84,30 @@ impl DirectLighting {
         &'r self,
         g: &mut FrameGraph<'r>,
         gb: &GBuffer,
+        shadows: &SunShadowMaps,
+        scene: &'r SceneGpu,
         view: &View,
-        params: &SunParams,
+        params: &LightingParams,
     ) -> Result<Tex> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
             "direct_lighting.radiance",
             TextureDesc::d2(w, h, RADIANCE_FORMAT),
         )?;
-        g.pass("direct_lighting.sun")
+        let lights = g.import_buffer("scene.lights", &scene.lights);
+        g.pass("direct_lighting.shade")
             .constants(view)
+            .constants(params)
             .read(gb.depth)
             .read(gb.normal)
             .read(gb.albedo)
+            .read(gb.material)
+            .read(gb.emissive)
+            .read(lights)
             .write(radiance)
-            .constants(params)
-            .dispatch_threads(&self.sun, [w, h, 1])?;
+            .constants(&shadows.params)
+            .read(shadows.texels)
+            .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(radiance)
     }
 }

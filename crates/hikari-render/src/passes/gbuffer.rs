@@ -1,90 +1,118 @@
-//! G-buffer: depth (reverse-Z), octahedral normal, base colour and roughness.
+//! G-buffer: the compute rasteriser writes a visibility buffer, then `gbuffer.resolve` turns it
+//! into the G-buffer textures. CPU twin: [`crate::reference::gbuffer`].
 
+use super::raster::{RasterJob, RasterTarget, Rasterizer};
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{FrameGraph, Tex, TextureDesc};
-use crate::pipeline::{RasterDesc, RasterPipeline};
+use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneGpu;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
-pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub const MATERIAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub const MOTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const EMISSIVE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const INSTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+/// `gbuffer.instance` of sky pixels.
+pub const NO_INSTANCE: u32 = u32::MAX;
 
-/// The G-buffer textures of a frame.
+/// The G-buffer of a frame.
 #[derive(Clone, Copy, Debug)]
 pub struct GBuffer {
+    /// One u64 a pixel: reverse-Z depth bits << 32 | visibility id (0: sky).
+    pub visibility: Buf,
+    /// Reverse-Z NDC depth; 0 is the sky.
     pub depth: Tex,
+    /// xy: octahedral shading normal; zw: octahedral anisotropy direction.
     pub normal: Tex,
+    /// rgb: base colour; a: interior mask (0 outdoors, 1 indoors).
     pub albedo: Tex,
+    /// Perceptual roughness, metalness, anisotropy strength, material occlusion.
+    pub material: Tex,
+    /// xy: previous minus current pixel position; z: view-space depth in metres.
+    pub motion: Tex,
+    /// Emitted luminance in nits.
+    pub emissive: Tex,
+    /// Scene instance index, [`NO_INSTANCE`] for the sky.
+    pub instance: Tex,
 }
 
 pub struct GBufferPass {
-    draw: RasterPipeline,
+    resolve: ComputePipeline,
 }
 
 impl GBufferPass {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
-        let draw = RasterPipeline::new(
-            ctx,
-            lib,
-            "gbuffer/draw.wgsl",
-            &RasterDesc {
-                vertex_entry: "vs",
-                fragment_entry: Some("fs"),
-                color_formats: &[NORMAL_FORMAT, ALBEDO_FORMAT],
-                depth: Some((DEPTH_FORMAT, wgpu::CompareFunction::Greater)),
-                cull_mode: Some(wgpu::Face::Back),
-            },
-            &[],
-        )?;
-        Ok(Self { draw })
+        Ok(Self {
+            resolve: ComputePipeline::new(ctx, lib, "gbuffer/resolve.wgsl", "main", &[])?,
+        })
     }
 
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        raster: &'r Rasterizer,
         scene: &'r SceneGpu,
         view: &View,
         [width, height]: [u32; 2],
     ) -> Result<GBuffer> {
-        let gb = GBuffer {
-            depth: g.texture(
-                "gbuffer.depth",
-                TextureDesc::d2(width, height, DEPTH_FORMAT),
-            )?,
-            normal: g.texture(
-                "gbuffer.normal",
-                TextureDesc::d2(width, height, NORMAL_FORMAT),
-            )?,
-            albedo: g.texture(
-                "gbuffer.albedo",
-                TextureDesc::d2(width, height, ALBEDO_FORMAT),
-            )?,
+        let tex = |g: &mut FrameGraph<'r>, name: &str, format| {
+            g.texture(name, TextureDesc::d2(width, height, format))
         };
-        let vertices = g.import_buffer("scene.vertices", &scene.vertices);
-        let instances = g.import_buffer("scene.instances", &scene.instances);
+        let gb = GBuffer {
+            visibility: g.buffer("gbuffer.visibility", width as u64 * height as u64 * 8)?,
+            depth: tex(g, "gbuffer.depth", DEPTH_FORMAT)?,
+            normal: tex(g, "gbuffer.normal", NORMAL_FORMAT)?,
+            albedo: tex(g, "gbuffer.albedo", ALBEDO_FORMAT)?,
+            material: tex(g, "gbuffer.material", MATERIAL_FORMAT)?,
+            motion: tex(g, "gbuffer.motion", MOTION_FORMAT)?,
+            emissive: tex(g, "gbuffer.emissive", EMISSIVE_FORMAT)?,
+            instance: tex(g, "gbuffer.instance", INSTANCE_FORMAT)?,
+        };
+        raster.record(
+            g,
+            scene,
+            &RasterJob {
+                technique: "gbuffer",
+                view_proj: &[view.view_proj()],
+                size: [width, height],
+                cull_back_faces: true,
+            },
+            RasterTarget::Visibility,
+            gb.visibility,
+        )?;
+        let positions = g.import_buffer("scene.positions", &scene.positions);
+        let attributes = g.import_buffer("scene.attributes", &scene.attributes);
         let indices = g.import_buffer("scene.indices", &scene.indices);
-        let draws = &scene.draws;
-        g.pass("gbuffer.draw")
+        let instances = g.import_buffer("scene.instances", &scene.instances);
+        let materials = g.import_buffer("scene.materials", &scene.materials);
+        let chunks = g.import_buffer("scene.chunks", &scene.chunks);
+        let color = g.import_texture("scene.color_textures", &scene.textures.color);
+        let data = g.import_texture("scene.data_textures", &scene.textures.data);
+        g.pass("gbuffer.resolve")
             .constants(view)
-            .read(vertices)
+            .read(gb.visibility)
+            .read(positions)
+            .read(attributes)
+            .read(indices)
             .read(instances)
-            .uses(indices, false)
-            .color(gb.normal, Some([0.0; 4]))
-            .color(gb.albedo, Some([0.0; 4]))
-            .depth(gb.depth, Some(0.0))
-            .draw(&self.draw, move |rp, res| {
-                rp.set_index_buffer(res.buffer(indices).slice(..), wgpu::IndexFormat::Uint32);
-                for d in draws {
-                    rp.draw_indexed(
-                        d.first_index..d.first_index + d.index_count,
-                        d.base_vertex,
-                        d.instance..d.instance + 1,
-                    );
-                }
-            })?;
+            .read(materials)
+            .read(chunks)
+            .read(color)
+            .read(data)
+            .sampler(SamplerKind::LinearRepeat)
+            .write(gb.depth)
+            .write(gb.normal)
+            .write(gb.albedo)
+            .write(gb.material)
+            .write(gb.motion)
+            .write(gb.emissive)
+            .write(gb.instance)
+            .dispatch_threads(&self.resolve, [width, height, 1])?;
         Ok(gb)
     }
 }

@@ -6,3 +6,5 @@ pub mod gbuffer;
 pub mod graph_check;
 pub mod math_check;
 pub mod placeholder_tonemap;
+pub mod raster;
+pub mod sun_shadows;

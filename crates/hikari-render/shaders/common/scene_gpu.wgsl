@@ -1,0 +1,50 @@
+#define_import_path hikari::scene_gpu
+
+// The scene as uploaded by `scene_gpu.rs`; field meanings are documented there.
+
+struct VertexAttr {
+    uv: vec2<f32>,
+    normal: u32,
+    tangent: u32,
+    color: vec2<u32>,
+    extra: u32,
+    pad: u32,
+}
+
+struct InstanceGpu {
+    model: mat4x4<f32>,
+    normal_model: mat4x4<f32>,
+    prev_model: mat4x4<f32>,
+    material: u32,
+    flags: u32,
+    pad: vec2<u32>,
+}
+
+struct MaterialGpu {
+    base_color: vec4<f32>,
+    emissive: vec4<f32>,
+    params: vec4<f32>,
+    extra: vec4<f32>,
+    textures: vec4<u32>,
+    more_textures: vec4<u32>,
+}
+
+struct Chunk {
+    instance: u32,
+    first_triangle: u32,
+    count: u32,
+    pad: u32,
+}
+
+struct LightGpu {
+    position_range: vec4<f32>,
+    direction_kind: vec4<f32>,
+    intensity: vec4<f32>,
+    spot: vec4<f32>,
+}
+
+const CHUNK_TRIANGLES: u32 = 64u;
+const NO_TEXTURE: u32 = 0xffffffffu;
+const INSTANCE_DOUBLE_SIDED: u32 = 1u;
+const EXTRA_BITANGENT_NEGATIVE: u32 = 0x10000u;
+const EXTRA_HAS_TANGENT: u32 = 0x20000u;

@@ -1,0 +1,190 @@
+// Deferred direct lighting: the sun (or moon) with its cascaded shadows, point and spot
+// lights culled per 16x16 tile, emissive surfaces, and the clearly named placeholders for sky
+// and ambient light that the atmosphere and probe issues replace. BRDF: hikari::brdf (GGX with
+// anisotropy, height-correlated Smith, Schlick Fresnel, Fresnel-weighted Lambert).
+// Output: radiance in nits. CPU twin: reference::direct_lighting.
+
+#import hikari::view::{View, view_ray, world_from_depth}
+#import hikari::octahedral::oct_decode
+#import hikari::brdf::{BrdfMaterial, brdf_evaluate, brdf_fresnel_schlick, brdf_material_f0}
+#import hikari::scene_gpu::LightGpu
+#import hikari::sun_shadows::sun_visibility
+
+struct LightingParams {
+    // xyz: unit vector towards the sun; w: illuminance in lux.
+    direction_lux: vec4<f32>,
+    // rgb: sun colour with luminance 1.
+    color: vec4<f32>,
+    // rgb: placeholder sky radiance at the zenith, in nits.
+    sky_zenith: vec4<f32>,
+    // rgb: placeholder sky radiance at the horizon, in nits.
+    sky_horizon: vec4<f32>,
+    // x: number of lights; y: LIGHTING_* flags.
+    config: vec4<u32>,
+}
+
+const LIGHTING_SUN: u32 = 1u;
+const LIGHTING_PUNCTUAL: u32 = 2u;
+const LIGHTING_EMISSIVE: u32 = 4u;
+const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8u;
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<uniform> params: LightingParams;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var gbuffer_normal: texture_2d<f32>;
+@group(0) @binding(4) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(5) var gbuffer_material: texture_2d<f32>;
+@group(0) @binding(6) var gbuffer_emissive: texture_2d<f32>;
+@group(0) @binding(7) var<storage, read> lights: array<LightGpu>;
+@group(0) @binding(8) var out_radiance: texture_storage_2d<rgba16float, write>;
+
+const PI: f32 = 3.14159265358979;
+// Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
+const MAX_RADIANCE: f32 = 65000.0;
+const TILE: u32 = 16u;
+const MAX_TILE_LIGHTS: u32 = 256u;
+
+var<workgroup> tile_lo: array<atomic<u32>, 3>;
+var<workgroup> tile_hi: array<atomic<u32>, 3>;
+var<workgroup> tile_count: atomic<u32>;
+var<workgroup> tile_lights: array<u32, MAX_TILE_LIGHTS>;
+
+// Order-preserving map from f32 to u32, so atomicMin/Max find float bounds.
+fn ordered(f: f32) -> u32 {
+    let b = bitcast<u32>(f);
+    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
+}
+
+fn unordered(u: u32) -> f32 {
+    return bitcast<f32>(select(~u, u & 0x7fffffffu, (u & 0x80000000u) != 0u));
+}
+
+fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
+    let t = clamp(dir.y, 0.0, 1.0);
+    return mix(params.sky_horizon.rgb, params.sky_zenith.rgb, sqrt(t));
+}
+
+// Irradiance from the placeholder sky on a surface with normal n: the sky is treated as a
+// uniform upper hemisphere of the mean of zenith and horizon, the ground as black, which
+// gives E = pi * L * (1 + n.y) / 2.
+fn ambient_placeholder(n: vec3<f32>) -> vec3<f32> {
+    let l = 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb);
+    return PI * l * 0.5 * (1.0 + n.y);
+}
+
+// Placeholder specular ambient: the placeholder sky seen in the mirror direction, blurred
+// towards its mean with roughness, weighted by Fresnel at n.v; black below the horizon.
+fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    let r = reflect(-v, n);
+    let mean = 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb);
+    let env = mix(sky_placeholder(r), mean, m.perceptual_roughness) * select(0.0, 1.0, r.y > 0.0);
+    return brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0)) * env;
+}
+
+// Illuminance factor of a punctual light at distance^2 `d2`: inverse square, windowed to 0 at
+// the range (the smooth window glTF's KHR_lights_punctual recommends), times the spot cone.
+fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
+    let range = light.position_range.w;
+    let x = d2 / (range * range);
+    let window = clamp(1.0 - x * x, 0.0, 1.0);
+    var a = window * window / max(d2, 1e-4);
+    if light.direction_kind.w > 0.5 {
+        let cos_angle = dot(-l, light.direction_kind.xyz);
+        let s = clamp(cos_angle * light.spot.x + light.spot.y, 0.0, 1.0);
+        a *= s * s;
+    }
+    return a;
+}
+
+@compute @workgroup_size(16, 16, 1)
+fn main(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let size = textureDimensions(out_radiance);
+    let pixel = gid.xy;
+    let inside = all(pixel < size);
+    if lid < 3u {
+        atomicStore(&tile_lo[lid], 0xffffffffu);
+        atomicStore(&tile_hi[lid], 0u);
+    }
+    if lid == 0u {
+        atomicStore(&tile_count, 0u);
+    }
+    workgroupBarrier();
+
+    var d = 0.0;
+    var world = vec3<f32>(0.0);
+    if inside {
+        d = textureLoad(depth, pixel, 0).r;
+        if d > 0.0 {
+            world = world_from_depth(view, pixel, d);
+            for (var k = 0u; k < 3u; k++) {
+                atomicMin(&tile_lo[k], ordered(world[k]));
+                atomicMax(&tile_hi[k], ordered(world[k]));
+            }
+        }
+    }
+    workgroupBarrier();
+
+    // Cull the lights against the bounds of the tile's visible surfaces.
+    let light_count = select(0u, params.config.x, (params.config.y & LIGHTING_PUNCTUAL) != 0u);
+    if atomicLoad(&tile_lo[0]) <= atomicLoad(&tile_hi[0]) {
+        let lo = vec3<f32>(unordered(atomicLoad(&tile_lo[0])), unordered(atomicLoad(&tile_lo[1])), unordered(atomicLoad(&tile_lo[2])));
+        let hi = vec3<f32>(unordered(atomicLoad(&tile_hi[0])), unordered(atomicLoad(&tile_hi[1])), unordered(atomicLoad(&tile_hi[2])));
+        for (var i = lid; i < light_count; i += TILE * TILE) {
+            let lp = lights[i].position_range;
+            let nearest = clamp(lp.xyz, lo, hi);
+            let dd = nearest - lp.xyz;
+            if dot(dd, dd) < lp.w * lp.w {
+                let slot = atomicAdd(&tile_count, 1u);
+                if slot < MAX_TILE_LIGHTS {
+                    tile_lights[slot] = i;
+                }
+            }
+        }
+    }
+    let tile_lights_n = min(workgroupUniformLoad(&tile_count), MAX_TILE_LIGHTS);
+
+    if !inside {
+        return;
+    }
+    var radiance: vec3<f32>;
+    let v = -view_ray(view, pixel);
+    let flags = params.config.y;
+    if d <= 0.0 {
+        radiance = select(vec3<f32>(0.0), sky_placeholder(-v), (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u);
+    } else {
+        let nt = textureLoad(gbuffer_normal, pixel, 0);
+        let n = oct_decode(nt.xy);
+        let ta = oct_decode(nt.zw);
+        let t = normalize(ta - n * dot(n, ta));
+        let b = cross(n, t);
+        let albedo = textureLoad(gbuffer_albedo, pixel, 0);
+        let mat = textureLoad(gbuffer_material, pixel, 0);
+        let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
+        radiance = vec3<f32>(0.0);
+        if (flags & LIGHTING_SUN) != 0u && params.direction_lux.w > 0.0 {
+            let l = params.direction_lux.xyz;
+            let vis = sun_visibility(world, n);
+            radiance += brdf_evaluate(m, n, t, b, v, l) * params.color.rgb * (params.direction_lux.w * vis);
+        }
+        for (var k = 0u; k < tile_lights_n; k++) {
+            let light = lights[tile_lights[k]];
+            let to_light = light.position_range.xyz - world;
+            let d2 = dot(to_light, to_light);
+            let l = to_light * inverseSqrt(max(d2, 1e-8));
+            radiance += brdf_evaluate(m, n, t, b, v, l) * light.intensity.rgb * light_attenuation(light, l, d2);
+        }
+        if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
+            let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);
+            radiance += (diffuse + specular_placeholder(m, n, v)) * mat.w;
+        }
+        if (flags & LIGHTING_EMISSIVE) != 0u {
+            radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;
+        }
+    }
+    // NaN fails every comparison, so this also turns NaN into 0.
+    radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
+    textureStore(out_radiance, pixel, vec4<f32>(radiance, 1.0));
+}

@@ -1,0 +1,248 @@
+// G-buffer resolve: turns the visibility buffer (depth and triangle id a pixel) into the
+// G-buffer. Barycentrics come from intersecting the pixel's camera ray with the triangle, and
+// texture derivatives from the rays through the neighbouring pixel centres, so textures are
+// filtered as a rasteriser's quads would. CPU twin: `reference::gbuffer`.
+
+#import hikari::view::View
+#import hikari::octahedral::oct_encode
+#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT}
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<storage, read> visibility: array<vec2<u32>>;
+@group(0) @binding(2) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> attributes: array<VertexAttr>;
+@group(0) @binding(4) var<storage, read> indices: array<u32>;
+@group(0) @binding(5) var<storage, read> instances: array<InstanceGpu>;
+@group(0) @binding(6) var<storage, read> materials: array<MaterialGpu>;
+@group(0) @binding(7) var<storage, read> chunks: array<Chunk>;
+@group(0) @binding(8) var color_textures: texture_2d_array<f32>;
+@group(0) @binding(9) var data_textures: texture_2d_array<f32>;
+@group(0) @binding(10) var texture_sampler: sampler;
+@group(0) @binding(11) var out_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(12) var out_normal: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(13) var out_albedo: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(14) var out_material: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(15) var out_motion: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(16) var out_emissive: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(17) var out_instance: texture_storage_2d<r32uint, write>;
+
+const NO_INSTANCE: u32 = 0xffffffffu;
+// Largest finite f16 is 65504.
+const MAX_HALF: f32 = 65000.0;
+
+// Any unit vector perpendicular to n (Duff et al. 2017); twin of scene_gpu::orthonormal_tangent.
+fn orthonormal_tangent(n: vec3<f32>) -> vec3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
+}
+
+fn unpack_oct(p: u32) -> vec3<f32> {
+    let e = unpack2x16snorm(p);
+    var v = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    if v.z < 0.0 {
+        let s = select(vec2<f32>(-1.0), vec2<f32>(1.0), v.xy >= vec2<f32>(0.0));
+        v = vec3<f32>((1.0 - abs(v.yx)) * s, v.z);
+    }
+    return normalize(v);
+}
+
+// Point on the near plane seen through a pixel position (not necessarily a centre).
+fn near_point(p: vec2<f32>) -> vec3<f32> {
+    let uv = p * view.viewport.zw;
+    let w = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
+    return w.xyz / w.w;
+}
+
+// Barycentrics (of p1, p2) where the ray o + t d meets the plane of the triangle.
+fn ray_barycentrics(o: vec3<f32>, d: vec3<f32>, p0: vec3<f32>, e1: vec3<f32>, e2: vec3<f32>) -> vec2<f32> {
+    let pv = cross(d, e2);
+    let inv_det = 1.0 / dot(e1, pv);
+    let tv = o - p0;
+    let qv = cross(tv, e1);
+    return vec2<f32>(dot(tv, pv), dot(d, qv)) * inv_det;
+}
+
+// Texture addressing the sampler cannot do per texture: 0 repeat, 1 mirrored, 2 clamp.
+fn wrap_coord(x: f32, mode: u32) -> f32 {
+    if mode == 1u {
+        let m = x - 2.0 * floor(x * 0.5);
+        return select(m, 2.0 - m, m > 1.0);
+    }
+    if mode == 2u {
+        return clamp(x, 0.0, 1.0);
+    }
+    return x;
+}
+
+fn wrap_uv(uv: vec2<f32>, bits: u32) -> vec2<f32> {
+    return vec2<f32>(wrap_coord(uv.x, bits & 3u), wrap_coord(uv.y, (bits >> 2u) & 3u));
+}
+
+struct UvGrad {
+    uv: vec2<f32>,
+    ddx: vec2<f32>,
+    ddy: vec2<f32>,
+}
+
+fn sample_color(layer: u32, wrap: u32, g: UvGrad) -> vec4<f32> {
+    if layer == NO_TEXTURE {
+        return vec4<f32>(1.0);
+    }
+    return textureSampleGrad(color_textures, texture_sampler, wrap_uv(g.uv, wrap), layer, g.ddx, g.ddy);
+}
+
+fn sample_data(layer: u32, wrap: u32, g: UvGrad) -> vec4<f32> {
+    if layer == NO_TEXTURE {
+        return vec4<f32>(1.0);
+    }
+    return textureSampleGrad(data_textures, texture_sampler, wrap_uv(g.uv, wrap), layer, g.ddx, g.ddy);
+}
+
+fn unpack_color(c: vec2<u32>) -> vec4<f32> {
+    return vec4<f32>(unpack2x16unorm(c.x), unpack2x16unorm(c.y));
+}
+
+fn mat3_of(m: mat4x4<f32>) -> mat3x3<f32> {
+    return mat3x3<f32>(m[0].xyz, m[1].xyz, m[2].xyz);
+}
+
+fn project_to_pixel(m: mat4x4<f32>, p: vec4<f32>) -> vec2<f32> {
+    let c = m * p;
+    let ndc = c.xy / c.w;
+    return vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * view.viewport.xy;
+}
+
+// Clamped to what f16 holds, and NaN (which fails every comparison) to 0: nothing non-finite
+// reaches the G-buffer.
+fn finite_half2(v: vec2<f32>) -> vec2<f32> {
+    return select(vec2<f32>(0.0), clamp(v, vec2<f32>(-MAX_HALF), vec2<f32>(MAX_HALF)), abs(v) <= vec2<f32>(MAX_HALF * 2.0));
+}
+
+fn write_sky(px: vec2<u32>) {
+    // The sky moves only with the camera's rotation: project the direction at infinity.
+    let centre = vec2<f32>(px) + 0.5;
+    let dir = near_point(centre) - view.position.xyz;
+    let prev = project_to_pixel(view.prev_view_proj, vec4<f32>(dir, 0.0));
+    textureStore(out_depth, px, vec4<f32>(0.0));
+    textureStore(out_normal, px, vec4<f32>(0.0));
+    textureStore(out_albedo, px, vec4<f32>(0.0));
+    textureStore(out_material, px, vec4<f32>(0.0));
+    textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre), 0.0, 0.0));
+    textureStore(out_emissive, px, vec4<f32>(0.0));
+    textureStore(out_instance, px, vec4<u32>(NO_INSTANCE));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let size = textureDimensions(out_depth);
+    if any(gid.xy >= size) {
+        return;
+    }
+    let px = gid.xy;
+    let vis = visibility[px.y * size.x + px.x];
+    if vis.y == 0u {
+        write_sky(px);
+        return;
+    }
+    let id = vis.x;
+    let chunk = chunks[id / CHUNK_TRIANGLES];
+    let tri = chunk.first_triangle + id % CHUNK_TRIANGLES;
+    let inst = instances[chunk.instance];
+    let mat = materials[inst.material];
+    let i = vec3<u32>(indices[tri * 3u], indices[tri * 3u + 1u], indices[tri * 3u + 2u]);
+    let q0 = positions[i.x].xyz;
+    let q1 = positions[i.y].xyz;
+    let q2 = positions[i.z].xyz;
+    let p0 = (inst.model * vec4<f32>(q0, 1.0)).xyz;
+    let e1 = (inst.model * vec4<f32>(q1, 1.0)).xyz - p0;
+    let e2 = (inst.model * vec4<f32>(q2, 1.0)).xyz - p0;
+
+    let o = view.position.xyz;
+    let centre = vec2<f32>(px) + 0.5;
+    let d = near_point(centre) - o;
+    let b = ray_barycentrics(o, d, p0, e1, e2);
+    let bx = ray_barycentrics(o, near_point(centre + vec2<f32>(1.0, 0.0)) - o, p0, e1, e2);
+    let by = ray_barycentrics(o, near_point(centre + vec2<f32>(0.0, 1.0)) - o, p0, e1, e2);
+    let w = vec3<f32>(1.0 - b.x - b.y, b.x, b.y);
+
+    let a0 = attributes[i.x];
+    let a1 = attributes[i.y];
+    let a2 = attributes[i.z];
+    let uv0 = a0.uv;
+    let duv1 = a1.uv - uv0;
+    let duv2 = a2.uv - uv0;
+    var g: UvGrad;
+    g.uv = uv0 + duv1 * b.x + duv2 * b.y;
+    g.ddx = duv1 * (bx.x - b.x) + duv2 * (bx.y - b.y);
+    g.ddy = duv1 * (by.x - b.x) + duv2 * (by.y - b.y);
+
+    // Frames: geometric normal faces the camera on double-sided surfaces (single-sided back
+    // faces were culled); shading normal and tangent follow it.
+    let normal_model = mat3_of(inst.normal_model);
+    var ng = normalize(cross(e1, e2));
+    var n = normalize(normal_model * (unpack_oct(a0.normal) * w.x + unpack_oct(a1.normal) * w.y + unpack_oct(a2.normal) * w.z));
+    let facing = select(1.0, -1.0, dot(ng, d) > 0.0 && (inst.flags & INSTANCE_DOUBLE_SIDED) != 0u);
+    n *= facing;
+    ng *= facing;
+    let model3 = mat3_of(inst.model);
+    var t = model3 * (unpack_oct(a0.tangent) * w.x + unpack_oct(a1.tangent) * w.y + unpack_oct(a2.tangent) * w.z);
+    t = t - n * dot(n, t);
+    if (a0.extra & EXTRA_HAS_TANGENT) == 0u || dot(t, t) < 1e-12 {
+        t = orthonormal_tangent(n);
+    } else {
+        t = normalize(t);
+    }
+    let handedness = select(1.0, -1.0, (a0.extra & EXTRA_BITANGENT_NEGATIVE) != 0u);
+    var bt = cross(n, t) * handedness;
+
+    let wraps = mat.more_textures.y;
+    let nt = mat.textures.z;
+    if nt != NO_TEXTURE {
+        let s = sample_data(nt, (wraps >> 8u) & 15u, g).xy * 2.0 - 1.0;
+        let xy = s * mat.emissive.w;
+        let tn = vec3<f32>(xy, sqrt(max(0.0, 1.0 - dot(xy, xy))));
+        let mapped = t * tn.x + bt * tn.y + n * tn.z;
+        if dot(mapped, mapped) > 1e-12 {
+            n = normalize(mapped);
+            t = normalize(t - n * dot(n, t));
+            bt = cross(n, t) * handedness;
+        }
+    }
+    // Degenerate vertex data (zero normals) must not leak NaN into the G-buffer.
+    if !all(n == n) || dot(n, n) < 0.5 {
+        n = ng;
+        t = orthonormal_tangent(n);
+        bt = cross(n, t);
+    }
+    // KHR_materials_anisotropy: the direction is the tangent rotated in the tangent plane.
+    let rot = mat.params.w;
+    let aniso_dir = normalize(t * cos(rot) + bt * sin(rot));
+
+    let vertex_color = unpack_color(a0.color) * w.x + unpack_color(a1.color) * w.y + unpack_color(a2.color) * w.z;
+    let base = mat.base_color.rgb * vertex_color.rgb * sample_color(mat.textures.x, wraps & 15u, g).rgb;
+    let mr = sample_data(mat.textures.y, (wraps >> 4u) & 15u, g);
+    let roughness = clamp(mat.params.x * mr.g, 0.0, 1.0);
+    let metalness = clamp(mat.params.y * mr.b, 0.0, 1.0);
+    let occlusion_tex = sample_data(mat.more_textures.x, (wraps >> 16u) & 15u, g).r;
+    let occlusion = 1.0 + mat.extra.x * (occlusion_tex - 1.0);
+    let emissive = mat.emissive.rgb * sample_color(mat.textures.w, (wraps >> 12u) & 15u, g).rgb;
+
+    let vertex_interior = f32(a0.extra & 0xffffu) * w.x + f32(a1.extra & 0xffffu) * w.y + f32(a2.extra & 0xffffu) * w.z;
+    let interior = select(vertex_interior / 65535.0, mat.extra.y, mat.extra.y >= 0.0);
+
+    // Motion: where this surface point was last frame, minus where it is now, in pixels.
+    let q = q0 * w.x + q1 * w.y + q2 * w.z;
+    let prev = project_to_pixel(view.prev_view_proj, inst.prev_model * vec4<f32>(q, 1.0));
+    let world = p0 + e1 * b.x + e2 * b.y;
+    let view_depth = dot(world - o, view.forward_near.xyz);
+
+    textureStore(out_depth, px, vec4<f32>(bitcast<f32>(vis.y), 0.0, 0.0, 0.0));
+    textureStore(out_normal, px, vec4<f32>(oct_encode(n), oct_encode(aniso_dir)));
+    textureStore(out_albedo, px, vec4<f32>(clamp(base, vec3<f32>(0.0), vec3<f32>(1.0)), clamp(interior, 0.0, 1.0)));
+    textureStore(out_material, px, vec4<f32>(roughness, metalness, clamp(mat.params.z, 0.0, 1.0), clamp(occlusion, 0.0, 1.0)));
+    textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre), finite_half2(vec2<f32>(view_depth, 0.0))));
+    textureStore(out_emissive, px, vec4<f32>(clamp(emissive, vec3<f32>(0.0), vec3<f32>(MAX_HALF)), 0.0));
+    textureStore(out_instance, px, vec4<u32>(chunk.instance, 0u, 0u, 0u));
+}

@@ -1,0 +1,162 @@
+//! hikari's compute rasteriser, shared by the G-buffer (visibility: depth and triangle id a
+//! pixel, in 64-bit atomics) and the sun's shadow maps (depth only, up to four views a
+//! dispatch). It exists because rasterising in compute is several times faster than the
+//! fixed-function path on the GPUs we measure on (BENCHMARKS.md: the H200 fills ~7 Gpixel/s).
+//!
+//! Pass 1 (`{technique}.rasterize`) runs a thread a triangle: small triangles are rasterised by
+//! their thread, larger ones split into 32x32 tiles queued for pass 2
+//! (`{technique}.rasterize_tiles`), where a workgroup covers a tile. CPU twin: rays through the
+//! pixel centres with `hikari_bvh` (tests/raster.rs).
+
+use bytemuck::{Pod, Zeroable};
+use glam::Mat4;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::graph::{Buf, FrameGraph};
+use crate::pipeline::ComputePipeline;
+use crate::scene_gpu::SceneGpu;
+use crate::shader::ShaderLibrary;
+use naga_oil::compose::ShaderDefValue;
+
+pub const TILE_SIZE: u32 = 32;
+/// Workgroups of the tile pass; each loops over the queue.
+const TILE_WORKGROUPS: u32 = 4096;
+pub const MAX_VIEWS: usize = 4;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct RasterParams {
+    pub view_proj: [[[f32; 4]; 4]; MAX_VIEWS],
+    pub viewport: [f32; 4],
+    pub config: [u32; 4],
+}
+
+/// Whether a target keeps the triangle id beside the depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RasterTarget {
+    /// 8 bytes a pixel: depth bits << 32 | visibility id.
+    Visibility,
+    /// 4 bytes a texel: depth bits.
+    Depth,
+}
+
+impl RasterTarget {
+    pub fn bytes_per_texel(self) -> u64 {
+        match self {
+            RasterTarget::Visibility => 8,
+            RasterTarget::Depth => 4,
+        }
+    }
+}
+
+/// One rasterisation: into which views, at which size.
+pub struct RasterJob<'a> {
+    /// Technique name; the passes are `{technique}.clear`, `.rasterize`, `.rasterize_tiles`.
+    pub technique: &'a str,
+    pub view_proj: &'a [Mat4],
+    pub size: [u32; 2],
+    pub cull_back_faces: bool,
+}
+
+pub struct Rasterizer {
+    visibility: [ComputePipeline; 2],
+    depth: [ComputePipeline; 2],
+}
+
+impl Rasterizer {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        let missing = crate::context::REQUIRED_FEATURES - ctx.features;
+        if !missing.is_empty() {
+            return Err(RenderError::Graph(format!(
+                "the compute rasteriser needs GPU features this adapter lacks: {missing:?} \
+                 (64-bit integer atomics; Vulkan's shaderBufferInt64Atomics)"
+            )));
+        }
+        let depth_only = [("DEPTH_ONLY", ShaderDefValue::Bool(true))];
+        Ok(Self {
+            visibility: [
+                ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &[])?,
+                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &[])?,
+            ],
+            depth: [
+                ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &depth_only)?,
+                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &depth_only)?,
+            ],
+        })
+    }
+
+    /// Clears `target` and rasterises every scene triangle into it, once per view.
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        scene: &'r SceneGpu,
+        job: &RasterJob<'_>,
+        kind: RasterTarget,
+        target: Buf,
+    ) -> Result<()> {
+        let views = job.view_proj.len();
+        assert!((1..=MAX_VIEWS).contains(&views), "1 to {MAX_VIEWS} views");
+        let [w, h] = job.size;
+        let tiles = (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as u64 * views as u64;
+        // Room for every tile covered eight times over by large triangles; beyond that, large
+        // triangles lose tiles (the overflow shows as holes, and `queue_count` tells).
+        let capacity = (tiles * 8).clamp(1 << 16, 1 << 22) as u32;
+        let t = job.technique;
+        let queue = g.buffer(&format!("{t}.tile_queue"), capacity as u64 * 8)?;
+        let count = g.buffer(&format!("{t}.tile_count"), 16)?;
+        g.pass(&format!("{t}.clear"))
+            .uses(target, true)
+            .uses(count, true)
+            .encode(move |enc, res| {
+                enc.clear_buffer(res.buffer(target), 0, None);
+                enc.clear_buffer(res.buffer(count), 0, None);
+            })?;
+        let mut view_proj = [[[0.0; 4]; 4]; MAX_VIEWS];
+        for (dst, m) in view_proj.iter_mut().zip(job.view_proj) {
+            *dst = m.to_cols_array_2d();
+        }
+        let params = RasterParams {
+            view_proj,
+            viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
+            config: [
+                job.cull_back_faces as u32,
+                capacity,
+                views as u32,
+                scene.chunk_count,
+            ],
+        };
+        let positions = g.import_buffer("scene.positions", &scene.positions);
+        let indices = g.import_buffer("scene.indices", &scene.indices);
+        let instances = g.import_buffer("scene.instances", &scene.instances);
+        let chunks = g.import_buffer("scene.chunks", &scene.chunks);
+        let pipelines = match kind {
+            RasterTarget::Visibility => &self.visibility,
+            RasterTarget::Depth => &self.depth,
+        };
+        let max = g.ctx().limits.max_compute_workgroups_per_dimension;
+        let n = scene.chunk_count.max(1);
+        let groups = [n.min(max), n.div_ceil(max), views as u32];
+        g.pass(&format!("{t}.rasterize"))
+            .constants(&params)
+            .read(positions)
+            .read(indices)
+            .read(instances)
+            .read(chunks)
+            .write(target)
+            .write(queue)
+            .write(count)
+            .dispatch(&pipelines[0], groups)?;
+        g.pass(&format!("{t}.rasterize_tiles"))
+            .constants(&params)
+            .read(positions)
+            .read(indices)
+            .read(instances)
+            .read(chunks)
+            .write(target)
+            .write(queue)
+            .write(count)
+            .dispatch(&pipelines[1], [TILE_WORKGROUPS, 1, 1])?;
+        Ok(())
+    }
+}

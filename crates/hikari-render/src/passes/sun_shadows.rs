@@ -1,0 +1,294 @@
+//! Cascaded shadow maps of the sun (or moon), rasterised in compute (`passes/raster.rs`) into
+//! one u32 depth a texel, looked up with 3x3 bilinear PCF by the deferred lighting
+//! (`shaders/sun_shadows/lookup.wgsl`; CPU twin [`crate::reference::sun_shadows`]).
+//!
+//! Stability under camera motion: each cascade is the bounding sphere of its slice of the view
+//! frustum, whose radius depends only on the slice distances and the field of view (not on the
+//! camera's orientation), and its centre is snapped to whole texels in light space, so texels
+//! keep their place in the world as the camera turns and moves.
+//!
+//! Depth convention as the camera's: 1 nearest the sun, 0 farthest (the cleared value), over
+//! the scene's extent along the sun direction, so every caster is inside the depth range.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+
+use hikari_scene::Camera;
+
+use super::raster::{MAX_VIEWS, RasterJob, RasterTarget, Rasterizer};
+use crate::error::Result;
+use crate::graph::{Buf, FrameGraph};
+use crate::scene_gpu::SceneGpu;
+use crate::settings::ShadowSettings;
+
+/// What the lookup needs; `cascades` of zero means no shadows (everything lit).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ShadowParams {
+    pub light_view_proj: [[[f32; 4]; 4]; MAX_VIEWS],
+    /// Per cascade: world-space size of a texel in metres.
+    pub texel_world: [f32; 4],
+    /// Cascades, resolution, PCF tap spacing in texels, normal bias in texels.
+    pub config: [f32; 4],
+    /// Per cascade: depth bias in NDC depth units.
+    pub depth_bias: [f32; 4],
+}
+
+/// One cascade: its projection and the size of its texels.
+#[derive(Clone, Copy, Debug)]
+pub struct Cascade {
+    pub view_proj: Mat4,
+    pub texel_world: f32,
+    /// Camera distance where the cascade's slice ends.
+    pub far: f32,
+    /// Radius of the cascade's bounding sphere, metres.
+    pub radius: f32,
+}
+
+/// Unit light-space axes: x and y across the map, z towards the sun.
+pub fn light_basis(to_sun: Vec3) -> (Vec3, Vec3, Vec3) {
+    let z = to_sun.normalize();
+    let helper = if z.y.abs() < 0.99 { Vec3::Y } else { Vec3::X };
+    let x = helper.cross(z).normalize();
+    (x, z.cross(x), z)
+}
+
+/// Camera distances of the cascade boundaries, from `near` to `far`: a blend of logarithmic
+/// and uniform splits (Zhang et al. 2006, "parallel-split shadow maps").
+pub fn split_distances(near: f32, far: f32, cascades: u32, lambda: f32) -> Vec<f32> {
+    (0..=cascades)
+        .map(|i| {
+            let f = i as f32 / cascades as f32;
+            let log = near * (far / near).powf(f);
+            let uniform = near + (far - near) * f;
+            lambda * log + (1.0 - lambda) * uniform
+        })
+        .collect()
+}
+
+/// Centre distance along the view axis and radius of the smallest sphere holding the frustum
+/// slice between `dn` and `df`, for a frustum whose corner rays make `k = tan^2` of the half
+/// diagonal angle with the axis.
+pub fn slice_sphere(dn: f32, df: f32, k: f32) -> (f32, f32) {
+    let z = 0.5 * (dn + df) * (1.0 + k);
+    if z >= df {
+        (df, df * k.sqrt())
+    } else {
+        (z, ((z - dn) * (z - dn) + dn * dn * k).sqrt())
+    }
+}
+
+pub fn fit_cascades(
+    camera: &Camera,
+    aspect: f32,
+    to_sun: Vec3,
+    scene_bounds: (Vec3, Vec3),
+    s: &ShadowSettings,
+) -> Vec<Cascade> {
+    let (lx, ly, lz) = light_basis(to_sun);
+    let (lo, hi) = scene_bounds;
+    let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
+    for i in 0..8 {
+        let c = Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        zmin = zmin.min(c.dot(lz));
+        zmax = zmax.max(c.dot(lz));
+    }
+    // A margin so surfaces on the bounds do not sit exactly on depth 0 or 1.
+    zmin -= 1.0;
+    zmax += 1.0;
+    let tan_half_v = (camera.vfov_deg.to_radians() * 0.5).tan();
+    let k = tan_half_v * tan_half_v * (1.0 + aspect * aspect);
+    let near = camera.near.max(0.01);
+    let splits = split_distances(near, s.max_distance_m.max(near * 2.0), s.cascades, s.split_lambda);
+    let forward = camera.forward();
+    let res = s.resolution as f32;
+    splits
+        .windows(2)
+        .map(|w| {
+            let (centre_d, radius) = slice_sphere(w[0], w[1], k);
+            let centre = camera.position + forward * centre_d;
+            let texel = 2.0 * radius / res;
+            let snap = |v: f32| (v / texel).floor() * texel;
+            let (cx, cy) = (snap(centre.dot(lx)), snap(centre.dot(ly)));
+            let depth = zmax - zmin;
+            // Rows: x_ndc = (p.lx - cx) / r, y_ndc = (p.ly - cy) / r, depth = (p.lz - zmin) / depth.
+            let rows = [
+                (lx / radius).extend(-cx / radius),
+                (ly / radius).extend(-cy / radius),
+                (lz / depth).extend(-zmin / depth),
+                Vec4::new(0.0, 0.0, 0.0, 1.0),
+            ];
+            Cascade {
+                view_proj: Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose(),
+                texel_world: texel,
+                far: w[1],
+                radius,
+            }
+        })
+        .collect()
+}
+
+impl ShadowParams {
+    pub fn disabled() -> Self {
+        Self::zeroed()
+    }
+
+    pub fn new(cascades: &[Cascade], depth_range: f32, s: &ShadowSettings) -> Self {
+        let mut p = Self::zeroed();
+        for (i, c) in cascades.iter().enumerate() {
+            p.light_view_proj[i] = c.view_proj.to_cols_array_2d();
+            p.texel_world[i] = c.texel_world;
+            p.depth_bias[i] = s.depth_bias_texels * c.texel_world / depth_range;
+        }
+        p.config = [
+            cascades.len() as f32,
+            s.resolution as f32,
+            s.filter_radius_texels,
+            s.normal_bias_texels,
+        ];
+        p
+    }
+}
+
+/// The shadow maps of a frame: `cascades * resolution^2` u32 depths, cascade-major.
+#[derive(Clone, Copy, Debug)]
+pub struct SunShadowMaps {
+    pub texels: Buf,
+    pub params: ShadowParams,
+}
+
+/// Extent of the scene bounds along `to_sun` (with the fit's margin), for depth biases.
+pub fn depth_range(to_sun: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
+    let z = to_sun.normalize();
+    (hi - lo).abs().dot(z.abs()) + 2.0
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn record<'r>(
+    g: &mut FrameGraph<'r>,
+    raster: &'r Rasterizer,
+    scene: &'r SceneGpu,
+    camera: &Camera,
+    aspect: f32,
+    to_sun: Vec3,
+    s: &ShadowSettings,
+) -> Result<SunShadowMaps> {
+    let bounds = match scene.bounds {
+        Some(b) if s.enabled && to_sun.length_squared() > 0.0 => b,
+        _ => {
+            let texels = g.buffer("sun_shadows.texels", 16)?;
+            g.pass("sun_shadows.clear")
+                .uses(texels, true)
+                .encode(move |enc, res| enc.clear_buffer(res.buffer(texels), 0, None))?;
+            return Ok(SunShadowMaps {
+                texels,
+                params: ShadowParams::disabled(),
+            });
+        }
+    };
+    let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
+    let res = s.resolution as u64;
+    let texels = g.buffer(
+        "sun_shadows.texels",
+        res * res * cascades.len() as u64 * 4,
+    )?;
+    let view_proj: Vec<Mat4> = cascades.iter().map(|c| c.view_proj).collect();
+    raster.record(
+        g,
+        scene,
+        &RasterJob {
+            technique: "sun_shadows",
+            view_proj: &view_proj,
+            size: [s.resolution, s.resolution],
+            // Both faces cast: thin walls are single panels in many scenes.
+            cull_back_faces: false,
+        },
+        RasterTarget::Depth,
+        texels,
+    )?;
+    Ok(SunShadowMaps {
+        texels,
+        params: ShadowParams::new(&cascades, depth_range(to_sun, bounds), s),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Quat;
+
+    fn camera(position: Vec3, forward: Vec3) -> Camera {
+        Camera {
+            name: "c".into(),
+            position,
+            target: position + forward,
+            vfov_deg: 60.0,
+            near: 0.1,
+            up: Vec3::Y,
+        }
+    }
+
+    fn corners(dn: f32, df: f32, fov_deg: f32, aspect: f32) -> Vec<Vec3> {
+        let t = (fov_deg.to_radians() * 0.5).tan();
+        let mut v = Vec::new();
+        for d in [dn, df] {
+            for (sx, sy) in [(-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0), (1.0, 1.0)] {
+                v.push(Vec3::new(sx * d * t * aspect, sy * d * t, d));
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn the_slice_sphere_holds_its_frustum_slice_and_is_minimal() {
+        for (dn, df, fov, aspect) in [(0.1, 5.0, 60.0, 1.78), (5.0, 40.0, 90.0, 1.0), (40.0, 250.0, 30.0, 2.4)] {
+            let t = (f32::to_radians(fov) * 0.5).tan();
+            let k = t * t * (1.0 + aspect * aspect);
+            let (z, r) = slice_sphere(dn, df, k);
+            let c = Vec3::new(0.0, 0.0, z);
+            let far = corners(dn, df, fov, aspect)
+                .iter()
+                .map(|p| p.distance(c))
+                .fold(0.0, f32::max);
+            assert!(far <= r * (1.0 + 1e-5), "corner at {far} outside radius {r}");
+            // Minimal: the farthest corner is on the sphere.
+            assert!(far >= r * (1.0 - 1e-4), "radius {r} larger than needed ({far})");
+        }
+    }
+
+    #[test]
+    fn cascades_keep_their_size_when_the_camera_turns_and_their_texels_when_it_moves() {
+        let s = ShadowSettings::default();
+        let bounds = (Vec3::splat(-200.0), Vec3::splat(200.0));
+        let sun = Vec3::new(-0.4, 0.8, 0.3).normalize();
+        let base = fit_cascades(&camera(Vec3::new(1.0, 2.0, 3.0), Vec3::Z), 1.78, sun, bounds, &s);
+        for i in 0..20 {
+            let q = Quat::from_euler(glam::EulerRot::YXZ, i as f32 * 0.37, (i as f32 * 0.11).sin() * 0.6, 0.0);
+            let pos = Vec3::new(1.0 + i as f32 * 0.731, 2.0 + i as f32 * 0.05, 3.0 - i as f32 * 1.37);
+            let moved = fit_cascades(&camera(pos, q * Vec3::Z), 1.78, sun, bounds, &s);
+            for (a, b) in base.iter().zip(&moved) {
+                assert!((a.radius - b.radius).abs() <= a.radius * 1e-5, "radius changed");
+                // A fixed world point lands on the same sub-texel position in every frame:
+                // the projections differ by whole texels.
+                let p = Vec3::new(3.3, 0.7, -2.1);
+                let (pa, pb) = (a.view_proj.project_point3(p), b.view_proj.project_point3(p));
+                let texels = (pa - pb).truncate() * 0.5 * s.resolution as f32;
+                let frac = (texels - texels.round()).abs();
+                assert!(frac.max_element() < 2e-2, "moved by {texels} texels");
+            }
+        }
+    }
+
+    #[test]
+    fn splits_run_from_near_to_far_and_blend_log_and_uniform() {
+        let d = split_distances(0.1, 100.0, 4, 1.0);
+        assert!((d[2] - (0.1f32 * 100.0).sqrt()).abs() < 1e-3, "log split {d:?}");
+        let d = split_distances(0.1, 100.0, 4, 0.0);
+        assert!((d[2] - 50.05).abs() < 1e-3, "uniform split {d:?}");
+        assert!(d.windows(2).all(|w| w[0] < w[1]));
+    }
+}

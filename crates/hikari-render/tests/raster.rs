@@ -1,0 +1,230 @@
+//! The compute rasteriser against rays through the same pixel (texel) centres, traced by
+//! brute force on the CPU with hikari-bvh's watertight triangle test: the G-buffer's
+//! visibility and the sun's shadow maps.
+
+mod common;
+
+use glam::{Affine3A, Mat4, Vec3, Vec4};
+use hikari_bvh::reference::closest_hit_instances;
+use hikari_bvh::{Instance, Mesh, Ray};
+use hikari_render::passes::sun_shadows;
+use hikari_render::reference::gbuffer::{decode_id, pixel_ray};
+use hikari_render::{FrameSettings, Renderer, Settings};
+use hikari_scene::Scene;
+
+fn bvh_scene(scene: &Scene) -> (Vec<Mesh>, Vec<Instance>) {
+    let meshes = scene
+        .meshes
+        .iter()
+        .map(|m| {
+            Mesh::new(
+                m.positions.clone(),
+                m.indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            )
+        })
+        .collect();
+    let instances = scene
+        .instances
+        .iter()
+        .map(|i| Instance::new(Affine3A::from_mat4(i.transform), i.mesh as u32))
+        .collect();
+    (meshes, instances)
+}
+
+fn frame_settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
+    let mut settings = Settings::default();
+    settings.shadows.resolution = 128;
+    settings.shadows.cascades = 2;
+    settings.shadows.max_distance_m = 40.0;
+    FrameSettings {
+        width: w,
+        height: h,
+        camera: scene.cameras[0].clone(),
+        prev_camera: None,
+        sun: scene.sun.clone(),
+        settings,
+    }
+}
+
+fn mesh_first_triangles(scene: &Scene) -> Vec<u32> {
+    let mut first = 0;
+    scene
+        .meshes
+        .iter()
+        .map(|m| {
+            let f = first;
+            first += m.indices.len() as u32 / 3;
+            f
+        })
+        .collect()
+}
+
+#[test]
+fn visibility_matches_rays_through_pixel_centres() {
+    for scene in [hikari_scene::builtin::boxes(), hikari_scene::builtin::cornell()] {
+        let Some(ctx) = common::gpu() else { return };
+        let (w, h) = (96u32, 64u32);
+        let s = frame_settings(&scene, w, h);
+        let mut renderer = Renderer::new(ctx, &scene).unwrap();
+        let r = renderer
+            .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
+            .unwrap();
+        let vis: &[u32] = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap());
+        let (meshes, instances) = bvh_scene(&scene);
+        let firsts = mesh_first_triangles(&scene);
+        let view = hikari_render::view::View::new(&s.camera, w, h);
+        let inv = Mat4::from_cols_array_2d(&view.inv_view_proj);
+        let vp = view.view_proj();
+        let cpu = &renderer.scene().cpu;
+        let (mut agree, mut differ, mut worst_depth) = (0, 0, 0f32);
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let (id, depth_bits) = (vis[2 * i], vis[2 * i + 1]);
+                let dir = pixel_ray(inv, s.camera.position, [x, y], [w, h]);
+                let ray = Ray::new(s.camera.position, dir, s.camera.near, f32::INFINITY);
+                let want = closest_hit_instances(&meshes, &instances, None, &ray);
+                let got = (depth_bits != 0).then(|| {
+                    let chunk = &cpu.chunks[(id / 64) as usize];
+                    let mesh = scene.instances[chunk.instance as usize].mesh;
+                    decode_id(cpu, id, firsts[mesh]).unwrap()
+                });
+                match (got, want) {
+                    (None, None) => agree += 1,
+                    (Some((inst, tri)), Some(hit)) if inst == hit.instance && tri == hit.primitive => {
+                        agree += 1;
+                        let p = s.camera.position + dir * hit.t;
+                        let c = vp * p.extend(1.0);
+                        let want_depth = c.z / c.w;
+                        let got_depth = f32::from_bits(depth_bits);
+                        worst_depth = worst_depth.max((got_depth - want_depth).abs() / want_depth);
+                    }
+                    _ => differ += 1,
+                }
+            }
+        }
+        // Pixel centres within rounding of a shared edge may go either way; nothing else.
+        assert!(
+            differ * 200 <= agree,
+            "{differ} pixels differ from the rays, {agree} agree"
+        );
+        assert!(worst_depth < 1e-4, "worst relative depth error {worst_depth}");
+    }
+}
+
+/// A unit sphere of `rings` x `segments` quads, outward-facing, sharing its vertices.
+fn uv_sphere(segments: u32, rings: u32) -> hikari_scene::Mesh {
+    let mut m = hikari_scene::Mesh {
+        name: "sphere".into(),
+        ..Default::default()
+    };
+    for r in 0..=rings {
+        let theta = std::f32::consts::PI * r as f32 / rings as f32;
+        for k in 0..=segments {
+            // The seam column repeats the first one exactly, so the mesh stays closed.
+            let phi = std::f32::consts::TAU * (k % segments) as f32 / segments as f32;
+            let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            m.positions.push(p);
+            m.normals.push(p);
+        }
+    }
+    let row = segments + 1;
+    for r in 0..rings {
+        for k in 0..segments {
+            let (a, b) = (r * row + k, (r + 1) * row + k);
+            m.indices.extend([a, a + 1, b, a + 1, b + 1, b]);
+        }
+    }
+    m
+}
+
+#[test]
+fn a_closed_mesh_has_no_cracks_or_holes() {
+    // A camera inside a closed, finely tessellated sphere: every pixel must see it. A crack
+    // between triangles (a pixel centre claimed by neither) shows as sky.
+    let Some(ctx) = common::gpu() else { return };
+    let mut scene = Scene::default();
+    scene.meshes.push(uv_sphere(96, 48));
+    // Seen from inside: the inward faces are back faces of the outward-wound sphere.
+    let mut m = hikari_scene::Material::diffuse("inside", Vec3::splat(0.5));
+    m.double_sided = true;
+    scene.materials.push(m);
+    scene.instances.push(hikari_scene::Instance {
+        mesh: 0,
+        material: 0,
+        transform: Mat4::from_scale(Vec3::splat(20.0)),
+    });
+    scene.cameras.push(hikari_scene::Camera {
+        name: "inside".into(),
+        position: Vec3::new(0.3, 0.2, 0.1),
+        target: Vec3::new(5.0, 1.0, 3.0),
+        vfov_deg: 100.0,
+        near: 0.1,
+        up: Vec3::Y,
+    });
+    let s = frame_settings(&scene, 128, 96);
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let r = renderer
+        .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
+        .unwrap();
+    let vis: &[u32] = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap());
+    let holes = vis.chunks(2).filter(|p| p[1] == 0).count();
+    assert_eq!(holes, 0, "{holes} pixels see through the sphere");
+}
+
+#[test]
+fn shadow_maps_match_rays_from_the_sun() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = hikari_scene::builtin::boxes();
+    let s = frame_settings(&scene, 64, 48);
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let r = renderer
+        .render_reading(&s, |out| vec![out.shadows.texels.into()])
+        .unwrap();
+    let texels: &[f32] = bytemuck::cast_slice(r.buffer("sun_shadows.texels").unwrap());
+    let sun = scene.sun.clone().unwrap();
+    let cascades = sun_shadows::fit_cascades(
+        &s.camera,
+        64.0 / 48.0,
+        sun.direction,
+        renderer.scene().bounds.unwrap(),
+        &s.settings.shadows,
+    );
+    let (meshes, instances) = bvh_scene(&scene);
+    let res = s.settings.shadows.resolution;
+    let (mut agree, mut differ, mut covered) = (0, 0, 0);
+    for (c, cascade) in cascades.iter().enumerate() {
+        let inv = cascade.view_proj.inverse();
+        let vp = cascade.view_proj;
+        for y in 0..res {
+            for x in 0..res {
+                let ndc = |z: f32| {
+                    let u = (x as f32 + 0.5) / res as f32;
+                    let v = (y as f32 + 0.5) / res as f32;
+                    let p = inv * Vec4::new(u * 2.0 - 1.0, 1.0 - v * 2.0, z, 1.0);
+                    p.truncate() / p.w
+                };
+                let (from, to) = (ndc(1.0), ndc(0.0));
+                let dir = (to - from).normalize();
+                let ray = Ray::new(from, dir, 0.0, (to - from).length());
+                let want = closest_hit_instances(&meshes, &instances, None, &ray)
+                    .map(|h| (vp * (from + dir * h.t).extend(1.0)).z)
+                    .unwrap_or(0.0);
+                let got = texels[(c as u32 * res * res + y * res + x) as usize];
+                if want > 0.0 {
+                    covered += 1;
+                }
+                if (got - want).abs() <= 1e-5 {
+                    agree += 1;
+                } else {
+                    differ += 1;
+                }
+            }
+        }
+    }
+    assert!(covered > 1000, "the maps see the scene ({covered} texels)");
+    assert!(
+        differ * 200 <= agree,
+        "{differ} texels differ from the rays, {agree} agree"
+    );
+}
