@@ -1,4 +1,6 @@
-//! Built-in scenes, generated in code (deterministic: no randomness, no assets).
+//! Built-in scenes, generated in code, without assets. Deterministic: `village` draws from a
+//! seeded generator (a fixed default seed, or [`village_with_seed`]), the others use no
+//! randomness.
 //!
 //! Units as everywhere in the crate: metres, lux, candela, nits.
 
@@ -7,15 +9,27 @@ use glam::{Mat4, Quat, Vec2, Vec3};
 use crate::{Camera, Instance, Material, Mesh, Scene, Sun, shapes};
 
 /// Names of the built-in scenes, for the CLI.
-pub const NAMES: &[&str] = &["boxes", "cornell", "terrain"];
+pub const NAMES: &[&str] = &["village", "boxes", "cornell", "terrain"];
 
 pub fn by_name(name: &str) -> Option<Scene> {
     match name {
+        "village" => Some(village()),
         "boxes" => Some(boxes()),
         "cornell" => Some(cornell()),
         "terrain" => Some(terrain()),
         _ => None,
     }
+}
+
+/// The village scene ([`crate::village`]) with its default seed
+/// ([`crate::village::DEFAULT_SEED`]).
+pub fn village() -> Scene {
+    village_with_seed(crate::village::DEFAULT_SEED)
+}
+
+/// The village scene generated from `seed`: the same seed gives a bit-identical scene.
+pub fn village_with_seed(seed: u64) -> Scene {
+    crate::village::build(seed).scene
 }
 
 /// A few boxes on a plane under the sun: the engine skeleton's first lit scene.

@@ -687,6 +687,8 @@ impl<'o> Loader<'o> {
         let mut mesh = Mesh {
             name: label.replace("mesh `", "").replace("` primitive ", "/"),
             positions,
+            // glTF animations and morph targets are not read: meshes are static.
+            deformation: None,
             ..Default::default()
         };
         if let Some(a) = prim.get(&gltf::Semantic::Normals) {

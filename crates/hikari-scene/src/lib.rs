@@ -8,6 +8,16 @@
 //! lux, point and spot lights ([`Light`]) in candela (with constructors from lumens), emissive
 //! surfaces ([`Material::emissive_nits`]) in nits (cd/m²).
 //!
+//! # Animation and time of day
+//!
+//! A mesh may carry a [`Deformation`] (vertex animation in object space: plants swaying,
+//! wheels spinning), evaluated deterministically by [`Mesh::deformed`]. [`time_of_day`] turns
+//! "HH:MM" into a sun (or moon) with a simple documented model.
+//!
+//! # Built-in scenes ([`builtin`])
+//!
+//! `village` (generated from a seed by [`village`]), `boxes`, `cornell` and `terrain`.
+//!
 //! # glTF 2.0 support ([`gltf::load`])
 //!
 //! Read:
@@ -54,10 +64,14 @@
 //! indices out of range, non-finite numbers (through [`Scene::validate`]).
 
 pub mod builtin;
+pub mod deformation;
 pub mod gltf;
 pub mod model;
 pub mod shapes;
+pub mod time_of_day;
+pub mod village;
 
+pub use deformation::Deformation;
 pub use model::{
     Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh, Scene,
     SceneError, Sun, Texture, TextureRef, Wrap,

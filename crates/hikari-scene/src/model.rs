@@ -7,6 +7,8 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use thiserror::Error;
 
+use crate::Deformation;
+
 /// Interior mask used when neither the mesh nor the material gives one: "don't know", halfway
 /// between outdoors (0) and indoors (1).
 pub const DEFAULT_INTERIOR: f32 = 0.5;
@@ -52,6 +54,9 @@ pub struct Mesh {
     /// Per-vertex interior mask in [0, 1] (0 outdoors, 1 indoors). Empty: use the
     /// material's [`Material::interior`], else [`DEFAULT_INTERIOR`].
     pub interior: Vec<f32>,
+    /// Vertex animation in object space, evaluated by [`Mesh::deformed`]; `None`: static.
+    /// Every instance of the mesh moves the same way.
+    pub deformation: Option<Deformation>,
 }
 
 impl Mesh {
@@ -472,6 +477,9 @@ impl Scene {
                     "interior mask {i} is {}, outside [0, 1]",
                     m.interior[i]
                 )));
+            }
+            if let Some(d) = &m.deformation {
+                d.check().map_err(err)?;
             }
         }
         for (t_index, t) in self.textures.iter().enumerate() {
