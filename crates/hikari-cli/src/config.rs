@@ -50,7 +50,10 @@ mod tests {
     fn an_out_of_range_value_names_the_field_and_the_range() {
         let e = parse("[shadows]\ncascades = 7\n").unwrap_err();
         let msg = format!("{e:#}");
-        assert!(msg.contains("shadows.cascades") && msg.contains("1 to 4"), "{msg}");
+        assert!(
+            msg.contains("shadows.cascades") && msg.contains("1 to 4"),
+            "{msg}"
+        );
         let e = parse("[shadows]\nresolution = 1000\n").unwrap_err();
         assert!(format!("{e:#}").contains("power of two"), "{e:#}");
         let e = parse("[exposure]\nev100 = 99.0\n").unwrap_err();

@@ -21,6 +21,6 @@ pub mod view;
 pub use context::{ContextOptions, GpuContext};
 pub use error::{RenderError, Result};
 pub use frame::FrameSettings;
-pub use settings::Settings;
 pub use renderer::{RenderedFrame, Renderer};
+pub use settings::Settings;
 pub use wgpu;

@@ -190,7 +190,11 @@ impl SceneCpu {
             for v in 0..m.positions.len() {
                 let n = m.normals[v].normalize_or(Vec3::Y);
                 let (t, negative, has) = match m.tangents.get(v) {
-                    Some(t) => (t.truncate().normalize_or(orthonormal_tangent(n)), t.w < 0.0, true),
+                    Some(t) => (
+                        t.truncate().normalize_or(orthonormal_tangent(n)),
+                        t.w < 0.0,
+                        true,
+                    ),
                     None => (orthonormal_tangent(n), false, false),
                 };
                 let c = m
@@ -198,7 +202,11 @@ impl SceneCpu {
                     .as_ref()
                     .and_then(|c| c.get(v).copied())
                     .unwrap_or(Vec4::ONE);
-                let interior = m.interior.get(v).copied().unwrap_or(hikari_scene::DEFAULT_INTERIOR);
+                let interior = m
+                    .interior
+                    .get(v)
+                    .copied()
+                    .unwrap_or(hikari_scene::DEFAULT_INTERIOR);
                 let mut extra = (interior.clamp(0.0, 1.0) * 65535.0).round() as u32;
                 if negative {
                     extra |= EXTRA_BITANGENT_NEGATIVE;
@@ -266,7 +274,9 @@ impl SceneCpu {
                 .iter()
                 .enumerate()
                 .fold(0, |acc, (k, s)| acc | (s.1 << (4 * k)));
-            let (aniso, rotation) = m.anisotropy.map_or((0.0, 0.0), |a| (a.strength, a.rotation));
+            let (aniso, rotation) = m
+                .anisotropy
+                .map_or((0.0, 0.0), |a| (a.strength, a.rotation));
             cpu.materials.push(MaterialGpu {
                 base_color: m.base_color.extend(m.alpha).to_array(),
                 emissive: m.emissive_nits.extend(m.normal_scale).to_array(),
@@ -286,11 +296,18 @@ impl SceneCpu {
                     // KHR_lights_punctual's smooth cone: linear in cos between the cones.
                     let (ci, co) = (inner_cone.cos(), outer_cone.cos());
                     let scale = 1.0 / (ci - co).max(1e-4);
-                    (LIGHT_SPOT, l.direction.normalize(), [scale, -co * scale, 0.0, 0.0])
+                    (
+                        LIGHT_SPOT,
+                        l.direction.normalize(),
+                        [scale, -co * scale, 0.0, 0.0],
+                    )
                 }
             };
             cpu.lights.push(LightGpu {
-                position_range: l.position.extend(light_range(l.intensity_cd, l.range)).to_array(),
+                position_range: l
+                    .position
+                    .extend(light_range(l.intensity_cd, l.range))
+                    .to_array(),
                 direction_kind: dir.extend(kind).to_array(),
                 intensity: (l.color * l.intensity_cd).extend(0.0).to_array(),
                 spot,
@@ -334,22 +351,26 @@ impl SceneGpu {
                     usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 }))
         };
-        let bounds = scene.instances.iter().fold(None, |acc: Option<(Vec3, Vec3)>, inst| {
-            let Some((lo, hi)) = scene.meshes[inst.mesh].bounds() else {
-                return acc;
-            };
-            let corners = (0..8).map(|i| {
-                let c = Vec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
-                );
-                inst.transform.transform_point3(c)
+        let bounds = scene
+            .instances
+            .iter()
+            .fold(None, |acc: Option<(Vec3, Vec3)>, inst| {
+                let Some((lo, hi)) = scene.meshes[inst.mesh].bounds() else {
+                    return acc;
+                };
+                let corners = (0..8).map(|i| {
+                    let c = Vec3::new(
+                        if i & 1 == 0 { lo.x } else { hi.x },
+                        if i & 2 == 0 { lo.y } else { hi.y },
+                        if i & 4 == 0 { lo.z } else { hi.z },
+                    );
+                    inst.transform.transform_point3(c)
+                });
+                Some(corners.fold(
+                    acc.unwrap_or((Vec3::INFINITY, Vec3::NEG_INFINITY)),
+                    |(a, b), c| (a.min(c), b.max(c)),
+                ))
             });
-            Some(corners.fold(acc.unwrap_or((Vec3::INFINITY, Vec3::NEG_INFINITY)), |(a, b), c| {
-                (a.min(c), b.max(c))
-            }))
-        });
         Ok(Self {
             positions: buffer("positions", bytemuck::cast_slice(&cpu.positions))?,
             attributes: buffer("vertex attributes", bytemuck::cast_slice(&cpu.attributes))?,

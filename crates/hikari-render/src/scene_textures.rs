@@ -26,7 +26,10 @@ impl LayerMap {
         let n = scene.textures.len();
         let (mut color_used, mut data_used) = (vec![false; n], vec![false; n]);
         for m in &scene.materials {
-            for t in [m.base_color_texture, m.emissive_texture].into_iter().flatten() {
+            for t in [m.base_color_texture, m.emissive_texture]
+                .into_iter()
+                .flatten()
+            {
                 color_used[t.texture] = true;
             }
             for t in [
@@ -99,7 +102,11 @@ fn mip_chain(base: image::RgbaImage, srgb: bool) -> Vec<image::RgbaImage> {
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let v = src.get_pixel(2 * x + dx, 2 * y + dy)[c];
                     // Alpha is coverage, always linear.
-                    sum += if c == 3 { v as f32 / 255.0 } else { to_linear(v) };
+                    sum += if c == 3 {
+                        v as f32 / 255.0
+                    } else {
+                        to_linear(v)
+                    };
                 }
                 *out = if c == 3 {
                     (sum / 4.0 * 255.0).round() as u8
@@ -154,15 +161,16 @@ fn build_array(
     }
     for &i in &used {
         let t = &scene.textures[i];
-        let img = image::RgbaImage::from_raw(t.width, t.height, t.data.clone()).ok_or_else(|| {
-            RenderError::Graph(format!(
-                "texture `{}`: {} bytes for {}x{} RGBA8",
-                t.name,
-                t.data.len(),
-                t.width,
-                t.height
-            ))
-        })?;
+        let img =
+            image::RgbaImage::from_raw(t.width, t.height, t.data.clone()).ok_or_else(|| {
+                RenderError::Graph(format!(
+                    "texture `{}`: {} bytes for {}x{} RGBA8",
+                    t.name,
+                    t.data.len(),
+                    t.width,
+                    t.height
+                ))
+            })?;
         let base = if img.width() == size && img.height() == size {
             img
         } else {

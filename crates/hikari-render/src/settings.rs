@@ -119,9 +119,19 @@ impl Settings {
         }
         range("shadows.max_distance_m", s.max_distance_m, 1.0, 100_000.0)?;
         range("shadows.split_lambda", s.split_lambda, 0.0, 1.0)?;
-        range("shadows.filter_radius_texels", s.filter_radius_texels, 0.0, 8.0)?;
+        range(
+            "shadows.filter_radius_texels",
+            s.filter_radius_texels,
+            0.0,
+            8.0,
+        )?;
         range("shadows.depth_bias_texels", s.depth_bias_texels, 0.0, 16.0)?;
-        range("shadows.normal_bias_texels", s.normal_bias_texels, 0.0, 16.0)?;
+        range(
+            "shadows.normal_bias_texels",
+            s.normal_bias_texels,
+            0.0,
+            16.0,
+        )?;
         if let Some(ev) = self.exposure.ev100 {
             range("exposure.ev100", ev, -10.0, 30.0)?;
         }

@@ -148,7 +148,11 @@ fn resolve_matches_its_cpu_twin() {
         for x in 0..w {
             let i = (y * w + x) as usize;
             if vis[2 * i + 1] == 0 {
-                assert_eq!(instance.pixel(x, y)[0], u32::MAX as f32, "sky has no instance");
+                assert_eq!(
+                    instance.pixel(x, y)[0],
+                    u32::MAX as f32,
+                    "sky has no instance"
+                );
                 continue;
             }
             let want: ResolvedTexel =
@@ -163,7 +167,9 @@ fn resolve_matches_its_cpu_twin() {
             let m = material.pixel(x, y);
             let mv = motion.pixel(x, y);
             let e = emissive.pixel(x, y);
-            let close = |got: f32, want: f32, abs: f32, rel: f32| (got - want).abs() <= abs + rel * want.abs();
+            let close = |got: f32, want: f32, abs: f32, rel: f32| {
+                (got - want).abs() <= abs + rel * want.abs()
+            };
             let checks = [
                 ("normal", n.dot(want.normal) > (0.5f32).to_radians().cos()),
                 ("albedo r", close(a[0], want.base_color.x, 2.5 / 255.0, 0.0)),
@@ -183,12 +189,17 @@ fn resolve_matches_its_cpu_twin() {
             ];
             for (what, ok) in checks {
                 if !ok {
-                    failures.push(format!("({x}, {y}) {what}: got {a:?} {m:?} {mv:?} {e:?}, want {want:?}"));
+                    failures.push(format!(
+                        "({x}, {y}) {what}: got {a:?} {m:?} {mv:?} {e:?}, want {want:?}"
+                    ));
                 }
             }
         }
     }
-    assert!(checked > 4000 && textured > 300, "{checked} surface pixels, {textured} textured");
+    assert!(
+        checked > 4000 && textured > 300,
+        "{checked} surface pixels, {textured} textured"
+    );
     assert!(
         failures.is_empty(),
         "{} failures, first: {}",

@@ -5,8 +5,8 @@ mod common;
 use glam::{Vec2, Vec3, Vec4};
 use hikari_render::graph::GraphRuntime;
 use hikari_render::passes::direct_lighting::LightingParams;
-use hikari_render::passes::sun_shadows;
 use hikari_render::passes::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
+use hikari_render::passes::sun_shadows;
 use hikari_render::reference;
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::{FrameSettings, Renderer, Settings};
@@ -200,7 +200,8 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
             } else {
                 lit += 1;
             }
-            let want = reference::direct_lighting::shade(&params, &cpu.lights, &texel, world, -dir, vis);
+            let want =
+                reference::direct_lighting::shade(&params, &cpu.lights, &texel, world, -dir, vis);
             let got = hdr.pixel(x, y);
             let mut px_worst = 0f32;
             for c in 0..3 {
@@ -220,7 +221,10 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
         "the view shows sky ({sky}), sunlit ({lit}) and shadowed ({shadowed}) surfaces"
     );
     // A shadow edge texel compared with a receiver depth within rounding may flip one PCF tap.
-    assert!(bad * 500 <= (w * h) as usize, "{bad} pixels beyond tolerance; worst {worst}");
+    assert!(
+        bad * 500 <= (w * h) as usize,
+        "{bad} pixels beyond tolerance; worst {worst}"
+    );
 }
 
 #[test]

@@ -61,7 +61,10 @@ fn mesh_first_triangles(scene: &Scene) -> Vec<u32> {
 
 #[test]
 fn visibility_matches_rays_through_pixel_centres() {
-    for scene in [hikari_scene::builtin::boxes(), hikari_scene::builtin::cornell()] {
+    for scene in [
+        hikari_scene::builtin::boxes(),
+        hikari_scene::builtin::cornell(),
+    ] {
         let Some(ctx) = common::gpu() else { return };
         let (w, h) = (96u32, 64u32);
         let s = frame_settings(&scene, w, h);
@@ -91,7 +94,9 @@ fn visibility_matches_rays_through_pixel_centres() {
                 });
                 match (got, want) {
                     (None, None) => agree += 1,
-                    (Some((inst, tri)), Some(hit)) if inst == hit.instance && tri == hit.primitive => {
+                    (Some((inst, tri)), Some(hit))
+                        if inst == hit.instance && tri == hit.primitive =>
+                    {
                         agree += 1;
                         let p = s.camera.position + dir * hit.t;
                         let c = vp * p.extend(1.0);
@@ -108,7 +113,10 @@ fn visibility_matches_rays_through_pixel_centres() {
             differ * 200 <= agree,
             "{differ} pixels differ from the rays, {agree} agree"
         );
-        assert!(worst_depth < 1e-4, "worst relative depth error {worst_depth}");
+        assert!(
+            worst_depth < 1e-4,
+            "worst relative depth error {worst_depth}"
+        );
     }
 }
 
@@ -123,7 +131,11 @@ fn uv_sphere(segments: u32, rings: u32) -> hikari_scene::Mesh {
         for k in 0..=segments {
             // The seam column repeats the first one exactly, so the mesh stays closed.
             let phi = std::f32::consts::TAU * (k % segments) as f32 / segments as f32;
-            let p = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let p = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             m.positions.push(p);
             m.normals.push(p);
         }

@@ -15,17 +15,31 @@ const MAX_MEAN_FLIP: f32 = 0.02;
 const SIZE: (u32, u32) = (128, 72);
 
 fn snapshot(name: &str) {
+    snapshot_at(name, name, None, None);
+}
+
+/// Scene `scene` seen from `camera` (its first if `None`) at `time` ("HH:MM"; the scene's sun
+/// if `None`), compared with `tests/snapshots/{name}.png`.
+fn snapshot_at(name: &str, scene: &str, camera: Option<&str>, time: Option<&str>) {
     let Some(ctx) = common::gpu() else { return };
-    let scene = hikari_scene::builtin::by_name(name).unwrap();
+    let scene = hikari_scene::builtin::by_name(scene).unwrap();
+    let camera = camera.map_or(scene.cameras[0].clone(), |c| {
+        scene.camera(c).unwrap().clone()
+    });
+    let sun = time.map_or(scene.sun.clone(), |t| {
+        Some(hikari_scene::time_of_day::sun_at(
+            hikari_scene::time_of_day::parse_time(t).unwrap(),
+        ))
+    });
     let mut settings = Settings::default();
     // Small maps keep the CPU driver fast; the cascades still cover the view.
     settings.shadows.resolution = 512;
     let s = FrameSettings {
         width: SIZE.0,
         height: SIZE.1,
-        camera: scene.cameras[0].clone(),
+        camera,
         prev_camera: None,
-        sun: scene.sun.clone(),
+        sun,
         settings,
     };
     let mut renderer = Renderer::new(ctx, &scene).unwrap();
@@ -67,6 +81,41 @@ fn snapshot(name: &str) {
         mean <= MAX_MEAN_FLIP,
         "{name}: mean FLIP {mean} > {MAX_MEAN_FLIP} against {}",
         path.display()
+    );
+}
+
+#[test]
+fn village() {
+    snapshot("village");
+}
+
+#[test]
+fn village_courtyard_afternoon() {
+    snapshot_at(
+        "village_courtyard_afternoon",
+        "village",
+        Some("courtyard"),
+        Some("16:30"),
+    );
+}
+
+#[test]
+fn village_night_street() {
+    snapshot_at(
+        "village_night_street",
+        "village",
+        Some("night_street"),
+        Some("21:30"),
+    );
+}
+
+#[test]
+fn village_house_interior() {
+    snapshot_at(
+        "village_house_interior",
+        "village",
+        Some("house_interior"),
+        None,
     );
 }
 

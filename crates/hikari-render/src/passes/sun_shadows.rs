@@ -103,7 +103,12 @@ pub fn fit_cascades(
     let tan_half_v = (camera.vfov_deg.to_radians() * 0.5).tan();
     let k = tan_half_v * tan_half_v * (1.0 + aspect * aspect);
     let near = camera.near.max(0.01);
-    let splits = split_distances(near, s.max_distance_m.max(near * 2.0), s.cascades, s.split_lambda);
+    let splits = split_distances(
+        near,
+        s.max_distance_m.max(near * 2.0),
+        s.cascades,
+        s.split_lambda,
+    );
     let forward = camera.forward();
     let res = s.resolution as f32;
     splits
@@ -192,10 +197,7 @@ pub fn record<'r>(
     };
     let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
     let res = s.resolution as u64;
-    let texels = g.buffer(
-        "sun_shadows.texels",
-        res * res * cascades.len() as u64 * 4,
-    )?;
+    let texels = g.buffer("sun_shadows.texels", res * res * cascades.len() as u64 * 4)?;
     let view_proj: Vec<Mat4> = cascades.iter().map(|c| c.view_proj).collect();
     raster.record(
         g,
@@ -245,7 +247,11 @@ mod tests {
 
     #[test]
     fn the_slice_sphere_holds_its_frustum_slice_and_is_minimal() {
-        for (dn, df, fov, aspect) in [(0.1, 5.0, 60.0, 1.78), (5.0, 40.0, 90.0, 1.0), (40.0, 250.0, 30.0, 2.4)] {
+        for (dn, df, fov, aspect) in [
+            (0.1, 5.0, 60.0, 1.78),
+            (5.0, 40.0, 90.0, 1.0),
+            (40.0, 250.0, 30.0, 2.4),
+        ] {
             let t = (f32::to_radians(fov) * 0.5).tan();
             let k = t * t * (1.0 + aspect * aspect);
             let (z, r) = slice_sphere(dn, df, k);
@@ -254,9 +260,15 @@ mod tests {
                 .iter()
                 .map(|p| p.distance(c))
                 .fold(0.0, f32::max);
-            assert!(far <= r * (1.0 + 1e-5), "corner at {far} outside radius {r}");
+            assert!(
+                far <= r * (1.0 + 1e-5),
+                "corner at {far} outside radius {r}"
+            );
             // Minimal: the farthest corner is on the sphere.
-            assert!(far >= r * (1.0 - 1e-4), "radius {r} larger than needed ({far})");
+            assert!(
+                far >= r * (1.0 - 1e-4),
+                "radius {r} larger than needed ({far})"
+            );
         }
     }
 
@@ -265,13 +277,31 @@ mod tests {
         let s = ShadowSettings::default();
         let bounds = (Vec3::splat(-200.0), Vec3::splat(200.0));
         let sun = Vec3::new(-0.4, 0.8, 0.3).normalize();
-        let base = fit_cascades(&camera(Vec3::new(1.0, 2.0, 3.0), Vec3::Z), 1.78, sun, bounds, &s);
+        let base = fit_cascades(
+            &camera(Vec3::new(1.0, 2.0, 3.0), Vec3::Z),
+            1.78,
+            sun,
+            bounds,
+            &s,
+        );
         for i in 0..20 {
-            let q = Quat::from_euler(glam::EulerRot::YXZ, i as f32 * 0.37, (i as f32 * 0.11).sin() * 0.6, 0.0);
-            let pos = Vec3::new(1.0 + i as f32 * 0.731, 2.0 + i as f32 * 0.05, 3.0 - i as f32 * 1.37);
+            let q = Quat::from_euler(
+                glam::EulerRot::YXZ,
+                i as f32 * 0.37,
+                (i as f32 * 0.11).sin() * 0.6,
+                0.0,
+            );
+            let pos = Vec3::new(
+                1.0 + i as f32 * 0.731,
+                2.0 + i as f32 * 0.05,
+                3.0 - i as f32 * 1.37,
+            );
             let moved = fit_cascades(&camera(pos, q * Vec3::Z), 1.78, sun, bounds, &s);
             for (a, b) in base.iter().zip(&moved) {
-                assert!((a.radius - b.radius).abs() <= a.radius * 1e-5, "radius changed");
+                assert!(
+                    (a.radius - b.radius).abs() <= a.radius * 1e-5,
+                    "radius changed"
+                );
                 // A fixed world point lands on the same sub-texel position in every frame:
                 // the projections differ by whole texels.
                 let p = Vec3::new(3.3, 0.7, -2.1);
@@ -286,7 +316,10 @@ mod tests {
     #[test]
     fn splits_run_from_near_to_far_and_blend_log_and_uniform() {
         let d = split_distances(0.1, 100.0, 4, 1.0);
-        assert!((d[2] - (0.1f32 * 100.0).sqrt()).abs() < 1e-3, "log split {d:?}");
+        assert!(
+            (d[2] - (0.1f32 * 100.0).sqrt()).abs() < 1e-3,
+            "log split {d:?}"
+        );
         let d = split_distances(0.1, 100.0, 4, 0.0);
         assert!((d[2] - 50.05).abs() < 1e-3, "uniform split {d:?}");
         assert!(d.windows(2).all(|w| w[0] < w[1]));

@@ -47,7 +47,8 @@ pub fn light_attenuation(light: &LightGpu, l: Vec3, d2: f32) -> f32 {
     let window = (1.0 - x * x).clamp(0.0, 1.0);
     let mut a = window * window / d2.max(1e-4);
     if light.direction_kind[3] > 0.5 {
-        let s = ((-l).dot(v3(light.direction_kind)) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
+        let s =
+            ((-l).dot(v3(light.direction_kind)) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
         a *= s * s;
     }
     a
@@ -108,8 +109,8 @@ pub fn shade(
         }
     }
     if flags & LIGHTING_PLACEHOLDER_AMBIENT != 0 {
-        let diffuse = m.base_color * (1.0 - m.metalness) / std::f32::consts::PI
-            * ambient_placeholder(p, n);
+        let diffuse =
+            m.base_color * (1.0 - m.metalness) / std::f32::consts::PI * ambient_placeholder(p, n);
         radiance += (diffuse + specular_placeholder(p, &m, n, v)) * texel.material.w;
     }
     if flags & LIGHTING_EMISSIVE != 0 {

@@ -131,11 +131,19 @@ pub fn resolve(
     if material.normal_texture.is_some() {
         return None;
     }
-    let idx = [cpu.indices[tri * 3], cpu.indices[tri * 3 + 1], cpu.indices[tri * 3 + 2]];
+    let idx = [
+        cpu.indices[tri * 3],
+        cpu.indices[tri * 3 + 1],
+        cpu.indices[tri * 3 + 2],
+    ];
     let model = inst.transform.as_dmat4();
     let object: Vec<DVec3> = idx
         .iter()
-        .map(|&i| Vec4::from_array(cpu.positions[i as usize]).truncate().as_dvec3())
+        .map(|&i| {
+            Vec4::from_array(cpu.positions[i as usize])
+                .truncate()
+                .as_dvec3()
+        })
         .collect();
     let world: Vec<DVec3> = object.iter().map(|&p| model.transform_point3(p)).collect();
     let inv = DMat4::from_cols_array_2d(&view.inv_view_proj.map(|c| c.map(|x| x as f64)));
@@ -165,9 +173,8 @@ pub fn resolve(
     let lerp3 = |f: &dyn Fn(&crate::scene_gpu::VertexAttr) -> DVec3| {
         f(attr[0]) * w.x + f(attr[1]) * w.y + f(attr[2]) * w.z
     };
-    let decode = |p: u32| {
-        super::octahedral::decode(crate::scene_gpu::unpack_snorm16x2(p)).as_dvec3()
-    };
+    let decode =
+        |p: u32| super::octahedral::decode(crate::scene_gpu::unpack_snorm16x2(p)).as_dvec3();
     let normal_model = glam::DMat3::from_mat4(model).inverse().transpose();
     let mut n = (normal_model * lerp3(&|a| decode(a.normal))).normalize();
     if material.double_sided && ng.dot(dir) > 0.0 {
@@ -213,7 +220,9 @@ pub fn resolve(
         interior: interior.clamp(0.0, 1.0) as f32,
         roughness: (material.roughness as f64 * mr.y).clamp(0.0, 1.0) as f32,
         metalness: (material.metalness as f64 * mr.z).clamp(0.0, 1.0) as f32,
-        anisotropy: material.anisotropy.map_or(0.0, |a| a.strength.clamp(0.0, 1.0)),
+        anisotropy: material
+            .anisotropy
+            .map_or(0.0, |a| a.strength.clamp(0.0, 1.0)),
         occlusion: (1.0 + material.occlusion_strength as f64 * (occ_tex - 1.0)).clamp(0.0, 1.0)
             as f32,
         emissive: emissive.as_vec3(),

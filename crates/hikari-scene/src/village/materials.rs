@@ -93,12 +93,8 @@ impl Palette {
         let timber = Vec3::new(0.20, 0.12, 0.065);
         let lacquer = Vec3::new(0.50, 0.07, 0.035);
         Palette {
-            // Grass; the terrain's vertex colours turn it into earth, gravel and mud.
-            terrain: b.material(outdoor(rough(
-                "terrain",
-                super::terrain::Terrain::GRASS,
-                0.95,
-            ))),
+            // White: the terrain's vertex colours hold grass, earth, gravel and mud.
+            terrain: b.material(outdoor(rough("terrain", Vec3::ONE, 0.95))),
             // Still water: a dark base (the little light scattered back out of the water) and
             // a near-mirror surface.
             water: b.material(outdoor(rough(

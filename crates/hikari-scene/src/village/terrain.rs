@@ -269,7 +269,9 @@ impl Terrain {
         c = c.lerp(gravel, court);
         let wet = 1.0 - smoothstep(s.pond_water_y + 0.05, s.pond_water_y + 0.3, h);
         c = c.lerp(mud, wet);
-        (c / Self::GRASS).extend(1.0)
+        // Vertex colours are the ground's albedo itself (within [0, 1], as glTF's COLOR_0);
+        // the terrain material's base colour is white.
+        c.clamp(Vec3::ZERO, Vec3::ONE).extend(1.0)
     }
 
     /// The terrain mesh: (CELLS + 1)² vertices on a 1 m grid, two triangles per cell
