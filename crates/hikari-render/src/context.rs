@@ -17,12 +17,15 @@ pub const OPTIONAL_FEATURES: wgpu::Features = wgpu::Features::TIMESTAMP_QUERY
     .union(wgpu::Features::SUBGROUP)
     .union(wgpu::Features::FLOAT32_FILTERABLE)
     .union(wgpu::Features::SHADER_INT64)
-    .union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX)
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
 
 /// What the renderer cannot run without beyond WebGPU's core: the software rasteriser of the
-/// G-buffer and shadow maps resolves visibility with 64-bit `atomicMax` on depth and id.
-pub const REQUIRED_FEATURES: wgpu::Features =
-    wgpu::Features::SHADER_INT64.union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX);
+/// G-buffer and shadow maps resolves visibility with 64-bit atomics on depth and id
+/// (`atomicLoad` to skip occluded fragments, `atomicMax` to keep the nearest).
+pub const REQUIRED_FEATURES: wgpu::Features = wgpu::Features::SHADER_INT64
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX)
+    .union(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS);
 
 /// How long each step of start-up took; `hikari bench` reports it.
 #[derive(Clone, Copy, Debug, Default)]

@@ -34,10 +34,23 @@ impl FrameSettings {
     /// meter rule EV100 = log2(E * 100 / C) with C = 250 (ISO 2720) on the sun's illuminance,
     /// floored at 20 lux so that nights are exposed for their lamps, not for the moon.
     pub fn ev100(&self) -> f32 {
-        self.settings.exposure.ev100.unwrap_or_else(|| {
-            let lux = self.sun.as_ref().map_or(0.0, |s| s.illuminance_lux);
-            (lux.max(20.0) * 100.0 / 250.0).log2()
-        })
+        self.settings
+            .exposure
+            .ev100
+            .unwrap_or_else(|| (self.metered_lux() * 100.0 / 250.0).log2())
+    }
+
+    /// The illuminance the exposure is set for: the configured EV100's, else the sun's,
+    /// at least 20 lux.
+    pub fn metered_lux(&self) -> f32 {
+        match self.settings.exposure.ev100 {
+            Some(ev) => 2f32.powf(ev) * 250.0 / 100.0,
+            None => self
+                .sun
+                .as_ref()
+                .map_or(0.0, |s| s.illuminance_lux)
+                .max(20.0),
+        }
     }
 }
 
@@ -111,7 +124,12 @@ pub fn record<'r>(
     // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
 
     // 11. Deferred direct lighting (sun, lights, emissive; placeholder sky and ambient).
-    let lighting = LightingParams::new(s.sun.as_ref(), scene.light_count, &s.settings.lighting);
+    let lighting = LightingParams::new(
+        s.sun.as_ref(),
+        scene.light_count,
+        s.metered_lux(),
+        &s.settings.lighting,
+    );
     let hdr = t
         .direct_lighting
         .record(g, &gbuffer, &shadows, scene, &view, &lighting)?;

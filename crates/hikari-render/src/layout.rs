@@ -63,7 +63,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             scene_gpu::Chunk,
             "gbuffer/resolve.wgsl",
-            [instance, first_triangle, count, pad]
+            [instance, first_triangle, count, pad, bounds_lo, bounds_hi]
         ),
         gpu_layout!(
             scene_gpu::LightGpu,
@@ -83,7 +83,14 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             direct_lighting::LightingParams,
             "direct_lighting/shade.wgsl",
-            [direction_lux, color, sky_zenith, sky_horizon, config]
+            [
+                direction_lux,
+                color,
+                sky_zenith,
+                sky_horizon,
+                config,
+                cutoff
+            ]
         ),
         gpu_layout!(
             placeholder_tonemap::TonemapParams,

@@ -77,7 +77,8 @@ pub struct MaterialGpu {
     pub more_textures: [u32; 4],
 }
 
-/// `instance`, first triangle (global, into the index buffer / 3), triangle count, 0.
+/// `instance`, first triangle (global, into the index buffer / 3), triangle count, and the
+/// object-space bounds of its triangles, so the rasteriser can skip a chunk outside a view.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct Chunk {
@@ -85,6 +86,8 @@ pub struct Chunk {
     pub first_triangle: u32,
     pub count: u32,
     pub pad: u32,
+    pub bounds_lo: [f32; 4],
+    pub bounds_hi: [f32; 4],
 }
 
 pub struct SceneGpu {
@@ -244,11 +247,20 @@ impl SceneCpu {
             let mut t = 0;
             while t < triangles {
                 let count = (triangles - t).min(CHUNK_TRIANGLES);
+                let first_index = ((first + t) * 3) as usize;
+                let (lo, hi) = cpu.indices[first_index..first_index + count as usize * 3]
+                    .iter()
+                    .map(|&v| Vec4::from_array(cpu.positions[v as usize]).truncate())
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+                        (lo.min(p), hi.max(p))
+                    });
                 cpu.chunks.push(Chunk {
                     instance: i as u32,
                     first_triangle: first + t,
                     count,
                     pad: 0,
+                    bounds_lo: lo.extend(0.0).to_array(),
+                    bounds_hi: hi.extend(0.0).to_array(),
                 });
                 t += count;
             }

@@ -180,6 +180,9 @@ pub fn capabilities_for(features: wgpu::Features) -> naga::valid::Capabilities {
     if features.contains(wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX) {
         c |= C::SHADER_INT64_ATOMIC_MIN_MAX;
     }
+    if features.contains(wgpu::Features::SHADER_INT64_ATOMIC_ALL_OPS) {
+        c |= C::SHADER_INT64_ATOMIC_ALL_OPS;
+    }
     c
 }
 

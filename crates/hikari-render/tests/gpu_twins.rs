@@ -155,6 +155,7 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
     let params = LightingParams::new(
         settings.sun.as_ref(),
         cpu.lights.len() as u32,
+        settings.metered_lux(),
         &settings.settings.lighting,
     );
     let sun = settings.sun.clone().unwrap();

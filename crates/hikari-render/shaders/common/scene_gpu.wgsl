@@ -34,6 +34,8 @@ struct Chunk {
     first_triangle: u32,
     count: u32,
     pad: u32,
+    bounds_lo: vec4<f32>,
+    bounds_hi: vec4<f32>,
 }
 
 struct LightGpu {

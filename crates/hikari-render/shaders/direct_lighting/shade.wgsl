@@ -21,6 +21,8 @@ struct LightingParams {
     sky_horizon: vec4<f32>,
     // x: number of lights; y: LIGHTING_* flags.
     config: vec4<u32>,
+    // x: illuminance in lux below which a punctual light is cut off this frame.
+    cutoff: vec4<f32>,
 }
 
 const LIGHTING_SUN: u32 = 1u;
@@ -44,20 +46,13 @@ const MAX_RADIANCE: f32 = 65000.0;
 const TILE: u32 = 16u;
 const MAX_TILE_LIGHTS: u32 = 256u;
 
-var<workgroup> tile_lo: array<atomic<u32>, 3>;
-var<workgroup> tile_hi: array<atomic<u32>, 3>;
+// Bounds of the tile's visible surfaces, reduced as a tree (contended shared atomics on six
+// addresses cost more than the lighting itself).
+var<workgroup> bounds_lo: array<vec3<f32>, 256>;
+var<workgroup> bounds_hi: array<vec3<f32>, 256>;
 var<workgroup> tile_count: atomic<u32>;
 var<workgroup> tile_lights: array<u32, MAX_TILE_LIGHTS>;
-
-// Order-preserving map from f32 to u32, so atomicMin/Max find float bounds.
-fn ordered(f: f32) -> u32 {
-    let b = bitcast<u32>(f);
-    return select(b | 0x80000000u, ~b, (b & 0x80000000u) != 0u);
-}
-
-fn unordered(u: u32) -> f32 {
-    return bitcast<f32>(select(~u, u & 0x7fffffffu, (u & 0x80000000u) != 0u));
-}
+const FAR: f32 = 3.0e38;
 
 fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
     let t = clamp(dir.y, 0.0, 1.0);
@@ -81,10 +76,16 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
     return brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0)) * env;
 }
 
+// Where a light's illuminance falls to the frame's cutoff, or its own range if nearer.
+fn light_range(light: LightGpu) -> f32 {
+    let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
+    return min(light.position_range.w, sqrt(peak / params.cutoff.x));
+}
+
 // Illuminance factor of a punctual light at distance^2 `d2`: inverse square, windowed to 0 at
 // the range (the smooth window glTF's KHR_lights_punctual recommends), times the spot cone.
 fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
-    let range = light.position_range.w;
+    let range = light_range(light);
     let x = d2 / (range * range);
     let window = clamp(1.0 - x * x, 0.0, 1.0);
     var a = window * window / max(d2, 1e-4);
@@ -104,39 +105,43 @@ fn main(
     let size = textureDimensions(out_radiance);
     let pixel = gid.xy;
     let inside = all(pixel < size);
-    if lid < 3u {
-        atomicStore(&tile_lo[lid], 0xffffffffu);
-        atomicStore(&tile_hi[lid], 0u);
-    }
     if lid == 0u {
         atomicStore(&tile_count, 0u);
     }
-    workgroupBarrier();
-
     var d = 0.0;
     var world = vec3<f32>(0.0);
+    var lo = vec3<f32>(FAR);
+    var hi = vec3<f32>(-FAR);
     if inside {
         d = textureLoad(depth, pixel, 0).r;
         if d > 0.0 {
             world = world_from_depth(view, pixel, d);
-            for (var k = 0u; k < 3u; k++) {
-                atomicMin(&tile_lo[k], ordered(world[k]));
-                atomicMax(&tile_hi[k], ordered(world[k]));
-            }
+            lo = world;
+            hi = world;
         }
     }
+    bounds_lo[lid] = lo;
+    bounds_hi[lid] = hi;
     workgroupBarrier();
+    for (var stride = TILE * TILE / 2u; stride > 0u; stride >>= 1u) {
+        if lid < stride {
+            bounds_lo[lid] = min(bounds_lo[lid], bounds_lo[lid + stride]);
+            bounds_hi[lid] = max(bounds_hi[lid], bounds_hi[lid + stride]);
+        }
+        workgroupBarrier();
+    }
 
     // Cull the lights against the bounds of the tile's visible surfaces.
     let light_count = select(0u, params.config.x, (params.config.y & LIGHTING_PUNCTUAL) != 0u);
-    if atomicLoad(&tile_lo[0]) <= atomicLoad(&tile_hi[0]) {
-        let lo = vec3<f32>(unordered(atomicLoad(&tile_lo[0])), unordered(atomicLoad(&tile_lo[1])), unordered(atomicLoad(&tile_lo[2])));
-        let hi = vec3<f32>(unordered(atomicLoad(&tile_hi[0])), unordered(atomicLoad(&tile_hi[1])), unordered(atomicLoad(&tile_hi[2])));
+    let tile_lo = bounds_lo[0];
+    let tile_hi = bounds_hi[0];
+    if tile_lo.x <= tile_hi.x {
         for (var i = lid; i < light_count; i += TILE * TILE) {
-            let lp = lights[i].position_range;
-            let nearest = clamp(lp.xyz, lo, hi);
-            let dd = nearest - lp.xyz;
-            if dot(dd, dd) < lp.w * lp.w {
+            let lp = lights[i].position_range.xyz;
+            let range = light_range(lights[i]);
+            let nearest = clamp(lp, tile_lo, tile_hi);
+            let dd = nearest - lp;
+            if dot(dd, dd) < range * range {
                 let slot = atomicAdd(&tile_count, 1u);
                 if slot < MAX_TILE_LIGHTS {
                     tile_lights[slot] = i;

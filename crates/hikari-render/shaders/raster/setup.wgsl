@@ -3,11 +3,11 @@
 // Triangle setup of hikari's compute rasteriser, shared by the triangle and tile passes.
 //
 // Watertightness: a pixel centre is inside when every edge function is positive, or zero on a
-// top-left edge. Each edge function is evaluated with its two end points in a canonical order
-// (lexicographic in x, then y) and negated as needed, so the two triangles sharing an edge get
-// bit-exact opposite values and every pixel centre on the edge belongs to exactly one of them.
-// Near-plane clipping interpolates from the inside end point, so neighbours clip a shared edge
-// to the same point.
+// top-left edge. Each edge's plane equation A x + B y + C is computed from its two end points
+// taken in a canonical order (lexicographic in x, then y) and negated as needed, so the two
+// triangles sharing an edge get bit-exact opposite values and every pixel centre on the edge
+// belongs to exactly one of them. Near-plane clipping interpolates from the inside end point,
+// so neighbours clip a shared edge to the same point.
 
 #import hikari::scene_gpu::{InstanceGpu, Chunk, CHUNK_TRIANGLES, INSTANCE_DOUBLE_SIDED}
 
@@ -37,14 +37,17 @@ struct RasterParams {
     config: vec4<u32>,
 }
 
-// Up to four screen-space vertices: the triangle, or the quad left after near clipping.
+// Up to four screen-space vertices (xy in pixels, z the NDC depth): the triangle, or the
+// quad left after near clipping. Plain fields, not arrays: dynamically indexed arrays would
+// live in slow local memory.
 struct Poly {
     count: u32,
     // The winding is clockwise on screen (negative area): edge functions are negated.
     flip: bool,
-    xy: array<vec2<f32>, 4>,
-    // NDC depth, reverse-Z (1 near, 0 far).
-    z: array<f32, 4>,
+    va: vec3<f32>,
+    vb: vec3<f32>,
+    vc: vec3<f32>,
+    vd: vec3<f32>,
 }
 
 // Pixels (inclusive) a polygon can touch, clamped to the target.
@@ -57,57 +60,81 @@ const TILE_SIZE: u32 = 32u;
 // Triangles whose clamped bounding box holds more pixels go to the tile queue.
 const SMALL_TRIANGLE_PIXELS: i32 = 96;
 
-// The polygon of triangle `tri` of `chunk` seen through `view_proj`; count 0 when it is culled
+fn to_screen(c: vec4<f32>, size: vec2<f32>) -> vec3<f32> {
+    let inv_w = 1.0 / c.w;
+    return vec3<f32>((c.x * inv_w * 0.5 + 0.5) * size.x, (0.5 - c.y * inv_w * 0.5) * size.y, c.z * inv_w);
+}
+
+// Point where edge a-b crosses the near plane, interpolated from its inside end point so both
+// triangles on the edge compute the same point.
+fn near_crossing(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    let da = a.w - a.z;
+    let db = b.w - b.z;
+    if da >= 0.0 {
+        return a + (b - a) * (da / (da - db));
+    }
+    return b + (a - b) * (db / (db - da));
+}
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+// The polygon of a triangle with clip-space vertices c0, c1, c2; count 0 when it is culled
 // (behind the near plane, outside a side of the frustum, back-facing and single-sided, or of
 // zero area).
-fn triangle_poly(
-    c: array<vec4<f32>, 3>,
-    size: vec2<f32>,
-    cull_back: bool,
-) -> Poly {
+fn triangle_poly(c0: vec4<f32>, c1: vec4<f32>, c2: vec4<f32>, size: vec2<f32>, cull_back: bool) -> Poly {
     var out: Poly;
     out.count = 0u;
     // Entirely outside one side plane of the frustum.
-    let outside_l = c[0].x < -c[0].w && c[1].x < -c[1].w && c[2].x < -c[2].w;
-    let outside_r = c[0].x > c[0].w && c[1].x > c[1].w && c[2].x > c[2].w;
-    let outside_b = c[0].y < -c[0].w && c[1].y < -c[1].w && c[2].y < -c[2].w;
-    let outside_t = c[0].y > c[0].w && c[1].y > c[1].w && c[2].y > c[2].w;
+    let outside_l = c0.x < -c0.w && c1.x < -c1.w && c2.x < -c2.w;
+    let outside_r = c0.x > c0.w && c1.x > c1.w && c2.x > c2.w;
+    let outside_b = c0.y < -c0.w && c1.y < -c1.w && c2.y < -c2.w;
+    let outside_t = c0.y > c0.w && c1.y > c1.w && c2.y > c2.w;
     if outside_l || outside_r || outside_b || outside_t {
         return out;
     }
-    // Clip against the near plane z <= w (reverse-Z: NDC depth <= 1).
-    var clipped: array<vec4<f32>, 4>;
-    var n = 0u;
-    for (var i = 0u; i < 3u; i++) {
-        let a = c[i];
-        let b = c[(i + 1u) % 3u];
-        let da = a.w - a.z;
-        let db = b.w - b.z;
-        if da >= 0.0 {
-            clipped[n] = a;
-            n++;
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            if da >= 0.0 {
-                clipped[n] = a + (b - a) * (da / (da - db));
-            } else {
-                clipped[n] = b + (a - b) * (db / (db - da));
+    // Near plane z <= w (reverse-Z: NDC depth <= 1).
+    let in0 = c0.w - c0.z >= 0.0;
+    let in1 = c1.w - c1.z >= 0.0;
+    let in2 = c2.w - c2.z >= 0.0;
+    var n = 3u;
+    if in0 && in1 && in2 {
+        out.va = to_screen(c0, size);
+        out.vb = to_screen(c1, size);
+        out.vc = to_screen(c2, size);
+    } else {
+        // Walk the edges c0-c1, c1-c2, c2-c0 (Sutherland-Hodgman with one plane), keeping
+        // inside vertices and crossings in order.
+        var v: array<vec4<f32>, 4>;
+        n = 0u;
+        let c = array<vec4<f32>, 3>(c0, c1, c2);
+        let inside = array<bool, 3>(in0, in1, in2);
+        for (var i = 0u; i < 3u; i++) {
+            let j = (i + 1u) % 3u;
+            if inside[i] {
+                v[n] = c[i];
+                n++;
             }
-            n++;
+            if inside[i] != inside[j] {
+                v[n] = near_crossing(c[i], c[j]);
+                n++;
+            }
         }
-    }
-    if n < 3u {
-        return out;
-    }
-    for (var i = 0u; i < n; i++) {
-        let p = clipped[i];
-        let inv_w = 1.0 / p.w;
-        out.xy[i] = vec2<f32>((p.x * inv_w * 0.5 + 0.5) * size.x, (0.5 - p.y * inv_w * 0.5) * size.y);
-        out.z[i] = p.z * inv_w;
+        if n < 3u {
+            return out;
+        }
+        out.va = to_screen(v[0], size);
+        out.vb = to_screen(v[1], size);
+        out.vc = to_screen(v[2], size);
+        out.vd = to_screen(v[3], size);
     }
     // Front faces are counter-clockwise in NDC, so clockwise (negative area) on the y-down
     // screen. Area of the whole polygon: the fan's first triangle has the polygon's winding.
-    let area = edge(out.xy[0], out.xy[1], out.xy[2]) + select(0.0, edge(out.xy[0], out.xy[2], out.xy[3]), n == 4u);
+    var area = cross2(out.vb.xy - out.va.xy, out.vc.xy - out.va.xy);
+    if n == 4u {
+        area += cross2(out.vc.xy - out.va.xy, out.vd.xy - out.va.xy);
+    }
     if area == 0.0 || (cull_back && area > 0.0) {
         return out;
     }
@@ -116,74 +143,111 @@ fn triangle_poly(
     return out;
 }
 
-// Edge function of the directed edge a -> b at p, evaluated in canonical end point order.
-fn edge(a: vec2<f32>, b: vec2<f32>, p: vec2<f32>) -> f32 {
+// One triangle ready to rasterise: three edge equations (A, B, C), E(p) = A p.x + B p.y + C,
+// oriented so that inside is positive (edge i is opposite vertex i), which of them own the
+// pixel centres exactly on them, and the depth plane.
+struct TriSetup {
+    edge_a: vec3<f32>,
+    edge_b: vec3<f32>,
+    edge_c: vec3<f32>,
+    own: vec3<bool>,
+    depth: vec3<f32>,
+}
+
+// A polygon ready to rasterise: one triangle, or two for a quad (the fan 0-1-2, 0-2-3).
+struct Setup {
+    tris: u32,
+    first: TriSetup,
+    second: TriSetup,
+}
+
+// Plane equation of the directed edge a -> b, oriented by `flip`; w is 1 when the edge owns
+// the pixel centres on it.
+fn edge_equation(a: vec2<f32>, b: vec2<f32>, flip: bool) -> vec4<f32> {
     let swap = a.x > b.x || (a.x == b.x && a.y > b.y);
     let s = select(a, b, swap);
     let e = select(b, a, swap);
-    let v = (e.x - s.x) * (p.y - s.y) - (e.y - s.y) * (p.x - s.x);
-    return select(v, -v, swap);
+    let coef_a = s.y - e.y;
+    let coef_b = e.x - s.x;
+    let coef_c = -(coef_a * s.x + coef_b * s.y);
+    let sign = select(1.0, -1.0, swap != flip);
+    // Reversing an edge reverses its direction: exactly one of two neighbours owns it.
+    let d = select(b - a, a - b, flip);
+    let owns = d.y > 0.0 || (d.y == 0.0 && d.x < 0.0);
+    return vec4<f32>(vec3<f32>(coef_a, coef_b, coef_c) * sign, select(0.0, 1.0, owns));
 }
 
-// Whether a pixel centre exactly on edge a -> b (of a triangle oriented so inside is
-// positive) belongs to this triangle. Reversing the edge flips the answer, which is all
-// watertightness needs.
-fn owns_edge(a: vec2<f32>, b: vec2<f32>) -> bool {
-    let d = b - a;
-    return d.y > 0.0 || (d.y == 0.0 && d.x < 0.0);
+fn tri_setup(v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, flip: bool) -> TriSetup {
+    var t: TriSetup;
+    let q0 = edge_equation(v1.xy, v2.xy, flip);
+    let q1 = edge_equation(v2.xy, v0.xy, flip);
+    let q2 = edge_equation(v0.xy, v1.xy, flip);
+    t.edge_a = q0.xyz;
+    t.edge_b = q1.xyz;
+    t.edge_c = q2.xyz;
+    t.own = vec3<bool>(q0.w > 0.0, q1.w > 0.0, q2.w > 0.0);
+    // The three edge functions sum to twice the area everywhere; their weighted sum
+    // interpolates the vertex depths.
+    let area = q0.z + q1.z + q2.z;
+    t.depth = select(vec3<f32>(0.0), (t.edge_a * v0.z + t.edge_b * v1.z + t.edge_c * v2.z) / area, area > 0.0);
+    return t;
+}
+
+fn poly_setup(poly: Poly) -> Setup {
+    var s: Setup;
+    s.tris = select(1u, 2u, poly.count == 4u);
+    s.first = tri_setup(poly.va, poly.vb, poly.vc, poly.flip);
+    if s.tris == 2u {
+        s.second = tri_setup(poly.va, poly.vc, poly.vd, poly.flip);
+    }
+    return s;
+}
+
+// NDC depth of triangle t at pixel centre p (homogeneous h = (p, 1)), or -1 outside.
+fn tri_depth(t: TriSetup, h: vec3<f32>) -> f32 {
+    let e = vec3<f32>(dot(t.edge_a, h), dot(t.edge_b, h), dot(t.edge_c, h));
+    let inside = e > vec3<f32>(0.0) | (e == vec3<f32>(0.0) & t.own);
+    return select(-1.0, dot(t.depth, h), all(inside));
+}
+
+// NDC depth at pixel centre p, or -1 when p is outside.
+fn setup_depth(s: Setup, p: vec2<f32>) -> f32 {
+    let h = vec3<f32>(p, 1.0);
+    let d = tri_depth(s.first, h);
+    if d >= 0.0 || s.tris == 1u {
+        return d;
+    }
+    return tri_depth(s.second, h);
+}
+
+// Whether triangle t may cover a pixel centre of the inclusive rectangle [p0, p1] of centres:
+// false when some edge is negative at every one of them.
+fn tri_touches(t: TriSetup, p0: vec2<f32>, p1: vec2<f32>) -> bool {
+    // Each edge at the rectangle's corner where it is largest.
+    let c0 = vec3<f32>(select(p0.x, p1.x, t.edge_a.x > 0.0), select(p0.y, p1.y, t.edge_a.y > 0.0), 1.0);
+    let c1 = vec3<f32>(select(p0.x, p1.x, t.edge_b.x > 0.0), select(p0.y, p1.y, t.edge_b.y > 0.0), 1.0);
+    let c2 = vec3<f32>(select(p0.x, p1.x, t.edge_c.x > 0.0), select(p0.y, p1.y, t.edge_c.y > 0.0), 1.0);
+    return dot(t.edge_a, c0) >= 0.0 && dot(t.edge_b, c1) >= 0.0 && dot(t.edge_c, c2) >= 0.0;
+}
+
+// Whether the polygon may cover a pixel centre in the inclusive pixel rectangle [lo, hi].
+fn setup_touches(s: Setup, lo: vec2<i32>, hi: vec2<i32>) -> bool {
+    let p0 = vec2<f32>(lo) + 0.5;
+    let p1 = vec2<f32>(hi) + 0.5;
+    return tri_touches(s.first, p0, p1) || (s.tris == 2u && tri_touches(s.second, p0, p1));
 }
 
 fn poly_rect(poly: Poly, size: vec2<f32>) -> PixelRect {
-    var lo = min(min(poly.xy[0], poly.xy[1]), poly.xy[2]);
-    var hi = max(max(poly.xy[0], poly.xy[1]), poly.xy[2]);
+    var lo = min(min(poly.va.xy, poly.vb.xy), poly.vc.xy);
+    var hi = max(max(poly.va.xy, poly.vb.xy), poly.vc.xy);
     if poly.count == 4u {
-        lo = min(lo, poly.xy[3]);
-        hi = max(hi, poly.xy[3]);
+        lo = min(lo, poly.vd.xy);
+        hi = max(hi, poly.vd.xy);
     }
     // Pixel i has its centre at i + 0.5.
     let first = clamp(ceil(lo - 0.5), vec2<f32>(0.0), size);
     let last = clamp(floor(hi - 0.5), vec2<f32>(-1.0), size - 1.0);
     return PixelRect(vec2<i32>(first), vec2<i32>(last));
-}
-
-// NDC depth of the polygon at pixel centre p, or a negative value when p is outside.
-fn poly_depth(poly: Poly, p: vec2<f32>) -> f32 {
-    let tris = select(1u, 2u, poly.count == 4u);
-    for (var k = 0u; k < tris; k++) {
-        let v0 = poly.xy[0];
-        let v1 = poly.xy[1u + k];
-        let v2 = poly.xy[2u + k];
-        var e0 = edge(v1, v2, p);
-        var e1 = edge(v2, v0, p);
-        var e2 = edge(v0, v1, p);
-        // Orient so that inside is positive.
-        let flip = poly.flip;
-        var a0 = v1;
-        var b0 = v2;
-        var a1 = v2;
-        var b1 = v0;
-        var a2 = v0;
-        var b2 = v1;
-        if flip {
-            e0 = -e0;
-            e1 = -e1;
-            e2 = -e2;
-            a0 = v2;
-            b0 = v1;
-            a1 = v0;
-            b1 = v2;
-            a2 = v1;
-            b2 = v0;
-        }
-        let in0 = e0 > 0.0 || (e0 == 0.0 && owns_edge(a0, b0));
-        let in1 = e1 > 0.0 || (e1 == 0.0 && owns_edge(a1, b1));
-        let in2 = e2 > 0.0 || (e2 == 0.0 && owns_edge(a2, b2));
-        if in0 && in1 && in2 {
-            let w = vec3<f32>(e0, e1, e2) / (e0 + e1 + e2);
-            return w.x * poly.z[0] + w.y * poly.z[1u + k] + w.z * poly.z[2u + k];
-        }
-    }
-    return -1.0;
 }
 
 // Polygon of visibility id `id` in view `view`, and whether the instance is double-sided.
@@ -197,14 +261,33 @@ fn id_poly(id: u32, view: u32) -> Poly {
     }
     let inst = instances[chunk.instance];
     let tri = chunk.first_triangle + lane;
-    let view_proj = params.view_proj[view];
-    var c: array<vec4<f32>, 3>;
-    for (var k = 0u; k < 3u; k++) {
-        let p = positions[indices[tri * 3u + k]];
-        c[k] = view_proj * (inst.model * vec4<f32>(p.xyz, 1.0));
-    }
+    let m = params.view_proj[view] * inst.model;
+    let c0 = m * vec4<f32>(positions[indices[tri * 3u]].xyz, 1.0);
+    let c1 = m * vec4<f32>(positions[indices[tri * 3u + 1u]].xyz, 1.0);
+    let c2 = m * vec4<f32>(positions[indices[tri * 3u + 2u]].xyz, 1.0);
     let cull_back = params.config.x != 0u && (inst.flags & INSTANCE_DOUBLE_SIDED) == 0u;
-    return triangle_poly(c, params.viewport.xy, cull_back);
+    return triangle_poly(c0, c1, c2, params.viewport.xy, cull_back);
+}
+
+// Whether every point of a chunk's bounds is outside one plane of the view's frustum (a side,
+// or in front of the near plane): then none of its triangles can be seen.
+fn chunk_outside(chunk: Chunk, view: u32) -> bool {
+    let m = params.view_proj[view] * instances[chunk.instance].model;
+    var all_l = true;
+    var all_r = true;
+    var all_b = true;
+    var all_t = true;
+    var all_near = true;
+    for (var k = 0u; k < 8u; k++) {
+        let p = select(chunk.bounds_lo.xyz, chunk.bounds_hi.xyz, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
+        let c = m * vec4<f32>(p, 1.0);
+        all_l = all_l && c.x < -c.w;
+        all_r = all_r && c.x > c.w;
+        all_b = all_b && c.y < -c.w;
+        all_t = all_t && c.y > c.w;
+        all_near = all_near && c.w - c.z < 0.0;
+    }
+    return all_l || all_r || all_b || all_t || all_near;
 }
 
 fn write_pixel(view: u32, px: vec2<i32>, depth: f32, id: u32) {
@@ -213,9 +296,13 @@ fn write_pixel(view: u32, px: vec2<i32>, depth: f32, id: u32) {
     }
     let w = u32(params.viewport.x);
     let i = view * w * u32(params.viewport.y) + u32(px.y) * w + u32(px.x);
+    // A plain load first: most occluded fragments then skip the atomic.
 #ifdef DEPTH_ONLY
-    atomicMax(&target_texels[i], bitcast<u32>(depth));
+    let value = bitcast<u32>(depth);
 #else
-    atomicMax(&target_texels[i], (u64(bitcast<u32>(depth)) << 32u) | u64(id));
+    let value = (u64(bitcast<u32>(depth)) << 32u) | u64(id);
 #endif
+    if value > atomicLoad(&target_texels[i]) {
+        atomicMax(&target_texels[i], value);
+    }
 }

@@ -1,7 +1,7 @@
 // Compute rasteriser, pass 2: the tiles of large triangles queued by `raster/triangles.wgsl`,
 // one workgroup a tile at a time; workgroups loop over the queue.
 
-#import hikari::raster::setup::{params, queue, queue_count, id_poly, poly_rect, poly_depth, write_pixel, TILE_SIZE}
+#import hikari::raster::setup::{params, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, write_pixel, TILE_SIZE}
 
 const THREADS: u32 = 64u;
 
@@ -23,13 +23,14 @@ fn main(
             continue;
         }
         let rect = poly_rect(poly, size);
+        let setup = poly_setup(poly);
         let origin = vec2<i32>(tile * TILE_SIZE);
         for (var i = lane; i < TILE_SIZE * TILE_SIZE; i += THREADS) {
             let px = origin + vec2<i32>(vec2<u32>(i % TILE_SIZE, i / TILE_SIZE));
             if any(px < rect.lo) || any(px > rect.hi) {
                 continue;
             }
-            let d = poly_depth(poly, vec2<f32>(px) + 0.5);
+            let d = setup_depth(setup, vec2<f32>(px) + 0.5);
             if d > 0.0 {
                 write_pixel(view, px, d, id);
             }

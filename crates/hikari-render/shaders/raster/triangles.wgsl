@@ -2,8 +2,14 @@
 // their thread; larger ones are split into TILE_SIZE tiles queued for `raster/tiles.wgsl`.
 // Dispatch: x * y workgroups cover the chunks, z is the view.
 
-#import hikari::raster::setup::{params, queue, queue_count, id_poly, poly_rect, poly_depth, write_pixel, TILE_SIZE, SMALL_TRIANGLE_PIXELS}
+#import hikari::raster::setup::{params, chunks, chunk_outside, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, setup_touches, write_pixel, Setup, PixelRect, TILE_SIZE, SMALL_TRIANGLE_PIXELS}
 #import hikari::scene_gpu::CHUNK_TRIANGLES
+
+fn tile_touched(setup: Setup, rect: PixelRect, tile: vec2<u32>) -> bool {
+    let lo = max(vec2<i32>(tile * TILE_SIZE), rect.lo);
+    let hi = min(vec2<i32>(tile * TILE_SIZE + TILE_SIZE - 1u), rect.hi);
+    return setup_touches(setup, lo, hi);
+}
 
 @compute @workgroup_size(64, 1, 1)
 fn main(
@@ -16,6 +22,10 @@ fn main(
         return;
     }
     let view = wg.z;
+    // The same answer for the whole workgroup: a chunk outside the view costs one test.
+    if chunk_outside(chunks[chunk], view) {
+        return;
+    }
     let id = chunk * CHUNK_TRIANGLES + lane;
     let poly = id_poly(id, view);
     if poly.count == 0u {
@@ -27,10 +37,11 @@ fn main(
     if extent.x <= 0 || extent.y <= 0 {
         return;
     }
+    let setup = poly_setup(poly);
     if extent.x * extent.y <= SMALL_TRIANGLE_PIXELS {
         for (var y = rect.lo.y; y <= rect.hi.y; y++) {
             for (var x = rect.lo.x; x <= rect.hi.x; x++) {
-                let d = poly_depth(poly, vec2<f32>(f32(x), f32(y)) + 0.5);
+                let d = setup_depth(setup, vec2<f32>(f32(x), f32(y)) + 0.5);
                 if d > 0.0 {
                     write_pixel(view, vec2<i32>(x, y), d, id);
                 }
@@ -38,19 +49,26 @@ fn main(
         }
         return;
     }
+    // Queue only the tiles the polygon touches (long thin triangles have mostly empty
+    // boxes): count them, reserve the slots with one atomic, then write them.
     let t_lo = vec2<u32>(rect.lo) / TILE_SIZE;
     let t_hi = vec2<u32>(rect.hi) / TILE_SIZE;
-    let tiles = (t_hi.x - t_lo.x + 1u) * (t_hi.y - t_lo.y + 1u);
-    let first = atomicAdd(&queue_count[0], tiles);
-    let capacity = params.config.y;
-    for (var k = 0u; k < tiles; k++) {
-        let slot = first + k;
-        if slot >= capacity {
-            // Overflow: queue_count keeps growing past the capacity, so a readback can tell.
-            break;
+    var touched = 0u;
+    for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
+        for (var tx = t_lo.x; tx <= t_hi.x; tx++) {
+            touched += select(0u, 1u, tile_touched(setup, rect, vec2<u32>(tx, ty)));
         }
-        let w = t_hi.x - t_lo.x + 1u;
-        let t = t_lo + vec2<u32>(k % w, k / w);
-        queue[slot] = vec2<u32>(id, t.x | (t.y << 12u) | (view << 24u));
+    }
+    let first = atomicAdd(&queue_count[0], touched);
+    let capacity = params.config.y;
+    var slot = first;
+    for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
+        for (var tx = t_lo.x; tx <= t_hi.x; tx++) {
+            // Overflow: queue_count keeps growing past the capacity, so a readback can tell.
+            if slot < capacity && tile_touched(setup, rect, vec2<u32>(tx, ty)) {
+                queue[slot] = vec2<u32>(id, tx | (ty << 12u) | (view << 24u));
+                slot++;
+            }
+        }
     }
 }

@@ -34,7 +34,14 @@ pub struct LightingParams {
     pub sky_horizon: [f32; 4],
     /// Number of lights, `LIGHTING_*` flags, 0, 0.
     pub config: [u32; 4],
+    /// x: illuminance in lux below which a punctual light is cut off this frame; yzw unused.
+    pub cutoff: [f32; 4],
 }
+
+/// A punctual light is cut off where its illuminance falls below this fraction of the frame's
+/// metered illuminance (or [`crate::scene_gpu::LIGHT_CUTOFF_LUX`], whichever is larger): in
+/// daylight a lantern's light a few metres away is far below what the exposure can show.
+pub const LIGHT_CUTOFF_FRACTION: f32 = 1e-4;
 
 /// Placeholder sky radiance (nits) under the default 100000 lux sun, until the atmosphere
 /// issue: a clear-day blue zenith and a paler horizon, of the order of a real clear sky (a
@@ -43,7 +50,13 @@ pub const PLACEHOLDER_SKY_ZENITH: Vec3 = Vec3::new(1800.0, 3200.0, 6500.0);
 pub const PLACEHOLDER_SKY_HORIZON: Vec3 = Vec3::new(6000.0, 7000.0, 8000.0);
 
 impl LightingParams {
-    pub fn new(sun: Option<&Sun>, light_count: u32, s: &LightingSettings) -> Self {
+    /// `metered_lux`: the illuminance the exposure is set for ([`crate::FrameSettings::metered_lux`]).
+    pub fn new(
+        sun: Option<&Sun>,
+        light_count: u32,
+        metered_lux: f32,
+        s: &LightingSettings,
+    ) -> Self {
         let (dir, lux, color) = match sun {
             Some(s) => (s.direction.normalize(), s.illuminance_lux, s.color),
             None => (Vec3::Y, 0.0, Vec3::ONE),
@@ -64,6 +77,12 @@ impl LightingParams {
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky).extend(0.0).to_array(),
             config: [light_count, flags, 0, 0],
+            cutoff: [
+                (metered_lux * LIGHT_CUTOFF_FRACTION).max(crate::scene_gpu::LIGHT_CUTOFF_LUX),
+                0.0,
+                0.0,
+                0.0,
+            ],
         }
     }
 }

@@ -39,10 +39,16 @@ pub fn specular_placeholder(p: &LightingParams, m: &Material, n: Vec3, v: Vec3) 
     brdf::fresnel::fresnel_schlick(f0, n.dot(v).max(0.0) as f64).as_vec3() * env
 }
 
+/// Where the light's illuminance falls to the frame's cutoff, or its own range if nearer.
+pub fn light_range(p: &LightingParams, light: &LightGpu) -> f32 {
+    let peak = v3(light.intensity).max_element();
+    light.position_range[3].min((peak / p.cutoff[0]).sqrt())
+}
+
 /// Illuminance per candela of a punctual light `d2` metres squared away in direction `l`
 /// (unit, surface to light): inverse square, the range window, the spot cone.
-pub fn light_attenuation(light: &LightGpu, l: Vec3, d2: f32) -> f32 {
-    let range = light.position_range[3];
+pub fn light_attenuation(p: &LightingParams, light: &LightGpu, l: Vec3, d2: f32) -> f32 {
+    let range = light_range(p, light);
     let x = d2 / (range * range);
     let window = (1.0 - x * x).clamp(0.0, 1.0);
     let mut a = window * window / d2.max(1e-4);
@@ -105,7 +111,7 @@ pub fn shade(
             let l = to_light / d2.max(1e-8).sqrt();
             radiance += brdf::evaluate(&m, n, t, b, v, l)
                 * v3(light.intensity)
-                * light_attenuation(light, l, d2);
+                * light_attenuation(p, light, l, d2);
         }
     }
     if flags & LIGHTING_PLACEHOLDER_AMBIENT != 0 {
