@@ -66,7 +66,9 @@ fn visibility_matches_rays_through_pixel_centres() {
         hikari_scene::builtin::cornell(),
     ] {
         let Some(ctx) = common::gpu() else { return };
-        let (w, h) = (96u32, 64u32);
+        // Wide enough that the ground's two triangles span more than 16 32x32 tiles and take
+        // the large-triangle pass, while the boxes take the per-thread and tile passes.
+        let (w, h) = (256u32, 160u32);
         let s = frame_settings(&scene, w, h);
         let mut renderer = Renderer::new(ctx, &scene).unwrap();
         let r = renderer
@@ -154,9 +156,16 @@ fn uv_sphere(segments: u32, rings: u32) -> hikari_scene::Mesh {
 fn a_closed_mesh_has_no_cracks_or_holes() {
     // A camera inside a closed, finely tessellated sphere: every pixel must see it. A crack
     // between triangles (a pixel centre claimed by neither) shows as sky.
+    // Fine tessellation: per-thread and tile passes; coarse: the large-triangle pass.
+    for (segments, rings) in [(96, 48), (6, 3)] {
+        sphere_has_no_holes(segments, rings);
+    }
+}
+
+fn sphere_has_no_holes(segments: u32, rings: u32) {
     let Some(ctx) = common::gpu() else { return };
     let mut scene = Scene::default();
-    scene.meshes.push(uv_sphere(96, 48));
+    scene.meshes.push(uv_sphere(segments, rings));
     // Seen from inside: the inward faces are back faces of the outward-wound sphere.
     let mut m = hikari_scene::Material::diffuse("inside", Vec3::splat(0.5));
     m.double_sided = true;
@@ -174,14 +183,17 @@ fn a_closed_mesh_has_no_cracks_or_holes() {
         near: 0.1,
         up: Vec3::Y,
     });
-    let s = frame_settings(&scene, 128, 96);
+    let s = frame_settings(&scene, 256, 192);
     let mut renderer = Renderer::new(ctx, &scene).unwrap();
     let r = renderer
         .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
         .unwrap();
     let vis: &[u32] = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap());
     let holes = vis.chunks(2).filter(|p| p[1] == 0).count();
-    assert_eq!(holes, 0, "{holes} pixels see through the sphere");
+    assert_eq!(
+        holes, 0,
+        "{holes} pixels see through the {segments}x{rings} sphere"
+    );
 }
 
 #[test]

@@ -23,8 +23,10 @@
 // One u64 a pixel: NDC depth bits above the visibility id, so atomicMax keeps the nearest.
 @group(0) @binding(5) var<storage, read_write> target_texels: array<atomic<u64>>;
 #endif
-// Tile queue: (visibility id, tile x | tile y << 12 | view << 24).
+// Tile queue: (visibility id, tile x | tile y << 12 | view << 24) in the first `config.y`
+// entries, then up to LARGE_CAPACITY large triangles as (visibility id, view).
 @group(0) @binding(6) var<storage, read_write> queue: array<vec2<u32>>;
+// [0]: tile entries, [1]: large triangles (both keep counting past their capacity).
 @group(0) @binding(7) var<storage, read_write> queue_count: array<atomic<u32>>;
 
 // The views one dispatch rasterises into (the camera, or up to four shadow cascades).
@@ -57,6 +59,10 @@ struct PixelRect {
 }
 
 const TILE_SIZE: u32 = 32u;
+// Triangles whose box spans more tiles are rasterised by every workgroup of the large pass
+// together, rather than by one thread queueing all their tiles.
+const LARGE_TRIANGLE_TILES: u32 = 16u;
+const LARGE_CAPACITY: u32 = 65536u;
 // Triangles whose clamped bounding box holds more pixels go to the tile queue.
 const SMALL_TRIANGLE_PIXELS: i32 = 96;
 
@@ -235,6 +241,28 @@ fn setup_touches(s: Setup, lo: vec2<i32>, hi: vec2<i32>) -> bool {
     let p0 = vec2<f32>(lo) + 0.5;
     let p1 = vec2<f32>(hi) + 0.5;
     return tri_touches(s.first, p0, p1) || (s.tris == 2u && tri_touches(s.second, p0, p1));
+}
+
+// Whether the polygon may cover a pixel centre of `tile` (in TILE_SIZE units) within `rect`.
+fn tile_touched(setup: Setup, rect: PixelRect, tile: vec2<u32>) -> bool {
+    let lo = max(vec2<i32>(tile * TILE_SIZE), rect.lo);
+    let hi = min(vec2<i32>(tile * TILE_SIZE + TILE_SIZE - 1u), rect.hi);
+    return setup_touches(setup, lo, hi);
+}
+
+// Rasterises the part of `rect` inside `tile`, the workgroup's threads sharing its pixels.
+fn raster_tile(setup: Setup, rect: PixelRect, tile: vec2<u32>, view: u32, id: u32, lane: u32, threads: u32) {
+    let origin = vec2<i32>(tile * TILE_SIZE);
+    for (var i = lane; i < TILE_SIZE * TILE_SIZE; i += threads) {
+        let px = origin + vec2<i32>(vec2<u32>(i % TILE_SIZE, i / TILE_SIZE));
+        if any(px < rect.lo) || any(px > rect.hi) {
+            continue;
+        }
+        let d = setup_depth(setup, vec2<f32>(px) + 0.5);
+        if d > 0.0 {
+            write_pixel(view, px, d, id);
+        }
+    }
 }
 
 fn poly_rect(poly: Poly, size: vec2<f32>) -> PixelRect {

@@ -1,15 +1,10 @@
 // Compute rasteriser, pass 1: one thread a triangle. Small triangles are rasterised here by
-// their thread; larger ones are split into TILE_SIZE tiles queued for `raster/tiles.wgsl`.
+// their thread; larger ones are split into TILE_SIZE tiles queued for `raster/tiles.wgsl`
+// (`main`), and the largest are listed whole for its `large` entry point.
 // Dispatch: x * y workgroups cover the chunks, z is the view.
 
-#import hikari::raster::setup::{params, chunks, chunk_outside, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, setup_touches, write_pixel, Setup, PixelRect, TILE_SIZE, SMALL_TRIANGLE_PIXELS}
+#import hikari::raster::setup::{params, chunks, chunk_outside, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, setup_touches, write_pixel, tile_touched, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
 #import hikari::scene_gpu::CHUNK_TRIANGLES
-
-fn tile_touched(setup: Setup, rect: PixelRect, tile: vec2<u32>) -> bool {
-    let lo = max(vec2<i32>(tile * TILE_SIZE), rect.lo);
-    let hi = min(vec2<i32>(tile * TILE_SIZE + TILE_SIZE - 1u), rect.hi);
-    return setup_touches(setup, lo, hi);
-}
 
 @compute @workgroup_size(64, 1, 1)
 fn main(
@@ -49,10 +44,18 @@ fn main(
         }
         return;
     }
-    // Queue only the tiles the polygon touches (long thin triangles have mostly empty
-    // boxes): count them, reserve the slots with one atomic, then write them.
     let t_lo = vec2<u32>(rect.lo) / TILE_SIZE;
     let t_hi = vec2<u32>(rect.hi) / TILE_SIZE;
+    let span = t_hi - t_lo + 1u;
+    if span.x * span.y > LARGE_TRIANGLE_TILES {
+        let slot = atomicAdd(&queue_count[1], 1u);
+        if slot < LARGE_CAPACITY {
+            queue[params.config.y + slot] = vec2<u32>(id, view);
+        }
+        return;
+    }
+    // Queue only the tiles the polygon touches (thin triangles have mostly empty boxes): count
+    // them, reserve the slots with one atomic, then write them.
     var touched = 0u;
     for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
         for (var tx = t_lo.x; tx <= t_hi.x; tx++) {

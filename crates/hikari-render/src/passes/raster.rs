@@ -5,8 +5,10 @@
 //!
 //! Pass 1 (`{technique}.rasterize`) runs a thread a triangle: small triangles are rasterised by
 //! their thread, larger ones split into 32x32 tiles queued for pass 2
-//! (`{technique}.rasterize_tiles`), where a workgroup covers a tile. CPU twin: rays through the
-//! pixel centres with `hikari_bvh` (tests/raster.rs).
+//! (`{technique}.rasterize_tiles`), where a workgroup covers a tile; triangles spanning more
+//! than 16 tiles are listed whole for pass 3 (`{technique}.rasterize_large`), where every
+//! workgroup takes its share of each one's tiles, so no thread walks thousands of tiles alone.
+//! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/raster.rs).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
@@ -59,9 +61,13 @@ pub struct RasterJob<'a> {
     pub cull_back_faces: bool,
 }
 
+/// Large triangles the queue holds after its tile entries (`LARGE_CAPACITY` in the shader).
+const LARGE_CAPACITY: u64 = 65536;
+
 pub struct Rasterizer {
-    visibility: [ComputePipeline; 2],
-    depth: [ComputePipeline; 2],
+    /// triangles, tiles, large
+    visibility: [ComputePipeline; 3],
+    depth: [ComputePipeline; 3],
 }
 
 impl Rasterizer {
@@ -78,10 +84,12 @@ impl Rasterizer {
             visibility: [
                 ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &[])?,
                 ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &[])?,
+                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "large", &[])?,
             ],
             depth: [
                 ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &depth_only)?,
                 ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &depth_only)?,
+                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "large", &depth_only)?,
             ],
         })
     }
@@ -103,7 +111,10 @@ impl Rasterizer {
         // triangles lose tiles (the overflow shows as holes, and `queue_count` tells).
         let capacity = (tiles * 8).clamp(1 << 16, 1 << 22) as u32;
         let t = job.technique;
-        let queue = g.buffer(&format!("{t}.tile_queue"), capacity as u64 * 8)?;
+        let queue = g.buffer(
+            &format!("{t}.tile_queue"),
+            (capacity as u64 + LARGE_CAPACITY) * 8,
+        )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
         g.pass(&format!("{t}.clear"))
             .uses(target, true)
@@ -157,6 +168,16 @@ impl Rasterizer {
             .write(queue)
             .write(count)
             .dispatch(&pipelines[1], [TILE_WORKGROUPS, 1, 1])?;
+        g.pass(&format!("{t}.rasterize_large"))
+            .constants(&params)
+            .read(positions)
+            .read(indices)
+            .read(instances)
+            .read(chunks)
+            .write(target)
+            .write(queue)
+            .write(count)
+            .dispatch(&pipelines[2], [TILE_WORKGROUPS, 1, 1])?;
         Ok(())
     }
 }
