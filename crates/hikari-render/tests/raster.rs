@@ -66,9 +66,9 @@ fn visibility_matches_rays_through_pixel_centres() {
         hikari_scene::builtin::cornell(),
     ] {
         let Some(ctx) = common::gpu() else { return };
-        // Wide enough that the ground's two triangles span more than 16 32x32 tiles and take
+        // Wide enough that the ground's two triangles span more than 256 32x32 tiles and take
         // the large-triangle pass, while the boxes take the per-thread and tile passes.
-        let (w, h) = (256u32, 160u32);
+        let (w, h) = (768u32, 480u32);
         let s = frame_settings(&scene, w, h);
         let mut renderer = Renderer::new(ctx, &scene).unwrap();
         let r = renderer
@@ -157,7 +157,7 @@ fn a_closed_mesh_has_no_cracks_or_holes() {
     // A camera inside a closed, finely tessellated sphere: every pixel must see it. A crack
     // between triangles (a pixel centre claimed by neither) shows as sky.
     // Fine tessellation: per-thread and tile passes; coarse: the large-triangle pass.
-    for (segments, rings) in [(96, 48), (6, 3)] {
+    for (segments, rings) in [(96, 48), (6, 3), (4, 2)] {
         sphere_has_no_holes(segments, rings);
     }
 }
@@ -183,7 +183,7 @@ fn sphere_has_no_holes(segments: u32, rings: u32) {
         near: 0.1,
         up: Vec3::Y,
     });
-    let s = frame_settings(&scene, 256, 192);
+    let s = frame_settings(&scene, 640, 480);
     let mut renderer = Renderer::new(ctx, &scene).unwrap();
     let r = renderer
         .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])

@@ -6,7 +6,7 @@
 //! Pass 1 (`{technique}.rasterize`) runs a thread a triangle: small triangles are rasterised by
 //! their thread, larger ones split into 32x32 tiles queued for pass 2
 //! (`{technique}.rasterize_tiles`), where a workgroup covers a tile; triangles spanning more
-//! than 16 tiles are listed whole for pass 3 (`{technique}.rasterize_large`), where every
+//! than 256 tiles are listed whole for pass 3 (`{technique}.rasterize_large`), where every
 //! workgroup takes its share of each one's tiles, so no thread walks thousands of tiles alone.
 //! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/raster.rs).
 
