@@ -38,6 +38,10 @@ pub struct FrameArgs {
     /// the frame span is the real cost (timing each pass adds about 10 us a pass).
     #[arg(long)]
     frame_only: bool,
+    /// Move the camera forward this many metres every frame (with motion vectors), so that
+    /// cached shadow cascades are redrawn as in a moving view; 0 keeps a still view.
+    #[arg(long, default_value_t = 0.0)]
+    dolly: f32,
 }
 
 #[derive(Args, Debug)]
@@ -103,7 +107,12 @@ pub fn print_single_frame(r: &FrameResult) {
 }
 
 fn frame(a: FrameArgs) -> anyhow::Result<()> {
-    let (scene, settings) = a.frame.resolve()?;
+    let (scene, mut settings) = a.frame.resolve()?;
+    anyhow::ensure!(
+        a.dolly.is_finite() && a.dolly.abs() <= 100.0,
+        "--dolly {} is outside -100 to 100 metres a frame",
+        a.dolly
+    );
     let scene_name = a.frame.scene.clone().unwrap_or_else(|| "village".into());
     anyhow::ensure!(a.frames > 0, "--frames must be at least 1");
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
@@ -124,6 +133,12 @@ fn frame(a: FrameArgs) -> anyhow::Result<()> {
     let mut per_pass: BTreeMap<String, (usize, Vec<f64>, Vec<f64>)> = BTreeMap::new();
     let (mut spans, mut encode) = (Vec::new(), Vec::new());
     for _ in 0..a.frames {
+        if a.dolly != 0.0 {
+            let step = settings.camera.forward() * a.dolly;
+            settings.prev_camera = Some(settings.camera.clone());
+            settings.camera.position += step;
+            settings.camera.target += step;
+        }
         let f = renderer.render(&settings, false)?;
         for (i, t) in f.result.timings.iter().enumerate() {
             let e = per_pass

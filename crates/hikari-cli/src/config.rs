@@ -7,6 +7,7 @@ use anyhow::Context;
 use serde::Deserialize;
 
 use hikari_render::Settings;
+use hikari_render::settings::{ExposureSettings, LightingSettings, ShadowSettings};
 
 /// The file: what to render, and the renderer's settings.
 #[derive(Debug, Default, Deserialize)]
@@ -18,8 +19,21 @@ pub struct ConfigFile {
     pub time: Option<String>,
     pub width: Option<u32>,
     pub height: Option<u32>,
-    #[serde(flatten)]
-    pub settings: Settings,
+    // Spelled out rather than flattened from `Settings`: serde's flatten would lose the
+    // position of type errors and could not refuse unknown keys.
+    pub shadows: ShadowSettings,
+    pub lighting: LightingSettings,
+    pub exposure: ExposureSettings,
+}
+
+impl ConfigFile {
+    pub fn settings(&self) -> Settings {
+        Settings {
+            shadows: self.shadows.clone(),
+            lighting: self.lighting.clone(),
+            exposure: self.exposure.clone(),
+        }
+    }
 }
 
 /// Reads and validates `path`; errors name the file, and the field with its allowed range.
@@ -31,7 +45,7 @@ pub fn load(path: &Path) -> anyhow::Result<ConfigFile> {
 
 pub fn parse(text: &str) -> anyhow::Result<ConfigFile> {
     let file: ConfigFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{e}"))?;
-    file.settings.validate()?;
+    file.settings().validate()?;
     Ok(file)
 }
 
@@ -42,7 +56,7 @@ mod tests {
     #[test]
     fn the_documented_example_parses_to_the_defaults_it_states() {
         let f = parse(include_str!("../../../docs/config.example.toml")).unwrap();
-        assert_eq!(f.settings, Settings::default());
+        assert_eq!(f.settings(), Settings::default());
         assert_eq!(f.scene.as_deref(), Some("village"));
     }
 

@@ -64,7 +64,7 @@ impl FrameArgs {
             )),
             None => scene.sun.clone(),
         };
-        let mut settings = file.settings;
+        let mut settings = file.settings();
         if let Some(ev) = self.ev100 {
             settings.exposure.ev100 = Some(ev);
         }

@@ -54,6 +54,12 @@ impl FrameSettings {
     }
 }
 
+/// What one frame leaves for the next, besides the graph's persistent resources.
+#[derive(Clone, Debug, Default)]
+pub struct FrameState {
+    pub shadow_cache: sun_shadows::ShadowCache,
+}
+
 /// Every technique's pipelines, built once.
 pub struct Techniques {
     pub raster: Rasterizer,
@@ -90,6 +96,7 @@ pub fn record<'r>(
     t: &'r Techniques,
     scene: &'r SceneGpu,
     s: &FrameSettings,
+    state: &mut FrameState,
 ) -> Result<FrameOutputs> {
     let size = [s.width, s.height];
     let aspect = s.width as f32 / s.height as f32;
@@ -112,6 +119,7 @@ pub fn record<'r>(
         g,
         &t.raster,
         scene,
+        &mut state.shadow_cache,
         &s.camera,
         aspect,
         to_sun,

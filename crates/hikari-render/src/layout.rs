@@ -73,7 +73,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             raster::RasterParams,
             "raster/triangles.wgsl",
-            [view_proj, viewport, config]
+            [view_proj, viewport, config, slices]
         ),
         gpu_layout!(
             sun_shadows::ShadowParams,

@@ -4,7 +4,7 @@ use hikari_scene::Scene;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::frame::{self, FrameOutputs, FrameSettings, Techniques};
+use crate::frame::{self, FrameOutputs, FrameSettings, FrameState, Techniques};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
 use crate::scene_gpu::SceneGpu;
 
@@ -20,6 +20,7 @@ pub struct Renderer {
     pub runtime: GraphRuntime,
     techniques: Techniques,
     scene: SceneGpu,
+    state: FrameState,
 }
 
 impl Renderer {
@@ -30,6 +31,7 @@ impl Renderer {
             runtime: GraphRuntime::new(),
             techniques,
             scene: scene_gpu,
+            state: FrameState::default(),
             ctx,
         })
     }
@@ -74,7 +76,13 @@ impl Renderer {
             }
         }
         let mut g = self.runtime.begin_frame(&self.ctx);
-        let out = frame::record(&mut g, &self.techniques, &self.scene, settings)?;
+        let out = frame::record(
+            &mut g,
+            &self.techniques,
+            &self.scene,
+            settings,
+            &mut self.state,
+        )?;
         for r in pick(&out) {
             g.readback(r);
         }

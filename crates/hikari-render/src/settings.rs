@@ -32,6 +32,10 @@ pub struct ShadowSettings {
     pub depth_bias_texels: f32,
     /// Receiver offset along its normal, in texels of the cascade's world-space size.
     pub normal_bias_texels: f32,
+    /// Keep each cascade's map across frames and redraw it only when its projection changes
+    /// (the camera moved by a texel or more, the sun moved, the settings changed): in a still
+    /// view the maps cost nothing. Off: every cascade is redrawn every frame.
+    pub cache: bool,
 }
 
 impl Default for ShadowSettings {
@@ -45,6 +49,7 @@ impl Default for ShadowSettings {
             filter_radius_texels: 1.0,
             depth_bias_texels: 1.0,
             normal_bias_texels: 1.5,
+            cache: true,
         }
     }
 }

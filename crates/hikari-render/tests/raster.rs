@@ -252,3 +252,57 @@ fn shadow_maps_match_rays_from_the_sun() {
         "{differ} texels differ from the rays, {agree} agree"
     );
 }
+
+#[test]
+fn cached_shadow_maps_give_the_image_a_full_redraw_gives() {
+    let scene = hikari_scene::builtin::boxes();
+    let first = frame_settings(&scene, 96, 64);
+    let mut moved = first.clone();
+    moved.camera.position += Vec3::new(0.37, 0.05, -0.21);
+    moved.camera.target += Vec3::new(0.3, 0.0, 0.1);
+    let hdr_bits = |f: &hikari_render::RenderedFrame| -> Vec<u32> {
+        f.hdr
+            .as_ref()
+            .unwrap()
+            .rgba
+            .iter()
+            .flatten()
+            .map(|v| v.to_bits())
+            .collect()
+    };
+    let drew_shadows = |f: &hikari_render::RenderedFrame| {
+        f.result
+            .timings
+            .iter()
+            .any(|t| t.name == "sun_shadows.rasterize")
+    };
+
+    let Some(ctx) = common::gpu() else { return };
+    let mut cached = Renderer::new(ctx, &scene).unwrap();
+    let a = cached.render(&first, true).unwrap();
+    let b = cached.render(&moved, true).unwrap();
+    let c = cached.render(&moved, true).unwrap();
+    assert!(
+        drew_shadows(&a) && drew_shadows(&b),
+        "new and moved views draw their maps"
+    );
+    assert!(!drew_shadows(&c), "a still view reuses them");
+
+    let mut uncached_settings = moved.clone();
+    uncached_settings.settings.shadows.cache = false;
+    let mut fresh = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
+    let d = fresh.render(&uncached_settings, true).unwrap();
+    let e = fresh.render(&uncached_settings, true).unwrap();
+    assert!(
+        drew_shadows(&e),
+        "without the cache every frame draws its maps"
+    );
+    assert!(
+        hdr_bits(&b) == hdr_bits(&d),
+        "moved view: cache and full redraw differ"
+    );
+    assert!(
+        hdr_bits(&c) == hdr_bits(&d),
+        "still view: cache and full redraw differ"
+    );
+}

@@ -37,6 +37,8 @@ struct RasterParams {
     // x: 1 to cull back faces of single-sided instances; y: capacity of the tile queue in
     // entries; z: number of views; w: number of chunks.
     config: vec4<u32>,
+    // Per view: the slice of the target (of width * height texels) it draws into.
+    slices: vec4<u32>,
 }
 
 // Up to four screen-space vertices (xy in pixels, z the NDC depth): the triangle, or the
@@ -324,7 +326,7 @@ fn write_pixel(view: u32, px: vec2<i32>, depth: f32, id: u32) {
         return;
     }
     let w = u32(params.viewport.x);
-    let i = view * w * u32(params.viewport.y) + u32(px.y) * w + u32(px.x);
+    let i = params.slices[view] * w * u32(params.viewport.y) + u32(px.y) * w + u32(px.x);
     // A plain load first: most occluded fragments then skip the atomic.
 #ifdef DEPTH_ONLY
     let value = bitcast<u32>(depth);

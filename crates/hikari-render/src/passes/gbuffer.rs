@@ -79,6 +79,7 @@ impl GBufferPass {
             &RasterJob {
                 technique: "gbuffer",
                 view_proj: &[view.view_proj()],
+                slices: &[0],
                 size: [width, height],
                 cull_back_faces: true,
             },

@@ -32,6 +32,8 @@ pub struct RasterParams {
     pub view_proj: [[[f32; 4]; 4]; MAX_VIEWS],
     pub viewport: [f32; 4],
     pub config: [u32; 4],
+    /// Per view: which slice of the target (of `width * height` texels) it draws into.
+    pub slices: [u32; 4],
 }
 
 /// Whether a target keeps the triangle id beside the depth.
@@ -57,6 +59,8 @@ pub struct RasterJob<'a> {
     /// Technique name; the passes are `{technique}.clear`, `.rasterize`, `.rasterize_tiles`.
     pub technique: &'a str,
     pub view_proj: &'a [Mat4],
+    /// Per view, the slice of the target it draws into (and clears first).
+    pub slices: &'a [u32],
     pub size: [u32; 2],
     pub cull_back_faces: bool,
 }
@@ -94,7 +98,7 @@ impl Rasterizer {
         })
     }
 
-    /// Clears `target` and rasterises every scene triangle into it, once per view.
+    /// Clears the views' slices of `target` and rasterises every scene triangle into them.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
@@ -116,17 +120,28 @@ impl Rasterizer {
             (capacity as u64 + LARGE_CAPACITY) * 8,
         )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
+        assert_eq!(job.slices.len(), views, "one slice a view");
+        let slice_bytes = w as u64 * h as u64 * kind.bytes_per_texel();
+        let slices: Vec<u32> = job.slices.to_vec();
         g.pass(&format!("{t}.clear"))
             .uses(target, true)
             .uses(count, true)
             .encode(move |enc, res| {
-                enc.clear_buffer(res.buffer(target), 0, None);
+                for &s in &slices {
+                    enc.clear_buffer(
+                        res.buffer(target),
+                        s as u64 * slice_bytes,
+                        Some(slice_bytes),
+                    );
+                }
                 enc.clear_buffer(res.buffer(count), 0, None);
             })?;
         let mut view_proj = [[[0.0; 4]; 4]; MAX_VIEWS];
         for (dst, m) in view_proj.iter_mut().zip(job.view_proj) {
             *dst = m.to_cols_array_2d();
         }
+        let mut slice_of_view = [0u32; MAX_VIEWS];
+        slice_of_view[..views].copy_from_slice(job.slices);
         let params = RasterParams {
             view_proj,
             viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
@@ -136,6 +151,7 @@ impl Rasterizer {
                 views as u32,
                 scene.chunk_count,
             ],
+            slices: slice_of_view,
         };
         let positions = g.import_buffer("scene.positions", &scene.positions);
         let indices = g.import_buffer("scene.indices", &scene.indices);

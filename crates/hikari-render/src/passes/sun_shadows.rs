@@ -7,6 +7,9 @@
 //! camera's orientation), and its centre is snapped to whole texels in light space, so texels
 //! keep their place in the world as the camera turns and moves.
 //!
+//! The maps persist across frames; a cascade is redrawn only when its projection changes
+//! ([`ShadowCache`]; `shadows.cache = false` redraws all every frame).
+//!
 //! Depth convention as the camera's: 1 nearest the sun, 0 farthest (the cleared value), over
 //! the scene's extent along the sun direction, so every caster is inside the depth range.
 
@@ -172,11 +175,37 @@ pub fn depth_range(to_sun: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
     (hi - lo).abs().dot(z.abs()) + 2.0
 }
 
+/// The cascades drawn in earlier frames, so that unchanged ones are not drawn again.
+#[derive(Clone, Debug, Default)]
+pub struct ShadowCache {
+    /// The projection each slice of the persistent maps was last drawn with.
+    drawn: Vec<Option<Mat4>>,
+}
+
+impl ShadowCache {
+    /// Slices to draw this frame: those whose projection changed, all of them when the maps
+    /// are new or caching is off.
+    fn stale(&mut self, cascades: &[Cascade], fresh: bool, cache: bool) -> Vec<u32> {
+        if fresh || !cache || self.drawn.len() != cascades.len() {
+            self.drawn = vec![None; cascades.len()];
+        }
+        let mut stale = Vec::new();
+        for (i, c) in cascades.iter().enumerate() {
+            if self.drawn[i] != Some(c.view_proj) {
+                stale.push(i as u32);
+                self.drawn[i] = Some(c.view_proj);
+            }
+        }
+        stale
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 pub fn record<'r>(
     g: &mut FrameGraph<'r>,
     raster: &'r Rasterizer,
     scene: &'r SceneGpu,
+    cache: &mut ShadowCache,
     camera: &Camera,
     aspect: f32,
     to_sun: Vec3,
@@ -185,6 +214,7 @@ pub fn record<'r>(
     let bounds = match scene.bounds {
         Some(b) if s.enabled && to_sun.length_squared() > 0.0 => b,
         _ => {
+            *cache = ShadowCache::default();
             let texels = g.buffer("sun_shadows.texels", 16)?;
             g.pass("sun_shadows.clear")
                 .uses(texels, true)
@@ -197,21 +227,29 @@ pub fn record<'r>(
     };
     let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
     let res = s.resolution as u64;
-    let texels = g.buffer("sun_shadows.texels", res * res * cascades.len() as u64 * 4)?;
-    let view_proj: Vec<Mat4> = cascades.iter().map(|c| c.view_proj).collect();
-    raster.record(
-        g,
-        scene,
-        &RasterJob {
-            technique: "sun_shadows",
-            view_proj: &view_proj,
-            size: [s.resolution, s.resolution],
-            // Both faces cast: thin walls are single panels in many scenes.
-            cull_back_faces: false,
-        },
-        RasterTarget::Depth,
-        texels,
-    )?;
+    let (texels, fresh) =
+        g.persistent_buffer("sun_shadows.texels", res * res * cascades.len() as u64 * 4)?;
+    let stale = cache.stale(&cascades, fresh, s.cache);
+    if !stale.is_empty() {
+        let view_proj: Vec<Mat4> = stale
+            .iter()
+            .map(|&i| cascades[i as usize].view_proj)
+            .collect();
+        raster.record(
+            g,
+            scene,
+            &RasterJob {
+                technique: "sun_shadows",
+                view_proj: &view_proj,
+                slices: &stale,
+                size: [s.resolution, s.resolution],
+                // Both faces cast: thin walls are single panels in many scenes.
+                cull_back_faces: false,
+            },
+            RasterTarget::Depth,
+            texels,
+        )?;
+    }
     Ok(SunShadowMaps {
         texels,
         params: ShadowParams::new(&cascades, depth_range(to_sun, bounds), s),
