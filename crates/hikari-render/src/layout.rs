@@ -107,7 +107,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             crate::passes::bvh_trace::TraceParams,
             "bvh/trace.wgsl",
-            [count, pad0, pad1, pad2]
+            [count, image_width, pad0, pad1]
         ),
         gpu_layout!(
             hikari_bvh::Ray,

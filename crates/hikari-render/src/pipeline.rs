@@ -309,6 +309,24 @@ fn shader_module(ctx: &GpuContext, path: &str, module: naga::Module) -> wgpu::Sh
         })
 }
 
+/// # Safety
+/// As [`ComputePipeline::new_unchecked`].
+unsafe fn unchecked_shader_module(
+    ctx: &GpuContext,
+    path: &str,
+    module: naga::Module,
+) -> wgpu::ShaderModule {
+    let desc = wgpu::ShaderModuleDescriptor {
+        label: Some(path),
+        source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(module)),
+    };
+    // SAFETY: the caller vouches for the shader (see `ComputePipeline::new_unchecked`).
+    unsafe {
+        ctx.device
+            .create_shader_module_trusted(desc, wgpu::ShaderRuntimeChecks::unchecked())
+    }
+}
+
 pub struct ComputePipeline {
     pub info: PipelineInfo,
     pub pipeline: wgpu::ComputePipeline,
@@ -323,6 +341,36 @@ impl ComputePipeline {
         path: &str,
         entry: &str,
         defs: &[(&str, ShaderDefValue)],
+    ) -> Result<Self> {
+        Self::build(ctx, lib, path, entry, defs, false)
+    }
+
+    /// [`ComputePipeline::new`] without wgpu's runtime checks (clamping of every array and
+    /// buffer index, a counter in every loop, guards on integer division) and without zeroing
+    /// workgroup memory at the start of each workgroup. For hot kernels that can show why they
+    /// need none of it.
+    ///
+    /// # Safety
+    /// For every input the kernel may be given: every index it computes is in range of the
+    /// array or bound buffer it indexes, every loop terminates, no integer division or
+    /// remainder has a zero divisor, and no workgroup memory is read before it is written.
+    pub unsafe fn new_unchecked(
+        ctx: &GpuContext,
+        lib: &mut ShaderLibrary,
+        path: &str,
+        entry: &str,
+        defs: &[(&str, ShaderDefValue)],
+    ) -> Result<Self> {
+        Self::build(ctx, lib, path, entry, defs, true)
+    }
+
+    fn build(
+        ctx: &GpuContext,
+        lib: &mut ShaderLibrary,
+        path: &str,
+        entry: &str,
+        defs: &[(&str, ShaderDefValue)],
+        unchecked: bool,
     ) -> Result<Self> {
         let (module, slots) = checked_module(ctx, lib, path, defs)?;
         let workgroup_size = module
@@ -343,7 +391,12 @@ impl ComputePipeline {
                 bind_group_layouts: &[Some(&info.bind_group_layout)],
                 immediate_size: 0,
             });
-        let sm = shader_module(ctx, path, module);
+        let sm = if unchecked {
+            // SAFETY: only reached through `new_unchecked`, whose caller vouches for the shader.
+            unsafe { unchecked_shader_module(ctx, path, module) }
+        } else {
+            shader_module(ctx, path, module)
+        };
         let pipeline = ctx
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -351,7 +404,10 @@ impl ComputePipeline {
                 layout: Some(&layout),
                 module: &sm,
                 entry_point: Some(entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    zero_initialize_workgroup_memory: !unchecked,
+                    ..Default::default()
+                },
                 cache: None,
             });
         Ok(Self {

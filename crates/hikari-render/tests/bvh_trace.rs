@@ -12,7 +12,9 @@ use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
 use hikari_render::GpuContext;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::passes::bvh_trace::{BvhTrace, HIT_BYTES, TraceMode};
+use hikari_render::passes::bvh_trace::{
+    BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode,
+};
 use hikari_render::shader::{self, ShaderLibrary};
 use wgpu::util::DeviceExt;
 
@@ -59,10 +61,49 @@ impl Gpu {
         Some(Self { ctx, lib })
     }
 
-    /// Hits of both modes for `rays`, traced in one frame.
+    /// Hits of both modes for `rays`, traced in one frame by the default kernels (closest hit
+    /// as coherent rays, any hit as incoherent ones).
     fn trace(&mut self, scene: &Scene, rays: &[Ray]) -> (Vec<Hit>, Vec<Hit>) {
+        let trace = BvhTrace::new(&self.ctx, &mut self.lib).unwrap();
+        self.trace_on(trace, scene, rays)
+    }
+
+    /// As [`Gpu::trace`] with both modes tracing the rays as a row-major image.
+    fn trace_image(&mut self, scene: &Scene, rays: &[Ray], width: u32) -> (Vec<Hit>, Vec<Hit>) {
+        let trace = BvhTrace::new(&self.ctx, &mut self.lib).unwrap();
+        let order = RayOrder::Image { width };
+        self.trace_on_with(trace, scene, rays, [order, order])
+    }
+
+    /// As [`Gpu::trace`] with one configuration for both.
+    fn trace_with(
+        &mut self,
+        scene: &Scene,
+        rays: &[Ray],
+        config: TraceConfig,
+    ) -> (Vec<Hit>, Vec<Hit>) {
+        let trace = BvhTrace::with_config(&self.ctx, &mut self.lib, config).unwrap();
+        self.trace_on(trace, scene, rays)
+    }
+
+    fn trace_on(&mut self, trace: BvhTrace, scene: &Scene, rays: &[Ray]) -> (Vec<Hit>, Vec<Hit>) {
+        self.trace_on_with(
+            trace,
+            scene,
+            rays,
+            [RayOrder::Coherent, RayOrder::Incoherent],
+        )
+    }
+
+    /// Closest hits traced as rays of `orders[0]`, any hits as rays of `orders[1]`.
+    fn trace_on_with(
+        &mut self,
+        mut trace: BvhTrace,
+        scene: &Scene,
+        rays: &[Ray],
+        orders: [RayOrder; 2],
+    ) -> (Vec<Hit>, Vec<Hit>) {
         let ctx = &self.ctx;
-        let mut trace = BvhTrace::new(ctx, &mut self.lib).unwrap();
         trace.upload_blases(ctx, &scene.blases).unwrap();
         trace.upload_tlas(ctx, &scene.tlas).unwrap();
         let ray_buffer = ctx
@@ -79,10 +120,10 @@ impl Gpu {
         let closest = g.buffer("test.closest", n as u64 * HIT_BYTES).unwrap();
         let any = g.buffer("test.any", n as u64 * HIT_BYTES).unwrap();
         trace
-            .record(&mut g, rays_buf, closest, n, TraceMode::Closest)
+            .record(&mut g, rays_buf, closest, n, TraceMode::Closest, orders[0])
             .unwrap();
         trace
-            .record(&mut g, rays_buf, any, n, TraceMode::Any)
+            .record(&mut g, rays_buf, any, n, TraceMode::Any, orders[1])
             .unwrap();
         g.readback(closest);
         g.readback(any);
@@ -99,9 +140,64 @@ fn as_option(h: Hit) -> Option<Hit> {
     h.is_hit().then_some(h)
 }
 
-/// GPU vs CPU twin vs brute force, closest and any hit; returns the number of hits.
+/// Kernel configurations every comparison runs: the two defaults, and the other code paths of
+/// the kernel (wgpu's checks on; every way of picking the next ray; every triangle budget per
+/// step; small and large workgroups).
+fn configs(ctx: &GpuContext) -> Vec<(String, TraceConfig)> {
+    let coherent = TraceConfig::coherent();
+    let mut v = vec![
+        coherent,
+        TraceConfig::incoherent(),
+        TraceConfig {
+            runtime_checks: true,
+            triangles_per_step: 0,
+            ..coherent
+        },
+        TraceConfig {
+            workgroup: 32,
+            rays_per_thread: 4,
+            triangles_per_step: 1,
+            ..coherent
+        },
+        TraceConfig {
+            workgroup: 128,
+            rays_per_thread: 16,
+            refill: Refill::Dynamic,
+            triangles_per_step: 3,
+            ..coherent
+        },
+    ];
+    if ctx.has(wgpu::Features::SUBGROUP) {
+        v.push(TraceConfig {
+            rays_per_thread: 32,
+            refill: Refill::Subgroup { min_free: 8 },
+            triangles_per_step: 4,
+            ..coherent
+        });
+    } else {
+        eprintln!("no subgroup operations on this adapter: Refill::Subgroup not tested");
+    }
+    v.into_iter().map(|c| (format!("{c:?}"), c)).collect()
+}
+
+/// GPU vs CPU twin vs brute force, closest and any hit, for every kernel configuration;
+/// returns the number of hits.
 fn check(gpu: &mut Gpu, name: &str, scene: &Scene, rays: &[Ray]) -> usize {
-    let (closest, any) = gpu.trace(scene, rays);
+    let mut hits = 0;
+    for (config_name, config) in configs(&gpu.ctx) {
+        let (closest, any) = gpu.trace_with(scene, rays, config);
+        hits = check_hits(
+            &format!("{name}, {config_name}"),
+            scene,
+            rays,
+            &closest,
+            &any,
+        );
+    }
+    hits
+}
+
+fn check_hits(name: &str, scene: &Scene, rays: &[Ray], closest: &[Hit], any: &[Hit]) -> usize {
     let mut hits = 0;
     let mut failures = Vec::new();
     for (i, ray) in rays.iter().enumerate() {
@@ -414,4 +510,189 @@ fn any_hit_respects_t_max_and_closest_reports_the_nearest() {
     // t is in units of the direction, in world and object space alike.
     assert!((closest[4].t - 0.5).abs() < 1e-6);
     check(&mut gpu, "two planes", &scene, &rays);
+}
+
+#[test]
+fn malformed_bvhs_and_short_buffers_are_refused() {
+    // The kernel runs without bounds checks, so everything it would index must be refused
+    // before it reaches the GPU, with an error that says what is wrong.
+    let Some(gpu) = Gpu::new() else { return };
+    let Gpu { ctx, mut lib } = gpu;
+    let scene = Scene::single(Mesh::random_soup(9, 300, 5.0, 2.0));
+    let mut trace = BvhTrace::new(&ctx, &mut lib).unwrap();
+    let refused = |blas: Blas, trace: &mut BvhTrace| -> String {
+        trace
+            .upload_blases(&ctx, std::slice::from_ref(&blas))
+            .expect_err("a malformed BLAS must be refused")
+            .to_string()
+    };
+    let good = &scene.blases[0];
+    let internal_slot = (0..8)
+        .find(|&s| good.nodes[0].imask() & (1 << s) != 0)
+        .expect("the root of a 300-triangle BLAS has internal children");
+
+    let mut b = good.clone();
+    b.nodes[0].child_base = b.nodes.len() as u32;
+    let e = refused(b, &mut trace);
+    assert!(e.contains("node 0") && e.contains("child node"), "{e}");
+
+    let mut b = good.clone();
+    b.nodes[0].child_base = 0;
+    let e = refused(b, &mut trace);
+    assert!(e.contains("not after this node"), "{e}");
+
+    let mut b = good.clone();
+    b.nodes[0].set_meta(internal_slot, 0x20);
+    let e = refused(b, &mut trace);
+    assert!(e.contains("internal child with meta"), "{e}");
+
+    // A leaf whose primitives run past the BLAS's triangles.
+    let leaf = b_leaf(good);
+    let mut b = good.clone();
+    b.nodes[leaf.0].prim_base = b.triangles.len() as u32;
+    let e = refused(b, &mut trace);
+    assert!(e.contains("out of the"), "{e}");
+
+    // A leaf count that is not unary.
+    let mut b = good.clone();
+    let m = b.nodes[leaf.0].meta(leaf.1);
+    b.nodes[leaf.0].set_meta(leaf.1, (m & 0x1f) | 0b010_00000);
+    let e = refused(b, &mut trace);
+    assert!(e.contains("leaf meta"), "{e}");
+
+    // The intact BLAS goes up; a TLAS pointing at a BLAS that is not there does not.
+    trace.upload_blases(&ctx, &scene.blases).unwrap();
+    let mut tlas = scene.tlas.clone();
+    tlas.instances[0].blas_index = 3;
+    let e = trace.upload_tlas(&ctx, &tlas).unwrap_err().to_string();
+    assert!(e.contains("instance record 0"), "{e}");
+    let mut tlas = scene.tlas.clone();
+    tlas.instances[0].blas_node_offset = 1;
+    assert!(trace.upload_tlas(&ctx, &tlas).is_err());
+    trace.upload_tlas(&ctx, &scene.tlas).unwrap();
+
+    // Buffers shorter than the ray count.
+    let rays = vec![Ray::new(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY); 4];
+    let ray_buffer = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("test.rays"),
+            contents: bytemuck::cast_slice(&rays),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+    let mut rt = GraphRuntime::new();
+    let mut g = rt.begin_frame(&ctx);
+    let rays_buf = g.import_buffer("test.rays", &ray_buffer);
+    let hits = g.buffer("test.hits", 4 * HIT_BYTES).unwrap();
+    let e = trace
+        .record(
+            &mut g,
+            rays_buf,
+            hits,
+            5,
+            TraceMode::Closest,
+            RayOrder::Coherent,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("rays buffer"), "{e}");
+    let short_hits = g.buffer("test.short_hits", 3 * HIT_BYTES).unwrap();
+    let e = trace
+        .record(
+            &mut g,
+            rays_buf,
+            short_hits,
+            4,
+            TraceMode::Any,
+            RayOrder::Incoherent,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("hits buffer"), "{e}");
+    trace
+        .record(
+            &mut g,
+            rays_buf,
+            hits,
+            4,
+            TraceMode::Closest,
+            RayOrder::Coherent,
+        )
+        .unwrap();
+    drop(g);
+
+    // A BLAS list of another shape drops the TLAS checked against the old one.
+    let other = Blas::from_mesh(
+        "other",
+        &Mesh::random_soup(10, 50, 5.0, 2.0),
+        &BuildOptions::default(),
+    )
+    .unwrap();
+    trace.upload_blases(&ctx, &[other]).unwrap();
+    let mut g = rt.begin_frame(&ctx);
+    let e = trace.import(&mut g).unwrap_err().to_string();
+    assert!(e.contains("TLAS"), "{e}");
+}
+
+/// (node, slot) of some leaf slot of `blas`.
+fn b_leaf(blas: &Blas) -> (usize, usize) {
+    for (i, n) in blas.nodes.iter().enumerate() {
+        for s in 0..8 {
+            if n.imask() & (1 << s) == 0 && n.meta(s) != 0 {
+                return (i, s);
+            }
+        }
+    }
+    panic!("a BLAS has leaves");
+}
+
+#[test]
+fn image_order_traces_every_ray_once() {
+    // Images whose sides are and are not multiples of the 8 x 8 tiles: every ray must be traced
+    // and its hit written in its own place.
+    let Some(mut gpu) = Gpu::new() else { return };
+    let scene = Scene::single(Mesh::terrain(33));
+    for (w, h) in [(16u32, 16u32), (21, 13), (7, 3), (1, 9), (30, 1)] {
+        let eye = Vec3::new(3.0, 25.0, -60.0);
+        let rays: Vec<Ray> = (0..h)
+            .flat_map(|y| {
+                (0..w).map(move |x| {
+                    let sx = (x as f32 + 0.5) / w as f32 - 0.5;
+                    let sy = (y as f32 + 0.5) / h as f32 - 0.5;
+                    Ray::new(
+                        eye,
+                        Vec3::new(sx * 1.6, -0.4 - sy * 0.6, 1.0),
+                        0.0,
+                        f32::INFINITY,
+                    )
+                })
+            })
+            .collect();
+        let (closest, any) = gpu.trace_image(&scene, &rays, w);
+        let hits = check_hits(&format!("{w}x{h} image"), &scene, &rays, &closest, &any);
+        assert!(hits > 0, "{w}x{h}: the camera looks at the terrain");
+    }
+    // A ray count that is not a whole number of rows is refused.
+    let Gpu { ctx, mut lib } = gpu;
+    let mut trace = BvhTrace::new(&ctx, &mut lib).unwrap();
+    trace.upload_blases(&ctx, &scene.blases).unwrap();
+    trace.upload_tlas(&ctx, &scene.tlas).unwrap();
+    let mut rt = GraphRuntime::new();
+    let mut g = rt.begin_frame(&ctx);
+    let rays = g.buffer("test.rays", 10 * HIT_BYTES).unwrap();
+    let hits = g.buffer("test.hits", 10 * HIT_BYTES).unwrap();
+    for width in [0, 3] {
+        let e = trace
+            .record(
+                &mut g,
+                rays,
+                hits,
+                10,
+                TraceMode::Closest,
+                RayOrder::Image { width },
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("whole number of rows"), "{e}");
+    }
 }

@@ -1,12 +1,22 @@
 // Two-level traversal of hikari's compressed 8-wide BVH (Ylitie, Karras, Laine 2017), the GPU
-// twin of hikari-bvh's `traverse.rs`: same node decoding, same visiting order (node groups,
-// `slot ^ octant`), same watertight triangle test (Woop, Benthin, Wald 2013). Byte layouts are
+// twin of hikari-bvh's `traverse.rs`: same node decoding, same node visiting order (node
+// groups, `slot ^ octant`), same watertight triangle test (Woop, Benthin, Wald 2013); a node's
+// triangles may be tested a few steps later (BVH_TRIANGLES_PER_STEP), which changes no result
+// but the choice between hits at exactly the same distance. Byte layouts are
 // documented in hikari-bvh's crate docs; every record is read as whole vec4s so that each load
 // is one 128-bit transaction whatever the driver makes of a struct load.
 //
 // A pass that traces binds the four BVH buffers first, @binding(0..4) in the order below
 // (`BvhTrace::import` in hikari-render gives them in that order), and its own resources from
-// @binding(4) on.
+// @binding(4) on. One ray per invocation: `bvh_closest_hit(ray)`, `bvh_any_hit(ray)`,
+// `bvh_occluded(ray)`. Kernels that trace many rays per invocation (bvh/trace.wgsl) drive the
+// walk themselves: `bvh_begin(ray)`, then `bvh_step` until it returns true, then `bvh_result()`.
+//
+// BvhTrace builds bvh/trace.wgsl without wgpu's runtime checks (no index clamping, no loop
+// counters; see `bvh_trace.rs`). Every index below stays in range because BvhTrace validates
+// the BVH it uploads (child and primitive indices, depth against BVH_STACK_SIZE); keep it that
+// way when editing. A pass importing this module may drop the checks too only if its own
+// indices are as safe.
 
 #define_import_path hikari::bvh
 
@@ -55,23 +65,37 @@ const BVH_NODE_BITS: u32 = 0xff000000u;
 // 1 + 2^-20: absorbs the rounding of the reassociated slab formula (see hikari-bvh).
 const BVH_BOX_FAR_SCALE: f32 = 1.00000095367431640625;
 const BVH_MIN_DIR: f32 = 1e-30;
+// Triangles a walk step tests at most; the rest wait for the next steps, while the warp's other
+// lanes test nodes, which keeps the lanes of a warp busy alike (BENCHMARKS.md). 24 is all of a
+// node's. `bvh_trace::TraceConfig::triangles_per_step` chooses for bvh/trace.wgsl; importers
+// get 2, measured the best with one ray per invocation.
+#ifdef BVH_TRIANGLES_PER_STEP_1
+const BVH_TRIANGLES_PER_STEP: u32 = 1u;
+#else ifdef BVH_TRIANGLES_PER_STEP_3
+const BVH_TRIANGLES_PER_STEP: u32 = 3u;
+#else ifdef BVH_TRIANGLES_PER_STEP_4
+const BVH_TRIANGLES_PER_STEP: u32 = 4u;
+#else ifdef BVH_TRIANGLES_PER_STEP_ALL
+const BVH_TRIANGLES_PER_STEP: u32 = 24u;
+#else
+const BVH_TRIANGLES_PER_STEP: u32 = 2u;
+#endif
 
 // Per-ray constants, computed once in world space and again on entering each instance.
 struct BvhPreparedRay {
     origin: vec3<f32>,
     inv_dir: vec3<f32>,
-    // Axis permutation of the triangle test: k.z is the dominant axis of the direction.
-    k: vec3<u32>,
     shear: vec3<f32>,
+    // Axis permutation of the triangle test, kx | ky << 2 | kz << 4 (each 0..2); kz is the
+    // dominant axis of the direction.
+    k: u32,
     // Bit a set if the direction along axis a is negative.
     octant: u32,
-    t_min: f32,
 }
 
-fn bvh_prepare(origin: vec3<f32>, dir: vec3<f32>, t_min: f32) -> BvhPreparedRay {
+fn bvh_prepare(origin: vec3<f32>, dir: vec3<f32>) -> BvhPreparedRay {
     var r: BvhPreparedRay;
     r.origin = origin;
-    r.t_min = t_min;
     let sgn = bitcast<vec3<u32>>(dir) & vec3<u32>(0x80000000u);
     // A tiny value of the same sign instead of zero keeps `0 * inf` out of the box test.
     let tiny = bitcast<vec3<f32>>(sgn | vec3<u32>(bitcast<u32>(BVH_MIN_DIR)));
@@ -85,8 +109,8 @@ fn bvh_prepare(origin: vec3<f32>, dir: vec3<f32>, t_min: f32) -> BvhPreparedRay 
     } else if ad.y >= ad.z {
         kz = 1u;
     }
-    var kx = (kz + 1u) % 3u;
-    var ky = (kx + 1u) % 3u;
+    var kx = select(kz + 1u, 0u, kz == 2u);
+    var ky = select(kx + 1u, 0u, kx == 2u);
     // Keeps the winding of the projected triangle, so the sign convention of the edge
     // functions does not depend on the ray.
     if dir[kz] < 0.0 {
@@ -94,13 +118,13 @@ fn bvh_prepare(origin: vec3<f32>, dir: vec3<f32>, t_min: f32) -> BvhPreparedRay 
         kx = ky;
         ky = t;
     }
-    r.k = vec3<u32>(kx, ky, kz);
+    r.k = kx | (ky << 2u) | (kz << 4u);
     r.shear = vec3<f32>(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
     return r;
 }
 
-fn bvh_permute(p: vec3<f32>, k: vec3<u32>) -> vec3<f32> {
-    return vec3<f32>(p[k.x], p[k.y], p[k.z]);
+fn bvh_permute(p: vec3<f32>, k: u32) -> vec3<f32> {
+    return vec3<f32>(p[k & 3u], p[(k >> 2u) & 3u], p[k >> 4u]);
 }
 
 struct BvhTriHit {
@@ -120,7 +144,7 @@ struct BvhTriHit {
 // and its mirror in the neighbouring triangle round differently; in canonical order both
 // triangles evaluate a shared edge from the same operands in the same order, so as long as the
 // driver fuses every lane alike the edge keeps one sign and no ray slips between them.
-fn bvh_intersect_triangle(r: BvhPreparedRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_max: f32) -> BvhTriHit {
+fn bvh_intersect_triangle(r: BvhPreparedRay, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>, t_min: f32, t_max: f32) -> BvhTriHit {
     var res: BvhTriHit;
     res.hit = false;
     let a = bvh_permute(v0 - r.origin, r.k);
@@ -153,7 +177,7 @@ fn bvh_intersect_triangle(r: BvhPreparedRay, v0: vec3<f32>, v1: vec3<f32>, v2: v
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
     // Written so that NaN fails.
-    if t > r.t_min && t < t_max {
+    if t > t_min && t < t_max {
         res.t = t;
         res.u = e.y * inv_det;
         res.v = e.z * inv_det;
@@ -162,15 +186,57 @@ fn bvh_intersect_triangle(r: BvhPreparedRay, v0: vec3<f32>, v1: vec3<f32>, v2: v
     return res;
 }
 
-// Slot s's byte of an 8-byte field held as two words.
-fn bvh_byte(w: vec2<u32>, s: u32) -> u32 {
-    return extractBits(w[s >> 2u], (s & 3u) * 8u, 8u);
+// The 8-bit plane at bit `shift` of `w`, as f32. (Placing the byte in the mantissa of 2^23 and
+// subtracting 2^23 is exact too, but measured 5-9% slower on an H200: the conversion takes
+// the byte select for free.)
+fn bvh_plane(w: u32, shift: u32) -> f32 {
+    return f32(extractBits(w, shift, 8u));
 }
 
-// Tests the ray against the 8 child boxes of the node whose first vec4 is `n0`. Returns the
-// internal-child bits at slot ^ octant (0..8) and the leaf triangle bits (0..24, relative to
-// prim_base), as hikari-bvh's `intersect_node_scalar`.
-fn bvh_intersect_node(n0: vec4<u32>, n1: vec4<u32>, n2: vec4<u32>, n3: vec4<u32>, n4: vec4<u32>, r: BvhPreparedRay, t_max: f32) -> vec2<u32> {
+// Whether the child box at bit `shift` of the four-slot plane words overlaps [t_min, t_max];
+// `n*` / `f*` hold the near and far planes per axis (already swapped for negative directions).
+fn bvh_slot_hit(shift: u32, nx: u32, ny: u32, nz: u32, fx: u32, fy: u32, fz: u32, scale: vec3<f32>, org: vec3<f32>, t_min: f32, t_max: f32) -> bool {
+    let tnx = bvh_plane(nx, shift) * scale.x + org.x;
+    let tny = bvh_plane(ny, shift) * scale.y + org.y;
+    let tnz = bvh_plane(nz, shift) * scale.z + org.z;
+    let tfx = bvh_plane(fx, shift) * scale.x + org.x;
+    let tfy = bvh_plane(fy, shift) * scale.y + org.y;
+    let tfz = bvh_plane(fz, shift) * scale.z + org.z;
+    let t_near = max(max(tnx, tny), max(tnz, t_min));
+    let t_far = min(min(tfx, tfy), min(tfz, t_max));
+    return t_near <= t_far * BVH_BOX_FAR_SCALE;
+}
+
+// Four slots (one word of each 8-byte field). Returns their hit bits: for a hit leaf, its
+// primitives' bits (the unary count in meta bits 5..8 shifted to the offset in bits 0..5); for
+// a hit internal child, bit 24 + (slot ^ octant). Both come from one formula: an internal
+// child's meta is 0b001_11000 | slot, so its count is 1 and its offset is 24 + slot, and the
+// octant is XORed into the offsets of internal children only (leaf offsets never have bits 3
+// and 4 both set, internal ones always do). Empty slots have meta 0 and set nothing.
+fn bvh_intersect_quad(meta_word: u32, nx: u32, ny: u32, nz: u32, fx: u32, fy: u32, fz: u32, scale: vec3<f32>, org: vec3<f32>, t_min: f32, t_max: f32, octant: u32) -> u32 {
+    let inner = meta_word & (meta_word << 1u) & 0x10101010u;
+    let index = (meta_word ^ ((inner >> 4u) * octant)) & 0x1f1f1f1fu;
+    let bits = (meta_word >> 5u) & 0x07070707u;
+    var mask = 0u;
+    if bvh_slot_hit(0u, nx, ny, nz, fx, fy, fz, scale, org, t_min, t_max) {
+        mask |= extractBits(bits, 0u, 3u) << extractBits(index, 0u, 5u);
+    }
+    if bvh_slot_hit(8u, nx, ny, nz, fx, fy, fz, scale, org, t_min, t_max) {
+        mask |= extractBits(bits, 8u, 3u) << extractBits(index, 8u, 5u);
+    }
+    if bvh_slot_hit(16u, nx, ny, nz, fx, fy, fz, scale, org, t_min, t_max) {
+        mask |= extractBits(bits, 16u, 3u) << extractBits(index, 16u, 5u);
+    }
+    if bvh_slot_hit(24u, nx, ny, nz, fx, fy, fz, scale, org, t_min, t_max) {
+        mask |= extractBits(bits, 24u, 3u) << extractBits(index, 24u, 5u);
+    }
+    return mask;
+}
+
+// Tests the ray against the 8 child boxes of the node held in n0..n4. Returns the internal-child
+// bits at 24 + (slot ^ octant) and the leaf primitive bits at 0..24 (relative to prim_base),
+// the two halves of hikari-bvh's `intersect_node_scalar`.
+fn bvh_intersect_node(n0: vec4<u32>, n1: vec4<u32>, n2: vec4<u32>, n3: vec4<u32>, n4: vec4<u32>, r: BvhPreparedRay, t_min: f32, t_max: f32) -> u32 {
     let p = bitcast<vec3<f32>>(n0.xyz);
     let e = n0.w;
     let grid = vec3<f32>(
@@ -178,10 +244,8 @@ fn bvh_intersect_node(n0: vec4<u32>, n1: vec4<u32>, n2: vec4<u32>, n3: vec4<u32>
         bitcast<f32>(((e >> 8u) & 0xffu) << 23u),
         bitcast<f32>(((e >> 16u) & 0xffu) << 23u),
     );
-    let imask = e >> 24u;
-    let adj_scale = grid * r.inv_dir;
-    let adj_origin = (p - r.origin) * r.inv_dir;
-    let meta_words = n1.zw;
+    let scale = grid * r.inv_dir;
+    let org = (p - r.origin) * r.inv_dir;
     // A negative direction meets the upper plane first.
     let neg_x = (r.octant & 1u) != 0u;
     let neg_y = (r.octant & 2u) != 0u;
@@ -192,28 +256,8 @@ fn bvh_intersect_node(n0: vec4<u32>, n1: vec4<u32>, n2: vec4<u32>, n3: vec4<u32>
     let far_y = select(n4.xy, n2.zw, neg_y);
     let near_z = select(n3.xy, n4.zw, neg_z);
     let far_z = select(n4.zw, n3.xy, neg_z);
-    var node_hits = 0u;
-    var tri_hits = 0u;
-    for (var s = 0u; s < 8u; s++) {
-        let m = bvh_byte(meta_words, s);
-        let tnx = f32(bvh_byte(near_x, s)) * adj_scale.x + adj_origin.x;
-        let tny = f32(bvh_byte(near_y, s)) * adj_scale.y + adj_origin.y;
-        let tnz = f32(bvh_byte(near_z, s)) * adj_scale.z + adj_origin.z;
-        let tfx = f32(bvh_byte(far_x, s)) * adj_scale.x + adj_origin.x;
-        let tfy = f32(bvh_byte(far_y, s)) * adj_scale.y + adj_origin.y;
-        let tfz = f32(bvh_byte(far_z, s)) * adj_scale.z + adj_origin.z;
-        let t_near = max(max(max(r.t_min, tnx), tny), tnz);
-        let t_far = min(min(min(t_max, tfx), tfy), tfz);
-        if m != 0u && t_near <= t_far * BVH_BOX_FAR_SCALE {
-            if (imask & (1u << s)) != 0u {
-                node_hits |= 1u << (s ^ r.octant);
-            } else {
-                let count = countOneBits(m >> 5u);
-                tri_hits |= ((1u << count) - 1u) << (m & 0x1fu);
-            }
-        }
-    }
-    return vec2<u32>(node_hits, tri_hits);
+    return bvh_intersect_quad(n1.z, near_x.x, near_y.x, near_z.x, far_x.x, far_y.x, far_z.x, scale, org, t_min, t_max, r.octant)
+        | bvh_intersect_quad(n1.w, near_x.y, near_y.y, near_z.y, far_x.y, far_y.y, far_z.y, scale, org, t_min, t_max, r.octant);
 }
 
 fn bvh_load_instance(i: u32) -> InstanceRecord {
@@ -243,139 +287,221 @@ fn bvh_is_hit(h: Hit) -> bool {
     return h.primitive != BVH_MISS;
 }
 
-// The walk over TLAS and BLAS in one loop with one stack. The state is the current node group
-// (`group`: base node index, hit bits << 24 | imask) and primitive group (`prims`: base index,
-// bits); a leaf primitive is a triangle inside a BLAS and an instance in the TLAS. Entering an
-// instance keeps the TLAS groups in registers and walks the BLAS above the TLAS's stack
-// entries (`stack_floor`); when the BLAS is done they come back, so the order of work is
-// exactly the CPU twin's nested walks. `stop_at_first` is a constant at every call site and folds away.
-fn bvh_trace(ray: Ray, stop_at_first: bool) -> Hit {
-    var best = bvh_miss();
-    var t_max = ray.t_max;
-    let world = bvh_prepare(ray.origin, ray.dir, ray.t_min);
-    var r = world;
-    var stack: array<vec2<u32>, BVH_STACK_SIZE>;
-    var sp = 0u;
-    var stack_floor = 0u;
-    var in_blas = false;
-    var node_offset = 0u;
-    var prim_offset = 0u;
-    var instance = 0u;
-    var saved_group = vec2<u32>(0u);
-    var saved_prims = vec2<u32>(0u);
+// The state of one ray's walk over TLAS and BLAS with one loop and one stack. `group` is the
+// current node group (base node index, hit bits << 24 | imask) and `prims` the primitive group
+// (base index, bits); a leaf primitive is a triangle inside a BLAS and an instance in the TLAS.
+// Entering an instance keeps the TLAS groups in `saved_*` and walks the BLAS above the TLAS's
+// stack entries (`stack_floor`); when the BLAS is done they come back, so the order of work is
+// exactly the CPU twin's nested walks.
+struct BvhWalk {
+    // The world-space ray, kept to prepare it again on leaving an instance.
+    origin: vec3<f32>,
+    t_min: f32,
+    dir: vec3<f32>,
+    // The ray's t_max, shrunk to the closest hit so far.
+    t_max: f32,
+    // The ray prepared in the space of the tree being walked.
+    r: BvhPreparedRay,
+    group: vec2<u32>,
+    prims: vec2<u32>,
+    sp: u32,
+    stack_floor: u32,
+    in_blas: bool,
+    node_offset: u32,
+    prim_offset: u32,
+    instance: u32,
+    saved_group: vec2<u32>,
+    saved_prims: vec2<u32>,
+    hit_u: f32,
+    hit_v: f32,
+    hit_primitive: u32,
+    hit_instance: u32,
+}
+
+var<private> bvh_w: BvhWalk;
+
+// In private memory, which the driver keeps in the L1 cache. (A stack in workgroup memory was
+// measured 2-3 times slower on an H200, probably because the shared-memory carve-out shrinks
+// the L1 cache that the nodes are read through.)
+var<private> bvh_stack: array<vec2<u32>, BVH_STACK_SIZE>;
+
+fn bvh_push(g: vec2<u32>) {
+    bvh_stack[bvh_w.sp] = g;
+    bvh_w.sp += 1u;
+}
+
+fn bvh_pop() -> vec2<u32> {
+    bvh_w.sp -= 1u;
+    return bvh_stack[bvh_w.sp];
+}
+
+// Starts a walk for `ray` (discarding any walk in progress).
+fn bvh_begin(ray: Ray) {
+    bvh_w.origin = ray.origin;
+    bvh_w.t_min = ray.t_min;
+    bvh_w.dir = ray.dir;
+    bvh_w.t_max = ray.t_max;
+    bvh_w.r = bvh_prepare(ray.origin, ray.dir);
     // The root as the only member of a synthetic group: slot 0 with imask bit 0.
-    var group = vec2<u32>(0u, (1u << (24u + r.octant)) | 1u);
-    var prims = vec2<u32>(0u);
-    loop {
-        if prims.y != 0u {
-            if in_blas {
-                loop {
-                    let k = firstTrailingBit(prims.y);
-                    prims.y &= prims.y - 1u;
-                    let i = 3u * (prims.x + k);
-                    let w0 = bvh_triangles[i];
-                    let w1 = bvh_triangles[i + 1u];
-                    let w2 = bvh_triangles[i + 2u];
-                    let h = bvh_intersect_triangle(r, w0.xyz, w1.xyz, w2.xyz, t_max);
-                    if h.hit {
-                        t_max = h.t;
-                        best.t = h.t;
-                        best.u = h.u;
-                        best.v = h.v;
-                        best.primitive = bitcast<u32>(w0.w);
-                        best.instance = instance;
-                        if stop_at_first {
-                            return best;
-                        }
-                    }
-                    if prims.y == 0u {
-                        break;
+    bvh_w.group = vec2<u32>(0u, (1u << (24u + bvh_w.r.octant)) | 1u);
+    bvh_w.prims = vec2<u32>(0u);
+    bvh_w.sp = 0u;
+    bvh_w.stack_floor = 0u;
+    bvh_w.in_blas = false;
+    bvh_w.node_offset = 0u;
+    bvh_w.prim_offset = 0u;
+    bvh_w.instance = 0u;
+    bvh_w.hit_u = 0.0;
+    bvh_w.hit_v = 0.0;
+    bvh_w.hit_primitive = BVH_MISS;
+    bvh_w.hit_instance = BVH_MISS;
+}
+
+// The hit of the walk (valid once bvh_step returned true).
+fn bvh_result() -> Hit {
+    if bvh_w.hit_primitive == BVH_MISS {
+        return bvh_miss();
+    }
+    var h: Hit;
+    h.t = bvh_w.t_max;
+    h.u = bvh_w.hit_u;
+    h.v = bvh_w.hit_v;
+    h.primitive = bvh_w.hit_primitive;
+    h.instance = bvh_w.hit_instance;
+    return h;
+}
+
+// One iteration of the walk: the next node of the current group (unless primitives are
+// pending), then the primitives it hit (the next BVH_TRIANGLES_PER_STEP triangles of a BLAS
+// leaf, or entering one instance of a TLAS leaf), then a pop when the group is used up. An
+// iteration costs a warp about one node test plus a few triangle tests whatever its lanes are
+// doing, so its lanes stay busy alike. Returns true when the walk is over: the tree is
+// exhausted, or (`stop_at_first`) a hit was found. `stop_at_first` is a constant at every call
+// site and folds away.
+fn bvh_step(stop_at_first: bool) -> bool {
+    if bvh_w.prims.y == 0u && (bvh_w.group.y & BVH_NODE_BITS) != 0u {
+        let g = bvh_w.group;
+        let pos = firstTrailingBit(g.y >> 24u);
+        let rest = g.y & ~(1u << (24u + pos));
+        let slot = pos ^ bvh_w.r.octant;
+        let index = 5u * (g.x + countOneBits(g.y & 0xffu & ((1u << slot) - 1u)));
+        if (rest & BVH_NODE_BITS) != 0u {
+            bvh_push(vec2<u32>(g.x, rest));
+        }
+        var n0: vec4<u32>;
+        var n1: vec4<u32>;
+        var n2: vec4<u32>;
+        var n3: vec4<u32>;
+        var n4: vec4<u32>;
+        if bvh_w.in_blas {
+            n0 = bvh_blas_nodes[index];
+            n1 = bvh_blas_nodes[index + 1u];
+            n2 = bvh_blas_nodes[index + 2u];
+            n3 = bvh_blas_nodes[index + 3u];
+            n4 = bvh_blas_nodes[index + 4u];
+        } else {
+            n0 = bvh_tlas_nodes[index];
+            n1 = bvh_tlas_nodes[index + 1u];
+            n2 = bvh_tlas_nodes[index + 2u];
+            n3 = bvh_tlas_nodes[index + 3u];
+            n4 = bvh_tlas_nodes[index + 4u];
+        }
+        let m = bvh_intersect_node(n0, n1, n2, n3, n4, bvh_w.r, bvh_w.t_min, bvh_w.t_max);
+        bvh_w.group = vec2<u32>(n1.x + bvh_w.node_offset, (m & BVH_NODE_BITS) | (n0.w >> 24u));
+        bvh_w.prims = vec2<u32>(n1.y + bvh_w.prim_offset, m & 0x00ffffffu);
+    }
+    if bvh_w.prims.y != 0u {
+        if bvh_w.in_blas {
+            var bits = bvh_w.prims.y;
+            let base = bvh_w.prims.x;
+            var budget = BVH_TRIANGLES_PER_STEP;
+            loop {
+                let k = firstTrailingBit(bits);
+                bits &= bits - 1u;
+                let i = 3u * (base + k);
+                let w0 = bvh_triangles[i];
+                let w1 = bvh_triangles[i + 1u];
+                let w2 = bvh_triangles[i + 2u];
+                let h = bvh_intersect_triangle(bvh_w.r, w0.xyz, w1.xyz, w2.xyz, bvh_w.t_min, bvh_w.t_max);
+                if h.hit {
+                    bvh_w.t_max = h.t;
+                    bvh_w.hit_u = h.u;
+                    bvh_w.hit_v = h.v;
+                    bvh_w.hit_primitive = bitcast<u32>(w0.w);
+                    bvh_w.hit_instance = bvh_w.instance;
+                    if stop_at_first {
+                        return true;
                     }
                 }
-            } else {
-                let k = firstTrailingBit(prims.y);
-                prims.y &= prims.y - 1u;
-                let inst = bvh_load_instance(prims.x + k);
-                let m0 = inst.world_to_object[0];
-                let m1 = inst.world_to_object[1];
-                let m2 = inst.world_to_object[2];
-                let o = ray.origin;
-                let d = ray.dir;
-                let oo = vec3<f32>(
-                    m0.x * o.x + m0.y * o.y + m0.z * o.z + m0.w,
-                    m1.x * o.x + m1.y * o.y + m1.z * o.z + m1.w,
-                    m2.x * o.x + m2.y * o.y + m2.z * o.z + m2.w,
-                );
-                let od = vec3<f32>(
-                    m0.x * d.x + m0.y * d.y + m0.z * d.z,
-                    m1.x * d.x + m1.y * d.y + m1.z * d.z,
-                    m2.x * d.x + m2.y * d.y + m2.z * d.z,
-                );
-                // The direction is not renormalized, so t means the same in both spaces.
-                r = bvh_prepare(oo, od, ray.t_min);
-                saved_group = group;
-                saved_prims = prims;
-                stack_floor = sp;
-                in_blas = true;
-                node_offset = inst.blas_node_offset;
-                prim_offset = inst.blas_triangle_offset;
-                instance = inst.instance_index;
-                group = vec2<u32>(node_offset, (1u << (24u + r.octant)) | 1u);
-                prims = vec2<u32>(0u);
+                budget -= 1u;
+                if bits == 0u || budget == 0u {
+                    break;
+                }
             }
-            continue;
+            bvh_w.prims.y = bits;
+        } else {
+            let k = firstTrailingBit(bvh_w.prims.y);
+            bvh_w.prims.y &= bvh_w.prims.y - 1u;
+            let inst = bvh_load_instance(bvh_w.prims.x + k);
+            let m0 = inst.world_to_object[0];
+            let m1 = inst.world_to_object[1];
+            let m2 = inst.world_to_object[2];
+            let o = bvh_w.origin;
+            let d = bvh_w.dir;
+            let oo = vec3<f32>(
+                m0.x * o.x + m0.y * o.y + m0.z * o.z + m0.w,
+                m1.x * o.x + m1.y * o.y + m1.z * o.z + m1.w,
+                m2.x * o.x + m2.y * o.y + m2.z * o.z + m2.w,
+            );
+            let od = vec3<f32>(
+                m0.x * d.x + m0.y * d.y + m0.z * d.z,
+                m1.x * d.x + m1.y * d.y + m1.z * d.z,
+                m2.x * d.x + m2.y * d.y + m2.z * d.z,
+            );
+            // The direction is not renormalized, so t means the same in both spaces.
+            bvh_w.r = bvh_prepare(oo, od);
+            bvh_w.saved_group = bvh_w.group;
+            bvh_w.saved_prims = bvh_w.prims;
+            bvh_w.stack_floor = bvh_w.sp;
+            bvh_w.in_blas = true;
+            bvh_w.node_offset = inst.blas_node_offset;
+            bvh_w.prim_offset = inst.blas_triangle_offset;
+            bvh_w.instance = inst.instance_index;
+            bvh_w.group = vec2<u32>(inst.blas_node_offset, (1u << (24u + bvh_w.r.octant)) | 1u);
+            bvh_w.prims = vec2<u32>(0u);
+            return false;
         }
-        if (group.y & BVH_NODE_BITS) != 0u {
-            let pos = firstTrailingBit(group.y >> 24u);
-            group.y &= ~(1u << (24u + pos));
-            let slot = pos ^ r.octant;
-            let below = group.y & 0xffu & ((1u << slot) - 1u);
-            let index = 5u * (group.x + countOneBits(below));
-            if (group.y & BVH_NODE_BITS) != 0u {
-                stack[sp] = group;
-                sp += 1u;
-            }
-            var n0: vec4<u32>;
-            var n1: vec4<u32>;
-            var n2: vec4<u32>;
-            var n3: vec4<u32>;
-            var n4: vec4<u32>;
-            if in_blas {
-                n0 = bvh_blas_nodes[index];
-                n1 = bvh_blas_nodes[index + 1u];
-                n2 = bvh_blas_nodes[index + 2u];
-                n3 = bvh_blas_nodes[index + 3u];
-                n4 = bvh_blas_nodes[index + 4u];
-            } else {
-                n0 = bvh_tlas_nodes[index];
-                n1 = bvh_tlas_nodes[index + 1u];
-                n2 = bvh_tlas_nodes[index + 2u];
-                n3 = bvh_tlas_nodes[index + 3u];
-                n4 = bvh_tlas_nodes[index + 4u];
-            }
-            let h = bvh_intersect_node(n0, n1, n2, n3, n4, r, t_max);
-            group = vec2<u32>(n1.x + node_offset, (h.x << 24u) | (n0.w >> 24u));
-            prims = vec2<u32>(n1.y + prim_offset, h.y);
-            continue;
+    }
+    if (bvh_w.group.y & BVH_NODE_BITS) == 0u {
+        if bvh_w.sp > bvh_w.stack_floor {
+            bvh_w.group = bvh_pop();
+        } else if bvh_w.prims.y != 0u {
+            // Triangles of this tree still to test (BVH_TRIANGLES_PER_STEP).
+        } else if bvh_w.in_blas {
+            // This instance is done: back to the TLAS, with t_max as the BLAS left it.
+            bvh_w.in_blas = false;
+            bvh_w.r = bvh_prepare(bvh_w.origin, bvh_w.dir);
+            bvh_w.stack_floor = 0u;
+            bvh_w.node_offset = 0u;
+            bvh_w.prim_offset = 0u;
+            bvh_w.group = bvh_w.saved_group;
+            bvh_w.prims = bvh_w.saved_prims;
+        } else {
+            return true;
         }
-        if sp > stack_floor {
-            sp -= 1u;
-            group = stack[sp];
-            continue;
-        }
-        if !in_blas {
+    }
+    return false;
+}
+
+// The whole walk for one ray.
+fn bvh_trace(ray: Ray, stop_at_first: bool) -> Hit {
+    bvh_begin(ray);
+    loop {
+        if bvh_step(stop_at_first) {
             break;
         }
-        // This instance is done: back to the TLAS, with t_max as the BLAS left it.
-        in_blas = false;
-        r = world;
-        stack_floor = 0u;
-        node_offset = 0u;
-        prim_offset = 0u;
-        group = saved_group;
-        prims = saved_prims;
     }
-    return best;
+    return bvh_result();
 }
 
 // Closest hit with ray.t_min < t < ray.t_max.

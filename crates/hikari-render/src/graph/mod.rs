@@ -293,6 +293,12 @@ impl<'r> FrameGraph<'r> {
         self.add_buffer(name, buffer.size(), false, Some(p))
     }
 
+    /// Size in bytes of a buffer of this frame (as declared, or the imported buffer's size);
+    /// `None` for a handle that is not of this frame.
+    pub fn buffer_size(&self, b: Buf) -> Option<u64> {
+        self.buffers.get(b.0 as usize).map(|v| v.size)
+    }
+
     /// Asks for `res` to be copied back to the CPU after the frame; it appears in
     /// [`FrameResult::images`] (textures) or [`FrameResult::buffers`] under its name.
     pub fn readback(&mut self, res: impl Into<Res>) {

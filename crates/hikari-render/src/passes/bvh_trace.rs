@@ -6,16 +6,28 @@
 //! let mut trace = BvhTrace::new(&ctx, &mut lib)?;
 //! trace.upload_blases(&ctx, &blases)?;      // once, and again after refits
 //! trace.upload_tlas(&ctx, &tlas)?;          // every frame
-//! trace.record(&mut g, rays, hits, count, TraceMode::Closest)?;
+//! trace.record(&mut g, rays, hits, count, TraceMode::Closest, RayOrder::Coherent)?;
 //! ```
 //!
+//! [`RayOrder`] says whether neighbouring rays in the buffer take similar paths; it picks one of
+//! two kernel configurations, measured best for each kind of ray (BENCHMARKS.md).
+//!
 //! The kernel is the twin of `hikari_bvh::traverse` (tests/bvh_trace.rs checks it against it
-//! and against brute force). Its stack lives in private memory and holds one entry per tree
-//! level below the root, TLAS and BLAS together; scenes deeper than [`STACK_SIZE`] are refused
-//! when recorded.
+//! and against brute force). Its stack holds one entry per tree level below the root, TLAS and
+//! BLAS together; scenes deeper than [`STACK_SIZE`] are refused when recorded.
+//!
+//! The kernel runs without wgpu's runtime checks (bounds clamping on every load, a counter in
+//! every loop), which made the first kernel 35-40% slower and the current one 5%
+//! (BENCHMARKS.md). What makes that safe is checked here, on the CPU, before anything reaches
+//! the GPU: every tree uploaded is walked once (`check_tree`: child and primitive indices in
+//! range, children after their parent, meta bytes well formed, depth measured rather than
+//! trusted), every instance record must point at an uploaded BLAS, and the ray and hit buffers
+//! must hold `count` records.
 
 use bytemuck::{Pod, Zeroable};
+use hikari_bvh::layout::{MAX_LEAF_TRIANGLES, META_INTERNAL, WIDTH};
 use hikari_bvh::{Blas, InstanceRecord, PackedBlases, Tlas, TriangleRecord, WideNode};
+use naga_oil::compose::ShaderDefValue;
 use wgpu::util::DeviceExt;
 
 use crate::context::GpuContext;
@@ -36,9 +48,10 @@ pub const HIT_BYTES: u64 = std::mem::size_of::<hikari_bvh::Hit>() as u64;
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct TraceParams {
     pub count: u32,
+    /// 0, or the width of the row-major image the rays form ([`RayOrder::Image`]).
+    pub image_width: u32,
     pub pad0: u32,
     pub pad1: u32,
-    pub pad2: u32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -59,6 +72,192 @@ impl TraceMode {
     }
 }
 
+/// How the rays of one dispatch relate; it picks the kernel configuration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum RayOrder {
+    /// Neighbouring rays take similar paths: camera rays in pixel order (best in small 2D
+    /// tiles, as 8 x 8 workgroups generate them), shadow rays from neighbouring pixels. One ray
+    /// per invocation keeps a warp's lanes in step on the same nodes.
+    Coherent,
+    /// Rays go anywhere (AO, diffuse GI, random shadow samples): each invocation traces several
+    /// rays and starts the next one as soon as it finishes one.
+    Incoherent,
+    /// Coherent rays forming a row-major image `width` pixels wide (the ray count a whole
+    /// number of rows), e.g. camera rays per pixel: traced in 8 x 8 pixel tiles, whose rays
+    /// stay together far longer than those of a 32-pixel strip of one row. Hits are written
+    /// where the rays are read, so the layout of both buffers stays row-major.
+    Image { width: u32 },
+}
+
+/// How an invocation that finished a ray picks its next one (with more than one ray per
+/// invocation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refill {
+    /// The ray `workgroup` further on in the chunk.
+    Stride,
+    /// The chunk's next untaken ray (a workgroup atomic).
+    Dynamic,
+    /// Waits until at least `min_free` lanes of its subgroup (or all) are free, then they all
+    /// take the chunk's next rays together, so neighbouring rays start in step. Needs
+    /// `wgpu::Features::SUBGROUP`; `min_free` is 4, 8, 16, 24 or 32.
+    Subgroup { min_free: u32 },
+}
+
+/// How a trace kernel is built. [`TraceConfig::coherent`] and [`TraceConfig::incoherent`] are
+/// the fastest configurations measured on an NVIDIA H200 for each [`RayOrder`]
+/// (BENCHMARKS.md, "Ray tracing core"); the other settings exist to measure against them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceConfig {
+    /// Invocations per workgroup: 32, 64 or 128.
+    pub workgroup: u32,
+    /// Rays each invocation traces, one after the other, from its workgroup's chunk of
+    /// `workgroup * rays_per_thread` consecutive rays: 1, 4, 8, 16 or 32.
+    pub rays_per_thread: u32,
+    pub refill: Refill,
+    /// Triangles an iteration of the walk tests at most: 1, 2, 3, 4, or 0 for all of a node's
+    /// hit triangles. Lanes with triangles left do those in the next iterations while their
+    /// warp's other lanes test nodes.
+    pub triangles_per_step: u32,
+    /// Keep wgpu's runtime checks (bounds clamping, loop counters); slower, for comparison.
+    pub runtime_checks: bool,
+}
+
+impl TraceConfig {
+    /// For [`RayOrder::Coherent`] and [`RayOrder::Image`]: one ray per invocation.
+    pub fn coherent() -> Self {
+        Self {
+            workgroup: 64,
+            rays_per_thread: 1,
+            refill: Refill::Stride,
+            triangles_per_step: 2,
+            runtime_checks: false,
+        }
+    }
+
+    /// For [`RayOrder::Incoherent`]: 8 rays per invocation, the next free one of the chunk as
+    /// soon as one is done; one triangle per step.
+    pub fn incoherent() -> Self {
+        Self {
+            rays_per_thread: 8,
+            refill: Refill::Dynamic,
+            triangles_per_step: 1,
+            ..Self::coherent()
+        }
+    }
+
+    pub fn for_order(order: RayOrder) -> Self {
+        match order {
+            RayOrder::Coherent | RayOrder::Image { .. } => Self::coherent(),
+            RayOrder::Incoherent => Self::incoherent(),
+        }
+    }
+
+    /// Entry shader and shader defs.
+    fn shader(
+        &self,
+        ctx: &GpuContext,
+    ) -> Result<(&'static str, Vec<(&'static str, ShaderDefValue)>)> {
+        let bad = |what: &str, v: u32, allowed: &str| RenderError::Pass {
+            pass: "bvh_trace".into(),
+            message: format!("TraceConfig::{what} is {v}; it must be one of {allowed}"),
+        };
+        let mut defs = Vec::new();
+        match self.workgroup {
+            32 => defs.push("TRACE_WORKGROUP_32"),
+            64 => {}
+            128 => defs.push("TRACE_WORKGROUP_128"),
+            v => return Err(bad("workgroup", v, "32, 64, 128")),
+        }
+        match self.rays_per_thread {
+            1 => defs.push("TRACE_RAYS_PER_THREAD_1"),
+            4 => defs.push("TRACE_RAYS_PER_THREAD_4"),
+            8 => {}
+            16 => defs.push("TRACE_RAYS_PER_THREAD_16"),
+            32 => defs.push("TRACE_RAYS_PER_THREAD_32"),
+            v => return Err(bad("rays_per_thread", v, "1, 4, 8, 16, 32")),
+        }
+        match self.refill {
+            Refill::Stride => {}
+            Refill::Dynamic => defs.push("TRACE_DYNAMIC_FETCH"),
+            Refill::Subgroup { min_free } => {
+                if !ctx.has(wgpu::Features::SUBGROUP) {
+                    return Err(RenderError::Pass {
+                        pass: "bvh_trace".into(),
+                        message: "Refill::Subgroup needs subgroup operations, which this GPU \
+                                  does not offer; use Refill::Stride or Refill::Dynamic"
+                            .into(),
+                    });
+                }
+                defs.push("TRACE_WARP_REFILL");
+                match min_free {
+                    4 => defs.push("TRACE_REFILL_MIN_4"),
+                    8 => defs.push("TRACE_REFILL_MIN_8"),
+                    16 => {}
+                    24 => defs.push("TRACE_REFILL_MIN_24"),
+                    32 => defs.push("TRACE_REFILL_MIN_32"),
+                    v => return Err(bad("refill min_free", v, "4, 8, 16, 24, 32")),
+                }
+            }
+        }
+        match self.triangles_per_step {
+            0 => defs.push("BVH_TRIANGLES_PER_STEP_ALL"),
+            1 => defs.push("BVH_TRIANGLES_PER_STEP_1"),
+            2 => {}
+            3 => defs.push("BVH_TRIANGLES_PER_STEP_3"),
+            4 => defs.push("BVH_TRIANGLES_PER_STEP_4"),
+            v => return Err(bad("triangles_per_step", v, "0 (all), 1, 2, 3, 4")),
+        }
+        Ok((
+            "bvh/trace.wgsl",
+            defs.into_iter()
+                .map(|d| (d, ShaderDefValue::Bool(true)))
+                .collect(),
+        ))
+    }
+
+    /// Rays one workgroup traces.
+    fn rays_per_workgroup(&self) -> u32 {
+        self.workgroup * self.rays_per_thread
+    }
+}
+
+/// The two pipelines of one configuration.
+struct Kernels {
+    config: TraceConfig,
+    closest: ComputePipeline,
+    any: ComputePipeline,
+}
+
+impl Kernels {
+    fn new(ctx: &GpuContext, lib: &mut ShaderLibrary, config: TraceConfig) -> Result<Self> {
+        let (path, defs) = config.shader(ctx)?;
+        let build = |lib: &mut ShaderLibrary, entry: &str| {
+            if config.runtime_checks {
+                ComputePipeline::new(ctx, lib, path, entry, &defs)
+            } else {
+                // SAFETY: the kernel indexes only (a) the BVH buffers, with indices that
+                // `check_tree` and `check_instances` prove in range before any upload, walking
+                // each tree from its root exactly as the kernel does; (b) rays and hits below
+                // `params.count`, which `record` checks both buffers hold; (c) its stack, whose
+                // depth `import` bounds by STACK_SIZE with depths measured by `check_tree`; (d)
+                // vector components 0..2 of its own making; `trace_ray_index` maps 0..count
+                // one to one onto itself. Loops end: every iteration consumes
+                // a hit bit or pops, and children lie after their parent (checked), so the walk
+                // is finite for every ray, NaN included; each invocation takes rays from a
+                // counter that only grows. Integer divisors are never zero (`trace_ray_index`:
+                // `record` refuses an image width of 0); workgroup memory is written before it
+                // is read (trace.wgsl).
+                unsafe { ComputePipeline::new_unchecked(ctx, lib, path, entry, &defs) }
+            }
+        };
+        Ok(Self {
+            config,
+            closest: build(lib, "closest_hit")?,
+            any: build(lib, "any_hit")?,
+        })
+    }
+}
+
 /// The four BVH buffers of a frame, in binding order (`@binding(0..4)` of `hikari::bvh`).
 #[derive(Clone, Copy, Debug)]
 pub struct BvhBuffers {
@@ -75,49 +274,118 @@ struct Upload {
     len: u64,
 }
 
+/// Where one uploaded BLAS lies in the packed buffers, and its measured depth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct BlasSpan {
+    node_offset: u32,
+    triangle_offset: u32,
+    nodes: u32,
+    depth: u32,
+}
+
 /// Pipelines plus the GPU copy of a BVH scene (all BLAS packed, and the TLAS).
 pub struct BvhTrace {
-    pub closest: ComputePipeline,
-    pub any: ComputePipeline,
+    coherent: Kernels,
+    /// `None` when both orders use the same configuration.
+    incoherent: Option<Kernels>,
     blas_nodes: Option<Upload>,
     triangles: Option<Upload>,
     tlas_nodes: Option<Upload>,
     instances: Option<Upload>,
+    blases: Vec<BlasSpan>,
     /// Deepest BLAS, in nodes on a root-to-leaf path.
     blas_depth: u32,
     tlas_depth: u32,
 }
 
 impl BvhTrace {
+    /// The measured best configuration for each [`RayOrder`].
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Self::with_configs(ctx, lib, TraceConfig::coherent(), TraceConfig::incoherent())
+    }
+
+    /// One configuration for both orders (to measure or test it).
+    pub fn with_config(
+        ctx: &GpuContext,
+        lib: &mut ShaderLibrary,
+        config: TraceConfig,
+    ) -> Result<Self> {
+        Self::with_configs(ctx, lib, config, config)
+    }
+
+    pub fn with_configs(
+        ctx: &GpuContext,
+        lib: &mut ShaderLibrary,
+        coherent: TraceConfig,
+        incoherent: TraceConfig,
+    ) -> Result<Self> {
+        let coherent_kernels = Kernels::new(ctx, lib, coherent)?;
+        let incoherent = if incoherent == coherent {
+            None
+        } else {
+            Some(Kernels::new(ctx, lib, incoherent)?)
+        };
         Ok(Self {
-            closest: ComputePipeline::new(ctx, lib, "bvh/trace.wgsl", "closest_hit", &[])?,
-            any: ComputePipeline::new(ctx, lib, "bvh/trace.wgsl", "any_hit", &[])?,
+            coherent: coherent_kernels,
+            incoherent,
             blas_nodes: None,
             triangles: None,
             tlas_nodes: None,
             instances: None,
+            blases: Vec::new(),
             blas_depth: 0,
             tlas_depth: 0,
         })
     }
 
+    fn kernels(&self, order: RayOrder) -> &Kernels {
+        match (order, &self.incoherent) {
+            (RayOrder::Incoherent, Some(k)) => k,
+            _ => &self.coherent,
+        }
+    }
+
+    /// The configuration used for rays of `order`.
+    pub fn config(&self, order: RayOrder) -> TraceConfig {
+        self.kernels(order).config
+    }
+
     /// Uploads every BLAS, concatenated as [`PackedBlases`] lays them out (the offsets a TLAS
     /// built over the same list stores in its instance records). Call again after refits.
     pub fn upload_blases(&mut self, ctx: &GpuContext, blases: &[Blas]) -> Result<()> {
-        let packed = PackedBlases::new(blases);
-        let depth = blases.iter().map(|b| b.stats.depth).max().unwrap_or(0);
-        self.upload_packed(ctx, &packed, depth)
+        self.upload_packed(ctx, &PackedBlases::new(blases))
     }
 
-    /// [`BvhTrace::upload_blases`] for an already packed list; `max_depth` is the largest
-    /// `BlasStats::depth` among them.
-    pub fn upload_packed(
-        &mut self,
-        ctx: &GpuContext,
-        packed: &PackedBlases,
-        max_depth: u32,
-    ) -> Result<()> {
+    /// [`BvhTrace::upload_blases`] for an already packed list. Every tree is checked first (see
+    /// the module docs); a TLAS uploaded before stays only if the BLAS list kept its shape.
+    pub fn upload_packed(&mut self, ctx: &GpuContext, packed: &PackedBlases) -> Result<()> {
+        let mut spans = Vec::with_capacity(packed.offsets.len());
+        for (i, &(node_offset, triangle_offset)) in packed.offsets.iter().enumerate() {
+            let (node_end, tri_end) = packed
+                .offsets
+                .get(i + 1)
+                .copied()
+                .unwrap_or((packed.nodes.len() as u32, packed.triangles.len() as u32));
+            let nodes = packed
+                .nodes
+                .get(node_offset as usize..node_end as usize)
+                .ok_or_else(|| invalid(format!("BLAS {i}: node range out of the packed list")))?;
+            let tris = tri_end.checked_sub(triangle_offset).ok_or_else(|| {
+                invalid(format!("BLAS {i}: triangle range out of the packed list"))
+            })?;
+            if tri_end as usize > packed.triangles.len() {
+                return Err(invalid(format!(
+                    "BLAS {i}: triangle range out of the packed list"
+                )));
+            }
+            let depth = check_tree(&format!("BLAS {i}"), nodes, tris as usize)?;
+            spans.push(BlasSpan {
+                node_offset,
+                triangle_offset,
+                nodes: nodes.len() as u32,
+                depth,
+            });
+        }
         // Zero-sized bindings are not allowed; a zeroed node has no children, so a BVH made
         // of it is empty and never reads the dummy triangle.
         let nodes: &[WideNode] = if packed.nodes.is_empty() {
@@ -136,13 +404,23 @@ impl BvhTrace {
         check_size(ctx, "bvh.triangles", tris_bytes.len() as u64)?;
         upload(ctx, &mut self.blas_nodes, "bvh.blas_nodes", nodes_bytes);
         upload(ctx, &mut self.triangles, "bvh.triangles", tris_bytes);
-        self.blas_depth = max_depth;
+        if spans != self.blases {
+            // The TLAS's instance records were checked against the old list.
+            self.tlas_nodes = None;
+            self.instances = None;
+            self.tlas_depth = 0;
+        }
+        self.blas_depth = spans.iter().map(|s| s.depth).max().unwrap_or(0);
+        self.blases = spans;
         Ok(())
     }
 
     /// Uploads the TLAS (every frame: it is rebuilt from the instances that survive culling).
-    /// Its instance records must point into the BLAS list given to [`BvhTrace::upload_blases`].
+    /// Its instance records must point into the BLAS list given to [`BvhTrace::upload_blases`]
+    /// before.
     pub fn upload_tlas(&mut self, ctx: &GpuContext, tlas: &Tlas) -> Result<()> {
+        let depth = check_tree("TLAS", &tlas.nodes, tlas.instances.len())?;
+        check_instances(&tlas.instances, &self.blases)?;
         let nodes: &[WideNode] = if tlas.nodes.is_empty() {
             &[WideNode::zeroed()]
         } else {
@@ -159,11 +437,7 @@ impl BvhTrace {
         check_size(ctx, "bvh.instances", inst_bytes.len() as u64)?;
         upload(ctx, &mut self.tlas_nodes, "bvh.tlas_nodes", nodes_bytes);
         upload(ctx, &mut self.instances, "bvh.instances", inst_bytes);
-        self.tlas_depth = if tlas.nodes.is_empty() {
-            0
-        } else {
-            tlas.stats.depth
-        };
+        self.tlas_depth = depth;
         Ok(())
     }
 
@@ -194,7 +468,9 @@ impl BvhTrace {
             return Err(missing("BLAS (upload_blases)"));
         };
         let (Some(tn), Some(inst)) = (&self.tlas_nodes, &self.instances) else {
-            return Err(missing("TLAS (upload_tlas)"));
+            return Err(missing(
+                "TLAS (upload_tlas, after the BLAS list it points into)",
+            ));
         };
         let need = self.stack_needed();
         if need > STACK_SIZE {
@@ -212,11 +488,11 @@ impl BvhTrace {
         })
     }
 
-    /// Workgroups for `count` rays: 2D once one dimension's limit is passed, with as few spare
-    /// workgroups as the split allows.
-    pub fn groups(&self, ctx: &GpuContext, count: u32) -> [u32; 3] {
-        let size = self.closest.workgroup_size[0].max(1);
-        let total = count.div_ceil(size).max(1);
+    /// Workgroups for `count` rays of `order`: 2D once one dimension's limit is passed, with
+    /// as few spare workgroups as the split allows.
+    pub fn groups(&self, ctx: &GpuContext, count: u32, order: RayOrder) -> [u32; 3] {
+        let per = self.config(order).rays_per_workgroup();
+        let total = count.div_ceil(per).max(1);
         let max = ctx.limits.max_compute_workgroups_per_dimension.max(1);
         let y = total.div_ceil(max);
         [total.div_ceil(y), y, 1]
@@ -224,7 +500,9 @@ impl BvhTrace {
 
     /// Adds the pass `bvh_trace.closest` or `bvh_trace.any`: reads `count` [`hikari_bvh::Ray`]s
     /// from `rays`, writes as many [`hikari_bvh::Hit`]s to `hits` (misses have
-    /// `primitive == instance == u32::MAX` and `t = inf`).
+    /// `primitive == instance == u32::MAX` and `t = inf`). `order` picks the kernel
+    /// configuration; results do not depend on it (except which of several hits at exactly
+    /// the same distance is reported).
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
@@ -232,22 +510,56 @@ impl BvhTrace {
         hits: Buf,
         count: u32,
         mode: TraceMode,
+        order: RayOrder,
     ) -> Result<()> {
+        let pass = mode.pass_name();
+        for (buf, what, per) in [(rays, "rays", RAY_BYTES), (hits, "hits", HIT_BYTES)] {
+            let size = g.buffer_size(buf).ok_or_else(|| RenderError::Pass {
+                pass: pass.into(),
+                message: format!("the {what} buffer is not of this frame"),
+            })?;
+            if size < count as u64 * per {
+                return Err(RenderError::Pass {
+                    pass: pass.into(),
+                    message: format!(
+                        "the {what} buffer holds {size} bytes, but {count} records need {}",
+                        count as u64 * per
+                    ),
+                });
+            }
+        }
+        let image_width = match order {
+            RayOrder::Image { width } => {
+                if width == 0 || !count.is_multiple_of(width) {
+                    return Err(RenderError::Pass {
+                        pass: pass.into(),
+                        message: format!(
+                            "RayOrder::Image {{ width: {width} }} needs a width of at least 1 \
+                             and a whole number of rows, but there are {count} rays"
+                        ),
+                    });
+                }
+                width
+            }
+            _ => 0,
+        };
         let bvh = self.import(g)?;
+        let kernels = self.kernels(order);
         let pipeline = match mode {
-            TraceMode::Closest => &self.closest,
-            TraceMode::Any => &self.any,
+            TraceMode::Closest => &kernels.closest,
+            TraceMode::Any => &kernels.any,
         };
         let params = TraceParams {
             count,
+            image_width,
             ..Default::default()
         };
         let groups = if count == 0 {
             [0, 1, 1]
         } else {
-            self.groups(g.ctx(), count)
+            self.groups(g.ctx(), count, order)
         };
-        g.pass(mode.pass_name())
+        g.pass(pass)
             .read(bvh.blas_nodes)
             .read(bvh.triangles)
             .read(bvh.tlas_nodes)
@@ -257,6 +569,109 @@ impl BvhTrace {
             .constants(&params)
             .dispatch(pipeline, groups)
     }
+}
+
+fn invalid(message: String) -> RenderError {
+    RenderError::Pass {
+        pass: "bvh_trace".into(),
+        message: format!("refusing to upload a malformed BVH: {message}"),
+    }
+}
+
+/// Checks, for one tree (a BLAS with `prims` triangles, or the TLAS with `prims` instances),
+/// everything the unchecked kernel relies on when it walks it from node 0, and returns its
+/// depth in nodes (0 for an empty tree). Nodes the walk cannot reach are not looked at.
+///
+/// Per reached node and slot: an internal slot (imask bit set) has meta `0b001_11000 | slot`
+/// and its child (`child_base` plus the internal slots before it) lies after the node and
+/// inside the tree; a leaf slot has a unary count of 1 to 3 primitives at an offset that keeps
+/// them within the node's 24 primitive bits and within the tree's primitives; an empty slot
+/// has meta 0.
+pub(crate) fn check_tree(what: &str, nodes: &[WideNode], prims: usize) -> Result<u32> {
+    if nodes.is_empty() {
+        return Ok(0);
+    }
+    let bad = |i: usize, s: usize, m: String| invalid(format!("{what}, node {i}, slot {s}: {m}"));
+    // 0 = not reached; children always lie after their parent, so one forward sweep reaches
+    // every node the kernel can.
+    let mut depth = vec![0u32; nodes.len()];
+    depth[0] = 1;
+    let mut max_depth = 1;
+    for i in 0..nodes.len() {
+        let d = depth[i];
+        if d == 0 {
+            continue;
+        }
+        max_depth = max_depth.max(d);
+        let n = &nodes[i];
+        let imask = n.imask();
+        let mut internal = 0u64;
+        for s in 0..WIDTH {
+            let m = n.meta(s);
+            if imask & (1 << s) != 0 {
+                if m != META_INTERNAL | s as u8 {
+                    return Err(bad(i, s, format!("internal child with meta {m:#04x}")));
+                }
+                let child = n.child_base as u64 + internal;
+                internal += 1;
+                if child <= i as u64 || child >= nodes.len() as u64 {
+                    return Err(bad(
+                        i,
+                        s,
+                        format!(
+                            "child node {child} is not after this node and within the {} nodes",
+                            nodes.len()
+                        ),
+                    ));
+                }
+                depth[child as usize] = depth[child as usize].max(d + 1);
+            } else if m != 0 {
+                let count = match m >> 5 {
+                    0b001 => 1u64,
+                    0b011 => 2,
+                    0b111 => 3,
+                    _ => return Err(bad(i, s, format!("leaf meta {m:#04x}"))),
+                };
+                debug_assert!(count as usize <= MAX_LEAF_TRIANGLES);
+                let offset = (m & 0x1f) as u64;
+                let end = n.prim_base as u64 + offset + count;
+                if offset + count > 24 || end > prims as u64 {
+                    return Err(bad(
+                        i,
+                        s,
+                        format!(
+                            "leaf primitives up to {end} (offset {offset}) out of the {prims} \
+                             primitives or past the node's 24"
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(max_depth)
+}
+
+/// Every instance record must point at the start of an uploaded, non-empty BLAS.
+fn check_instances(instances: &[InstanceRecord], blases: &[BlasSpan]) -> Result<()> {
+    for (i, r) in instances.iter().enumerate() {
+        let ok = blases.get(r.blas_index as usize).is_some_and(|b| {
+            b.nodes > 0
+                && b.node_offset == r.blas_node_offset
+                && b.triangle_offset == r.blas_triangle_offset
+        });
+        if !ok {
+            return Err(invalid(format!(
+                "TLAS instance record {i} points at BLAS {} (nodes from {}, triangles from {}), \
+                 which is not one of the {} uploaded BLAS or is empty; upload the BLAS list the \
+                 TLAS was built over first",
+                r.blas_index,
+                r.blas_node_offset,
+                r.blas_triangle_offset,
+                blases.len()
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn check_size(ctx: &GpuContext, name: &str, bytes: u64) -> Result<()> {
@@ -294,4 +709,49 @@ fn upload(ctx: &GpuContext, slot: &mut Option<Upload>, name: &str, bytes: &[u8])
                 | wgpu::BufferUsages::COPY_SRC,
         });
     *slot = Some(Upload { buffer, len });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hikari_bvh::{BuildOptions, Mesh};
+
+    /// Depth by recursion from the root, independent of `check_tree`'s forward sweep.
+    fn depth_by_recursion(nodes: &[WideNode], i: usize) -> u32 {
+        let n = &nodes[i];
+        let mut below = 0;
+        let mut k = 0;
+        for s in 0..WIDTH {
+            if n.imask() & (1 << s) != 0 {
+                below = below.max(depth_by_recursion(nodes, (n.child_base + k) as usize));
+                k += 1;
+            }
+        }
+        1 + below
+    }
+
+    #[test]
+    fn check_tree_measures_depth_and_accepts_built_trees() {
+        for (seed, count) in [(1u64, 1usize), (2, 40), (3, 3000)] {
+            let mesh = Mesh::random_soup(seed, count, 10.0, 2.0);
+            let blas = Blas::from_mesh("soup", &mesh, &BuildOptions::default()).unwrap();
+            let depth = check_tree("soup", &blas.nodes, blas.triangles.len()).unwrap();
+            assert_eq!(depth, depth_by_recursion(&blas.nodes, 0));
+            assert_eq!(depth, blas.stats.depth);
+            // One primitive fewer than the leaves reference is refused.
+            assert!(check_tree("soup", &blas.nodes, blas.triangles.len() - 1).is_err());
+        }
+        assert_eq!(check_tree("empty", &[], 0).unwrap(), 0);
+    }
+
+    #[test]
+    fn a_leaf_past_the_nodes_24_primitive_bits_is_refused() {
+        // Offset 22 with 3 primitives would set bit 24, which the kernel reads as a child node.
+        let mut n = WideNode::default();
+        n.set_meta(0, 0b111_00000 | 22);
+        let e = check_tree("t", &[n], 100).unwrap_err().to_string();
+        assert!(e.contains("past the node's 24"), "{e}");
+        n.set_meta(0, 0b111_00000 | 21);
+        assert_eq!(check_tree("t", &[n], 100).unwrap(), 1);
+    }
 }
