@@ -14,7 +14,7 @@ use hikari_render::{ContextOptions, GpuContext, Renderer};
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
     /// Render N frames of a scene and print per-pass GPU median/min/max.
-    Frame(FrameArgs),
+    Frame(BenchFrameArgs),
     /// Frame-graph overhead: frames of N near-empty passes, CPU and GPU cost per pass.
     Overhead(OverheadArgs),
     /// BVH build times and GPU ray throughput (Grays/s) for closest and any hit.
@@ -22,7 +22,7 @@ pub enum BenchCommand {
 }
 
 #[derive(Args, Debug)]
-pub struct FrameArgs {
+pub struct BenchFrameArgs {
     #[command(flatten)]
     frame: crate::render::FrameArgs,
     /// Frames measured.
@@ -106,7 +106,7 @@ pub fn print_single_frame(r: &FrameResult) {
     }
 }
 
-fn frame(a: FrameArgs) -> anyhow::Result<()> {
+fn frame(a: BenchFrameArgs) -> anyhow::Result<()> {
     let (scene, mut settings) = a.frame.resolve()?;
     anyhow::ensure!(
         a.dolly.is_finite() && a.dolly.abs() <= 100.0,

@@ -20,7 +20,9 @@ use glam::{Affine3A, Vec3};
 use serde_json::json;
 
 use hikari_bvh::rng::SplitMix64;
-use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
+use hikari_bvh::{
+    Blas, BuildOptions, Hit, Instance, Mesh, Ray, RefitScheduler, ThrottleSettings, Tlas,
+};
 use hikari_render::graph::{GraphRuntime, TimestampMode};
 use hikari_render::passes::bvh_trace::{
     BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, Refill, TraceConfig, TraceMode,
@@ -80,6 +82,129 @@ struct BenchScene {
     /// Wall-clock milliseconds to build all BLAS, per repetition.
     blas_build_ms: Vec<f64>,
     rays: RaySource,
+    /// The scene's deforming meshes played for a while with throttled refits.
+    animation: Option<AnimationReport>,
+}
+
+/// Frames of a scene's vertex animation with Metro's refit throttling ([`RefitScheduler`]).
+struct AnimationReport {
+    deforming_meshes: usize,
+    frames: usize,
+    /// Per frame, CPU milliseconds to deform the chosen meshes and refit their BLAS.
+    refit_ms_median: f64,
+    refits_per_frame_max: usize,
+    vertices_per_frame_max: usize,
+    /// Most deforming meshes left outdated after a frame's batch.
+    outdated_max: usize,
+    /// After the last frame: rays traced through the refit BLAS and through BLAS rebuilt from
+    /// the same deformed meshes, and how many hits differ.
+    checked: usize,
+    mismatches: usize,
+}
+
+/// Frames played at 60 Hz for the animation report.
+const ANIMATION_FRAMES: usize = 120;
+
+fn animate(scene: &hikari_scene::Scene, blases: &[Blas], instances: &[Instance]) -> anyhow::Result<Option<AnimationReport>> {
+    let deforming: Vec<usize> = (0..scene.meshes.len())
+        .filter(|&m| scene.meshes[m].deformation.is_some())
+        .collect();
+    if deforming.is_empty() {
+        return Ok(None);
+    }
+    let camera = scene.cameras.first().map(|c| c.position).unwrap_or(Vec3::ZERO);
+    let mut blases = blases.to_vec();
+    let mut scheduler = RefitScheduler::new(ThrottleSettings::default());
+    let ids: Vec<usize> = deforming
+        .iter()
+        .map(|&m| scheduler.register(scene.meshes[m].positions.len()))
+        .collect();
+    let mut times = Vec::new();
+    let (mut refits_max, mut vertices_max, mut outdated_max) = (0, 0, 0);
+    for frame in 0..ANIMATION_FRAMES {
+        let t = frame as f32 / 60.0;
+        for (k, &m) in deforming.iter().enumerate() {
+            // Priority from the nearest instance: size over distance, as the talk weighs it.
+            let (lo, hi) = scene.meshes[m].bounds().unwrap_or_default();
+            let radius = 0.5 * (hi - lo).length();
+            let distance = scene
+                .instances
+                .iter()
+                .filter(|i| i.mesh == m)
+                .map(|i| i.transform.transform_point3(0.5 * (lo + hi)).distance(camera))
+                .fold(f32::INFINITY, f32::min);
+            scheduler.touch(ids[k], true, radius, distance);
+        }
+        let batch = scheduler.select();
+        let t0 = Instant::now();
+        for &id in &batch.ids {
+            let m = deforming[id];
+            let (positions, _) = scene.meshes[m].deformed(t);
+            blases[m]
+                .refit(&positions)
+                .with_context(|| format!("refitting mesh `{}`", scene.meshes[m].name))?;
+        }
+        times.push(t0.elapsed().as_secs_f64() * 1e3);
+        refits_max = refits_max.max(batch.ids.len());
+        vertices_max = vertices_max.max(batch.vertices);
+        outdated_max = outdated_max.max(batch.outdated);
+    }
+    // Every mesh refit at the last frame's time, compared with a rebuild at that time.
+    let t_last = (ANIMATION_FRAMES - 1) as f32 / 60.0;
+    let mut rebuilt = blases.clone();
+    for &m in &deforming {
+        let (positions, _) = scene.meshes[m].deformed(t_last);
+        blases[m].refit(&positions)?;
+        let mesh = Mesh::new(
+            positions,
+            scene.meshes[m]
+                .indices
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect(),
+        );
+        rebuilt[m] = Blas::from_mesh(&scene.meshes[m].name, &mesh, &BuildOptions::default())?;
+    }
+    let all: Vec<u32> = (0..instances.len() as u32).collect();
+    let refit_tlas = Tlas::build(instances, &all, &blases)?;
+    let rebuilt_tlas = Tlas::build(instances, &all, &rebuilt)?;
+    // Rays aimed at the deforming instances, from the camera, so they test what moved.
+    let mut rng = SplitMix64::new(SEED ^ 0xA11);
+    let targets: Vec<Vec3> = scene
+        .instances
+        .iter()
+        .filter(|i| deforming.contains(&i.mesh))
+        .map(|i| {
+            let (lo, hi) = scene.meshes[i.mesh].bounds().unwrap_or_default();
+            i.transform.transform_point3(0.5 * (lo + hi))
+        })
+        .collect();
+    let rays: Vec<Ray> = (0..4000)
+        .map(|k| {
+            let aim = targets[k % targets.len()]
+                + (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5) * 4.0;
+            Ray::new(camera, (aim - camera).normalize(), 0.0, f32::INFINITY)
+        })
+        .collect();
+    let a = refit_tlas.closest_hits(&blases, &rays, 0);
+    let b = rebuilt_tlas.closest_hits(&rebuilt, &rays, 0);
+    let mismatches = a
+        .iter()
+        .zip(&b)
+        .zip(&rays)
+        .filter(|((x, y), r)| !same_hit(x, y, r))
+        .count();
+    let (median, _) = median_min(&mut times);
+    Ok(Some(AnimationReport {
+        deforming_meshes: deforming.len(),
+        frames: ANIMATION_FRAMES,
+        refit_ms_median: median,
+        refits_per_frame_max: refits_max,
+        vertices_per_frame_max: vertices_max,
+        outdated_max,
+        checked: rays.len(),
+        mismatches,
+    }))
 }
 
 enum RaySource {
@@ -373,6 +498,15 @@ pub fn run(args: RaysArgs) -> anyhow::Result<()> {
                 "bytes": tlas.gpu_bytes(),
                 "build_us": { "median": tlas_med, "min": tlas_min },
             },
+            "animation": scene.animation.as_ref().map(|a| json!({
+                "deforming_meshes": a.deforming_meshes,
+                "frames": a.frames,
+                "refit_ms_median": a.refit_ms_median,
+                "refits_per_frame_max": a.refits_per_frame_max,
+                "vertices_per_frame_max": a.vertices_per_frame_max,
+                "outdated_max": a.outdated_max,
+                "refit_vs_rebuild": { "checked": a.checked, "mismatches": a.mismatches },
+            })),
             "gpu_bvh_bytes": gpu_bytes,
             "upload_ms": upload_ms,
             "workloads": workloads,
@@ -399,6 +533,22 @@ pub fn run(args: RaysArgs) -> anyhow::Result<()> {
             tlas.stats.depth,
             tlas.gpu_bytes()
         );
+        if let Some(a) = &scene.animation {
+            println!(
+                "animation: {} deforming meshes, {} frames at 60 Hz with throttled refits (16 by \
+                 priority + 4 random, vertex budget): refit {:.3} ms/frame (CPU, median), at most \
+                 {} refits and {} vertices a frame, at most {} outdated after a frame; refit vs \
+                 rebuild: {}/{} rays differ",
+                a.deforming_meshes,
+                a.frames,
+                a.refit_ms_median,
+                a.refits_per_frame_max,
+                a.vertices_per_frame_max,
+                a.outdated_max,
+                a.mismatches,
+                a.checked
+            );
+        }
         println!(
             "GPU BVH memory {:.2} MiB, upload {upload_ms:.1} ms; timing: {timing}, {} passes after 2 untimed",
             mib(gpu_bytes as usize),
@@ -484,6 +634,7 @@ fn load(name: &str) -> anyhow::Result<BenchScene> {
             instances: vec![Instance::new(Affine3A::IDENTITY, 0)],
             blas_build_ms,
             rays: RaySource::Terrain(mesh),
+            animation: None,
         });
     }
     let scene = crate::render::load_scene(name)?;
@@ -542,6 +693,7 @@ fn load(name: &str) -> anyhow::Result<BenchScene> {
         !triangles.is_empty(),
         "scene `{name}` has no triangle with an area to start rays from"
     );
+    let animation = animate(&scene, &blases, &instances)?;
     let camera = match scene.cameras.first() {
         Some(c) => c.clone(),
         None => {
@@ -561,6 +713,7 @@ fn load(name: &str) -> anyhow::Result<BenchScene> {
         blases,
         instances,
         blas_build_ms,
+        animation,
         rays: RaySource::Surfaces {
             triangles,
             cdf,

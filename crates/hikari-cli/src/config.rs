@@ -1,4 +1,4 @@
-//! `--config FILE`: a TOML file with the frame's settings (see docs/config.md). Command-line
+//! `--config FILE`: a TOML file with the frame's settings (see docs/config.example.toml). Command-line
 //! flags win over the file, the file over the defaults.
 
 use std::path::Path;

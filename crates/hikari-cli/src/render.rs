@@ -27,7 +27,7 @@ pub struct FrameArgs {
     /// Image height in pixels [default: 720].
     #[arg(long)]
     pub height: Option<u32>,
-    /// TOML settings file (docs/config.md); flags win over it.
+    /// TOML settings file (docs/config.example.toml); flags win over it.
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Placeholder exposure: EV at ISO 100 (sunny day about 15, overcast 12, interior 7)
@@ -66,6 +66,9 @@ impl FrameArgs {
         };
         let mut settings = file.settings();
         if let Some(ev) = self.ev100 {
+            if !ev.is_finite() || !(-10.0..=30.0).contains(&ev) {
+                bail!("--ev100 {ev} is outside the range -10 to 30");
+            }
             settings.exposure.ev100 = Some(ev);
         }
         settings.validate().context("settings")?;

@@ -67,7 +67,7 @@ fn render_writes_png_exr_and_dumps() {
     );
     assert!(dir.join("gbuffer.normal.exr").exists());
     assert!(
-        text(&o).contains("gbuffer.draw"),
+        text(&o).contains("gbuffer.resolve") && text(&o).contains("sun_shadows.rasterize"),
         "timing table: {}",
         text(&o)
     );
@@ -101,6 +101,11 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     );
     assert_clean_failure(&["render", "--camera", "nope"], "no camera named `nope`");
     assert_clean_failure(&["render", "--ev100", "99"], "--ev100 99");
+    assert_clean_failure(&["render", "--time", "25:00"], "25:00");
+    assert_clean_failure(
+        &["render", "--config", "/nonexistent/hikari.toml"],
+        "cannot read config file",
+    );
     assert_clean_failure(&["render", "--width", "banana"], "invalid value");
     assert_clean_failure(&["bench", "frame", "--frames", "0"], "--frames");
     if gpu_tests_skipped() {
@@ -108,6 +113,12 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     }
     let dir = tmp("bad");
     let out = dir.join("x.png");
+    let config = dir.join("bad.toml");
+    std::fs::write(&config, "[shadows]\ncascades = 9\n").unwrap();
+    assert_clean_failure(
+        &["render", "--config", config.to_str().unwrap()],
+        "`shadows.cascades` is 9; allowed: 1 to 4",
+    );
     assert_clean_failure(
         &["render", "--width", "0", "-o", out.to_str().unwrap()],
         "image width",

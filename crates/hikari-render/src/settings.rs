@@ -1,5 +1,5 @@
 //! What a user may tune about a frame, with the ranges each value must lie in. The CLI reads
-//! these from a TOML file (`--config`, see docs/config.md); `validate` names the offending
+//! these from a TOML file (`--config`, see docs/config.example.toml); `validate` names the offending
 //! field and its allowed range.
 
 use serde::{Deserialize, Serialize};

@@ -696,3 +696,47 @@ fn image_order_traces_every_ray_once() {
         assert!(e.contains("whole number of rows"), "{e}");
     }
 }
+
+#[test]
+fn village_matches() {
+    let Some(mut gpu) = Gpu::new() else { return };
+    let village = hikari_scene::builtin::village();
+    let meshes: Vec<Mesh> = village
+        .meshes
+        .iter()
+        .map(|m| {
+            Mesh::new(
+                m.positions.clone(),
+                m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            )
+        })
+        .collect();
+    let instances: Vec<Instance> = village
+        .instances
+        .iter()
+        .map(|i| Instance::new(Affine3A::from_mat4(i.transform), i.mesh as u32))
+        .collect();
+    let scene = Scene::new(meshes, instances);
+    // From every named camera (inside houses and the temple too) in random directions, so
+    // the rays meet thin walls, furniture, leaves and terrain; brute force keeps the count low.
+    let mut rng = SplitMix64::new(55);
+    let rays: Vec<Ray> = (0..120)
+        .map(|k| {
+            let cam = &village.cameras[k % village.cameras.len()];
+            Ray::new(cam.position, random_dir(&mut rng), 0.0, f32::INFINITY)
+        })
+        .collect();
+    // Brute force over 561k triangles is slow in a test: once, with the two kernels that
+    // `hikari bench rays` uses (the other configurations are covered on smaller scenes).
+    let (closest, any) = gpu.trace_with(&scene, &rays, TraceConfig::incoherent());
+    let hits = check_hits("village, incoherent", &scene, &rays, &closest, &any);
+    assert!(hits > 50, "{hits} hits");
+    let (coherent_closest, coherent_any) = gpu.trace_with(&scene, &rays, TraceConfig::coherent());
+    for (i, ray) in rays.iter().enumerate() {
+        assert!(
+            same_hit(as_option(coherent_closest[i]), as_option(closest[i])).is_ok()
+                && coherent_any[i].is_hit() == any[i].is_hit(),
+            "ray {i} {ray:?}: coherent and incoherent kernels disagree"
+        );
+    }
+}
