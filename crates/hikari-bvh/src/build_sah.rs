@@ -149,15 +149,37 @@ pub(crate) fn build_in(
     // its scatter to the other buffer needs no copy back.
     let top = (n >= 2 * MIN_PARALLEL_PRIMS)
         .then(|| (n / (params.threads.max(1) * 8)).clamp(MIN_PARALLEL_PRIMS, MAX_SUBTREE_PRIMS));
-    build_with(prims, &mut scratch[..n], params, top)
+    build_with(prims, &mut scratch[..n], Vec::new(), params, top)
+}
+
+/// Serial [`build`] for inputs rebuilt every frame (the TLAS): `scratch` and `nodes` are
+/// buffers from a previous build, grown as needed and kept by the caller, so a rebuild
+/// allocates nothing once they are large enough. Gives the tree of [`build`].
+pub(crate) fn build_reusing(
+    prims: Vec<PrimRef>,
+    scratch: &mut Vec<PrimRef>,
+    nodes: Vec<BinNode>,
+    max_leaf: usize,
+) -> BinaryBvh {
+    let n = prims.len();
+    if scratch.len() < n {
+        scratch.resize(n, PrimRef::new(&Aabb::EMPTY, 0));
+    }
+    let params = SahParams {
+        max_leaf,
+        threads: 1,
+    };
+    // One thread: level-by-level splitting (only ever useful to share work) is not used.
+    build_with(prims, &mut scratch[..n], nodes, &params, None)
 }
 
 /// [`build_in`], with the top split level by level until no node holds more than
 /// `top_threshold` primitives, if given. The tree does not depend on it. `scratch` is as long
-/// as `prims`.
+/// as `prims`; `recycled_nodes` is a node buffer to reuse (its contents do not matter).
 fn build_with(
     mut prims: Vec<PrimRef>,
     scratch: &mut [PrimRef],
+    recycled_nodes: Vec<BinNode>,
     params: &SahParams,
     top_threshold: Option<usize>,
 ) -> BinaryBvh {
@@ -201,7 +223,15 @@ fn build_with(
         reserve.push(total..total + 2 * m.max(1) - 2);
         total += 2 * m.max(1) - 2;
     }
-    let mut nodes: Vec<BinNode> = bytemuck::zeroed_vec(total);
+    let mut nodes = recycled_nodes;
+    if nodes.capacity() >= total {
+        // Entries are written before they are read; stale ones can only remain in the gaps
+        // between subtrees, which nothing references.
+        nodes.truncate(total);
+        nodes.resize(total, bytemuck::Zeroable::zeroed());
+    } else {
+        nodes = bytemuck::zeroed_vec(total);
+    }
     nodes[..top.len()].copy_from_slice(&top);
     let prim_ranges: Vec<_> = subtrees.iter().map(|s| s.task.begin..s.task.end).collect();
     let jobs: Vec<_> = split_ranges(&mut nodes, &reserve)
@@ -652,11 +682,18 @@ mod tests {
                 threads,
             };
             let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-            let serial = canonical(&build_with(prims.clone(), &mut scratch, &params(1), None));
+            let serial = canonical(&build_with(
+                prims.clone(),
+                &mut scratch,
+                Vec::new(),
+                &params(1),
+                None,
+            ));
             for (threads, threshold) in [(1, 1000), (3, 700), (8, 64), (16, 5000)] {
                 let got = canonical(&build_with(
                     prims.clone(),
                     &mut scratch,
+                    Vec::new(),
                     &params(threads),
                     Some(threshold),
                 ));
@@ -678,8 +715,20 @@ mod tests {
             threads: 4,
         };
         let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-        let serial = canonical(&build_with(prims.clone(), &mut scratch, &params, None));
-        let top = canonical(&build_with(prims, &mut scratch, &params, Some(300)));
+        let serial = canonical(&build_with(
+            prims.clone(),
+            &mut scratch,
+            Vec::new(),
+            &params,
+            None,
+        ));
+        let top = canonical(&build_with(
+            prims,
+            &mut scratch,
+            Vec::new(),
+            &params,
+            Some(300),
+        ));
         assert!(top == serial);
     }
 }
