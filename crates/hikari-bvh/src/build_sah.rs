@@ -445,15 +445,22 @@ fn small_split(prims: &mut [PrimRef]) -> (usize, [Aabb; 2]) {
     let mut best_order = [0u8; SMALL_NODE];
     let mut best_mid = n / 2;
     let mut order = [0u8; SMALL_NODE];
+    // Without NaN the centroids are totally ordered, and the stable sort can be computed as
+    // ranks without a branch (an insertion sort's comparisons are coin flips for a predictor).
+    let ordered = c2[..n].iter().all(|c| c.cmpeq(*c).all());
     for axis in [0usize, 1, 2] {
-        for (i, o) in order[..n].iter_mut().enumerate() {
-            *o = i as u8;
-        }
-        for i in 1..n {
-            let mut j = i;
-            while j > 0 && c2[order[j - 1] as usize][axis] > c2[order[j] as usize][axis] {
-                order.swap(j - 1, j);
-                j -= 1;
+        if ordered {
+            stable_ranks(&c2[..n], axis, &mut order);
+        } else {
+            for (i, o) in order[..n].iter_mut().enumerate() {
+                *o = i as u8;
+            }
+            for i in 1..n {
+                let mut j = i;
+                while j > 0 && c2[order[j - 1] as usize][axis] > c2[order[j] as usize][axis] {
+                    order.swap(j - 1, j);
+                    j -= 1;
+                }
             }
         }
         let mut right = [0.0f32; SMALL_NODE];
@@ -494,6 +501,31 @@ fn small_split(prims: &mut [PrimRef]) -> (usize, [Aabb; 2]) {
     let left = side_bounds(&prims[..best_mid]).0;
     let right = side_bounds(&prims[best_mid..]).0;
     (best_mid, [left, right])
+}
+
+/// Indices of `c2` (at most [`SMALL_NODE`], none NaN) in ascending order of `axis`, ties in
+/// index order: each one's place is the number of values below it plus the equal ones before it.
+fn stable_ranks(c2: &[Vec3A], axis: usize, order: &mut [u8; SMALL_NODE]) {
+    const LANES: usize = SMALL_NODE.div_ceil(4) * 4;
+    // Unused lanes hold NaN, which is neither below nor equal to anything.
+    let mut key = [f32::NAN; LANES];
+    for (k, c) in key.iter_mut().zip(c2) {
+        *k = c[axis];
+    }
+    let mut lanes = [Vec4::ZERO; LANES / 4];
+    for (l, k) in lanes.iter_mut().zip(key.chunks_exact(4)) {
+        *l = Vec4::from_slice(k);
+    }
+    for (i, &k) in key[..c2.len()].iter().enumerate() {
+        let k = Vec4::splat(k);
+        let (mut below, mut equal) = (0u32, 0u32);
+        for (g, l) in lanes.iter().enumerate() {
+            below |= l.cmplt(k).bitmask() << (4 * g);
+            equal |= l.cmpeq(k).bitmask() << (4 * g);
+        }
+        let place = below.count_ones() + (equal & ((1 << i) - 1)).count_ones();
+        order[place as usize] = i as u8;
+    }
 }
 
 #[inline]
@@ -730,5 +762,35 @@ mod tests {
             Some(300),
         ));
         assert!(top == serial);
+    }
+
+    #[test]
+    fn stable_ranks_sort_like_a_stable_sort() {
+        let mut rng = SplitMix64::new(12);
+        for it in 0..5000 {
+            let n = 2 + rng.below(SMALL_NODE - 1);
+            // Few distinct values (many ties), signed zeros among them, or arbitrary values.
+            let value = |rng: &mut SplitMix64| match it % 3 {
+                0 => rng.below(3) as f32,
+                1 => [0.0, -0.0, 1.0][rng.below(3)],
+                _ => rng.range(-1e3, 1e3),
+            };
+            let c2: Vec<Vec3A> = (0..n)
+                .map(|_| Vec3A::new(value(&mut rng), value(&mut rng), value(&mut rng)))
+                .collect();
+            for axis in 0..3 {
+                // Ties (-0 and +0 included) in index order.
+                let mut want: Vec<u8> = (0..n as u8).collect();
+                want.sort_by(|&a, &b| {
+                    c2[a as usize][axis]
+                        .partial_cmp(&c2[b as usize][axis])
+                        .unwrap()
+                        .then(a.cmp(&b))
+                });
+                let mut got = [0u8; SMALL_NODE];
+                stable_ranks(&c2, axis, &mut got);
+                assert_eq!(&got[..n], &want[..], "{c2:?}, axis {axis}");
+            }
+        }
     }
 }
