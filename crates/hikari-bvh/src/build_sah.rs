@@ -149,15 +149,37 @@ pub(crate) fn build_in(
     // its scatter to the other buffer needs no copy back.
     let top = (n >= 2 * MIN_PARALLEL_PRIMS)
         .then(|| (n / (params.threads.max(1) * 8)).clamp(MIN_PARALLEL_PRIMS, MAX_SUBTREE_PRIMS));
-    build_with(prims, &mut scratch[..n], params, top)
+    build_with(prims, &mut scratch[..n], Vec::new(), params, top)
+}
+
+/// Serial [`build`] for inputs rebuilt every frame (the TLAS): `scratch` and `nodes` are
+/// buffers from a previous build, grown as needed and kept by the caller, so a rebuild
+/// allocates nothing once they are large enough. Gives the tree of [`build`].
+pub(crate) fn build_reusing(
+    prims: Vec<PrimRef>,
+    scratch: &mut Vec<PrimRef>,
+    nodes: Vec<BinNode>,
+    max_leaf: usize,
+) -> BinaryBvh {
+    let n = prims.len();
+    if scratch.len() < n {
+        scratch.resize(n, PrimRef::new(&Aabb::EMPTY, 0));
+    }
+    let params = SahParams {
+        max_leaf,
+        threads: 1,
+    };
+    // One thread: level-by-level splitting (only ever useful to share work) is not used.
+    build_with(prims, &mut scratch[..n], nodes, &params, None)
 }
 
 /// [`build_in`], with the top split level by level until no node holds more than
 /// `top_threshold` primitives, if given. The tree does not depend on it. `scratch` is as long
-/// as `prims`.
+/// as `prims`; `recycled_nodes` is a node buffer to reuse (its contents do not matter).
 fn build_with(
     mut prims: Vec<PrimRef>,
     scratch: &mut [PrimRef],
+    recycled_nodes: Vec<BinNode>,
     params: &SahParams,
     top_threshold: Option<usize>,
 ) -> BinaryBvh {
@@ -201,7 +223,15 @@ fn build_with(
         reserve.push(total..total + 2 * m.max(1) - 2);
         total += 2 * m.max(1) - 2;
     }
-    let mut nodes: Vec<BinNode> = bytemuck::zeroed_vec(total);
+    let mut nodes = recycled_nodes;
+    if nodes.capacity() >= total {
+        // Entries are written before they are read; stale ones can only remain in the gaps
+        // between subtrees, which nothing references.
+        nodes.truncate(total);
+        nodes.resize(total, bytemuck::Zeroable::zeroed());
+    } else {
+        nodes = bytemuck::zeroed_vec(total);
+    }
     nodes[..top.len()].copy_from_slice(&top);
     let prim_ranges: Vec<_> = subtrees.iter().map(|s| s.task.begin..s.task.end).collect();
     let jobs: Vec<_> = split_ranges(&mut nodes, &reserve)
@@ -415,15 +445,22 @@ fn small_split(prims: &mut [PrimRef]) -> (usize, [Aabb; 2]) {
     let mut best_order = [0u8; SMALL_NODE];
     let mut best_mid = n / 2;
     let mut order = [0u8; SMALL_NODE];
+    // Without NaN the centroids are totally ordered, and the stable sort can be computed as
+    // ranks without a branch (an insertion sort's comparisons are coin flips for a predictor).
+    let ordered = c2[..n].iter().all(|c| c.cmpeq(*c).all());
     for axis in [0usize, 1, 2] {
-        for (i, o) in order[..n].iter_mut().enumerate() {
-            *o = i as u8;
-        }
-        for i in 1..n {
-            let mut j = i;
-            while j > 0 && c2[order[j - 1] as usize][axis] > c2[order[j] as usize][axis] {
-                order.swap(j - 1, j);
-                j -= 1;
+        if ordered {
+            stable_ranks(&c2[..n], axis, &mut order);
+        } else {
+            for (i, o) in order[..n].iter_mut().enumerate() {
+                *o = i as u8;
+            }
+            for i in 1..n {
+                let mut j = i;
+                while j > 0 && c2[order[j - 1] as usize][axis] > c2[order[j] as usize][axis] {
+                    order.swap(j - 1, j);
+                    j -= 1;
+                }
             }
         }
         let mut right = [0.0f32; SMALL_NODE];
@@ -464,6 +501,31 @@ fn small_split(prims: &mut [PrimRef]) -> (usize, [Aabb; 2]) {
     let left = side_bounds(&prims[..best_mid]).0;
     let right = side_bounds(&prims[best_mid..]).0;
     (best_mid, [left, right])
+}
+
+/// Indices of `c2` (at most [`SMALL_NODE`], none NaN) in ascending order of `axis`, ties in
+/// index order: each one's place is the number of values below it plus the equal ones before it.
+fn stable_ranks(c2: &[Vec3A], axis: usize, order: &mut [u8; SMALL_NODE]) {
+    const LANES: usize = SMALL_NODE.div_ceil(4) * 4;
+    // Unused lanes hold NaN, which is neither below nor equal to anything.
+    let mut key = [f32::NAN; LANES];
+    for (k, c) in key.iter_mut().zip(c2) {
+        *k = c[axis];
+    }
+    let mut lanes = [Vec4::ZERO; LANES / 4];
+    for (l, k) in lanes.iter_mut().zip(key.chunks_exact(4)) {
+        *l = Vec4::from_slice(k);
+    }
+    for (i, &k) in key[..c2.len()].iter().enumerate() {
+        let k = Vec4::splat(k);
+        let (mut below, mut equal) = (0u32, 0u32);
+        for (g, l) in lanes.iter().enumerate() {
+            below |= l.cmplt(k).bitmask() << (4 * g);
+            equal |= l.cmpeq(k).bitmask() << (4 * g);
+        }
+        let place = below.count_ones() + (equal & ((1 << i) - 1)).count_ones();
+        order[place as usize] = i as u8;
+    }
 }
 
 #[inline]
@@ -652,11 +714,18 @@ mod tests {
                 threads,
             };
             let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-            let serial = canonical(&build_with(prims.clone(), &mut scratch, &params(1), None));
+            let serial = canonical(&build_with(
+                prims.clone(),
+                &mut scratch,
+                Vec::new(),
+                &params(1),
+                None,
+            ));
             for (threads, threshold) in [(1, 1000), (3, 700), (8, 64), (16, 5000)] {
                 let got = canonical(&build_with(
                     prims.clone(),
                     &mut scratch,
+                    Vec::new(),
                     &params(threads),
                     Some(threshold),
                 ));
@@ -678,8 +747,50 @@ mod tests {
             threads: 4,
         };
         let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-        let serial = canonical(&build_with(prims.clone(), &mut scratch, &params, None));
-        let top = canonical(&build_with(prims, &mut scratch, &params, Some(300)));
+        let serial = canonical(&build_with(
+            prims.clone(),
+            &mut scratch,
+            Vec::new(),
+            &params,
+            None,
+        ));
+        let top = canonical(&build_with(
+            prims,
+            &mut scratch,
+            Vec::new(),
+            &params,
+            Some(300),
+        ));
         assert!(top == serial);
+    }
+
+    #[test]
+    fn stable_ranks_sort_like_a_stable_sort() {
+        let mut rng = SplitMix64::new(12);
+        for it in 0..5000 {
+            let n = 2 + rng.below(SMALL_NODE - 1);
+            // Few distinct values (many ties), signed zeros among them, or arbitrary values.
+            let value = |rng: &mut SplitMix64| match it % 3 {
+                0 => rng.below(3) as f32,
+                1 => [0.0, -0.0, 1.0][rng.below(3)],
+                _ => rng.range(-1e3, 1e3),
+            };
+            let c2: Vec<Vec3A> = (0..n)
+                .map(|_| Vec3A::new(value(&mut rng), value(&mut rng), value(&mut rng)))
+                .collect();
+            for axis in 0..3 {
+                // Ties (-0 and +0 included) in index order.
+                let mut want: Vec<u8> = (0..n as u8).collect();
+                want.sort_by(|&a, &b| {
+                    c2[a as usize][axis]
+                        .partial_cmp(&c2[b as usize][axis])
+                        .unwrap()
+                        .then(a.cmp(&b))
+                });
+                let mut got = [0u8; SMALL_NODE];
+                stable_ranks(&c2, axis, &mut got);
+                assert_eq!(&got[..n], &want[..], "{c2:?}, axis {axis}");
+            }
+        }
     }
 }

@@ -3,12 +3,13 @@
 
 use crate::aabb::Aabb;
 use crate::blas::Blas;
-use crate::build_sah::{self, PrimRef, SahParams};
+use crate::build_sah::{self, BinNode, PrimRef};
 use crate::error::BvhError;
 use crate::layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
 use crate::traverse::{self, TraversalStacks};
 use crate::wide;
 use glam::Affine3A;
+use std::cell::RefCell;
 
 /// One placement of a BLAS in the world.
 #[derive(Clone, Copy, Debug)]
@@ -58,17 +59,18 @@ pub fn world_to_object(transform: &Affine3A) -> Option<[[f32; 4]; 3]> {
 
 /// Where each BLAS starts in the packed GPU buffers (see [`PackedBlases`]).
 pub fn blas_offsets(blases: &[Blas]) -> Vec<(u32, u32)> {
+    blas_offsets_iter(blases).collect()
+}
+
+fn blas_offsets_iter(blases: &[Blas]) -> impl Iterator<Item = (u32, u32)> + '_ {
     let mut nodes = 0u32;
     let mut tris = 0u32;
-    blases
-        .iter()
-        .map(|b| {
-            let o = (nodes, tris);
-            nodes += b.nodes.len() as u32;
-            tris += b.triangles.len() as u32;
-            o
-        })
-        .collect()
+    blases.iter().map(move |b| {
+        let o = (nodes, tris);
+        nodes += b.nodes.len() as u32;
+        tris += b.triangles.len() as u32;
+        o
+    })
 }
 
 /// All BLAS concatenated for upload: node and triangle buffers the kernel indexes with the
@@ -115,17 +117,47 @@ pub struct Tlas {
     pub stats: TlasStats,
 }
 
-impl Tlas {
-    /// Builds the TLAS over `selected` (indices into `instances`, e.g. from
-    /// [`crate::cull::cull_instances`]); hits report the index into `instances`.
+/// Buffers for rebuilding a TLAS every frame, kept from one build to the next so that a
+/// rebuild allocates only the arrays of the TLAS it returns. [`Tlas::build`] keeps one per
+/// thread; own one to control when its memory is released.
+#[derive(Default)]
+pub struct TlasBuilder {
+    offsets: Vec<(u32, u32)>,
+    records: Vec<InstanceRecord>,
+    prims: Vec<PrimRef>,
+    scratch: Vec<PrimRef>,
+    nodes: Vec<BinNode>,
+}
+
+/// Instances above which [`Tlas::build`] gives its per-thread buffers back after a build rather
+/// than holding them (about 200 bytes per instance) until the thread ends.
+const KEEP_BUFFERS_UP_TO: usize = 64 * 1024;
+
+thread_local! {
+    static BUILDER: RefCell<TlasBuilder> = RefCell::default();
+}
+
+impl TlasBuilder {
+    /// Builds the TLAS over `selected` (indices into `instances`); see [`Tlas::build`].
     pub fn build(
+        &mut self,
         instances: &[Instance],
         selected: &[u32],
         blases: &[Blas],
     ) -> Result<Tlas, BvhError> {
-        let offsets = blas_offsets(blases);
-        let mut records = Vec::with_capacity(selected.len());
-        let mut prims = Vec::with_capacity(selected.len());
+        let Self {
+            offsets,
+            records,
+            prims,
+            scratch,
+            nodes,
+        } = self;
+        offsets.clear();
+        offsets.extend(blas_offsets_iter(blases));
+        records.clear();
+        prims.clear();
+        records.reserve(selected.len());
+        prims.reserve(selected.len());
         let mut stats = TlasStats::default();
         for &i in selected {
             let Some(inst) = instances.get(i as usize) else {
@@ -139,11 +171,11 @@ impl Tlas {
                     blas_count: blases.len(),
                 });
             };
-            let bounds = blas.bounds.transformed(&inst.transform);
             let Some(w2o) = world_to_object(&inst.transform) else {
                 stats.skipped_invalid += 1;
                 continue;
             };
+            let bounds = blas.bounds.transformed(&inst.transform);
             if bounds.is_empty() || !bounds.is_finite() {
                 stats.skipped_invalid += 1;
                 continue;
@@ -168,12 +200,11 @@ impl Tlas {
         // visit, so the tightest possible TLAS boxes pay off. The binary build stops at 8
         // instances, which the collapse turns into one node of single-instance leaves; splitting
         // further would only decide slot order, at most of the TLAS build's cost.
-        let binary = build_sah::build(
-            prims,
-            &SahParams {
-                max_leaf: crate::layout::WIDTH,
-                threads: 1,
-            },
+        let binary = build_sah::build_reusing(
+            std::mem::take(prims),
+            scratch,
+            std::mem::take(nodes),
+            crate::layout::WIDTH,
         );
         let bounds = binary.nodes[0].bounds;
         let wide = wide::collapse(&binary, 1, 1);
@@ -182,6 +213,8 @@ impl Tlas {
             .iter()
             .map(|&p| records[binary.prims[p as usize].id() as usize])
             .collect();
+        *prims = binary.prims;
+        *nodes = binary.nodes;
         stats.instances = leaf_records.len();
         stats.nodes = wide.nodes.len();
         stats.depth = wide.depth;
@@ -190,6 +223,38 @@ impl Tlas {
             instances: leaf_records,
             bounds,
             stats,
+        })
+    }
+
+    /// Bytes held between builds.
+    pub fn capacity_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.offsets.capacity() * size_of::<(u32, u32)>()
+            + self.records.capacity() * size_of::<InstanceRecord>()
+            + (self.prims.capacity() + self.scratch.capacity()) * size_of::<PrimRef>()
+            + self.nodes.capacity() * size_of::<BinNode>()
+    }
+}
+
+impl Tlas {
+    /// Builds the TLAS over `selected` (indices into `instances`, e.g. from
+    /// [`crate::cull::cull_instances`]); hits report the index into `instances`. Reuses buffers
+    /// kept per thread (see [`TlasBuilder`]).
+    pub fn build(
+        instances: &[Instance],
+        selected: &[u32],
+        blases: &[Blas],
+    ) -> Result<Tlas, BvhError> {
+        BUILDER.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut builder) => {
+                let tlas = builder.build(instances, selected, blases);
+                if selected.len() > KEEP_BUFFERS_UP_TO {
+                    *builder = TlasBuilder::default();
+                }
+                tlas
+            }
+            // Only reachable if a build on this thread were re-entered.
+            Err(_) => TlasBuilder::default().build(instances, selected, blases),
         })
     }
 

@@ -5,7 +5,7 @@ use crate::aabb::Aabb;
 use crate::build_sah::BinaryBvh;
 use crate::build_sah::parallel::{collect_pieces, map_largest_first};
 use crate::layout::{META_INTERNAL, WIDTH, WideNode, leaf_meta};
-use glam::Vec3A;
+use glam::{BVec3A, Vec3A, Vec4};
 
 /// Result of a collapse: nodes in depth-first order of their allocation (every child index is
 /// larger than its parent's, which refit relies on) and, in leaf order, positions into `BinaryBvh::prims`.
@@ -32,6 +32,9 @@ pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
     // Small trees are not worth splitting into jobs (nor spawning threads for).
     let split_into_jobs = bin.nodes[0].prims > 2 * JOB_PRIMS;
     if !split_into_jobs {
+        // Wide nodes hold 4 primitives or more on average (TLAS: one per slot, 4 to 5 slots
+        // used): room enough that the arrays are not regrown on every rebuild.
+        nodes.reserve(bin.prims.len() / 3 + 1);
         leaf_prims.reserve(bin.prims.len());
     }
     let mut depth = emit(
@@ -319,41 +322,61 @@ fn gather_prims(bin: &BinaryBvh, root: u32, out: &mut Vec<u32>) {
 /// largest centre offset) choose first, each taking the free slot whose corner direction best
 /// matches its offset; returns, per slot, the child index.
 pub(crate) fn assign_slots(parent_center: Vec3A, centers: &[Vec3A]) -> [Option<usize>; WIDTH] {
+    // Eight lanes as two `Vec4`s throughout: every comparison here is a coin flip for a branch
+    // predictor, and this runs for every node of every TLAS rebuild.
     let n = centers.len().min(WIDTH);
     let mut offsets = [Vec3A::ZERO; WIDTH];
-    let mut order = [0usize; WIDTH];
-    let mut strength = [0.0f32; WIDTH];
+    // Unused lanes hold NaN, which compares neither greater nor equal.
+    let mut strength = [f32::NAN; WIDTH];
     for c in 0..n {
         let off = centers[c] - parent_center;
         offsets[c] = if off.is_finite() { off } else { Vec3A::ZERO };
         strength[c] = offsets[c].abs().element_sum();
-        order[c] = c;
     }
-    // Stable insertion sort by decreasing strength keeps ties in child order (deterministic).
-    for i in 1..n {
-        let mut j = i;
-        while j > 0 && strength[order[j - 1]] < strength[order[j]] {
-            order.swap(j - 1, j);
-            j -= 1;
-        }
+    let lanes = |v: &[f32; WIDTH]| {
+        (
+            Vec4::new(v[0], v[1], v[2], v[3]),
+            Vec4::new(v[4], v[5], v[6], v[7]),
+        )
+    };
+    let bits = |lo: glam::BVec4A, hi: glam::BVec4A| lo.bitmask() | hi.bitmask() << 4;
+    // Stable sort by decreasing strength, ties in child order (deterministic): each child's
+    // rank is the number of children stronger than it, or as strong and before it.
+    let (s_lo, s_hi) = lanes(&strength);
+    let mut order = [0usize; WIDTH];
+    for (c, &strength_c) in strength[..n].iter().enumerate() {
+        let sc = Vec4::splat(strength_c);
+        let stronger = bits(s_lo.cmpgt(sc), s_hi.cmpgt(sc));
+        let tied_before = bits(s_lo.cmpeq(sc), s_hi.cmpeq(sc)) & ((1u32 << c) - 1);
+        order[(stronger | tied_before).count_ones() as usize] = c;
     }
+    // Corner direction of each slot: +1 on axes whose bit is set, -1 otherwise.
+    const X: Vec4 = Vec4::new(-1.0, 1.0, -1.0, 1.0);
+    const Y: Vec4 = Vec4::new(-1.0, -1.0, 1.0, 1.0);
     let mut slots = [None; WIDTH];
+    let mut free = (1u32 << WIDTH) - 1;
     for &c in &order[..n] {
         let o = offsets[c];
-        // Branch-free argmax over the free slots: the comparisons are unpredictable, and this
-        // runs for every node of every TLAS rebuild.
-        let mut best_score = f32::NEG_INFINITY;
-        let mut best_slot = usize::MAX;
-        for (s, slot) in slots.iter().enumerate() {
-            // Dot product with the corner direction (+1 on axes whose bit is set, -1 otherwise).
-            let score = (if s & 1 != 0 { o.x } else { -o.x })
-                + (if s & 2 != 0 { o.y } else { -o.y })
-                + (if s & 4 != 0 { o.z } else { -o.z });
-            let take = slot.is_none() & ((score > best_score) | (best_slot == usize::MAX));
-            best_score = if take { score } else { best_score };
-            best_slot = if take { s } else { best_slot };
-        }
-        slots[best_slot] = Some(c);
+        // Dot products with all eight corner directions; multiplying by +-1 is exact, so each
+        // score is exactly the sum of the signed offsets (x, then y, then z). Offsets are
+        // finite, so no score is NaN.
+        let xy = X * o.x + Y * o.y;
+        let z = Vec4::splat(o.z);
+        let free_lo = glam::BVec4A::new(free & 1 != 0, free & 2 != 0, free & 4 != 0, free & 8 != 0);
+        let free_hi = glam::BVec4A::new(
+            free & 16 != 0,
+            free & 32 != 0,
+            free & 64 != 0,
+            free & 128 != 0,
+        );
+        let ninf = Vec4::NEG_INFINITY;
+        let lo = Vec4::select(free_lo, xy - z, ninf);
+        let hi = Vec4::select(free_hi, xy + z, ninf);
+        // The first free slot of the highest score (any free one if all scores are -inf).
+        let best = Vec4::splat(lo.max(hi).max_element());
+        let slot = (bits(lo.cmpeq(best), hi.cmpeq(best)) & free).trailing_zeros() as usize;
+        free &= !(1 << slot);
+        slots[slot] = Some(c);
     }
     slots
 }
@@ -375,6 +398,9 @@ fn step_exponent(extent: f32) -> u32 {
 
 /// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
 /// (`origin + q * step`, evaluated in f32 as the kernel does) contains the exact child box.
+///
+/// The three axes are quantized together in SIMD lanes (every node of every TLAS rebuild comes
+/// through here); each lane computes exactly what a scalar loop per axis would.
 pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], imask: u8) {
     let mut all = Aabb::EMPTY;
     for b in boxes.iter().flatten() {
@@ -386,59 +412,96 @@ pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], i
         return;
     }
     let origin = all.min;
-    let mut exps = [0u8; 3];
-    let mut q = [([0u8; 3], [0u8; 3]); WIDTH];
-    for a in 0..3 {
-        let mut e = step_exponent(all.max[a] - origin[a]);
-        'retry: loop {
-            let step = f32::from_bits(e << 23);
-            // 1 / step, exact (a power of two; 2^-127 is the denormal 1 << 22), so multiplying
-            // by it rounds exactly as dividing by `step` would, at a fraction of the latency.
-            let inv_step = if e <= 253 {
+    let ext = all.max - origin;
+    let mut e = [0u32; 3];
+    for (a, ea) in e.iter_mut().enumerate() {
+        *ea = step_exponent(ext[a]);
+    }
+    // Plane indices are small integers, held as floats (exact) so that they stay in SIMD lanes.
+    let mut q = [(Vec3A::ZERO, Vec3A::ZERO); WIDTH];
+    loop {
+        let step = Vec3A::new(
+            f32::from_bits(e[0] << 23),
+            f32::from_bits(e[1] << 23),
+            f32::from_bits(e[2] << 23),
+        );
+        // 1 / step, exact (a power of two; 2^-127 is the denormal 1 << 22), so multiplying by it
+        // rounds exactly as dividing by `step` would, at a fraction of the latency.
+        let inv = |e: u32| {
+            if e <= 253 {
                 f32::from_bits((254 - e) << 23)
             } else {
                 f32::from_bits(1 << 22)
-            };
-            let decode = |k: u32| origin[a] + k as f32 * step;
-            for (slot, b) in boxes.iter().enumerate() {
-                let Some(b) = b else { continue };
-                // Offsets are >= 0 (the origin is the minimum), so truncation is floor; the
-                // saturating casts clamp to 255 below.
-                let mut lo = (((b.min[a] - origin[a]) * inv_step) as u32).min(255);
-                while lo > 0 && decode(lo) > b.min[a] {
-                    lo -= 1;
-                }
-                let f = (b.max[a] - origin[a]) * inv_step;
-                let mut hi = f as u32;
-                if (hi as f32) < f {
-                    hi += 1;
-                }
-                hi = hi.min(255);
-                while hi < 255 && decode(hi) < b.max[a] {
-                    hi += 1;
-                }
-                // Rounding of the origin addition left the top unreachable: coarser step. At the
-                // largest finite step the decoded planes already reach +-inf, so stop there.
-                if (decode(hi) < b.max[a] || decode(lo) > b.min[a]) && e < 254 {
-                    e += 1;
-                    continue 'retry;
-                }
-                q[slot].0[a] = lo as u8;
-                q[slot].1[a] = hi as u8;
             }
+        };
+        let inv_step = Vec3A::new(inv(e[0]), inv(e[1]), inv(e[2]));
+        let decode = |k: Vec3A| origin + k * step;
+        let one = Vec3A::ONE;
+        let top = Vec3A::splat(255.0);
+        // Axes where some child box is not covered by its decoded planes.
+        let mut missed = BVec3A::FALSE;
+        for (slot, b) in boxes.iter().enumerate() {
+            let Some(b) = b else { continue };
+            // Offsets are >= 0 (the origin is the minimum), so truncation is floor; planes
+            // clamp to 255.
+            let mut lo = truncated((b.min - origin) * inv_step, 255.0);
+            loop {
+                let down = lo.cmpgt(Vec3A::ZERO) & decode(lo).cmpgt(b.min);
+                if !down.any() {
+                    break;
+                }
+                lo -= Vec3A::select(down, one, Vec3A::ZERO);
+            }
+            let f = (b.max - origin) * inv_step;
+            let mut hi = truncated(f, 256.0);
+            hi += Vec3A::select(hi.cmplt(f), one, Vec3A::ZERO);
+            hi = hi.min(top);
+            loop {
+                let up = hi.cmplt(top) & decode(hi).cmplt(b.max);
+                if !up.any() {
+                    break;
+                }
+                hi += Vec3A::select(up, one, Vec3A::ZERO);
+            }
+            missed |= decode(hi).cmplt(b.max) | decode(lo).cmpgt(b.min);
+            q[slot] = (lo, hi);
+        }
+        // Rounding of the origin addition left a plane unreachable: coarser step on that axis.
+        // At the largest finite step the decoded planes already reach +-inf, so stop there.
+        let retry = missed.bitmask();
+        let mut again = false;
+        for (a, ea) in e.iter_mut().enumerate() {
+            if retry & (1 << a) != 0 && *ea < 254 {
+                *ea += 1;
+                again = true;
+            }
+        }
+        if !again {
             break;
         }
-        exps[a] = e as u8;
     }
     node.origin = origin.into();
-    node.set_exponents_imask(exps, imask);
+    node.set_exponents_imask(e.map(|x| x as u8), imask);
     for (slot, b) in boxes.iter().enumerate() {
         if b.is_some() {
-            node.set_quantized(slot, q[slot].0, q[slot].1);
+            let (lo, hi) = q[slot];
+            node.set_quantized(
+                slot,
+                lo.to_array().map(|v| v as u8),
+                hi.to_array().map(|v| v as u8),
+            );
         } else {
             node.set_quantized(slot, [0; 3], [0; 3]);
         }
     }
+}
+
+/// Non-negative lanes truncated to integers (kept as floats), clamped to `max` first, with NaN
+/// lanes taken as 0: what Rust's saturating `as u32` casts give, for the range that matters.
+#[inline]
+fn truncated(v: Vec3A, max: f32) -> Vec3A {
+    let v = Vec3A::select(v.cmpeq(v), v, Vec3A::ZERO);
+    v.max(Vec3A::ZERO).min(Vec3A::splat(max)).trunc()
 }
 
 #[cfg(test)]
@@ -465,6 +528,116 @@ mod tests {
                     "e = {e}, x = {x:e}"
                 );
             }
+        }
+    }
+
+    use super::{WIDTH, assign_slots, encode_boxes};
+    use crate::aabb::Aabb;
+    use crate::layout::WideNode;
+    use glam::Vec3A;
+
+    /// Child boxes from 1e-30 to 1e30 wide, some flat, some far from the origin.
+    fn random_boxes(rng: &mut SplitMix64, it: usize) -> [Option<Aabb>; WIDTH] {
+        let scale = [1e-30f32, 1e-3, 1.0, 1e3, 1e30][it % 5];
+        let offset = [0.0f32, 1e4, -1e6, 3.0][it / 5 % 4];
+        let mut boxes = [None; WIDTH];
+        for b in boxes.iter_mut() {
+            if rng.below(4) == 0 {
+                continue;
+            }
+            let v = |rng: &mut SplitMix64, lo, hi| {
+                Vec3A::new(rng.range(lo, hi), rng.range(lo, hi), rng.range(lo, hi))
+            };
+            let c = v(rng, -1.0, 1.0) * scale + Vec3A::splat(offset);
+            let flat = if rng.below(3) == 0 { 0.0 } else { 1.0 };
+            let e = v(rng, 0.0, 1.0) * scale * flat;
+            *b = Some(Aabb::new(c - e, c + e));
+        }
+        boxes
+    }
+
+    #[test]
+    fn decoded_child_boxes_contain_the_exact_ones_within_a_step_or_two() {
+        let mut rng = SplitMix64::new(9);
+        for it in 0..20_000 {
+            let boxes = random_boxes(&mut rng, it);
+            let mut node = WideNode::default();
+            encode_boxes(&mut node, &boxes, 0);
+            let step = node.scale();
+            let origin = node.origin;
+            // The kernel's decoding: origin + q * step in f32.
+            let decode = |a: usize, q: u8| origin[a] + q as f32 * step[a];
+            for (slot, b) in boxes.iter().enumerate() {
+                let Some(b) = b else { continue };
+                let (lo, hi) = node.quantized(slot);
+                for a in 0..3 {
+                    let ctx = format!("case {it}, slot {slot}, axis {a}: {b:?}");
+                    assert!(
+                        decode(a, lo[a]) <= b.min[a],
+                        "{ctx}: low plane above the box"
+                    );
+                    assert!(
+                        decode(a, hi[a]) >= b.max[a],
+                        "{ctx}: high plane below the box"
+                    );
+                    // Loose by at most two grid steps (plus the rounding of the origin
+                    // addition, which can exceed a step far from zero).
+                    let slack = |x: f32| 2.0 * step[a] + 4.0 * f32::EPSILON * x.abs();
+                    assert!(
+                        decode(a, lo[a]) >= b.min[a] - slack(b.min[a]),
+                        "{ctx}: low plane too loose"
+                    );
+                    assert!(
+                        decode(a, hi[a]) <= b.max[a] + slack(b.max[a]),
+                        "{ctx}: high plane too loose"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn slots_follow_the_octants_of_the_child_centres() {
+        // Children in distinct octants of the parent centre land in the slot of their octant
+        // (bit 0: +x, bit 1: +y, bit 2: +z), whatever order they come in.
+        let mut rng = SplitMix64::new(2);
+        for _ in 0..1000 {
+            let mut octants: Vec<usize> = (0..WIDTH).collect();
+            for i in (1..WIDTH).rev() {
+                octants.swap(i, rng.below(i + 1));
+            }
+            let n = 1 + rng.below(WIDTH);
+            let centres: Vec<Vec3A> = octants[..n]
+                .iter()
+                .map(|&o| {
+                    let sign = |bit: usize| if o & bit != 0 { 1.0 } else { -1.0 };
+                    Vec3A::new(sign(1), sign(2), sign(4)) * rng.range(0.5, 2.0)
+                })
+                .collect();
+            let slots = assign_slots(Vec3A::ZERO, &centres);
+            for (c, &o) in octants[..n].iter().enumerate() {
+                assert_eq!(slots[o], Some(c), "octants {:?}", &octants[..n]);
+            }
+            assert_eq!(slots.iter().flatten().count(), n);
+        }
+    }
+
+    #[test]
+    fn children_crowding_one_octant_all_get_distinct_slots() {
+        let mut rng = SplitMix64::new(3);
+        for _ in 0..1000 {
+            let n = 1 + rng.below(WIDTH);
+            // Equal centres too: ties must still give every child its own slot.
+            let centres: Vec<Vec3A> = (0..n)
+                .map(|_| Vec3A::new(rng.below(2) as f32, 1.0, rng.below(2) as f32))
+                .collect();
+            let slots = assign_slots(Vec3A::ZERO, &centres);
+            let mut seen = [false; WIDTH];
+            for c in slots.iter().flatten() {
+                assert!(!seen[*c], "child {c} twice");
+                seen[*c] = true;
+            }
+            assert_eq!(seen.iter().filter(|&&s| s).count(), n);
         }
     }
 }

@@ -1,0 +1,147 @@
+//! Per-frame TLAS rebuilds: a builder reused across frames whose instance sets grow, shrink and
+//! move (so its kept buffers hold stale data from a larger build) must trace exactly like brute
+//! force over every triangle of the selected instances, on a scene large enough (hundreds of
+//! instances, several TLAS levels, village-like rows with equal boxes) to take every path of the
+//! small-input build.
+
+use glam::{Affine3A, Quat, Vec3};
+use hikari_bvh::reference::{any_hit_instances, closest_hit_instances, random_rays, same_hit};
+use hikari_bvh::rng::SplitMix64;
+use hikari_bvh::tlas::TlasBuilder;
+use hikari_bvh::{Blas, BuildOptions, Instance, Mesh, Ray, Tlas};
+
+/// Small meshes (brute force is over every triangle of every instance) placed as in a village:
+/// half on a grid with equal rotations (many equal boxes and centroids, so SAH ties), half
+/// scattered with arbitrary rotation, scale and mirroring.
+fn village(count: usize) -> (Vec<Mesh>, Vec<Blas>, Vec<Instance>) {
+    let meshes = vec![
+        Mesh::random_soup(1, 12, 1.0, 0.6),
+        Mesh::terrain(3),
+        Mesh::random_soup(2, 6, 0.5, 1.0),
+    ];
+    let blases: Vec<Blas> = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| Blas::from_mesh(&format!("m{i}"), m, &BuildOptions::default()).unwrap())
+        .collect();
+    let mut rng = SplitMix64::new(17);
+    let instances = (0..count)
+        .map(|i| {
+            let blas = (i % meshes.len()) as u32;
+            let shrink = if blas == 1 { 0.02 } else { 1.0 };
+            let transform = if i % 2 == 0 {
+                let cell = (i / 2) as f32;
+                let t = Vec3::new((cell % 16.0) * 3.0 - 24.0, 0.0, (cell / 16.0).floor() * 3.0);
+                Affine3A::from_scale_rotation_translation(Vec3::splat(shrink), Quat::IDENTITY, t)
+            } else {
+                let axis = hikari_bvh::reference::random_dir(&mut rng);
+                let rot = Quat::from_axis_angle(axis, rng.range(0.0, std::f32::consts::TAU));
+                let mut scale = Vec3::new(
+                    rng.range(0.5, 2.0),
+                    rng.range(0.5, 2.0),
+                    rng.range(0.5, 2.0),
+                ) * shrink;
+                if i % 5 == 1 {
+                    scale.y = -scale.y;
+                }
+                let t = Vec3::new(
+                    rng.range(-30.0, 30.0),
+                    rng.range(-5.0, 5.0),
+                    rng.range(-5.0, 40.0),
+                );
+                Affine3A::from_scale_rotation_translation(scale, rot, t)
+            };
+            Instance::new(transform, blas)
+        })
+        .collect();
+    (meshes, blases, instances)
+}
+
+/// Checks every ray against brute force; returns the number of hits.
+fn check(
+    meshes: &[Mesh],
+    blases: &[Blas],
+    instances: &[Instance],
+    selected: &[u32],
+    tlas: &Tlas,
+    rays: &[Ray],
+) -> usize {
+    let mut hits = 0;
+    for (i, ray) in rays.iter().enumerate() {
+        let want = closest_hit_instances(meshes, instances, Some(selected), ray);
+        if let Err(e) = same_hit(tlas.closest_hit(blases, ray), want) {
+            panic!("{} instances, ray {i} {ray:?}: {e}", selected.len());
+        }
+        hits += want.is_some() as usize;
+        assert_eq!(
+            tlas.any_hit(blases, ray),
+            any_hit_instances(meshes, instances, Some(selected), ray),
+            "{} instances: any-hit disagrees on ray {i} {ray:?}",
+            selected.len()
+        );
+    }
+    hits
+}
+
+#[test]
+fn reused_builder_matches_brute_force_frame_after_frame() {
+    let (meshes, blases, mut instances) = village(600);
+    let mut rng = SplitMix64::new(5);
+    // Random rays, and rays aimed near random instances so that most of them hit something.
+    let mut rays = random_rays(&mut rng, 60, 30.0);
+    for ray in random_rays(&mut rng, 100, 30.0) {
+        let target = Vec3::from(instances[rng.below(instances.len())].transform.translation);
+        let jitter = hikari_bvh::reference::random_dir(&mut rng) * rng.range(0.0, 0.5);
+        let origin = Vec3::from(ray.origin);
+        rays.push(Ray::new(
+            origin,
+            target + jitter - origin,
+            0.0,
+            f32::INFINITY,
+        ));
+    }
+    let mut builder = TlasBuilder::default();
+    // Frames: everything, a culled half, a handful, a single instance, everything again after
+    // some instances moved.
+    let all: Vec<u32> = (0..instances.len() as u32).collect();
+    let half: Vec<u32> = all.iter().copied().filter(|i| i % 7 < 4).collect();
+    let few: Vec<u32> = vec![599, 3, 250, 17, 18, 401, 2, 90, 91, 92, 300];
+    let frames: [&[u32]; 4] = [&all, &half, &few, &[42]];
+    let mut total_hits = 0;
+    for selected in frames {
+        let tlas = builder.build(&instances, selected, &blases).unwrap();
+        assert_eq!(tlas.stats.instances, selected.len());
+        total_hits += check(&meshes, &blases, &instances, selected, &tlas, &rays);
+    }
+    for inst in instances.iter_mut().step_by(3) {
+        inst.transform.translation += glam::Vec3A::new(0.5, 1.0, -0.25);
+    }
+    let tlas = builder.build(&instances, &all, &blases).unwrap();
+    assert!(tlas.stats.depth >= 3, "depth {}", tlas.stats.depth);
+    total_hits += check(&meshes, &blases, &instances, &all, &tlas, &rays);
+    // Rays that miss everything would pass trivially.
+    assert!(total_hits > 100, "{total_hits} hits");
+}
+
+#[test]
+fn builder_and_one_shot_build_give_the_same_tlas() {
+    let (_, blases, instances) = village(400);
+    let all: Vec<u32> = (0..instances.len() as u32).collect();
+    let mut builder = TlasBuilder::default();
+    // A larger build first, so the builder's buffers hold stale data.
+    let first = builder.build(&instances, &all, &blases).unwrap();
+    let subset: Vec<u32> = all.iter().copied().filter(|i| i % 3 != 0).collect();
+    for selected in [&subset, &all] {
+        let reused = builder.build(&instances, selected, &blases).unwrap();
+        let fresh = TlasBuilder::default()
+            .build(&instances, selected, &blases)
+            .unwrap();
+        let wrapper = Tlas::build(&instances, selected, &blases).unwrap();
+        for other in [&fresh, &wrapper] {
+            assert_eq!(reused.nodes, other.nodes);
+            assert_eq!(reused.instances, other.instances);
+            assert_eq!(reused.stats, other.stats);
+        }
+    }
+    assert_eq!(first.stats.instances, all.len());
+}
