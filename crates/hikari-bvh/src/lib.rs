@@ -238,5 +238,5 @@ pub use error::BvhError;
 pub use layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
 pub use mesh::Mesh;
 pub use throttle::{RefitBatch, RefitScheduler, ThrottleSettings};
-pub use tlas::{Instance, PackedBlases, Tlas, TlasStats};
+pub use tlas::{Instance, PackedBlases, Tlas, TlasBuilder, TlasStats};
 pub use traverse::{Stack, TraversalStacks};

@@ -105,14 +105,22 @@ struct AnimationReport {
 /// Frames played at 60 Hz for the animation report.
 const ANIMATION_FRAMES: usize = 120;
 
-fn animate(scene: &hikari_scene::Scene, blases: &[Blas], instances: &[Instance]) -> anyhow::Result<Option<AnimationReport>> {
+fn animate(
+    scene: &hikari_scene::Scene,
+    blases: &[Blas],
+    instances: &[Instance],
+) -> anyhow::Result<Option<AnimationReport>> {
     let deforming: Vec<usize> = (0..scene.meshes.len())
         .filter(|&m| scene.meshes[m].deformation.is_some())
         .collect();
     if deforming.is_empty() {
         return Ok(None);
     }
-    let camera = scene.cameras.first().map(|c| c.position).unwrap_or(Vec3::ZERO);
+    let camera = scene
+        .cameras
+        .first()
+        .map(|c| c.position)
+        .unwrap_or(Vec3::ZERO);
     let mut blases = blases.to_vec();
     let mut scheduler = RefitScheduler::new(ThrottleSettings::default());
     let ids: Vec<usize> = deforming
@@ -131,7 +139,11 @@ fn animate(scene: &hikari_scene::Scene, blases: &[Blas], instances: &[Instance])
                 .instances
                 .iter()
                 .filter(|i| i.mesh == m)
-                .map(|i| i.transform.transform_point3(0.5 * (lo + hi)).distance(camera))
+                .map(|i| {
+                    i.transform
+                        .transform_point3(0.5 * (lo + hi))
+                        .distance(camera)
+                })
                 .fold(f32::INFINITY, f32::min);
             scheduler.touch(ids[k], true, radius, distance);
         }
@@ -641,19 +653,7 @@ fn load(name: &str) -> anyhow::Result<BenchScene> {
     scene
         .validate()
         .with_context(|| format!("scene `{name}`"))?;
-    let meshes: Vec<Mesh> = scene
-        .meshes
-        .iter()
-        .map(|m| {
-            Mesh::new(
-                m.positions.clone(),
-                m.indices
-                    .chunks_exact(3)
-                    .map(|t| [t[0], t[1], t[2]])
-                    .collect(),
-            )
-        })
-        .collect();
+    let meshes = hikari_render::scene_bvh::meshes(&scene);
     let mut blases = Vec::new();
     for _ in 0..3 {
         let t0 = Instant::now();
@@ -667,11 +667,7 @@ fn load(name: &str) -> anyhow::Result<BenchScene> {
             .collect::<anyhow::Result<_>>()?;
         blas_build_ms.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    let instances: Vec<Instance> = scene
-        .instances
-        .iter()
-        .map(|i| Instance::new(Affine3A::from_mat4(i.transform), i.mesh as u32))
-        .collect();
+    let instances = hikari_render::scene_bvh::instances(&scene);
     let mut triangles = Vec::new();
     let mut cdf = Vec::new();
     let mut area = 0.0f64;

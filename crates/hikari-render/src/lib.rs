@@ -12,6 +12,7 @@ pub mod passes;
 pub mod pipeline;
 pub mod reference;
 pub mod renderer;
+pub mod scene_bvh;
 pub mod scene_gpu;
 pub mod scene_textures;
 pub mod settings;

@@ -186,6 +186,12 @@ pub fn capabilities_for(features: wgpu::Features) -> naga::valid::Capabilities {
     c
 }
 
+/// The shader capabilities every adapter the renderer accepts has
+/// ([`crate::context::REQUIRED_FEATURES`]), for validating shaders without a GPU.
+pub fn required_capabilities() -> naga::valid::Capabilities {
+    capabilities_for(crate::context::REQUIRED_FEATURES)
+}
+
 /// The name a struct or function had in its WGSL file, without naga_oil's module decoration.
 pub fn undecorated(name: &str) -> &str {
     name.split("X_naga_oil_mod_").next().unwrap_or(name)

@@ -701,22 +701,10 @@ fn image_order_traces_every_ray_once() {
 fn village_matches() {
     let Some(mut gpu) = Gpu::new() else { return };
     let village = hikari_scene::builtin::village();
-    let meshes: Vec<Mesh> = village
-        .meshes
-        .iter()
-        .map(|m| {
-            Mesh::new(
-                m.positions.clone(),
-                m.indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
-            )
-        })
-        .collect();
-    let instances: Vec<Instance> = village
-        .instances
-        .iter()
-        .map(|i| Instance::new(Affine3A::from_mat4(i.transform), i.mesh as u32))
-        .collect();
-    let scene = Scene::new(meshes, instances);
+    let scene = Scene::new(
+        hikari_render::scene_bvh::meshes(&village),
+        hikari_render::scene_bvh::instances(&village),
+    );
     // From every named camera (inside houses and the temple too) in random directions, so
     // the rays meet thin walls, furniture, leaves and terrain; brute force keeps the count low.
     let mut rng = SplitMix64::new(55);

@@ -9,7 +9,7 @@ use hikari_render::passes::placeholder_tonemap::{PlaceholderTonemap, TonemapPara
 use hikari_render::passes::sun_shadows;
 use hikari_render::reference;
 use hikari_render::shader::{self, ShaderLibrary};
-use hikari_render::{FrameSettings, Renderer, Settings};
+use hikari_render::{FrameSettings, Renderer};
 use rand::{Rng, SeedableRng, rngs::SmallRng};
 
 #[test]
@@ -105,18 +105,7 @@ fn lit_boxes() -> hikari_scene::Scene {
 }
 
 fn settings_for(scene: &hikari_scene::Scene, w: u32, h: u32) -> FrameSettings {
-    let mut settings = Settings::default();
-    settings.shadows.resolution = 256;
-    settings.shadows.cascades = 2;
-    settings.shadows.max_distance_m = 40.0;
-    FrameSettings {
-        width: w,
-        height: h,
-        camera: scene.cameras[0].clone(),
-        prev_camera: None,
-        sun: scene.sun.clone(),
-        settings,
-    }
+    common::small_frame_settings(scene, w, h)
 }
 
 #[test]

@@ -4,46 +4,23 @@
 
 mod common;
 
-use glam::{Affine3A, Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3, Vec4};
 use hikari_bvh::reference::closest_hit_instances;
 use hikari_bvh::{Instance, Mesh, Ray};
 use hikari_render::passes::sun_shadows;
 use hikari_render::reference::gbuffer::{decode_id, pixel_ray};
-use hikari_render::{FrameSettings, Renderer, Settings};
+use hikari_render::{FrameSettings, Renderer};
 use hikari_scene::Scene;
 
 fn bvh_scene(scene: &Scene) -> (Vec<Mesh>, Vec<Instance>) {
-    let meshes = scene
-        .meshes
-        .iter()
-        .map(|m| {
-            Mesh::new(
-                m.positions.clone(),
-                m.indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect(),
-            )
-        })
-        .collect();
-    let instances = scene
-        .instances
-        .iter()
-        .map(|i| Instance::new(Affine3A::from_mat4(i.transform), i.mesh as u32))
-        .collect();
-    (meshes, instances)
+    (
+        hikari_render::scene_bvh::meshes(scene),
+        hikari_render::scene_bvh::instances(scene),
+    )
 }
 
 fn frame_settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
-    let mut settings = Settings::default();
-    settings.shadows.resolution = 128;
-    settings.shadows.cascades = 2;
-    settings.shadows.max_distance_m = 40.0;
-    FrameSettings {
-        width: w,
-        height: h,
-        camera: scene.cameras[0].clone(),
-        prev_camera: None,
-        sun: scene.sun.clone(),
-        settings,
-    }
+    common::small_frame_settings(scene, w, h)
 }
 
 fn mesh_first_triangles(scene: &Scene) -> Vec<u32> {

@@ -5,9 +5,7 @@ use hikari_render::shader::{self, ShaderLibrary};
 #[test]
 fn every_entry_shader_composes_and_validates() {
     // What the renderer requires of every adapter (64-bit atomics for the rasteriser).
-    let caps = naga::valid::Capabilities::SHADER_INT64
-        | naga::valid::Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
-        | naga::valid::Capabilities::SHADER_INT64_ATOMIC_ALL_OPS;
+    let caps = shader::required_capabilities();
     let mut lib = ShaderLibrary::new(caps).expect("modules load");
     let entries = lib.entry_shaders();
     assert!(entries.len() >= 5, "found only {entries:?}");

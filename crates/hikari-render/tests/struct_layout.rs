@@ -4,7 +4,7 @@ use hikari_render::shader::{self, ShaderLibrary};
 
 #[test]
 fn rust_structs_match_wgsl_layouts() {
-    let mut lib = ShaderLibrary::new(naga::valid::Capabilities::empty()).unwrap();
+    let mut lib = ShaderLibrary::new(shader::required_capabilities()).unwrap();
     let mut failures = Vec::new();
     let layouts = hikari_render::layout::all();
     assert!(!layouts.is_empty());

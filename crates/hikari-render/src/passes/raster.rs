@@ -164,36 +164,24 @@ impl Rasterizer {
         let max = g.ctx().limits.max_compute_workgroups_per_dimension;
         let n = scene.chunk_count.max(1);
         let groups = [n.min(max), n.div_ceil(max), views as u32];
-        g.pass(&format!("{t}.rasterize"))
-            .constants(&params)
-            .read(positions)
-            .read(indices)
-            .read(instances)
-            .read(chunks)
-            .write(target)
-            .write(queue)
-            .write(count)
-            .dispatch(&pipelines[0], groups)?;
-        g.pass(&format!("{t}.rasterize_tiles"))
-            .constants(&params)
-            .read(positions)
-            .read(indices)
-            .read(instances)
-            .read(chunks)
-            .write(target)
-            .write(queue)
-            .write(count)
-            .dispatch(&pipelines[1], [TILE_WORKGROUPS, 1, 1])?;
-        g.pass(&format!("{t}.rasterize_large"))
-            .constants(&params)
-            .read(positions)
-            .read(indices)
-            .read(instances)
-            .read(chunks)
-            .write(target)
-            .write(queue)
-            .write(count)
-            .dispatch(&pipelines[2], [TILE_WORKGROUPS, 1, 1])?;
+        // The three passes bind the same resources; they differ in entry point and dispatch.
+        let stages = [
+            ("rasterize", groups),
+            ("rasterize_tiles", [TILE_WORKGROUPS, 1, 1]),
+            ("rasterize_large", [TILE_WORKGROUPS, 1, 1]),
+        ];
+        for ((stage, dispatch), pipeline) in stages.into_iter().zip(pipelines) {
+            g.pass(&format!("{t}.{stage}"))
+                .constants(&params)
+                .read(positions)
+                .read(indices)
+                .read(instances)
+                .read(chunks)
+                .write(target)
+                .write(queue)
+                .write(count)
+                .dispatch(pipeline, dispatch)?;
+        }
         Ok(())
     }
 }

@@ -47,3 +47,24 @@ pub fn texture_with_data(
         data,
     )
 }
+
+/// Frame settings for a small test image of `scene` from its first camera: the scene's sun,
+/// two 256-texel shadow cascades over 40 m (small maps keep the CPU driver fast).
+pub fn small_frame_settings(
+    scene: &hikari_scene::Scene,
+    w: u32,
+    h: u32,
+) -> hikari_render::FrameSettings {
+    let mut settings = hikari_render::Settings::default();
+    settings.shadows.resolution = 256;
+    settings.shadows.cascades = 2;
+    settings.shadows.max_distance_m = 40.0;
+    hikari_render::FrameSettings {
+        width: w,
+        height: h,
+        camera: scene.cameras[0].clone(),
+        prev_camera: None,
+        sun: scene.sun.clone(),
+        settings,
+    }
+}
