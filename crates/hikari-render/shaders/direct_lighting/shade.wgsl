@@ -155,8 +155,9 @@ fn main(
         return;
     }
     var radiance: vec3<f32>;
-    let v = -view_ray(view, pixel);
     let flags = params.config.y;
+    // Towards the camera: from the surface point where there is one (no second unprojection).
+    let v = select(-view_ray(view, pixel), normalize(view.position.xyz - world), d > 0.0);
     if d <= 0.0 {
         radiance = select(vec3<f32>(0.0), sky_placeholder(-v), (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u);
     } else {

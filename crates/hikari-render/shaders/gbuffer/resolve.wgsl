@@ -163,8 +163,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let centre = vec2<f32>(px) + 0.5;
     let d = near_point(centre) - o;
     let b = ray_barycentrics(o, d, p0, e1, e2);
-    let bx = ray_barycentrics(o, near_point(centre + vec2<f32>(1.0, 0.0)) - o, p0, e1, e2);
-    let by = ray_barycentrics(o, near_point(centre + vec2<f32>(0.0, 1.0)) - o, p0, e1, e2);
     let w = vec3<f32>(1.0 - b.x - b.y, b.x, b.y);
 
     let a0 = attributes[i.x];
@@ -175,8 +173,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let duv2 = a2.uv - uv0;
     var g: UvGrad;
     g.uv = uv0 + duv1 * b.x + duv2 * b.y;
-    g.ddx = duv1 * (bx.x - b.x) + duv2 * (bx.y - b.y);
-    g.ddy = duv1 * (by.x - b.x) + duv2 * (by.y - b.y);
+    // Texture derivatives only for textured materials: the neighbours' rays cost as much as
+    // the pixel's own.
+    let textured = any(mat.textures != vec4<u32>(NO_TEXTURE)) || mat.more_textures.x != NO_TEXTURE;
+    g.ddx = vec2<f32>(0.0);
+    g.ddy = vec2<f32>(0.0);
+    if textured {
+        let bx = ray_barycentrics(o, near_point(centre + vec2<f32>(1.0, 0.0)) - o, p0, e1, e2);
+        let by = ray_barycentrics(o, near_point(centre + vec2<f32>(0.0, 1.0)) - o, p0, e1, e2);
+        g.ddx = duv1 * (bx.x - b.x) + duv2 * (bx.y - b.y);
+        g.ddy = duv1 * (by.x - b.x) + duv2 * (by.y - b.y);
+    }
 
     // Frames: geometric normal faces the camera on double-sided surfaces (single-sided back
     // faces were culled); shading normal and tangent follow it.
