@@ -110,6 +110,7 @@ pub fn record<'r>(
         s.height,
     );
     let to_sun = s.sun.as_ref().map_or(glam::Vec3::ZERO, |sun| sun.direction);
+    let scene = &scene.import(g);
 
     // 2. Atmosphere LUTs, 3. sky SH, 4. irradiance probes, 5. reflection probes, 6. clouds:
     //    their issues add them here.

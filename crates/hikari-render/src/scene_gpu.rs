@@ -15,6 +15,7 @@ use hikari_scene::{Scene, Wrap};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
+use crate::graph::{Buf, FrameGraph, Tex};
 use crate::scene_textures::{self, TextureArrays};
 
 /// Triangles per chunk; the rasteriser's workgroup size.
@@ -124,7 +125,8 @@ pub struct SceneCpu {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct LightGpu {
-    /// xyz: world position; w: range in metres (the light is exactly 0 beyond it).
+    /// xyz: world position; w: the scene's range in metres (`f32::MAX` when it gives none);
+    /// the lighting pass shortens it to where the light falls below the frame's cut-off.
     pub position_range: [f32; 4],
     /// xyz: unit direction the spot points along; w: 0 point, 1 spot.
     pub direction_kind: [f32; 4],
@@ -137,11 +139,6 @@ pub struct LightGpu {
 
 pub const LIGHT_POINT: f32 = 0.0;
 pub const LIGHT_SPOT: f32 = 1.0;
-
-/// Illuminance below which a punctual light is cut off (its range, when the scene gives none):
-/// a hundredth of a lux is far below moonlight, so the cut is invisible at any exposure that
-/// shows the scene.
-pub const LIGHT_CUTOFF_LUX: f32 = 0.01;
 
 pub fn snorm16x2(v: glam::Vec2) -> u32 {
     let q = |x: f32| ((x.clamp(-1.0, 1.0) * 32767.0).round() as i16) as u16 as u32;
@@ -173,11 +170,6 @@ pub fn orthonormal_tangent(n: Vec3) -> Vec3 {
     let a = -1.0 / (s + n.z);
     let b = n.x * n.y * a;
     Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x)
-}
-
-pub fn light_range(intensity_cd: f32, range: Option<f32>) -> f32 {
-    let cutoff = (intensity_cd.max(0.0) / LIGHT_CUTOFF_LUX).sqrt();
-    range.map_or(cutoff, |r| r.min(cutoff)).max(1e-3)
 }
 
 impl SceneCpu {
@@ -316,10 +308,7 @@ impl SceneCpu {
                 }
             };
             cpu.lights.push(LightGpu {
-                position_range: l
-                    .position
-                    .extend(light_range(l.intensity_cd, l.range))
-                    .to_array(),
+                position_range: l.position.extend(l.range.unwrap_or(f32::MAX)).to_array(),
                 direction_kind: dir.extend(kind).to_array(),
                 intensity: (l.color * l.intensity_cd).extend(0.0).to_array(),
                 spot,
@@ -329,7 +318,41 @@ impl SceneCpu {
     }
 }
 
+/// The scene's buffers and textures imported into one frame's graph, once, for every pass.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneInFrame {
+    pub positions: Buf,
+    pub attributes: Buf,
+    pub indices: Buf,
+    pub instances: Buf,
+    pub materials: Buf,
+    pub chunks: Buf,
+    pub lights: Buf,
+    pub color_textures: Tex,
+    pub data_textures: Tex,
+    pub chunk_count: u32,
+    pub light_count: u32,
+    pub bounds: Option<(Vec3, Vec3)>,
+}
+
 impl SceneGpu {
+    pub fn import(&self, g: &mut FrameGraph<'_>) -> SceneInFrame {
+        SceneInFrame {
+            positions: g.import_buffer("scene.positions", &self.positions),
+            attributes: g.import_buffer("scene.attributes", &self.attributes),
+            indices: g.import_buffer("scene.indices", &self.indices),
+            instances: g.import_buffer("scene.instances", &self.instances),
+            materials: g.import_buffer("scene.materials", &self.materials),
+            chunks: g.import_buffer("scene.chunks", &self.chunks),
+            lights: g.import_buffer("scene.lights", &self.lights),
+            color_textures: g.import_texture("scene.color_textures", &self.textures.color),
+            data_textures: g.import_texture("scene.data_textures", &self.textures.data),
+            chunk_count: self.chunk_count,
+            light_count: self.light_count,
+            bounds: self.bounds,
+        }
+    }
+
     /// Validates and uploads `scene`. Sizes beyond the device limits are an error that says
     /// which buffer and by how much.
     pub fn upload(ctx: &GpuContext, scene: &Scene) -> Result<Self> {

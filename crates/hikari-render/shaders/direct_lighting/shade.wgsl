@@ -79,7 +79,7 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
 // Where a light's illuminance falls to the frame's cutoff, or its own range if nearer.
 fn light_range(light: LightGpu) -> f32 {
     let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
-    return min(light.position_range.w, sqrt(peak / params.cutoff.x));
+    return max(min(light.position_range.w, sqrt(peak / params.cutoff.x)), 1e-3);
 }
 
 // Illuminance factor of a punctual light at distance^2 `d2`: inverse square, windowed to 0 at

@@ -13,7 +13,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::scene_gpu::SceneGpu;
+use crate::scene_gpu::SceneInFrame;
 use crate::settings::LightingSettings;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
@@ -39,9 +39,13 @@ pub struct LightingParams {
 }
 
 /// A punctual light is cut off where its illuminance falls below this fraction of the frame's
-/// metered illuminance (or [`crate::scene_gpu::LIGHT_CUTOFF_LUX`], whichever is larger): in
-/// daylight a lantern's light a few metres away is far below what the exposure can show.
+/// metered illuminance (or [`LIGHT_CUTOFF_LUX`], whichever is larger): in daylight a lantern's
+/// light a few metres away is far below what the exposure can show.
 pub const LIGHT_CUTOFF_FRACTION: f32 = 1e-4;
+
+/// The least cut-off illuminance: a hundredth of a lux is far below moonlight, so the cut is
+/// invisible at any exposure that shows the scene.
+pub const LIGHT_CUTOFF_LUX: f32 = 0.01;
 
 /// Placeholder sky radiance (nits) under the default 100000 lux sun, until the atmosphere
 /// issue: a clear-day blue zenith and a paler horizon, of the order of a real clear sky (a
@@ -78,7 +82,7 @@ impl LightingParams {
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky).extend(0.0).to_array(),
             config: [light_count, flags, 0, 0],
             cutoff: [
-                (metered_lux * LIGHT_CUTOFF_FRACTION).max(crate::scene_gpu::LIGHT_CUTOFF_LUX),
+                (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX),
                 0.0,
                 0.0,
                 0.0,
@@ -104,7 +108,7 @@ impl DirectLighting {
         g: &mut FrameGraph<'r>,
         gb: &GBuffer,
         shadows: &SunShadowMaps,
-        scene: &'r SceneGpu,
+        scene: &SceneInFrame,
         view: &View,
         params: &LightingParams,
     ) -> Result<Tex> {
@@ -113,7 +117,6 @@ impl DirectLighting {
             "direct_lighting.radiance",
             TextureDesc::d2(w, h, RADIANCE_FORMAT),
         )?;
-        let lights = g.import_buffer("scene.lights", &scene.lights);
         g.pass("direct_lighting.shade")
             .constants(view)
             .constants(params)
@@ -122,7 +125,7 @@ impl DirectLighting {
             .read(gb.albedo)
             .read(gb.material)
             .read(gb.emissive)
-            .read(lights)
+            .read(scene.lights)
             .write(radiance)
             .constants(&shadows.params)
             .read(shadows.texels)

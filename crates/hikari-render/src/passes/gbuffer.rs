@@ -6,7 +6,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::scene_gpu::SceneGpu;
+use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
@@ -56,7 +56,7 @@ impl GBufferPass {
         &'r self,
         g: &mut FrameGraph<'r>,
         raster: &'r Rasterizer,
-        scene: &'r SceneGpu,
+        scene: &SceneInFrame,
         view: &View,
         [width, height]: [u32; 2],
     ) -> Result<GBuffer> {
@@ -86,25 +86,17 @@ impl GBufferPass {
             RasterTarget::Visibility,
             gb.visibility,
         )?;
-        let positions = g.import_buffer("scene.positions", &scene.positions);
-        let attributes = g.import_buffer("scene.attributes", &scene.attributes);
-        let indices = g.import_buffer("scene.indices", &scene.indices);
-        let instances = g.import_buffer("scene.instances", &scene.instances);
-        let materials = g.import_buffer("scene.materials", &scene.materials);
-        let chunks = g.import_buffer("scene.chunks", &scene.chunks);
-        let color = g.import_texture("scene.color_textures", &scene.textures.color);
-        let data = g.import_texture("scene.data_textures", &scene.textures.data);
         g.pass("gbuffer.resolve")
             .constants(view)
             .read(gb.visibility)
-            .read(positions)
-            .read(attributes)
-            .read(indices)
-            .read(instances)
-            .read(materials)
-            .read(chunks)
-            .read(color)
-            .read(data)
+            .read(scene.positions)
+            .read(scene.attributes)
+            .read(scene.indices)
+            .read(scene.instances)
+            .read(scene.materials)
+            .read(scene.chunks)
+            .read(scene.color_textures)
+            .read(scene.data_textures)
             .sampler(SamplerKind::LinearRepeat)
             .write(gb.depth)
             .write(gb.normal)

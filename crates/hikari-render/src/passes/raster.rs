@@ -17,7 +17,7 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::{Buf, FrameGraph};
 use crate::pipeline::ComputePipeline;
-use crate::scene_gpu::SceneGpu;
+use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use naga_oil::compose::ShaderDefValue;
 
@@ -102,7 +102,7 @@ impl Rasterizer {
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
-        scene: &'r SceneGpu,
+        scene: &SceneInFrame,
         job: &RasterJob<'_>,
         kind: RasterTarget,
         target: Buf,
@@ -153,10 +153,13 @@ impl Rasterizer {
             ],
             slices: slice_of_view,
         };
-        let positions = g.import_buffer("scene.positions", &scene.positions);
-        let indices = g.import_buffer("scene.indices", &scene.indices);
-        let instances = g.import_buffer("scene.instances", &scene.instances);
-        let chunks = g.import_buffer("scene.chunks", &scene.chunks);
+        let SceneInFrame {
+            positions,
+            indices,
+            instances,
+            chunks,
+            ..
+        } = *scene;
         let pipelines = match kind {
             RasterTarget::Visibility => &self.visibility,
             RasterTarget::Depth => &self.depth,

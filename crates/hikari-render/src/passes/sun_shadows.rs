@@ -21,7 +21,7 @@ use hikari_scene::Camera;
 use super::raster::{MAX_VIEWS, RasterJob, RasterTarget, Rasterizer};
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph};
-use crate::scene_gpu::SceneGpu;
+use crate::scene_gpu::SceneInFrame;
 use crate::settings::ShadowSettings;
 
 /// What the lookup needs; `cascades` of zero means no shadows (everything lit).
@@ -204,7 +204,7 @@ impl ShadowCache {
 pub fn record<'r>(
     g: &mut FrameGraph<'r>,
     raster: &'r Rasterizer,
-    scene: &'r SceneGpu,
+    scene: &SceneInFrame,
     cache: &mut ShadowCache,
     camera: &Camera,
     aspect: f32,

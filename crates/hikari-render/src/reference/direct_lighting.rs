@@ -42,7 +42,9 @@ pub fn specular_placeholder(p: &LightingParams, m: &Material, n: Vec3, v: Vec3) 
 /// Where the light's illuminance falls to the frame's cutoff, or its own range if nearer.
 pub fn light_range(p: &LightingParams, light: &LightGpu) -> f32 {
     let peak = v3(light.intensity).max_element();
-    light.position_range[3].min((peak / p.cutoff[0]).sqrt())
+    light.position_range[3]
+        .min((peak / p.cutoff[0]).sqrt())
+        .max(1e-3)
 }
 
 /// Illuminance per candela of a punctual light `d2` metres squared away in direction `l`
