@@ -15,6 +15,7 @@ fn main() {
     let mut threads = 0usize;
     let mut runs = 5usize;
     let mut ray_count = 1usize << 20;
+    let mut tlas_only = false;
     let args: Vec<String> = std::env::args().collect();
     let mut i = 1;
     while i < args.len() {
@@ -22,6 +23,11 @@ fn main() {
             "--threads" => threads = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(0),
             "--runs" => runs = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(5),
             "--rays" => ray_count = args.get(i + 1).and_then(|s| s.parse().ok()).unwrap_or(0),
+            "--tlas-only" => {
+                tlas_only = true;
+                i += 1;
+                continue;
+            }
             _ => {}
         }
         i += 2;
@@ -29,6 +35,9 @@ fn main() {
     let mesh = Mesh::terrain(708);
     for count in [959, 5000] {
         tlas_rebuild(count);
+    }
+    if tlas_only {
+        return;
     }
     let options = BuildOptions {
         threads,
