@@ -10,7 +10,7 @@ use crate::passes::direct_lighting::{DirectLighting, LightingParams};
 use crate::passes::gbuffer::{GBuffer, GBufferPass};
 use crate::passes::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::passes::raster::Rasterizer;
-use crate::passes::sun_shadows::{self, SunShadowMaps};
+use crate::passes::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
@@ -63,6 +63,7 @@ pub struct FrameState {
 /// Every technique's pipelines, built once.
 pub struct Techniques {
     pub raster: Rasterizer,
+    pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
     pub placeholder_tonemap: PlaceholderTonemap,
@@ -73,6 +74,7 @@ impl Techniques {
         let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
         Ok(Self {
             raster: Rasterizer::new(ctx, &mut lib)?,
+            sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
@@ -116,7 +118,7 @@ pub fn record<'r>(
     //    their issues add them here.
 
     // 7. Sun shadow maps.
-    let shadows = sun_shadows::record(
+    let shadows = t.sun_shadows.record(
         g,
         &t.raster,
         scene,

@@ -34,6 +34,8 @@ pub enum BindingKind {
     },
     Sampler {
         comparison: bool,
+        /// False where the shader gathers integer texels with it.
+        filtering: bool,
     },
 }
 
@@ -123,14 +125,15 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
         path: path.into(),
         message,
     };
-    let has_filtering_sampler = module.global_variables.iter().any(|(_, g)| {
+    let integer_samplers = samplers_of_integer_textures(module);
+    let has_filtering_sampler = module.global_variables.iter().any(|(h, g)| {
         matches!(
             module.types[g.ty].inner,
             naga::TypeInner::Sampler { comparison: false }
-        )
+        ) && !integer_samplers.contains(&h)
     });
     let mut slots = Vec::new();
-    for (_, g) in module.global_variables.iter() {
+    for (handle, g) in module.global_variables.iter() {
         let Some(rb) = &g.binding else { continue };
         let name = g.name.clone().unwrap_or_default();
         if rb.group != 0 {
@@ -183,6 +186,7 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
             },
             (naga::TypeInner::Sampler { comparison }, _) => BindingKind::Sampler {
                 comparison: *comparison,
+                filtering: !integer_samplers.contains(&handle),
             },
             (_, naga::AddressSpace::Uniform) => BindingKind::Uniform,
             (_, naga::AddressSpace::Storage { access }) => BindingKind::Storage {
@@ -210,6 +214,46 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
         }
     }
     Ok(slots)
+}
+
+/// Samplers a shader uses with integer textures (`textureGather` of a `texture_2d<u32>`): a
+/// filtering sampler may not meet an integer texture, so their slots take non-filtering ones.
+fn samplers_of_integer_textures(module: &naga::Module) -> Vec<naga::Handle<naga::GlobalVariable>> {
+    let integer = |h: naga::Handle<naga::GlobalVariable>| {
+        matches!(
+            module.types[module.global_variables[h].ty].inner,
+            naga::TypeInner::Image {
+                class: naga::ImageClass::Sampled {
+                    kind: naga::ScalarKind::Uint | naga::ScalarKind::Sint,
+                    ..
+                },
+                ..
+            }
+        )
+    };
+    let mut out = Vec::new();
+    let functions = module
+        .functions
+        .iter()
+        .map(|(_, f)| f)
+        .chain(module.entry_points.iter().map(|e| &e.function));
+    for f in functions {
+        for (_, e) in f.expressions.iter() {
+            let naga::Expression::ImageSample { image, sampler, .. } = *e else {
+                continue;
+            };
+            if let (
+                naga::Expression::GlobalVariable(image),
+                naga::Expression::GlobalVariable(sampler),
+            ) = (&f.expressions[image], &f.expressions[sampler])
+                && integer(*image)
+                && !out.contains(sampler)
+            {
+                out.push(*sampler);
+            }
+        }
+    }
+    out
 }
 
 fn layout_entries(
@@ -248,10 +292,15 @@ fn layout_entries(
                     has_dynamic_offset: false,
                     min_binding_size: None,
                 },
-                BindingKind::Sampler { comparison } => wgpu::BindingType::Sampler(if *comparison {
+                BindingKind::Sampler {
+                    comparison,
+                    filtering,
+                } => wgpu::BindingType::Sampler(if *comparison {
                     wgpu::SamplerBindingType::Comparison
-                } else {
+                } else if *filtering {
                     wgpu::SamplerBindingType::Filtering
+                } else {
+                    wgpu::SamplerBindingType::NonFiltering
                 }),
             },
             count: None,

@@ -36,6 +36,10 @@ pub struct ShadowSettings {
     /// (the camera moved by a texel or more, the sun moved, the settings changed): in a still
     /// view the maps cost nothing. Off: every cascade is redrawn every frame.
     pub cache: bool,
+    /// With the cache: most cascades redrawn in one frame of a moving view, those drifted
+    /// farthest (relative to their size) first, 1 to 4. A cascade is redrawn regardless once
+    /// it drifts by a tenth of its radius, or when the sun moves.
+    pub cascades_per_frame: u32,
 }
 
 impl Default for ShadowSettings {
@@ -50,6 +54,7 @@ impl Default for ShadowSettings {
             depth_bias_texels: 1.0,
             normal_bias_texels: 1.5,
             cache: true,
+            cascades_per_frame: 1,
         }
     }
 }
@@ -120,6 +125,13 @@ impl Settings {
                 field: "shadows.resolution".into(),
                 value: s.resolution.to_string(),
                 allowed: "a power of two from 64 to 8192".into(),
+            });
+        }
+        if !(1..=4).contains(&s.cascades_per_frame) {
+            return Err(SettingError {
+                field: "shadows.cascades_per_frame".into(),
+                value: s.cascades_per_frame.to_string(),
+                allowed: "1 to 4".into(),
             });
         }
         range("shadows.max_distance_m", s.max_distance_m, 1.0, 100_000.0)?;

@@ -2,7 +2,8 @@
 
 // Sun shadow lookup: cascade selection and 3x3 bilinear PCF over the compute-rasterised
 // shadow maps (`passes/sun_shadows.rs`). CPU twin: reference::sun_shadows. A shader that
-// imports this module binds the parameters and the maps at bindings 9 and 10, after its own.
+// imports this module binds the parameters, the maps and a nearest sampler at bindings 9 to
+// 11, after its own.
 
 struct ShadowParams {
     light_view_proj: array<mat4x4<f32>, 4>,
@@ -13,43 +14,55 @@ struct ShadowParams {
 }
 
 @group(0) @binding(9) var<uniform> shadow: ShadowParams;
-// Cascade-major u32 depth bits, `resolution^2` a cascade.
-@group(0) @binding(10) var<storage, read> shadow_texels: array<u32>;
+// Depth bits, a layer a cascade.
+@group(0) @binding(10) var shadow_map: texture_2d_array<u32>;
+@group(0) @binding(11) var shadow_sampler: sampler;
+
+fn shadow_depth(layer: u32, c: vec2<i32>) -> f32 {
+    return bitcast<f32>(textureLoad(shadow_map, c, layer, 0).r);
+}
+
+// Which of four texels' casters are no nearer the sun than `receiver`, as 0 or 1.
+fn lit4(depth_bits: vec4<u32>, receiver: f32) -> vec4<f32> {
+    return select(vec4<f32>(0.0), vec4<f32>(1.0), bitcast<vec4<f32>>(depth_bits) <= vec4<f32>(receiver));
+}
 
 // Fraction of a bilinear footprint whose casters are no nearer the sun than `receiver`
 // (reverse depth: larger is nearer the sun).
-fn bilinear_lit(base: u32, res: i32, st: vec2<f32>, receiver: f32) -> f32 {
+fn bilinear_lit(layer: u32, res: i32, st: vec2<f32>, receiver: f32) -> f32 {
     let p = floor(st);
     let f = st - p;
     let i = vec2<i32>(p);
     var lit = vec4<f32>(0.0);
     for (var k = 0; k < 4; k++) {
         let c = clamp(i + vec2<i32>(k & 1, k >> 1), vec2<i32>(0), vec2<i32>(res - 1));
-        let d = bitcast<f32>(shadow_texels[base + u32(c.y * res + c.x)]);
-        lit[k] = select(0.0, 1.0, d <= receiver);
+        lit[k] = select(0.0, 1.0, shadow_depth(layer, c) <= receiver);
     }
     return mix(mix(lit.x, lit.y, f.x), mix(lit.z, lit.w, f.x), f.y);
 }
 
 // The nine bilinear taps one texel apart, as the 4x4 texels they touch with tent weights
-// (1 - f, 1, 1, f) / 3 along each axis: the same sum with 16 loads instead of 36.
-fn tent_lit(base: u32, res: i32, st: vec2<f32>, receiver: f32) -> f32 {
+// (1 - f, 1, 1, f) / 3 along each axis: the same sum from four 2x2 gathers instead of 36
+// loads. A gather at the corner shared by texels (x, y) and (x + 1, y + 1) returns them as
+// ((x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y)); the clamp-to-edge sampler repeats edge
+// texels as the twin's clamped indices do.
+fn tent_lit(layer: u32, res: f32, st: vec2<f32>, receiver: f32) -> f32 {
     let p = floor(st);
     let f = st - p;
-    let i = vec2<i32>(p) - 1;
+    // The block starts at texel p - 1: its first 2x2 share the corner at p.
+    let corner = p / res;
+    let step = 2.0 / res;
+    let top_left = lit4(textureGather(0, shadow_map, shadow_sampler, corner, layer), receiver);
+    let top_right = lit4(textureGather(0, shadow_map, shadow_sampler, corner + vec2<f32>(step, 0.0), layer), receiver);
+    let bottom_left = lit4(textureGather(0, shadow_map, shadow_sampler, corner + vec2<f32>(0.0, step), layer), receiver);
+    let bottom_right = lit4(textureGather(0, shadow_map, shadow_sampler, corner + vec2<f32>(step), layer), receiver);
+    // Rows 0 and 1 of the block are the gathers' w, z (upper) and x, y (lower) lanes.
     let wx = vec4<f32>(1.0 - f.x, 1.0, 1.0, f.x);
-    let wy = vec4<f32>(1.0 - f.y, 1.0, 1.0, f.y);
-    var sum = 0.0;
-    for (var y = 0; y < 4; y++) {
-        let row = clamp(i.y + y, 0, res - 1) * res;
-        var line = 0.0;
-        for (var x = 0; x < 4; x++) {
-            let d = bitcast<f32>(shadow_texels[base + u32(row + clamp(i.x + x, 0, res - 1))]);
-            line += select(0.0, wx[x], d <= receiver);
-        }
-        sum += line * wy[y];
-    }
-    return sum / 9.0;
+    let row0 = dot(vec4<f32>(top_left.w, top_left.z, top_right.w, top_right.z), wx);
+    let row1 = dot(vec4<f32>(top_left.x, top_left.y, top_right.x, top_right.y), wx);
+    let row2 = dot(vec4<f32>(bottom_left.w, bottom_left.z, bottom_right.w, bottom_right.z), wx);
+    let row3 = dot(vec4<f32>(bottom_left.x, bottom_left.y, bottom_right.x, bottom_right.y), wx);
+    return dot(vec4<f32>(row0, row1, row2, row3), vec4<f32>(1.0 - f.y, 1.0, 1.0, f.y)) / 9.0;
 }
 
 // Sun visibility in [0, 1] of a surface at `world` with unit normal `n`; 1 outside every
@@ -67,14 +80,13 @@ fn sun_visibility(world: vec3<f32>, n: vec3<f32>) -> f32 {
         if all(uv > vec2<f32>(margin)) && all(uv < vec2<f32>(1.0 - margin)) {
             let receiver = s.z + shadow.depth_bias[c];
             let st = uv * res - 0.5;
-            let base = c * u32(res) * u32(res);
             if spacing == 1.0 {
-                return tent_lit(base, i32(res), st, receiver);
+                return tent_lit(c, res, st, receiver);
             }
             var sum = 0.0;
             for (var y = -1; y <= 1; y++) {
                 for (var x = -1; x <= 1; x++) {
-                    sum += bilinear_lit(base, i32(res), st + vec2<f32>(f32(x), f32(y)) * spacing, receiver);
+                    sum += bilinear_lit(c, i32(res), st + vec2<f32>(f32(x), f32(y)) * spacing, receiver);
                 }
             }
             return sum / 9.0;

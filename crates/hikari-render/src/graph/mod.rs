@@ -484,6 +484,16 @@ impl<'r> FrameGraph<'r> {
                 }
                 (Binding::Buffer(_), BindingKind::Storage { .. } | BindingKind::Uniform) => {}
                 (Binding::Constants { .. }, BindingKind::Uniform) => {}
+                (
+                    Binding::Sampler(SamplerKind::LinearClamp | SamplerKind::LinearRepeat),
+                    BindingKind::Sampler {
+                        filtering: false, ..
+                    },
+                ) => {
+                    return Err(err(format!(
+                        "{here} gathers integer texels, which takes SamplerKind::NearestClamp"
+                    )));
+                }
                 (Binding::Sampler(_), BindingKind::Sampler { .. }) => {}
                 (b, k) => return Err(err(format!("{here} is {k:?} but the pass binds {b:?}"))),
             }

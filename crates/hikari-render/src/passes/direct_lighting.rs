@@ -11,7 +11,7 @@ use super::gbuffer::GBuffer;
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{FrameGraph, Tex, TextureDesc};
+use crate::graph::{FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::settings::LightingSettings;
@@ -128,7 +128,8 @@ impl DirectLighting {
             .read(scene.lights)
             .write(radiance)
             .constants(&shadows.params)
-            .read(shadows.texels)
+            .read(shadows.map)
+            .sampler(SamplerKind::NearestClamp)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(radiance)
     }

@@ -8,7 +8,10 @@
 //! keep their place in the world as the camera turns and moves.
 //!
 //! The maps persist across frames; a cascade is redrawn only when its projection changes
-//! ([`ShadowCache`]; `shadows.cache = false` redraws all every frame).
+//! ([`ShadowCache`]; `shadows.cache = false` redraws all every frame). The rasteriser's atomics
+//! need a buffer; each redrawn cascade is then copied into a layer of an R32Uint texture array,
+//! which the lookup gathers 2x2 texels at a time from (a quarter of the loads, and a texture
+//! cache laid out for 2D neighbourhoods).
 //!
 //! Depth convention as the camera's: 1 nearest the sun, 0 farthest (the cleared value), over
 //! the scene's extent along the sun direction, so every caster is inside the depth range.
@@ -19,10 +22,13 @@ use glam::{Mat4, Vec3, Vec4};
 use hikari_scene::Camera;
 
 use super::raster::{MAX_VIEWS, RasterJob, RasterTarget, Rasterizer};
+use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{Buf, FrameGraph};
+use crate::graph::{Buf, FrameGraph, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::settings::ShadowSettings;
+use crate::shader::ShaderLibrary;
 
 /// What the lookup needs; `cascades` of zero means no shadows (everything lit).
 #[repr(C)]
@@ -162,11 +168,24 @@ impl ShadowParams {
     }
 }
 
-/// The shadow maps of a frame: `cascades * resolution^2` u32 depths, cascade-major.
+/// The shadow maps of a frame.
 #[derive(Clone, Copy, Debug)]
 pub struct SunShadowMaps {
+    /// `cascades * resolution^2` u32 depth bits, cascade-major: what the rasteriser draws.
     pub texels: Buf,
+    /// The same depth bits as an R32Uint 2D array, a layer a cascade (at least two layers,
+    /// so that its view is an array), for the lookup.
+    pub map: Tex,
     pub params: ShadowParams,
+}
+
+pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+
+fn map_desc(resolution: u32, cascades: u32) -> TextureDesc {
+    TextureDesc {
+        size: [resolution, resolution, cascades.max(2)],
+        ..TextureDesc::d2(resolution, resolution, MAP_FORMAT)
+    }
 }
 
 /// Extent of the scene bounds along `to_sun` (with the fit's margin), for depth biases.
@@ -178,82 +197,161 @@ pub fn depth_range(to_sun: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
 /// The cascades drawn in earlier frames, so that unchanged ones are not drawn again.
 #[derive(Clone, Debug, Default)]
 pub struct ShadowCache {
-    /// The projection each slice of the persistent maps was last drawn with.
-    drawn: Vec<Option<Mat4>>,
+    /// The cascade each slice of the persistent maps holds, as it was drawn.
+    drawn: Vec<Option<Cascade>>,
 }
+
+/// How far a cascade drawn as `held` lies from where `want` puts it, in cascade radii; infinite
+/// when they differ in more than their centre (sun direction, size or depth range).
+fn drift(held: &Cascade, want: &Cascade) -> f32 {
+    let (h, w) = (held.view_proj, want.view_proj);
+    let same_shape = h.x_axis == w.x_axis
+        && h.y_axis == w.y_axis
+        && h.z_axis == w.z_axis
+        && h.w_axis.z == w.w_axis.z;
+    if !same_shape {
+        return f32::INFINITY;
+    }
+    // x and y of NDC span the cascade's diameter: a radius is one unit.
+    (h.w_axis.truncate().truncate() - w.w_axis.truncate().truncate()).length()
+}
+
+/// A cascade that has drifted this far (in radii) is redrawn whatever the per-frame limit, so
+/// that the held cascades keep covering nearly all of their slices.
+pub const MAX_DRIFT: f32 = 0.1;
 
 impl ShadowCache {
-    /// Slices to draw this frame: those whose projection changed, all of them when the maps
-    /// are new or caching is off.
-    fn stale(&mut self, cascades: &[Cascade], fresh: bool, cache: bool) -> Vec<u32> {
-        if fresh || !cache || self.drawn.len() != cascades.len() {
+    /// Slices to draw this frame. All of them when the maps are new or caching is off; else
+    /// those that moved, at most `per_frame` of them (the farthest drifted first) unless they
+    /// are new, changed shape or drifted beyond [`MAX_DRIFT`].
+    fn update(&mut self, cascades: &[Cascade], fresh: bool, s: &ShadowSettings) -> Vec<u32> {
+        if fresh || !s.cache || self.drawn.len() != cascades.len() {
             self.drawn = vec![None; cascades.len()];
         }
-        let mut stale = Vec::new();
-        for (i, c) in cascades.iter().enumerate() {
-            if self.drawn[i] != Some(c.view_proj) {
-                stale.push(i as u32);
-                self.drawn[i] = Some(c.view_proj);
+        let mut must = Vec::new();
+        let mut may = Vec::new();
+        for (i, (held, want)) in self.drawn.iter().zip(cascades).enumerate() {
+            match held.as_ref().map(|h| drift(h, want)) {
+                None => must.push(i),
+                Some(d) if d > MAX_DRIFT => must.push(i),
+                Some(d) if d > 0.0 => may.push((d, i)),
+                Some(_) => {}
             }
         }
-        stale
+        may.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let room = (s.cascades_per_frame as usize).saturating_sub(must.len());
+        must.extend(may.iter().take(room).map(|&(_, i)| i));
+        must.sort_unstable();
+        for &i in &must {
+            self.drawn[i] = Some(cascades[i]);
+        }
+        must.into_iter().map(|i| i as u32).collect()
+    }
+
+    /// What the maps hold after this frame's update.
+    fn held(&self) -> Vec<Cascade> {
+        self.drawn.iter().flatten().copied().collect()
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-pub fn record<'r>(
-    g: &mut FrameGraph<'r>,
-    raster: &'r Rasterizer,
-    scene: &SceneInFrame,
-    cache: &mut ShadowCache,
-    camera: &Camera,
-    aspect: f32,
-    to_sun: Vec3,
-    s: &ShadowSettings,
-) -> Result<SunShadowMaps> {
-    let bounds = match scene.bounds {
-        Some(b) if s.enabled && to_sun.length_squared() > 0.0 => b,
-        _ => {
-            *cache = ShadowCache::default();
-            let texels = g.buffer("sun_shadows.texels", 16)?;
-            g.pass("sun_shadows.clear")
-                .uses(texels, true)
-                .encode(move |enc, res| enc.clear_buffer(res.buffer(texels), 0, None))?;
-            return Ok(SunShadowMaps {
-                texels,
-                params: ShadowParams::disabled(),
-            });
-        }
-    };
-    let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
-    let res = s.resolution as u64;
-    let (texels, fresh) =
-        g.persistent_buffer("sun_shadows.texels", res * res * cascades.len() as u64 * 4)?;
-    let stale = cache.stale(&cascades, fresh, s.cache);
-    if !stale.is_empty() {
-        let view_proj: Vec<Mat4> = stale
-            .iter()
-            .map(|&i| cascades[i as usize].view_proj)
-            .collect();
-        raster.record(
-            g,
-            scene,
-            &RasterJob {
-                technique: "sun_shadows",
-                view_proj: &view_proj,
-                slices: &stale,
-                size: [s.resolution, s.resolution],
-                // Both faces cast: thin walls are single panels in many scenes.
-                cull_back_faces: false,
-            },
-            RasterTarget::Depth,
-            texels,
-        )?;
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct CopyParams {
+    layers: [u32; 4],
+    config: [u32; 4],
+}
+
+/// The technique's pipelines (the drawing itself is the shared rasteriser's).
+pub struct SunShadows {
+    copy: ComputePipeline,
+}
+
+impl SunShadows {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Ok(Self {
+            copy: ComputePipeline::new(ctx, lib, "sun_shadows/copy.wgsl", "main", &[])?,
+        })
     }
-    Ok(SunShadowMaps {
-        texels,
-        params: ShadowParams::new(&cascades, depth_range(to_sun, bounds), s),
-    })
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        raster: &'r Rasterizer,
+        scene: &SceneInFrame,
+        cache: &mut ShadowCache,
+        camera: &Camera,
+        aspect: f32,
+        to_sun: Vec3,
+        s: &ShadowSettings,
+    ) -> Result<SunShadowMaps> {
+        let bounds = match scene.bounds {
+            Some(b) if s.enabled && to_sun.length_squared() > 0.0 => b,
+            _ => {
+                *cache = ShadowCache::default();
+                let texels = g.buffer("sun_shadows.texels", 16)?;
+                let map = g.texture("sun_shadows.map", map_desc(1, 2))?;
+                g.pass("sun_shadows.clear")
+                    .uses(texels, true)
+                    // Never read: no cascades means no lookup. wgpu zeroes the map.
+                    .uses(map, true)
+                    .encode(move |enc, res| enc.clear_buffer(res.buffer(texels), 0, None))?;
+                return Ok(SunShadowMaps {
+                    texels,
+                    map,
+                    params: ShadowParams::disabled(),
+                });
+            }
+        };
+        let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
+        let res = s.resolution as u64;
+        let (texels, fresh_texels) =
+            g.persistent_buffer("sun_shadows.texels", res * res * cascades.len() as u64 * 4)?;
+        let (map, fresh_map) = g.persistent_texture(
+            "sun_shadows.map",
+            map_desc(s.resolution, cascades.len() as u32),
+        )?;
+        let stale = cache.update(&cascades, fresh_texels || fresh_map, s);
+        if !stale.is_empty() {
+            let view_proj: Vec<Mat4> = stale
+                .iter()
+                .map(|&i| cascades[i as usize].view_proj)
+                .collect();
+            raster.record(
+                g,
+                scene,
+                &RasterJob {
+                    technique: "sun_shadows",
+                    view_proj: &view_proj,
+                    slices: &stale,
+                    size: [s.resolution, s.resolution],
+                    // Both faces cast: thin walls are single panels in many scenes.
+                    cull_back_faces: false,
+                },
+                RasterTarget::Depth,
+                texels,
+            )?;
+            let mut layers = [0u32; 4];
+            layers[..stale.len()].copy_from_slice(&stale);
+            let copy = CopyParams {
+                layers,
+                config: [s.resolution, stale.len() as u32, 0, 0],
+            };
+            g.pass("sun_shadows.copy")
+                .constants(&copy)
+                .read(texels)
+                .write(map)
+                .dispatch_threads(
+                    &self.copy,
+                    [s.resolution / 4, s.resolution, stale.len() as u32],
+                )?;
+        }
+        Ok(SunShadowMaps {
+            texels,
+            map,
+            params: ShadowParams::new(&cache.held(), depth_range(to_sun, bounds), s),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -349,6 +447,87 @@ mod tests {
                 assert!(frac.max_element() < 2e-2, "moved by {texels} texels");
             }
         }
+    }
+
+    #[test]
+    fn a_moving_view_redraws_the_most_drifted_cascades_within_the_frame_limit() {
+        let s = ShadowSettings {
+            cascades_per_frame: 1,
+            ..Default::default()
+        };
+        let bounds = (Vec3::splat(-200.0), Vec3::splat(200.0));
+        let sun = Vec3::new(-0.4, 0.8, 0.3).normalize();
+        let fit = |z: f32| {
+            fit_cascades(
+                &camera(Vec3::new(0.0, 2.0, z), Vec3::Z),
+                1.78,
+                sun,
+                bounds,
+                &s,
+            )
+        };
+        let mut cache = ShadowCache::default();
+        assert_eq!(
+            cache.update(&fit(0.0), true, &s),
+            vec![0, 1, 2, 3],
+            "new maps: all"
+        );
+        assert!(cache.update(&fit(0.0), false, &s).is_empty(), "still: none");
+        // Walking forward: one cascade a frame, and each is drawn where it was wanted then.
+        let mut drawn_at = vec![0.0f32; 4];
+        for frame in 1..=40 {
+            let z = frame as f32 * 0.05;
+            let want = fit(z);
+            let drawn = cache.update(&want, false, &s);
+            assert!(
+                drawn.len() <= 1
+                    || drawn.iter().all(|&i| {
+                        // Beyond the limit only for cascades drifted past MAX_DRIFT.
+                        drift(&fit(drawn_at[i as usize])[i as usize], &want[i as usize]) > MAX_DRIFT
+                    }),
+                "frame {frame}: drew {drawn:?}"
+            );
+            for &i in &drawn {
+                drawn_at[i as usize] = z;
+            }
+            for (i, held) in cache.held().iter().enumerate() {
+                let d = drift(held, &want[i]);
+                assert!(
+                    d <= MAX_DRIFT,
+                    "frame {frame}: cascade {i} drifted {d} radii"
+                );
+            }
+        }
+        // The nearest cascade, the smallest, drifts fastest and is redrawn most often.
+        let mut counts = [0; 4];
+        let mut cache2 = ShadowCache::default();
+        cache2.update(&fit(0.0), true, &s);
+        for frame in 1..=40 {
+            for i in cache2.update(&fit(frame as f32 * 0.05), false, &s) {
+                counts[i as usize] += 1;
+            }
+        }
+        assert!(counts[0] > counts[3], "redraws per cascade {counts:?}");
+        // Standing still again, the remaining ones catch up and then nothing is drawn.
+        let end = fit(2.0);
+        let mut frames = 0;
+        while !cache2.update(&end, false, &s).is_empty() {
+            frames += 1;
+            assert!(frames <= 4, "still view keeps redrawing");
+        }
+        for (held, want) in cache2.held().iter().zip(&end) {
+            assert_eq!(held.view_proj, want.view_proj);
+        }
+        // A sun that moves changes every cascade's shape: all are redrawn at once.
+        let sun2 = Vec3::new(-0.41, 0.8, 0.3).normalize();
+        let turned = fit_cascades(
+            &camera(Vec3::new(0.0, 2.0, 2.0), Vec3::Z),
+            1.78,
+            sun2,
+            bounds,
+            &s,
+        );
+        assert_eq!(cache2.update(&turned, false, &s).len(), 4);
     }
 
     #[test]
