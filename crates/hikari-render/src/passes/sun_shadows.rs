@@ -474,7 +474,7 @@ mod tests {
         );
         assert!(cache.update(&fit(0.0), false, &s).is_empty(), "still: none");
         // Walking forward: one cascade a frame, and each is drawn where it was wanted then.
-        let mut drawn_at = vec![0.0f32; 4];
+        let mut drawn_at = [0.0f32; 4];
         for frame in 1..=40 {
             let z = frame as f32 * 0.05;
             let want = fit(z);
