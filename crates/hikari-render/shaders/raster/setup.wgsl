@@ -24,7 +24,8 @@
 @group(0) @binding(5) var<storage, read_write> target_texels: array<atomic<u64>>;
 #endif
 // Tile queue: (visibility id, tile x | tile y << 12 | view << 24) in the first `config.y`
-// entries, then up to LARGE_CAPACITY large triangles as (visibility id, view).
+// entries, then up to LARGE_CAPACITY large triangles as (visibility id, view) followed by
+// their tile rectangle (x | y << 16 of the first and of the last tile).
 @group(0) @binding(6) var<storage, read_write> queue: array<vec2<u32>>;
 // [0]: tile entries, [1]: large triangles (both keep counting past their capacity).
 @group(0) @binding(7) var<storage, read_write> queue_count: array<atomic<u32>>;

@@ -35,8 +35,24 @@ fn large(
 ) {
     let count = min(atomicLoad(&queue_count[1]), LARGE_CAPACITY);
     let size = params.viewport.xy;
+    // The tiles of all large triangles, one after the other, are dealt to the workgroups in
+    // turn: `first_slot` is where this triangle's first tile falls in that deal. A workgroup
+    // sets up only the triangles it draws tiles of (setting up each in every workgroup cost
+    // more than drawing them).
+    var first_slot = 0u;
     for (var e = 0u; e < count; e++) {
-        let entry = queue[params.config.y + e];
+        let at = params.config.y + e * 2u;
+        let rect_bits = queue[at + 1u];
+        let t_lo = vec2<u32>(rect_bits.x & 0xffffu, rect_bits.x >> 16u);
+        let t_hi = vec2<u32>(rect_bits.y & 0xffffu, rect_bits.y >> 16u);
+        let span = t_hi - t_lo + 1u;
+        let tiles = span.x * span.y;
+        let mine = (wg.x + groups.x - first_slot) % groups.x;
+        first_slot = (first_slot + tiles) % groups.x;
+        if mine >= tiles {
+            continue;
+        }
+        let entry = queue[at];
         let id = entry.x;
         let view = entry.y;
         let poly = id_poly(id, view);
@@ -45,10 +61,7 @@ fn large(
         }
         let rect = poly_rect(poly, size);
         let setup = poly_setup(poly);
-        let t_lo = vec2<u32>(rect.lo) / TILE_SIZE;
-        let t_hi = vec2<u32>(rect.hi) / TILE_SIZE;
-        let span = t_hi - t_lo + 1u;
-        for (var t = wg.x; t < span.x * span.y; t += groups.x) {
+        for (var t = mine; t < tiles; t += groups.x) {
             let tile = t_lo + vec2<u32>(t % span.x, t / span.x);
             if tile_touched(setup, rect, tile) {
                 raster_tile(setup, rect, tile, view, id, lane, THREADS);

@@ -50,7 +50,10 @@ fn main(
     if span.x * span.y > LARGE_TRIANGLE_TILES {
         let slot = atomicAdd(&queue_count[1], 1u);
         if slot < LARGE_CAPACITY {
-            queue[params.config.y + slot] = vec2<u32>(id, view);
+            // Its tile rectangle beside it, so that the large pass sets it up only in the
+            // workgroups that draw some of its tiles.
+            queue[params.config.y + slot * 2u] = vec2<u32>(id, view);
+            queue[params.config.y + slot * 2u + 1u] = vec2<u32>(t_lo.x | (t_lo.y << 16u), t_hi.x | (t_hi.y << 16u));
         }
         return;
     }

@@ -115,9 +115,10 @@ impl Rasterizer {
         // triangles lose tiles (the overflow shows as holes, and `queue_count` tells).
         let capacity = (tiles * 8).clamp(1 << 16, 1 << 22) as u32;
         let t = job.technique;
+        // A large triangle takes two entries: its id and view, then its tile rectangle.
         let queue = g.buffer(
             &format!("{t}.tile_queue"),
-            (capacity as u64 + LARGE_CAPACITY) * 8,
+            (capacity as u64 + 2 * LARGE_CAPACITY) * 8,
         )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
         assert_eq!(job.slices.len(), views, "one slice a view");
