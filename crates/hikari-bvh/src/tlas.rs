@@ -3,13 +3,15 @@
 
 use crate::aabb::Aabb;
 use crate::blas::Blas;
-use crate::build_sah::{self, BinNode, PrimRef};
 use crate::error::BvhError;
 use crate::layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
 use crate::traverse::{self, TraversalStacks};
-use crate::wide;
 use glam::Affine3A;
 use std::cell::RefCell;
+
+mod instance_cache;
+mod morton;
+mod sweep_build;
 
 /// One placement of a BLAS in the world.
 #[derive(Clone, Copy, Debug)]
@@ -117,20 +119,24 @@ pub struct Tlas {
     pub stats: TlasStats,
 }
 
-/// Buffers for rebuilding a TLAS every frame, kept from one build to the next so that a
-/// rebuild allocates only the arrays of the TLAS it returns. [`Tlas::build`] keeps one per
-/// thread; own one to control when its memory is released.
+/// What a TLAS rebuild keeps from one build to the next: its buffers, so that a rebuild
+/// allocates only the arrays of the TLAS it returns, and what it derived from each instance
+/// (world-to-object matrix, world box), derived again only for instances whose transform, BLAS
+/// index or BLAS box changed. [`Tlas::build`] keeps one per thread; own one to control when its
+/// memory is released.
 #[derive(Default)]
 pub struct TlasBuilder {
     offsets: Vec<(u32, u32)>,
-    records: Vec<InstanceRecord>,
-    prims: Vec<PrimRef>,
-    scratch: Vec<PrimRef>,
-    nodes: Vec<BinNode>,
+    cache: instance_cache::InstanceCache,
+    /// Cache entries of this build's instances, in selection order.
+    entries: Vec<u32>,
+    sweep: sweep_build::SweepBuilder,
+    /// Cache entries in leaf order.
+    leaves: Vec<u32>,
 }
 
 /// Instances above which [`Tlas::build`] gives its per-thread buffers back after a build rather
-/// than holding them (about 200 bytes per instance) until the thread ends.
+/// than holding them (about 300 bytes per instance) until the thread ends.
 const KEEP_BUFFERS_UP_TO: usize = 64 * 1024;
 
 thread_local! {
@@ -147,81 +153,63 @@ impl TlasBuilder {
     ) -> Result<Tlas, BvhError> {
         let Self {
             offsets,
-            records,
-            prims,
-            scratch,
-            nodes,
+            cache,
+            entries,
+            sweep,
+            leaves,
         } = self;
         offsets.clear();
         offsets.extend(blas_offsets_iter(blases));
-        records.clear();
-        prims.clear();
-        records.reserve(selected.len());
-        prims.reserve(selected.len());
+        cache.begin(instances.len(), blases);
+        entries.clear();
         let mut stats = TlasStats::default();
         for &i in selected {
             let Some(inst) = instances.get(i as usize) else {
                 stats.skipped_invalid += 1;
                 continue;
             };
-            let Some(blas) = blases.get(inst.blas as usize) else {
+            if inst.blas as usize >= blases.len() {
                 return Err(BvhError::BadBlasIndex {
                     instance: i as usize,
                     blas: inst.blas,
                     blas_count: blases.len(),
                 });
-            };
-            let Some(w2o) = world_to_object(&inst.transform) else {
-                stats.skipped_invalid += 1;
-                continue;
-            };
-            let bounds = blas.bounds.transformed(&inst.transform);
-            if bounds.is_empty() || !bounds.is_finite() {
-                stats.skipped_invalid += 1;
-                continue;
             }
-            let (node_off, tri_off) = offsets[inst.blas as usize];
-            prims.push(PrimRef::new(&bounds, records.len() as u32));
-            records.push(InstanceRecord {
-                world_to_object: w2o,
-                blas_node_offset: node_off,
-                blas_triangle_offset: tri_off,
-                instance_index: i,
-                blas_index: inst.blas,
-            });
+            match cache.entry(i, inst, blases) {
+                Some(e) => entries.push(e),
+                None => stats.skipped_invalid += 1,
+            }
         }
-        if prims.is_empty() {
+        if entries.is_empty() {
             return Ok(Tlas {
                 stats,
                 ..Default::default()
             });
         }
-        // One instance per leaf slot: entering an instance costs a transform and a BLAS root
-        // visit, so the tightest possible TLAS boxes pay off. The binary build stops at 8
-        // instances, which the collapse turns into one node of single-instance leaves; splitting
-        // further would only decide slot order, at most of the TLAS build's cost.
-        let binary = build_sah::build_reusing(
-            std::mem::take(prims),
-            scratch,
-            std::mem::take(nodes),
-            crate::layout::WIDTH,
-        );
-        let bounds = binary.nodes[0].bounds;
-        let wide = wide::collapse(&binary, 1, 1);
-        let leaf_records: Vec<InstanceRecord> = wide
-            .leaf_prims
+        // Nodes hold about four instances on average: room enough not to regrow.
+        let mut nodes = Vec::with_capacity(entries.len() / 3 + 1);
+        let built = sweep.build(cache.bounds(), entries, &mut nodes, leaves);
+        let records: Vec<InstanceRecord> = leaves
             .iter()
-            .map(|&p| records[binary.prims[p as usize].id() as usize])
+            .map(|&e| {
+                let (world_to_object, instance_index, blas_index) = cache.record_data(e);
+                let (blas_node_offset, blas_triangle_offset) = offsets[blas_index as usize];
+                InstanceRecord {
+                    world_to_object: *world_to_object,
+                    blas_node_offset,
+                    blas_triangle_offset,
+                    instance_index,
+                    blas_index,
+                }
+            })
             .collect();
-        *prims = binary.prims;
-        *nodes = binary.nodes;
-        stats.instances = leaf_records.len();
-        stats.nodes = wide.nodes.len();
-        stats.depth = wide.depth;
+        stats.instances = records.len();
+        stats.nodes = nodes.len();
+        stats.depth = built.depth;
         Ok(Tlas {
-            nodes: wide.nodes,
-            instances: leaf_records,
-            bounds,
+            nodes,
+            instances: records,
+            bounds: built.bounds,
             stats,
         })
     }
@@ -230,9 +218,9 @@ impl TlasBuilder {
     pub fn capacity_bytes(&self) -> usize {
         use std::mem::size_of;
         self.offsets.capacity() * size_of::<(u32, u32)>()
-            + self.records.capacity() * size_of::<InstanceRecord>()
-            + (self.prims.capacity() + self.scratch.capacity()) * size_of::<PrimRef>()
-            + self.nodes.capacity() * size_of::<BinNode>()
+            + self.cache.capacity_bytes()
+            + (self.entries.capacity() + self.leaves.capacity()) * size_of::<u32>()
+            + self.sweep.capacity_bytes()
     }
 }
 
