@@ -684,12 +684,7 @@ mod tests {
                 threads,
             };
             let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-            let serial = canonical(&build_with(
-                prims.clone(),
-                &mut scratch,
-                &params(1),
-                None,
-            ));
+            let serial = canonical(&build_with(prims.clone(), &mut scratch, &params(1), None));
             for (threads, threshold) in [(1, 1000), (3, 700), (8, 64), (16, 5000)] {
                 let got = canonical(&build_with(
                     prims.clone(),
@@ -715,18 +710,8 @@ mod tests {
             threads: 4,
         };
         let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-        let serial = canonical(&build_with(
-            prims.clone(),
-            &mut scratch,
-            &params,
-            None,
-        ));
-        let top = canonical(&build_with(
-            prims,
-            &mut scratch,
-            &params,
-            Some(300),
-        ));
+        let serial = canonical(&build_with(prims.clone(), &mut scratch, &params, None));
+        let top = canonical(&build_with(prims, &mut scratch, &params, Some(300)));
         assert!(top == serial);
     }
 

@@ -602,7 +602,9 @@ fn small_trunc(v: Vec4) -> Vec4 {
 #[cfg(target_arch = "x86_64")]
 #[inline]
 fn plane_bytes(q: [Vec4; 2]) -> [u32; 2] {
-    use std::arch::x86_64::{_mm_cvtsi128_si64, _mm_cvttps_epi32, _mm_packs_epi32, _mm_packus_epi16};
+    use std::arch::x86_64::{
+        _mm_cvtsi128_si64, _mm_cvttps_epi32, _mm_packs_epi32, _mm_packus_epi16,
+    };
     // Convert, then narrow to 16 and to 8 bits (the values fit, so neither saturates).
     // SAFETY: SSE2 is part of the x86_64 baseline; these touch no memory.
     let bytes = unsafe {
@@ -647,9 +649,9 @@ mod tests {
     }
 
     use super::{WIDTH, assign_slots, encode_boxes, step_exponent};
-    use glam::BVec3A;
     use crate::aabb::Aabb;
     use crate::layout::WideNode;
+    use glam::BVec3A;
     use glam::Vec3A;
 
     /// Child boxes from 1e-30 to 1e30 wide, some flat, some far from the origin.
@@ -673,8 +675,8 @@ mod tests {
     }
 
     /// The encoder as it was before slots became lanes (all axes of one slot per SIMD operation):
-        /// the reference the lane version must match bit for bit.
-        /// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
+    /// the reference the lane version must match bit for bit.
+    /// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
     /// (`origin + q * step`, evaluated in f32 as the kernel does) contains the exact child box.
     ///
     /// The three axes are quantized together in SIMD lanes (every node of every TLAS rebuild comes
@@ -892,8 +894,7 @@ mod tests {
         for c in order {
             let o = offsets[c];
             let sign = |slot: usize, bit: usize| if slot & bit != 0 { 1.0 } else { -1.0 };
-            let score =
-                |s: usize| (sign(s, 1) * o.x + sign(s, 2) * o.y) + sign(s, 4) * o.z;
+            let score = |s: usize| (sign(s, 1) * o.x + sign(s, 2) * o.y) + sign(s, 4) * o.z;
             let mut best: Option<usize> = None;
             for s in (0..WIDTH).filter(|&s| slots[s].is_none()) {
                 if best.is_none_or(|b| score(s) > score(b)) {

@@ -121,12 +121,16 @@ impl InstanceCache {
                 *generation += 1;
             }
         }
-        self.by_instance = instance_count <= MAX_CACHED;
-        if !self.by_instance {
+        let by_instance = instance_count <= MAX_CACHED;
+        // Entries made per selected instance are no instance's: start over after (and for)
+        // such a build.
+        if !(by_instance && self.by_instance) {
             self.sources.clear();
             self.bounds.clear();
             self.world_to_object.clear();
-        } else if self.sources.len() < instance_count {
+        }
+        self.by_instance = by_instance;
+        if by_instance && self.sources.len() < instance_count {
             self.sources.resize(instance_count, EMPTY_SOURCE);
             self.bounds.resize(instance_count, Aabb::EMPTY);
             self.world_to_object.resize(instance_count, [[0.0; 4]; 3]);

@@ -13,10 +13,15 @@
 //!
 //! A node is made the way the BLAS collapse makes one: starting from its whole range, the child
 //! with the largest box is split until there are eight children or every child holds at most
-//! eight instances. A child of one instance becomes a leaf slot, any other child a node.
+//! eight instances. Then, while slots are free, the small child with the largest box whose
+//! instances all fit in them is replaced by those instances: a ray that would have entered it
+//! tests them in this node instead of visiting one more node (on the village: a fifth fewer
+//! nodes, 6% fewer node visits per ray, 1-2% more instances entered). A child of one instance
+//! becomes a leaf slot, any other child a node.
 
 use super::morton::{Grid, sort_by_code};
 use crate::aabb::Aabb;
+use crate::build_sah::PrimRef;
 use crate::layout::{META_INTERNAL, WIDTH, WideNode, leaf_meta};
 use crate::wide::{assign_slots, encode_children};
 use glam::{Vec3A, Vec3Swizzles};
@@ -61,8 +66,7 @@ pub(crate) struct SweepBuilder {
     keys: Vec<u64>,
     keys_scratch: Vec<u64>,
     /// Instance boxes and ids in Morton order.
-    boxes: Vec<Aabb>,
-    ids: Vec<u32>,
+    boxes: Vec<PrimRef>,
     /// Per-position scratch of the splits (suffix and chunk boxes).
     scratch: Vec<Aabb>,
     stack: Vec<Pending>,
@@ -98,16 +102,17 @@ impl SweepBuilder {
         // Keys: Morton code, then the position in `ids`, which makes the order deterministic.
         let grid = Grid::new(&centres);
         self.keys.clear();
-        self.keys.extend(ids.iter().enumerate().map(|(k, &id)| {
-            (grid.code(bounds[id as usize].center()) as u64) << 32 | k as u64
-        }));
+        self.keys.extend(
+            ids.iter()
+                .enumerate()
+                .map(|(k, &id)| (grid.code(bounds[id as usize].center()) as u64) << 32 | k as u64),
+        );
         sort_by_code(&mut self.keys, &mut self.keys_scratch);
-        self.ids.clear();
-        self.ids
-            .extend(self.keys.iter().map(|&k| ids[k as u32 as usize]));
         self.boxes.clear();
-        self.boxes
-            .extend(self.ids.iter().map(|&id| bounds[id as usize]));
+        self.boxes.extend(self.keys.iter().map(|&k| {
+            let id = ids[k as u32 as usize];
+            PrimRef::new(&bounds[id as usize], id)
+        }));
         if self.scratch.len() < n {
             self.scratch.resize(n, Aabb::EMPTY);
         }
@@ -137,10 +142,10 @@ impl SweepBuilder {
             let len = (p.end - p.begin) as usize;
             if len <= WIDTH {
                 kids.count = len;
-                kids.bounds[..len].copy_from_slice(&self.boxes[p.begin as usize..p.end as usize]);
-                for (k, r) in kids.range[..len].iter_mut().enumerate() {
+                for k in 0..len {
                     let i = p.begin + k as u32;
-                    *r = (i, i + 1);
+                    kids.range[k] = (i, i + 1);
+                    kids.bounds[k] = aabb(&self.boxes[i as usize]);
                 }
             } else {
                 self.open(&p, &mut kids);
@@ -165,7 +170,7 @@ impl SweepBuilder {
                 let Some(k) = *k else { continue };
                 let (begin, end) = kids.range[k as usize];
                 if end - begin == 1 {
-                    leaves.push(self.ids[begin as usize]);
+                    leaves.push(self.boxes[begin as usize].id());
                     meta[slot] = leaf_meta(leaf_offset, 1);
                     leaf_offset += 1;
                 } else {
@@ -201,14 +206,15 @@ impl SweepBuilder {
     pub(crate) fn capacity_bytes(&self) -> usize {
         use std::mem::size_of;
         (self.keys.capacity() + self.keys_scratch.capacity()) * size_of::<u64>()
-            + (self.boxes.capacity() + self.scratch.capacity()) * size_of::<Aabb>()
-            + self.ids.capacity() * size_of::<u32>()
+            + self.boxes.capacity() * size_of::<PrimRef>()
+            + self.scratch.capacity() * size_of::<Aabb>()
             + self.stack.capacity() * size_of::<Pending>()
     }
 
     /// Splits the range of `p` (more than [`WIDTH`] instances) into `kids`: repeatedly the
     /// child with the largest box (the one most rays enter) among those of more than
-    /// [`WIDTH`] instances, until there are [`WIDTH`] children or none is that large.
+    /// [`WIDTH`] instances, until there are [`WIDTH`] children or none is that large; then
+    /// fills free slots with the instances of small children, largest box first.
     fn open(&mut self, p: &Pending, kids: &mut Kids) {
         kids.range[0] = (p.begin, p.end);
         kids.bounds[0] = p.bounds;
@@ -246,6 +252,36 @@ impl SweepBuilder {
             rank[count] = open_rank(end - mid, &right);
             count += 1;
         }
+        // Slots left free: the small child with the largest box whose instances all fit
+        // becomes leaf slots of this node (one node fewer to visit), and so on.
+        loop {
+            let free = WIDTH - count;
+            let mut best = usize::MAX;
+            let mut best_area = f32::NEG_INFINITY;
+            for k in 0..count {
+                let (b, e) = kids.range[k];
+                let len = (e - b) as usize;
+                if len >= 2 && len - 1 <= free {
+                    let a = half_area(&kids.bounds[k]);
+                    // NaN areas (boxes near +-f32::MAX) compare false: taken only if alone.
+                    if best == usize::MAX || a > best_area {
+                        best = k;
+                        best_area = a;
+                    }
+                }
+            }
+            if best == usize::MAX {
+                break;
+            }
+            let (b, e) = kids.range[best];
+            kids.range[best] = (b, b + 1);
+            kids.bounds[best] = aabb(&self.boxes[b as usize]);
+            for i in b + 1..e {
+                kids.range[count] = (i, i + 1);
+                kids.bounds[count] = aabb(&self.boxes[i as usize]);
+                count += 1;
+            }
+        }
         kids.count = count;
     }
 }
@@ -268,6 +304,12 @@ fn half_area(b: &Aabb) -> f32 {
     e.x * e.y + e.y * e.z + e.z * e.x
 }
 
+/// The box of an instance record.
+#[inline]
+fn aabb(p: &PrimRef) -> Aabb {
+    Aabb::new(p.lo3(), p.hi3())
+}
+
 /// Splits a range of at least two boxes (whose union is `bounds`) where the surface area
 /// heuristic is lowest (see [`SplitCost`]); returns the split position and both sides' boxes.
 /// `scratch` is as long as `boxes`.
@@ -275,7 +317,12 @@ fn half_area(b: &Aabb) -> f32 {
 /// Small ranges try every position. A large one is cut into equal chunks, the best chunk
 /// boundary is found from the chunks' boxes (one cheap pass over the range instead of two
 /// dependent sweeps), and then every position between the two neighbouring boundaries is tried.
-fn split(boxes: &[Aabb], bounds: &Aabb, scratch: &mut [Aabb], splits: u32) -> (usize, Aabb, Aabb) {
+fn split(
+    boxes: &[PrimRef],
+    bounds: &Aabb,
+    scratch: &mut [Aabb],
+    splits: u32,
+) -> (usize, Aabb, Aabb) {
     let m = boxes.len();
     debug_assert!(m >= 2);
     if splits < MEDIAN_SPLIT_DEPTH {
@@ -323,7 +370,11 @@ impl SplitCost {
 }
 
 /// [`split`] of a large range: the best chunk boundary, then the exact sweep around it.
-fn chunked(boxes: &[Aabb], cost: &SplitCost, scratch: &mut [Aabb]) -> Option<(usize, Aabb, Aabb)> {
+fn chunked(
+    boxes: &[PrimRef],
+    cost: &SplitCost,
+    scratch: &mut [Aabb],
+) -> Option<(usize, Aabb, Aabb)> {
     let m = boxes.len();
     let chunks = (m / CHUNK).clamp(2, MAX_CHUNKS);
     let bound = |k: usize| k * m / chunks;
@@ -352,14 +403,22 @@ fn chunked(boxes: &[Aabb], cost: &SplitCost, scratch: &mut [Aabb]) -> Option<(us
     }
     let (k, previous) = best?;
     let next = after[k + 1];
-    sweep(boxes, bound(k - 1), bound(k + 1), previous, next, cost, scratch)
+    sweep(
+        boxes,
+        bound(k - 1),
+        bound(k + 1),
+        previous,
+        next,
+        cost,
+        scratch,
+    )
 }
 
 /// The cheapest split of `boxes` among the positions strictly between `lo` and `hi`, where
 /// `before` is the box of `boxes[..lo]` and `after` that of `boxes[hi..]`: the split position,
 /// left box and right box. `None` if every cost is NaN. The first of equal costs wins.
 fn sweep(
-    boxes: &[Aabb],
+    boxes: &[PrimRef],
     lo: usize,
     hi: usize,
     before: Aabb,
@@ -369,7 +428,7 @@ fn sweep(
 ) -> Option<(usize, Aabb, Aabb)> {
     let mut acc = after;
     for i in (lo + 1..hi).rev() {
-        acc.grow(&boxes[i]);
+        acc.grow(&aabb(&boxes[i]));
         suffix[i] = acc;
     }
     let mut acc = before;
@@ -377,7 +436,7 @@ fn sweep(
     let mut best = None;
     let mut fi = lo as f32;
     for i in lo + 1..hi {
-        acc.grow(&boxes[i - 1]);
+        acc.grow(&aabb(&boxes[i - 1]));
         fi += 1.0;
         let c = cost.at(&acc, &suffix[i], fi);
         if c < best_cost {
@@ -390,15 +449,15 @@ fn sweep(
 
 /// Box of a non-empty run of boxes, with two accumulators so that consecutive boxes do not wait
 /// on each other.
-fn union(boxes: &[Aabb]) -> Aabb {
+fn union(boxes: &[PrimRef]) -> Aabb {
     let (mut a, mut b) = (Aabb::EMPTY, Aabb::EMPTY);
     let mut pairs = boxes.chunks_exact(2);
     for p in &mut pairs {
-        a.grow(&p[0]);
-        b.grow(&p[1]);
+        a.grow(&aabb(&p[0]));
+        b.grow(&aabb(&p[1]));
     }
     for x in pairs.remainder() {
-        a.grow(x);
+        a.grow(&aabb(x));
     }
     a.union(&b)
 }
@@ -408,23 +467,55 @@ mod tests {
     use super::*;
     use crate::rng::SplitMix64;
 
-    /// The SAH cost of every split position, from scratch, and the cheapest.
+    fn refs(boxes: &[Aabb]) -> Vec<PrimRef> {
+        boxes
+            .iter()
+            .enumerate()
+            .map(|(i, b)| PrimRef::new(b, i as u32))
+            .collect()
+    }
+
+    fn union_of(boxes: &[Aabb]) -> Aabb {
+        boxes.iter().fold(Aabb::EMPTY, |u, b| u.union(b))
+    }
+
+    /// Every split position's cost from boxes made from scratch, and the cheapest (first of
+    /// equal ones).
     fn cheapest_by_brute_force(boxes: &[Aabb]) -> (usize, f32) {
         let m = boxes.len();
-        let cost = SplitCost::new(m, &union(boxes));
+        let cost = SplitCost::new(m, &union_of(boxes));
         (1..m)
-            .map(|i| (i, cost.at(&union(&boxes[..i]), &union(&boxes[i..]), i as f32)))
+            .map(|i| {
+                let c = cost.at(&union_of(&boxes[..i]), &union_of(&boxes[i..]), i as f32);
+                (i, c)
+            })
             .fold((0, f32::INFINITY), |b, c| if c.1 < b.1 { c } else { b })
     }
 
     fn random_boxes(rng: &mut SplitMix64, m: usize) -> Vec<Aabb> {
-        (0..m)
+        let mut boxes: Vec<Aabb> = (0..m)
             .map(|_| {
-                let c = Vec3A::new(rng.range(-50.0, 50.0), rng.range(-5.0, 5.0), rng.range(-50.0, 50.0));
-                let e = Vec3A::new(rng.range(0.1, 3.0), rng.range(0.1, 3.0), rng.range(0.1, 3.0));
+                let c = Vec3A::new(
+                    rng.range(-50.0, 50.0),
+                    rng.range(-5.0, 5.0),
+                    rng.range(-50.0, 50.0),
+                );
+                let e = Vec3A::new(
+                    rng.range(0.1, 3.0),
+                    rng.range(0.1, 3.0),
+                    rng.range(0.1, 3.0),
+                );
                 Aabb::new(c - e, c + e)
             })
-            .collect()
+            .collect();
+        // Roughly in order along x, as a Morton order would have them.
+        boxes.sort_by(|a, b| a.min.x.total_cmp(&b.min.x));
+        boxes
+    }
+
+    fn split_of(boxes: &[Aabb]) -> (usize, Aabb, Aabb) {
+        let m = boxes.len();
+        split(&refs(boxes), &union_of(boxes), &mut vec![Aabb::EMPTY; m], 0)
     }
 
     #[test]
@@ -433,32 +524,28 @@ mod tests {
         for _ in 0..2000 {
             let m = 2 + rng.below(EXACT_UP_TO - 1);
             let boxes = random_boxes(&mut rng, m);
-            let (mid, left, right) = split(&boxes, &union(&boxes), &mut vec![Aabb::EMPTY; m], 0);
-            let (want, _) = cheapest_by_brute_force(&boxes);
-            assert_eq!(mid, want, "{m} boxes");
-            assert_eq!(left, union(&boxes[..mid]));
-            assert_eq!(right, union(&boxes[mid..]));
+            let (mid, left, right) = split_of(&boxes);
+            assert_eq!(mid, cheapest_by_brute_force(&boxes).0, "{m} boxes");
+            assert_eq!(left, union_of(&boxes[..mid]));
+            assert_eq!(right, union_of(&boxes[mid..]));
         }
     }
 
     #[test]
-    fn large_ranges_split_near_the_cheapest_position() {
-        // The chunked search may miss the best position, but its split must be a real one
+    fn large_ranges_split_nearly_where_the_cost_is_lowest() {
+        // The chunked search may miss the cheapest position, but its split must be a real one
         // with the right boxes, and nearly as cheap.
         let mut rng = SplitMix64::new(42);
         for _ in 0..300 {
             let m = EXACT_UP_TO + 1 + rng.below(2000);
-            let mut boxes = random_boxes(&mut rng, m);
-            // Sorted along x, as a Morton order would roughly have them.
-            boxes.sort_by(|a, b| a.min.x.total_cmp(&b.min.x));
-            let (mid, left, right) = split(&boxes, &union(&boxes), &mut vec![Aabb::EMPTY; m], 0);
+            let boxes = random_boxes(&mut rng, m);
+            let (mid, left, right) = split_of(&boxes);
             assert!((1..m).contains(&mid));
-            assert_eq!(left, union(&boxes[..mid]));
-            assert_eq!(right, union(&boxes[mid..]));
-            let cost = SplitCost::new(m, &union(&boxes));
-            let got = cost.at(&left, &right, mid as f32);
+            assert_eq!(left, union_of(&boxes[..mid]));
+            assert_eq!(right, union_of(&boxes[mid..]));
+            let got = SplitCost::new(m, &union_of(&boxes)).at(&left, &right, mid as f32);
             let (_, best) = cheapest_by_brute_force(&boxes);
-            assert!(got <= best * 1.1, "{m} boxes: cost {got}, best {best}");
+            assert!(got <= best * 1.1, "{m} boxes: cost {got}, cheapest {best}");
         }
     }
 
@@ -466,9 +553,12 @@ mod tests {
     fn equal_boxes_split_in_the_middle() {
         for m in [2usize, 3, 10, 24, 25, 100, 1000, 4097] {
             let boxes = vec![Aabb::new(Vec3A::splat(1.0), Vec3A::splat(2.5)); m];
-            let (mid, _, _) = split(&boxes, &union(&boxes), &mut vec![Aabb::EMPTY; m], 0);
-            // Rounding may shift it by a little, never far.
-            assert!(mid.abs_diff(m / 2) <= (m / 16).max(1), "{m} boxes split at {mid}");
+            let (mid, _, _) = split_of(&boxes);
+            // Rounding may move it a little, never far.
+            assert!(
+                mid.abs_diff(m / 2) <= (m / 16).max(1),
+                "{m} boxes split at {mid}"
+            );
         }
     }
 
@@ -476,8 +566,7 @@ mod tests {
     fn boxes_of_infinite_area_split_in_the_middle() {
         let huge = Aabb::new(Vec3A::splat(-3e38), Vec3A::splat(3e38));
         for m in [2usize, 5, 40] {
-            let boxes = vec![huge; m];
-            let (mid, left, right) = split(&boxes, &huge, &mut vec![Aabb::EMPTY; m], 0);
+            let (mid, left, right) = split_of(&vec![huge; m]);
             assert_eq!(mid, m / 2);
             assert_eq!((left, right), (huge, huge));
         }
