@@ -123,10 +123,12 @@ fn main() {
         s.triangles as f64 / s.nodes as f64,
         node_bytes as f64 / s.triangles as f64
     );
-    let (sah, internal_area) = sah_cost(&blas.nodes);
+    let sah = hikari_bvh::sah_cost(&blas.nodes);
     println!(
-        "  SAH cost {sah:.2} (node 1, triangle 1, areas of the decoded child boxes relative to \
-         the root's), internal node area sum {internal_area:.2}"
+        "  SAH cost {:.2} (node 1, triangle 1, areas of the decoded child boxes relative to \
+         the root's), internal node area sum {:.2}",
+        sah.total(),
+        sah.nodes
     );
     if ray_count == 0 {
         return;
@@ -219,46 +221,21 @@ fn tlas_rebuild(count: usize) {
         times.push(t0.elapsed().as_secs_f64() * 1e6);
     }
     times.sort_by(f64::total_cmp);
+    let sah = hikari_bvh::sah_cost(&tlas.nodes);
     println!(
-        "TLAS rebuild, {} instances: median {:.1} us, min {:.1} us over {} rebuilds, {} nodes, depth {}, {:.1} KiB",
+        "TLAS rebuild, {} instances: median {:.1} us, min {:.1} us over {} rebuilds, {} nodes, depth {}, {:.1} KiB, \
+         SAH cost {:.3} (nodes {:.3} + instances {:.3})",
         count,
         times[times.len() / 2],
         times[0],
         times.len(),
         tlas.stats.nodes,
         tlas.stats.depth,
-        tlas.gpu_bytes() as f64 / 1024.0
+        tlas.gpu_bytes() as f64 / 1024.0,
+        sah.total(),
+        sah.nodes,
+        sah.prims
     );
-}
-
-/// Surface area heuristic cost of a BLAS as the kernel sees it: each wide node visited costs 1
-/// and each triangle tested costs 1, weighted by the probability that a random ray through the
-/// root box hits the box (surface area ratio). Boxes are the quantized child boxes the kernel
-/// decodes. Also returns the area-weighted internal node count alone.
-fn sah_cost(nodes: &[hikari_bvh::WideNode]) -> (f64, f64) {
-    use hikari_bvh::layout::SlotKind;
-    let root = nodes[0];
-    let mut root_box = hikari_bvh::Aabb::EMPTY;
-    for slot in 0..8 {
-        if root.slot_kind(slot) != SlotKind::Empty {
-            root_box.grow(&root.child_box(slot));
-        }
-    }
-    let root_area = root_box.half_area() as f64;
-    // The root is always visited.
-    let mut internal = 1.0;
-    let mut triangles = 0.0;
-    for node in nodes {
-        for slot in 0..8 {
-            let area = || node.child_box(slot).half_area() as f64 / root_area;
-            match node.slot_kind(slot) {
-                SlotKind::Internal(_) => internal += area(),
-                SlotKind::Leaf { count, .. } => triangles += area() * count as f64,
-                SlotKind::Empty => {}
-            }
-        }
-    }
-    (internal + triangles, internal)
 }
 
 /// CPU time of this process (all threads) from /proc, in ns; None where /proc is missing.

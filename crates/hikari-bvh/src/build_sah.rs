@@ -1,4 +1,4 @@
-//! Binary BVH over primitive boxes by binned SAH, the first stage of every build (BLAS and TLAS).
+//! Binary BVH over primitive boxes by binned SAH, the first stage of every BLAS build.
 //!
 //! Primitives travel as 32-byte [`PrimRef`]s that every split reorders with a stable partition
 //! (left side first, each side in its previous order), so every pass over a node reads memory
@@ -149,37 +149,15 @@ pub(crate) fn build_in(
     // its scatter to the other buffer needs no copy back.
     let top = (n >= 2 * MIN_PARALLEL_PRIMS)
         .then(|| (n / (params.threads.max(1) * 8)).clamp(MIN_PARALLEL_PRIMS, MAX_SUBTREE_PRIMS));
-    build_with(prims, &mut scratch[..n], Vec::new(), params, top)
-}
-
-/// Serial [`build`] for inputs rebuilt every frame (the TLAS): `scratch` and `nodes` are
-/// buffers from a previous build, grown as needed and kept by the caller, so a rebuild
-/// allocates nothing once they are large enough. Gives the tree of [`build`].
-pub(crate) fn build_reusing(
-    prims: Vec<PrimRef>,
-    scratch: &mut Vec<PrimRef>,
-    nodes: Vec<BinNode>,
-    max_leaf: usize,
-) -> BinaryBvh {
-    let n = prims.len();
-    if scratch.len() < n {
-        scratch.resize(n, PrimRef::new(&Aabb::EMPTY, 0));
-    }
-    let params = SahParams {
-        max_leaf,
-        threads: 1,
-    };
-    // One thread: level-by-level splitting (only ever useful to share work) is not used.
-    build_with(prims, &mut scratch[..n], nodes, &params, None)
+    build_with(prims, &mut scratch[..n], params, top)
 }
 
 /// [`build_in`], with the top split level by level until no node holds more than
 /// `top_threshold` primitives, if given. The tree does not depend on it. `scratch` is as long
-/// as `prims`; `recycled_nodes` is a node buffer to reuse (its contents do not matter).
+/// as `prims`.
 fn build_with(
     mut prims: Vec<PrimRef>,
     scratch: &mut [PrimRef],
-    recycled_nodes: Vec<BinNode>,
     params: &SahParams,
     top_threshold: Option<usize>,
 ) -> BinaryBvh {
@@ -223,15 +201,7 @@ fn build_with(
         reserve.push(total..total + 2 * m.max(1) - 2);
         total += 2 * m.max(1) - 2;
     }
-    let mut nodes = recycled_nodes;
-    if nodes.capacity() >= total {
-        // Entries are written before they are read; stale ones can only remain in the gaps
-        // between subtrees, which nothing references.
-        nodes.truncate(total);
-        nodes.resize(total, bytemuck::Zeroable::zeroed());
-    } else {
-        nodes = bytemuck::zeroed_vec(total);
-    }
+    let mut nodes: Vec<BinNode> = bytemuck::zeroed_vec(total);
     nodes[..top.len()].copy_from_slice(&top);
     let prim_ranges: Vec<_> = subtrees.iter().map(|s| s.task.begin..s.task.end).collect();
     let jobs: Vec<_> = split_ranges(&mut nodes, &reserve)
@@ -432,7 +402,7 @@ fn side_bounds(ps: &[PrimRef]) -> (Aabb, Aabb) {
 fn small_split(prims: &mut [PrimRef]) -> (usize, [Aabb; 2]) {
     let n = prims.len();
     if n == 2 {
-        // The only split there is (common in the TLAS, with one instance per leaf).
+        // The only split there is.
         let b = |p: &PrimRef| Aabb::new(p.lo3(), p.hi3());
         return (1, [b(&prims[0]), b(&prims[1])]);
     }
@@ -714,18 +684,11 @@ mod tests {
                 threads,
             };
             let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-            let serial = canonical(&build_with(
-                prims.clone(),
-                &mut scratch,
-                Vec::new(),
-                &params(1),
-                None,
-            ));
+            let serial = canonical(&build_with(prims.clone(), &mut scratch, &params(1), None));
             for (threads, threshold) in [(1, 1000), (3, 700), (8, 64), (16, 5000)] {
                 let got = canonical(&build_with(
                     prims.clone(),
                     &mut scratch,
-                    Vec::new(),
                     &params(threads),
                     Some(threshold),
                 ));
@@ -747,20 +710,8 @@ mod tests {
             threads: 4,
         };
         let mut scratch = vec![PrimRef::new(&Aabb::EMPTY, 0); prims.len()];
-        let serial = canonical(&build_with(
-            prims.clone(),
-            &mut scratch,
-            Vec::new(),
-            &params,
-            None,
-        ));
-        let top = canonical(&build_with(
-            prims,
-            &mut scratch,
-            Vec::new(),
-            &params,
-            Some(300),
-        ));
+        let serial = canonical(&build_with(prims.clone(), &mut scratch, &params, None));
+        let top = canonical(&build_with(prims, &mut scratch, &params, Some(300)));
         assert!(top == serial);
     }
 

@@ -56,6 +56,9 @@ pub enum BvhError {
         got: usize,
     },
 
+    #[error("TLAS over {selected} instances: at most {max} are supported")]
+    TooManyInstances { selected: usize, max: usize },
+
     #[error("instance {instance}: refers to BLAS {blas}, but only {blas_count} BLAS exist")]
     BadBlasIndex {
         instance: usize,

@@ -208,8 +208,16 @@
 //!    binary nodes lie in memory); subtrees of at most 8K primitives are collapsed as separate
 //!    jobs, scheduled dynamically on threads, and assembled in a fixed order.
 //!
-//! The TLAS uses the same builder with one instance per leaf slot; its binary build stops at
-//! 8 instances, and each such group becomes one node of single-instance leaves.
+//! The TLAS has a builder of its own ([`tlas`]), rebuilt every frame over at most a few thousand
+//! instances, where the binned builder's fixed costs per node dominate: instances are sorted
+//! once by the 30-bit Morton code of their box centre (radix sort), and wide nodes are emitted
+//! top-down directly, with no binary tree. A node's range of that order is split where the SAH
+//! cost is lowest (every position for up to 24 instances; else the best boundary of at most 32
+//! equal chunks, then every position around it), the child with the largest box first, until
+//! the node has 8 children or none holds more than 8 instances; a child of one instance is a
+//! leaf slot (one instance per slot). Slots and quantization as in step 3. What a rebuild
+//! derives from each instance (world-to-object matrix, world box) is kept and derived again only
+//! for instances whose transform, BLAS index or BLAS box changed.
 //!
 //! [`Blas::refit`] keeps the topology and slot assignment, recomputes boxes bottom-up
 //! (children follow parents, so one reverse sweep suffices) and re-quantizes every node. Triangles skipped at build time (for
@@ -225,6 +233,7 @@ pub mod mesh;
 pub mod reference;
 pub mod refit;
 pub mod rng;
+pub mod sah_cost;
 pub mod throttle;
 pub mod tlas;
 pub mod traverse;
@@ -237,6 +246,7 @@ pub use cull::{CullSettings, CullStats, Frustum, cull_instances};
 pub use error::BvhError;
 pub use layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
 pub use mesh::Mesh;
+pub use sah_cost::{SahCost, sah_cost};
 pub use throttle::{RefitBatch, RefitScheduler, ThrottleSettings};
 pub use tlas::{Instance, PackedBlases, Tlas, TlasBuilder, TlasStats};
 pub use traverse::{Stack, TraversalStacks};

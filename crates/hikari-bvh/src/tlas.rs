@@ -3,13 +3,15 @@
 
 use crate::aabb::Aabb;
 use crate::blas::Blas;
-use crate::build_sah::{self, BinNode, PrimRef};
 use crate::error::BvhError;
 use crate::layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
 use crate::traverse::{self, TraversalStacks};
-use crate::wide;
 use glam::Affine3A;
 use std::cell::RefCell;
+
+mod instance_cache;
+mod morton;
+mod sweep_build;
 
 /// One placement of a BLAS in the world.
 #[derive(Clone, Copy, Debug)]
@@ -101,10 +103,12 @@ impl PackedBlases {
 pub struct TlasStats {
     /// Instances in the TLAS.
     pub instances: usize,
-    /// Selected instances left out because their transform is singular or not finite, or their
-    /// BLAS box is empty.
+    /// Selected instances left out: an index past the end of the instance list, a transform
+    /// that is singular or not finite, or a world box that is empty or not finite.
     pub skipped_invalid: usize,
+    /// Wide nodes.
     pub nodes: usize,
+    /// Nodes on the longest root-to-leaf path (the kernel's TLAS stack needs this many entries).
     pub depth: u32,
 }
 
@@ -117,20 +121,24 @@ pub struct Tlas {
     pub stats: TlasStats,
 }
 
-/// Buffers for rebuilding a TLAS every frame, kept from one build to the next so that a
-/// rebuild allocates only the arrays of the TLAS it returns. [`Tlas::build`] keeps one per
-/// thread; own one to control when its memory is released.
+/// What a TLAS rebuild keeps from one build to the next: its buffers, so that a rebuild
+/// allocates only the arrays of the TLAS it returns, and what it derived from each instance
+/// (world-to-object matrix, world box), derived again only for instances whose transform, BLAS
+/// index or BLAS box changed. [`Tlas::build`] keeps one per thread; own one to control when its
+/// memory is released.
 #[derive(Default)]
 pub struct TlasBuilder {
     offsets: Vec<(u32, u32)>,
-    records: Vec<InstanceRecord>,
-    prims: Vec<PrimRef>,
-    scratch: Vec<PrimRef>,
-    nodes: Vec<BinNode>,
+    cache: instance_cache::InstanceCache,
+    /// Cache entries of this build's instances, in selection order.
+    entries: Vec<u32>,
+    sweep: sweep_build::SweepBuilder,
+    /// Cache entries in leaf order.
+    leaves: Vec<u32>,
 }
 
 /// Instances above which [`Tlas::build`] gives its per-thread buffers back after a build rather
-/// than holding them (about 200 bytes per instance) until the thread ends.
+/// than holding them (about 300 bytes per instance) until the thread ends.
 const KEEP_BUFFERS_UP_TO: usize = 64 * 1024;
 
 thread_local! {
@@ -145,83 +153,71 @@ impl TlasBuilder {
         selected: &[u32],
         blases: &[Blas],
     ) -> Result<Tlas, BvhError> {
+        if selected.len() > crate::build_sah::MAX_PRIMS {
+            return Err(BvhError::TooManyInstances {
+                selected: selected.len(),
+                max: crate::build_sah::MAX_PRIMS,
+            });
+        }
         let Self {
             offsets,
-            records,
-            prims,
-            scratch,
-            nodes,
+            cache,
+            entries,
+            sweep,
+            leaves,
         } = self;
         offsets.clear();
         offsets.extend(blas_offsets_iter(blases));
-        records.clear();
-        prims.clear();
-        records.reserve(selected.len());
-        prims.reserve(selected.len());
+        cache.begin(instances.len(), blases);
+        entries.clear();
         let mut stats = TlasStats::default();
         for &i in selected {
             let Some(inst) = instances.get(i as usize) else {
                 stats.skipped_invalid += 1;
                 continue;
             };
-            let Some(blas) = blases.get(inst.blas as usize) else {
+            if inst.blas as usize >= blases.len() {
                 return Err(BvhError::BadBlasIndex {
                     instance: i as usize,
                     blas: inst.blas,
                     blas_count: blases.len(),
                 });
-            };
-            let Some(w2o) = world_to_object(&inst.transform) else {
-                stats.skipped_invalid += 1;
-                continue;
-            };
-            let bounds = blas.bounds.transformed(&inst.transform);
-            if bounds.is_empty() || !bounds.is_finite() {
-                stats.skipped_invalid += 1;
-                continue;
             }
-            let (node_off, tri_off) = offsets[inst.blas as usize];
-            prims.push(PrimRef::new(&bounds, records.len() as u32));
-            records.push(InstanceRecord {
-                world_to_object: w2o,
-                blas_node_offset: node_off,
-                blas_triangle_offset: tri_off,
-                instance_index: i,
-                blas_index: inst.blas,
-            });
+            match cache.entry(i, inst, blases) {
+                Some(e) => entries.push(e),
+                None => stats.skipped_invalid += 1,
+            }
         }
-        if prims.is_empty() {
+        if entries.is_empty() {
             return Ok(Tlas {
                 stats,
                 ..Default::default()
             });
         }
-        // One instance per leaf slot: entering an instance costs a transform and a BLAS root
-        // visit, so the tightest possible TLAS boxes pay off. The binary build stops at 8
-        // instances, which the collapse turns into one node of single-instance leaves; splitting
-        // further would only decide slot order, at most of the TLAS build's cost.
-        let binary = build_sah::build_reusing(
-            std::mem::take(prims),
-            scratch,
-            std::mem::take(nodes),
-            crate::layout::WIDTH,
-        );
-        let bounds = binary.nodes[0].bounds;
-        let wide = wide::collapse(&binary, 1, 1);
-        let leaf_records: Vec<InstanceRecord> = wide
-            .leaf_prims
+        // Nodes hold about four instances on average: room enough not to regrow.
+        let mut nodes = Vec::with_capacity(entries.len() / 3 + 1);
+        let built = sweep.build(cache.bounds(), entries, &mut nodes, leaves);
+        let records: Vec<InstanceRecord> = leaves
             .iter()
-            .map(|&p| records[binary.prims[p as usize].id() as usize])
+            .map(|&e| {
+                let (world_to_object, instance_index, blas_index) = cache.record_data(e);
+                let (blas_node_offset, blas_triangle_offset) = offsets[blas_index as usize];
+                InstanceRecord {
+                    world_to_object: *world_to_object,
+                    blas_node_offset,
+                    blas_triangle_offset,
+                    instance_index,
+                    blas_index,
+                }
+            })
             .collect();
-        *prims = binary.prims;
-        *nodes = binary.nodes;
-        stats.instances = leaf_records.len();
-        stats.nodes = wide.nodes.len();
-        stats.depth = wide.depth;
+        stats.instances = records.len();
+        stats.nodes = nodes.len();
+        stats.depth = built.depth;
         Ok(Tlas {
-            nodes: wide.nodes,
-            instances: leaf_records,
-            bounds,
+            nodes,
+            instances: records,
+            bounds: built.bounds,
             stats,
         })
     }
@@ -230,9 +226,9 @@ impl TlasBuilder {
     pub fn capacity_bytes(&self) -> usize {
         use std::mem::size_of;
         self.offsets.capacity() * size_of::<(u32, u32)>()
-            + self.records.capacity() * size_of::<InstanceRecord>()
-            + (self.prims.capacity() + self.scratch.capacity()) * size_of::<PrimRef>()
-            + self.nodes.capacity() * size_of::<BinNode>()
+            + self.cache.capacity_bytes()
+            + (self.entries.capacity() + self.leaves.capacity()) * size_of::<u32>()
+            + self.sweep.capacity_bytes()
     }
 }
 
@@ -324,4 +320,170 @@ fn for_each_chunk<T: Send>(
             });
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::build_sah::{PrimRef, SahParams};
+
+    /// The builder the TLAS used before it had its own: binned SAH down to 8 instances, then
+    /// the BLAS collapse with one instance per leaf slot. The reference for tree quality.
+    pub(crate) fn binned_reference(
+        instances: &[Instance],
+        selected: &[u32],
+        blases: &[Blas],
+    ) -> Tlas {
+        let offsets = blas_offsets(blases);
+        let mut records = Vec::new();
+        let mut prims = Vec::new();
+        for &i in selected {
+            let Some(inst) = instances.get(i as usize) else {
+                continue;
+            };
+            let blas = &blases[inst.blas as usize];
+            let Some(w2o) = world_to_object(&inst.transform) else {
+                continue;
+            };
+            let bounds = blas.bounds.transformed(&inst.transform);
+            if bounds.is_empty() || !bounds.is_finite() {
+                continue;
+            }
+            let (node_off, tri_off) = offsets[inst.blas as usize];
+            prims.push(PrimRef::new(&bounds, records.len() as u32));
+            records.push(InstanceRecord {
+                world_to_object: w2o,
+                blas_node_offset: node_off,
+                blas_triangle_offset: tri_off,
+                instance_index: i,
+                blas_index: inst.blas,
+            });
+        }
+        let params = SahParams {
+            max_leaf: crate::layout::WIDTH,
+            threads: 1,
+        };
+        let binary = crate::build_sah::build(prims, &params);
+        let wide = crate::wide::collapse(&binary, 1, 1);
+        let leaf_records: Vec<InstanceRecord> = wide
+            .leaf_prims
+            .iter()
+            .map(|&p| records[binary.prims[p as usize].id() as usize])
+            .collect();
+        Tlas {
+            stats: TlasStats {
+                instances: leaf_records.len(),
+                skipped_invalid: 0,
+                nodes: wide.nodes.len(),
+                depth: wide.depth,
+            },
+            nodes: wide.nodes,
+            instances: leaf_records,
+            bounds: binary.nodes[0].bounds,
+        }
+    }
+
+    /// Instances as a village places them (rows on a grid with equal rotations, props
+    /// scattered between, a few large buildings), uniformly scattered, or in dense clusters.
+    fn scene(kind: usize, count: usize, seed: u64) -> Vec<Instance> {
+        let mut rng = crate::rng::SplitMix64::new(seed);
+        (0..count)
+            .map(|i| {
+                let (centre, scale) = match kind {
+                    0 if i % 3 == 0 => {
+                        let cell = (i / 3) as f32;
+                        let c = glam::Vec3::new(
+                            (cell % 20.0) * 12.0,
+                            0.0,
+                            (cell / 20.0).floor() * 12.0,
+                        );
+                        (c, 3.0)
+                    }
+                    0 if i % 50 == 1 => (
+                        glam::Vec3::new(rng.range(0.0, 240.0), 0.0, rng.range(0.0, 240.0)),
+                        15.0,
+                    ),
+                    0 => (
+                        glam::Vec3::new(
+                            rng.range(0.0, 240.0),
+                            rng.range(0.0, 2.0),
+                            rng.range(0.0, 240.0),
+                        ),
+                        rng.range(0.2, 1.5),
+                    ),
+                    1 => (
+                        glam::Vec3::new(
+                            rng.range(-100.0, 100.0),
+                            rng.range(-100.0, 100.0),
+                            rng.range(-100.0, 100.0),
+                        ),
+                        rng.range(0.5, 3.0),
+                    ),
+                    _ => {
+                        let cluster = (i % 7) as f32;
+                        let c = glam::Vec3::new(
+                            cluster * 40.0,
+                            (cluster * 13.0) % 30.0,
+                            (cluster * 71.0) % 90.0,
+                        );
+                        let d = glam::Vec3::new(
+                            rng.range(-4.0, 4.0),
+                            rng.range(-4.0, 4.0),
+                            rng.range(-4.0, 4.0),
+                        );
+                        (c + d, rng.range(0.1, 1.0))
+                    }
+                };
+                let rot = glam::Quat::from_rotation_y(if kind == 0 && i % 3 == 0 {
+                    0.0
+                } else {
+                    rng.range(0.0, std::f32::consts::TAU)
+                });
+                Instance::new(
+                    Affine3A::from_scale_rotation_translation(
+                        glam::Vec3::splat(scale),
+                        rot,
+                        centre,
+                    ),
+                    (i % 2) as u32,
+                )
+            })
+            .collect()
+    }
+
+    /// SAH cost against the binned builder's on scenes unlike the village: the instances a ray
+    /// enters (the part issue 5 bounds) within 5%, and the nodes it visits not far off (the
+    /// Morton order limits the candidate splits, and a node can hold small children's
+    /// instances directly; on these scenes the total comes out between 4% below and 14% above).
+    #[test]
+    fn instances_entered_stay_within_five_percent_of_binned_sah() {
+        let blases: Vec<Blas> = [
+            crate::Mesh::random_soup(1, 40, 1.0, 0.5),
+            crate::Mesh::random_soup(2, 30, 2.0, 1.0),
+        ]
+        .iter()
+        .map(|m| Blas::from_mesh("m", m, &Default::default()).unwrap())
+        .collect();
+        for kind in 0..3 {
+            for (count, seed) in [(300, 1), (1000, 2), (4000, 3)] {
+                let instances = scene(kind, count, seed);
+                let all: Vec<u32> = (0..count as u32).collect();
+                let new = crate::sah_cost(&Tlas::build(&instances, &all, &blases).unwrap().nodes);
+                let old = crate::sah_cost(&binned_reference(&instances, &all, &blases).nodes);
+                println!(
+                    "scene {kind}, {count}: SAH {:.3} ({:.3} + {:.3}), binned {:.3} ({:.3} + {:.3})",
+                    new.total(),
+                    new.nodes,
+                    new.prims,
+                    old.total(),
+                    old.nodes,
+                    old.prims
+                );
+                assert!(
+                    new.prims <= 1.05 * old.prims && new.total() <= 1.2 * old.total(),
+                    "scene {kind}, {count} instances: {new:?} vs binned {old:?}"
+                );
+            }
+        }
+    }
 }

@@ -5,7 +5,7 @@ use crate::aabb::Aabb;
 use crate::build_sah::BinaryBvh;
 use crate::build_sah::parallel::{collect_pieces, map_largest_first};
 use crate::layout::{META_INTERNAL, WIDTH, WideNode, leaf_meta};
-use glam::{BVec3A, Vec3A, Vec4};
+use glam::{Vec3A, Vec4};
 
 /// Result of a collapse: nodes in depth-first order of their allocation (every child index is
 /// larger than its parent's, which refit relies on) and, in leaf order, positions into `BinaryBvh::prims`.
@@ -32,8 +32,8 @@ pub fn collapse(bin: &BinaryBvh, max_leaf: usize, threads: usize) -> WideBvh {
     // Small trees are not worth splitting into jobs (nor spawning threads for).
     let split_into_jobs = bin.nodes[0].prims > 2 * JOB_PRIMS;
     if !split_into_jobs {
-        // Wide nodes hold 4 primitives or more on average (TLAS: one per slot, 4 to 5 slots
-        // used): room enough that the arrays are not regrown on every rebuild.
+        // Wide nodes hold 4 primitives or more on average: room enough that the arrays are
+        // not regrown.
         nodes.reserve(bin.prims.len() / 3 + 1);
         leaf_prims.reserve(bin.prims.len());
     }
@@ -212,6 +212,7 @@ fn emit(
         let todo_start = todo.len();
         for slot in 0..WIDTH {
             let Some(ci) = slots[slot] else { continue };
+            let ci = ci as usize;
             let c = open[ci];
             boxes[slot] = Some(bn[c as usize].bounds);
             if bn[c as usize].prims as usize > max_leaf {
@@ -236,8 +237,8 @@ fn emit(
     depth
 }
 
-/// A node for a binary leaf holding more primitives than one leaf slot may (the TLAS builds
-/// binary leaves of up to 8 instances): each slot takes a chunk of at most `max_leaf`.
+/// A node for a binary leaf holding more primitives than one leaf slot may (a binary tree built
+/// with larger leaves than `max_leaf`): each slot takes a chunk of at most `max_leaf`.
 fn leaf_bundle(
     bin: &BinaryBvh,
     leaf: &crate::build_sah::BinNode,
@@ -287,6 +288,7 @@ fn leaf_bundle(
     let mut offset = 0u32;
     for (slot, k) in slots.iter().enumerate() {
         let Some(k) = *k else { continue };
+        let k = k as usize;
         let chunk = &order[k * max_leaf..((k + 1) * max_leaf).min(count)];
         leaf_prims.extend_from_slice(chunk);
         node.set_meta(slot, leaf_meta(offset, chunk.len() as u32));
@@ -320,18 +322,34 @@ fn gather_prims(bin: &BinaryBvh, root: u32, out: &mut Vec<u32>) {
 /// parent's centre. Traversal visits slots in the order `slot ^ ray_octant`, so a ray meets
 /// children roughly front to back without sorting. Children with the strongest preference (the
 /// largest centre offset) choose first, each taking the free slot whose corner direction best
-/// matches its offset; returns, per slot, the child index.
-pub(crate) fn assign_slots(parent_center: Vec3A, centers: &[Vec3A]) -> [Option<usize>; WIDTH] {
+/// matches its offset; returns, per slot, the child index (at most 8 children).
+pub(crate) fn assign_slots(parent_center: Vec3A, centers: &[Vec3A]) -> [Option<u8>; WIDTH] {
     // Eight lanes as two `Vec4`s throughout: every comparison here is a coin flip for a branch
     // predictor, and this runs for every node of every TLAS rebuild.
     let n = centers.len().min(WIDTH);
-    let mut offsets = [Vec3A::ZERO; WIDTH];
     // Unused lanes hold NaN, which compares neither greater nor equal.
     let mut strength = [f32::NAN; WIDTH];
+    // Per child, its scores for the eight slots (two lane groups) and the first slot of its
+    // highest score: the slot it takes if still free when its turn comes, which is usually so.
+    // Computed for all children up front, where they do not wait on each other.
+    let mut scores = [(Vec4::ZERO, Vec4::ZERO); WIDTH];
+    let mut favourite = [0u32; WIDTH];
+    // Corner direction of each slot: +1 on axes whose bit is set, -1 otherwise.
+    const X: Vec4 = Vec4::new(-1.0, 1.0, -1.0, 1.0);
+    const Y: Vec4 = Vec4::new(-1.0, -1.0, 1.0, 1.0);
     for c in 0..n {
         let off = centers[c] - parent_center;
-        offsets[c] = if off.is_finite() { off } else { Vec3A::ZERO };
-        strength[c] = offsets[c].abs().element_sum();
+        let o = if off.is_finite() { off } else { Vec3A::ZERO };
+        strength[c] = o.abs().element_sum();
+        // Dot products with all eight corner directions; multiplying by +-1 is exact, so each
+        // score is exactly the sum of the signed offsets (x, then y, then z). Offsets are
+        // finite, so no score is NaN.
+        let xy = X * o.x + Y * o.y;
+        let z = Vec4::splat(o.z);
+        let (lo, hi) = (xy - z, xy + z);
+        scores[c] = (lo, hi);
+        let best = Vec4::splat(lo.max(hi).max_element());
+        favourite[c] = (lo.cmpeq(best).bitmask() | hi.cmpeq(best).bitmask() << 4).trailing_zeros();
     }
     let lanes = |v: &[f32; WIDTH]| {
         (
@@ -343,43 +361,46 @@ pub(crate) fn assign_slots(parent_center: Vec3A, centers: &[Vec3A]) -> [Option<u
     // Stable sort by decreasing strength, ties in child order (deterministic): each child's
     // rank is the number of children stronger than it, or as strong and before it.
     let (s_lo, s_hi) = lanes(&strength);
-    let mut order = [0usize; WIDTH];
+    let mut order = [0u8; WIDTH];
     for (c, &strength_c) in strength[..n].iter().enumerate() {
         let sc = Vec4::splat(strength_c);
         let stronger = bits(s_lo.cmpgt(sc), s_hi.cmpgt(sc));
         let tied_before = bits(s_lo.cmpeq(sc), s_hi.cmpeq(sc)) & ((1u32 << c) - 1);
-        order[(stronger | tied_before).count_ones() as usize] = c;
+        order[(stronger | tied_before).count_ones() as usize] = c as u8;
     }
-    // Corner direction of each slot: +1 on axes whose bit is set, -1 otherwise.
-    const X: Vec4 = Vec4::new(-1.0, 1.0, -1.0, 1.0);
-    const Y: Vec4 = Vec4::new(-1.0, -1.0, 1.0, 1.0);
     let mut slots = [None; WIDTH];
     let mut free = (1u32 << WIDTH) - 1;
     for &c in &order[..n] {
-        let o = offsets[c];
-        // Dot products with all eight corner directions; multiplying by +-1 is exact, so each
-        // score is exactly the sum of the signed offsets (x, then y, then z). Offsets are
-        // finite, so no score is NaN.
-        let xy = X * o.x + Y * o.y;
-        let z = Vec4::splat(o.z);
-        let free_lo = glam::BVec4A::new(free & 1 != 0, free & 2 != 0, free & 4 != 0, free & 8 != 0);
-        let free_hi = glam::BVec4A::new(
-            free & 16 != 0,
-            free & 32 != 0,
-            free & 64 != 0,
-            free & 128 != 0,
-        );
-        let ninf = Vec4::NEG_INFINITY;
-        let lo = Vec4::select(free_lo, xy - z, ninf);
-        let hi = Vec4::select(free_hi, xy + z, ninf);
-        // The first free slot of the highest score (any free one if all scores are -inf).
-        let best = Vec4::splat(lo.max(hi).max_element());
-        let slot = (bits(lo.cmpeq(best), hi.cmpeq(best)) & free).trailing_zeros() as usize;
+        let c = c as usize;
+        // The favourite is the first slot of the highest score overall, hence also among the
+        // free slots when it is free itself.
+        let mut slot = favourite[c];
+        if free & (1 << slot) == 0 {
+            let (lo, hi) = scores[c];
+            let ninf = Vec4::NEG_INFINITY;
+            let lo = Vec4::select(FREE_LANES[(free & 0xF) as usize], lo, ninf);
+            let hi = Vec4::select(FREE_LANES[(free >> 4) as usize], hi, ninf);
+            // The first free slot of the highest score (any free one if all scores are -inf).
+            let best = Vec4::splat(lo.max(hi).max_element());
+            slot = (bits(lo.cmpeq(best), hi.cmpeq(best)) & free).trailing_zeros();
+        }
         free &= !(1 << slot);
-        slots[slot] = Some(c);
+        slots[slot as usize] = Some(c as u8);
     }
     slots
 }
+
+/// Lane masks of four slots from four bits of a free-slot mask (bit `k` set: lane `k` true):
+/// a table lookup instead of four scalar-to-vector moves on the slot assignment's critical path.
+const FREE_LANES: [glam::BVec4A; 16] = {
+    let mut t = [glam::BVec4A::FALSE; 16];
+    let mut i = 0;
+    while i < 16 {
+        t[i] = glam::BVec4A::new(i & 1 != 0, i & 2 != 0, i & 4 != 0, i & 8 != 0);
+        i += 1;
+    }
+    t
+};
 
 /// Smallest power-of-two step `2^(e-127)` with `255 * step >= extent`, as the biased exponent.
 fn step_exponent(extent: f32) -> u32 {
@@ -399,12 +420,32 @@ fn step_exponent(extent: f32) -> u32 {
 /// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
 /// (`origin + q * step`, evaluated in f32 as the kernel does) contains the exact child box.
 ///
-/// The three axes are quantized together in SIMD lanes (every node of every TLAS rebuild comes
-/// through here); each lane computes exactly what a scalar loop per axis would.
+/// The eight slots are quantized together as SIMD lanes, one axis at a time (every node of
+/// every TLAS rebuild comes through here); each lane computes exactly what a scalar loop per
+/// slot and axis would.
 pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], imask: u8) {
+    let mut list = [Aabb::EMPTY; WIDTH];
+    let mut slots = [None; WIDTH];
+    for (slot, b) in boxes.iter().enumerate() {
+        if let Some(b) = b {
+            list[slot] = *b;
+            slots[slot] = Some(slot as u8);
+        }
+    }
+    encode_children(node, &list, &slots, imask);
+}
+
+/// [`encode_boxes`] with slot `s` holding the child box `boxes[slots[s]]`, as
+/// [`assign_slots`] places them.
+pub(crate) fn encode_children(
+    node: &mut WideNode,
+    boxes: &[Aabb],
+    slots: &[Option<u8>; WIDTH],
+    imask: u8,
+) {
     let mut all = Aabb::EMPTY;
-    for b in boxes.iter().flatten() {
-        all.grow(b);
+    for &k in slots.iter().flatten() {
+        all.grow(&boxes[k as usize]);
     }
     if all.is_empty() {
         node.origin = [0.0; 3];
@@ -413,95 +454,171 @@ pub(crate) fn encode_boxes(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], i
     }
     let origin = all.min;
     let ext = all.max - origin;
+    // Per lane group (slots 0..4, 4..8), the slots' lower and upper bounds transposed to one
+    // vector per axis.
+    let o4 = as_lanes(origin);
+    let mut lo = [[Vec4::ZERO; 2]; 3];
+    let mut hi = [[Vec4::ZERO; 2]; 3];
+    for h in 0..2 {
+        // Empty slots sit at the origin, where they quantize to 0 and never force a coarser
+        // step.
+        let corner = |k: usize, upper: bool| match slots[4 * h + k] {
+            None => o4,
+            Some(c) if upper => as_lanes(boxes[c as usize].max),
+            Some(c) => as_lanes(boxes[c as usize].min),
+        };
+        for (upper, out) in [(false, &mut lo), (true, &mut hi)] {
+            let t = glam::Mat4::from_cols(
+                corner(0, upper),
+                corner(1, upper),
+                corner(2, upper),
+                corner(3, upper),
+            )
+            .transpose();
+            out[0][h] = t.x_axis;
+            out[1][h] = t.y_axis;
+            out[2][h] = t.z_axis;
+        }
+    }
     let mut e = [0u32; 3];
     for (a, ea) in e.iter_mut().enumerate() {
         *ea = step_exponent(ext[a]);
     }
-    // Plane indices are small integers, held as floats (exact) so that they stay in SIMD lanes.
-    let mut q = [(Vec3A::ZERO, Vec3A::ZERO); WIDTH];
-    loop {
-        let step = Vec3A::new(
-            f32::from_bits(e[0] << 23),
-            f32::from_bits(e[1] << 23),
-            f32::from_bits(e[2] << 23),
-        );
-        // 1 / step, exact (a power of two; 2^-127 is the denormal 1 << 22), so multiplying by it
-        // rounds exactly as dividing by `step` would, at a fraction of the latency.
-        let inv = |e: u32| {
-            if e <= 253 {
-                f32::from_bits((254 - e) << 23)
+    // Quantized planes (small integers held as floats): per axis, the two lane groups of the
+    // lower planes, then of the upper ones.
+    let mut q = [[[Vec4::ZERO; 2]; 2]; 3];
+    // Axes still to quantize: all at first, then those whose step had to grow.
+    let mut todo = 0b111u32;
+    while todo != 0 {
+        let mut again = 0u32;
+        for a in 0..3 {
+            if todo & (1 << a) == 0 {
+                continue;
+            }
+            let step = f32::from_bits(e[a] << 23);
+            // 1 / step, exact (a power of two; 2^-127 is the denormal 1 << 22), so multiplying
+            // by it rounds exactly as dividing by `step` would, at a fraction of the latency.
+            let inv = if e[a] <= 253 {
+                f32::from_bits((254 - e[a]) << 23)
             } else {
                 f32::from_bits(1 << 22)
-            }
-        };
-        let inv_step = Vec3A::new(inv(e[0]), inv(e[1]), inv(e[2]));
-        let decode = |k: Vec3A| origin + k * step;
-        let one = Vec3A::ONE;
-        let top = Vec3A::splat(255.0);
-        // Axes where some child box is not covered by its decoded planes.
-        let mut missed = BVec3A::FALSE;
-        for (slot, b) in boxes.iter().enumerate() {
-            let Some(b) = b else { continue };
-            // Offsets are >= 0 (the origin is the minimum), so truncation is floor; planes
-            // clamp to 255.
-            let mut lo = truncated((b.min - origin) * inv_step, 255.0);
-            loop {
-                let down = lo.cmpgt(Vec3A::ZERO) & decode(lo).cmpgt(b.min);
-                if !down.any() {
-                    break;
+            };
+            let (o, st, iv) = (Vec4::splat(origin[a]), Vec4::splat(step), Vec4::splat(inv));
+            let decode = |k: Vec4| o + k * st;
+            let one = Vec4::ONE;
+            let top = Vec4::splat(255.0);
+            let mut missed = false;
+            for h in 0..2 {
+                let (mn, mx) = (lo[a][h], hi[a][h]);
+                // Offsets are >= 0 (the origin is the minimum), so truncation is floor; planes
+                // clamp to 255. Step down while the decoded plane lies above the box.
+                let mut l = truncated((mn - o) * iv, 255.0);
+                let mut above = decode(l).cmpgt(mn);
+                loop {
+                    let down = l.cmpgt(Vec4::ZERO) & above;
+                    if !down.any() {
+                        break;
+                    }
+                    l -= Vec4::select(down, one, Vec4::ZERO);
+                    above = decode(l).cmpgt(mn);
                 }
-                lo -= Vec3A::select(down, one, Vec3A::ZERO);
-            }
-            let f = (b.max - origin) * inv_step;
-            let mut hi = truncated(f, 256.0);
-            hi += Vec3A::select(hi.cmplt(f), one, Vec3A::ZERO);
-            hi = hi.min(top);
-            loop {
-                let up = hi.cmplt(top) & decode(hi).cmplt(b.max);
-                if !up.any() {
-                    break;
+                // Round up, then step up while the decoded plane lies below the box.
+                let f = (mx - o) * iv;
+                let mut u = truncated(f, 256.0);
+                u += Vec4::select(u.cmplt(f), one, Vec4::ZERO);
+                u = u.min(top);
+                let mut below = decode(u).cmplt(mx);
+                loop {
+                    let up = u.cmplt(top) & below;
+                    if !up.any() {
+                        break;
+                    }
+                    u += Vec4::select(up, one, Vec4::ZERO);
+                    below = decode(u).cmplt(mx);
                 }
-                hi += Vec3A::select(up, one, Vec3A::ZERO);
+                missed |= (below | above).any();
+                q[a][0][h] = l;
+                q[a][1][h] = u;
             }
-            missed |= decode(hi).cmplt(b.max) | decode(lo).cmpgt(b.min);
-            q[slot] = (lo, hi);
-        }
-        // Rounding of the origin addition left a plane unreachable: coarser step on that axis.
-        // At the largest finite step the decoded planes already reach +-inf, so stop there.
-        let retry = missed.bitmask();
-        let mut again = false;
-        for (a, ea) in e.iter_mut().enumerate() {
-            if retry & (1 << a) != 0 && *ea < 254 {
-                *ea += 1;
-                again = true;
+            // Rounding of the origin addition left a plane unreachable: coarser step on this
+            // axis. At the largest finite step the decoded planes already reach +-inf, so stop
+            // there.
+            if missed && e[a] < 254 {
+                e[a] += 1;
+                again |= 1 << a;
             }
         }
-        if !again {
-            break;
-        }
+        todo = again;
     }
     node.origin = origin.into();
     node.set_exponents_imask(e.map(|x| x as u8), imask);
-    for (slot, b) in boxes.iter().enumerate() {
-        if b.is_some() {
-            let (lo, hi) = q[slot];
-            node.set_quantized(
-                slot,
-                lo.to_array().map(|v| v as u8),
-                hi.to_array().map(|v| v as u8),
-            );
-        } else {
-            node.set_quantized(slot, [0; 3], [0; 3]);
-        }
-    }
+    node.lo_x = plane_bytes(q[0][0]);
+    node.lo_y = plane_bytes(q[1][0]);
+    node.lo_z = plane_bytes(q[2][0]);
+    node.hi_x = plane_bytes(q[0][1]);
+    node.hi_y = plane_bytes(q[1][1]);
+    node.hi_z = plane_bytes(q[2][1]);
 }
 
-/// Non-negative lanes truncated to integers (kept as floats), clamped to `max` first, with NaN
-/// lanes taken as 0: what Rust's saturating `as u32` casts give, for the range that matters.
+/// The vector's lanes as a `Vec4` (the fourth lane is unspecified).
+#[cfg(target_arch = "x86_64")]
 #[inline]
-fn truncated(v: Vec3A, max: f32) -> Vec3A {
-    let v = Vec3A::select(v.cmpeq(v), v, Vec3A::ZERO);
-    v.max(Vec3A::ZERO).min(Vec3A::splat(max)).trunc()
+fn as_lanes(v: Vec3A) -> Vec4 {
+    Vec4::from(std::arch::x86_64::__m128::from(v))
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline]
+fn as_lanes(v: Vec3A) -> Vec4 {
+    v.extend(0.0)
+}
+
+/// Non-negative lanes truncated to integers (kept as floats), clamped to `max` (at most 256)
+/// first, with NaN lanes taken as 0: what Rust's saturating `as u32` casts give, for the range
+/// that matters.
+#[inline]
+fn truncated(v: Vec4, max: f32) -> Vec4 {
+    let v = Vec4::select(v.cmpeq(v), v, Vec4::ZERO);
+    small_trunc(v.max(Vec4::ZERO).min(Vec4::splat(max)))
+}
+
+/// Truncation of lanes in `[0, 256]`: a round trip through integers, exact in that range.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn small_trunc(v: Vec4) -> Vec4 {
+    use std::arch::x86_64::{_mm_cvtepi32_ps, _mm_cvttps_epi32};
+    // SAFETY: SSE2 is part of the x86_64 baseline; these touch no memory.
+    Vec4::from(unsafe { _mm_cvtepi32_ps(_mm_cvttps_epi32(v.into())) })
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline]
+fn small_trunc(v: Vec4) -> Vec4 {
+    v.trunc()
+}
+
+/// Eight planes (integers 0..=255 held as floats, slots 0..4 and 4..8) as the bytes of a
+/// node field.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+fn plane_bytes(q: [Vec4; 2]) -> [u32; 2] {
+    use std::arch::x86_64::{
+        _mm_cvtsi128_si64, _mm_cvttps_epi32, _mm_packs_epi32, _mm_packus_epi16,
+    };
+    // Convert, then narrow to 16 and to 8 bits (the values fit, so neither saturates).
+    // SAFETY: SSE2 is part of the x86_64 baseline; these touch no memory.
+    let bytes = unsafe {
+        let words = _mm_packs_epi32(_mm_cvttps_epi32(q[0].into()), _mm_cvttps_epi32(q[1].into()));
+        _mm_cvtsi128_si64(_mm_packus_epi16(words, words)) as u64
+    };
+    [bytes as u32, (bytes >> 32) as u32]
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline]
+fn plane_bytes(q: [Vec4; 2]) -> [u32; 2] {
+    let b = |v: Vec4| u32::from_le_bytes(v.to_array().map(|x| x as u8));
+    [b(q[0]), b(q[1])]
 }
 
 #[cfg(test)]
@@ -531,9 +648,10 @@ mod tests {
         }
     }
 
-    use super::{WIDTH, assign_slots, encode_boxes};
+    use super::{WIDTH, assign_slots, encode_boxes, step_exponent};
     use crate::aabb::Aabb;
     use crate::layout::WideNode;
+    use glam::BVec3A;
     use glam::Vec3A;
 
     /// Child boxes from 1e-30 to 1e30 wide, some flat, some far from the origin.
@@ -554,6 +672,140 @@ mod tests {
             *b = Some(Aabb::new(c - e, c + e));
         }
         boxes
+    }
+
+    /// The encoder as it was before slots became lanes (all axes of one slot per SIMD operation):
+    /// the reference the lane version must match bit for bit.
+    /// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
+    /// (`origin + q * step`, evaluated in f32 as the kernel does) contains the exact child box.
+    ///
+    /// The three axes are quantized together in SIMD lanes (every node of every TLAS rebuild comes
+    /// through here); each lane computes exactly what a scalar loop per axis would.
+    fn encode_boxes_by_slot(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], imask: u8) {
+        let mut all = Aabb::EMPTY;
+        for b in boxes.iter().flatten() {
+            all.grow(b);
+        }
+        if all.is_empty() {
+            node.origin = [0.0; 3];
+            node.set_exponents_imask([127; 3], imask);
+            return;
+        }
+        let origin = all.min;
+        let ext = all.max - origin;
+        let mut e = [0u32; 3];
+        for (a, ea) in e.iter_mut().enumerate() {
+            *ea = step_exponent(ext[a]);
+        }
+        // Plane indices are small integers, held as floats (exact) so that they stay in SIMD lanes.
+        let mut q = [(Vec3A::ZERO, Vec3A::ZERO); WIDTH];
+        loop {
+            let step = Vec3A::new(
+                f32::from_bits(e[0] << 23),
+                f32::from_bits(e[1] << 23),
+                f32::from_bits(e[2] << 23),
+            );
+            // 1 / step, exact (a power of two; 2^-127 is the denormal 1 << 22), so multiplying by it
+            // rounds exactly as dividing by `step` would, at a fraction of the latency.
+            let inv = |e: u32| {
+                if e <= 253 {
+                    f32::from_bits((254 - e) << 23)
+                } else {
+                    f32::from_bits(1 << 22)
+                }
+            };
+            let inv_step = Vec3A::new(inv(e[0]), inv(e[1]), inv(e[2]));
+            let decode = |k: Vec3A| origin + k * step;
+            let one = Vec3A::ONE;
+            let top = Vec3A::splat(255.0);
+            // Axes where some child box is not covered by its decoded planes.
+            let mut missed = BVec3A::FALSE;
+            for (slot, b) in boxes.iter().enumerate() {
+                let Some(b) = b else { continue };
+                // Offsets are >= 0 (the origin is the minimum), so truncation is floor; planes
+                // clamp to 255.
+                let mut lo = truncated3((b.min - origin) * inv_step, 255.0);
+                loop {
+                    let down = lo.cmpgt(Vec3A::ZERO) & decode(lo).cmpgt(b.min);
+                    if !down.any() {
+                        break;
+                    }
+                    lo -= Vec3A::select(down, one, Vec3A::ZERO);
+                }
+                let f = (b.max - origin) * inv_step;
+                let mut hi = truncated3(f, 256.0);
+                hi += Vec3A::select(hi.cmplt(f), one, Vec3A::ZERO);
+                hi = hi.min(top);
+                loop {
+                    let up = hi.cmplt(top) & decode(hi).cmplt(b.max);
+                    if !up.any() {
+                        break;
+                    }
+                    hi += Vec3A::select(up, one, Vec3A::ZERO);
+                }
+                missed |= decode(hi).cmplt(b.max) | decode(lo).cmpgt(b.min);
+                q[slot] = (lo, hi);
+            }
+            // Rounding of the origin addition left a plane unreachable: coarser step on that axis.
+            // At the largest finite step the decoded planes already reach +-inf, so stop there.
+            let retry = missed.bitmask();
+            let mut again = false;
+            for (a, ea) in e.iter_mut().enumerate() {
+                if retry & (1 << a) != 0 && *ea < 254 {
+                    *ea += 1;
+                    again = true;
+                }
+            }
+            if !again {
+                break;
+            }
+        }
+        node.origin = origin.into();
+        node.set_exponents_imask(e.map(|x| x as u8), imask);
+        // Bytes gathered per field and stored as whole words (empty slots stay 0).
+        let mut planes = [[0u8; WIDTH]; 6];
+        for (slot, b) in boxes.iter().enumerate() {
+            if b.is_some() {
+                let (lo, hi) = q[slot];
+                for a in 0..3 {
+                    planes[a][slot] = lo[a] as u8;
+                    planes[3 + a][slot] = hi[a] as u8;
+                }
+            }
+        }
+        let words = |p: &[u8; WIDTH]| {
+            [
+                u32::from_le_bytes([p[0], p[1], p[2], p[3]]),
+                u32::from_le_bytes([p[4], p[5], p[6], p[7]]),
+            ]
+        };
+        node.lo_x = words(&planes[0]);
+        node.lo_y = words(&planes[1]);
+        node.lo_z = words(&planes[2]);
+        node.hi_x = words(&planes[3]);
+        node.hi_y = words(&planes[4]);
+        node.hi_z = words(&planes[5]);
+    }
+
+    /// Non-negative lanes truncated to integers (kept as floats), clamped to `max` first, with NaN
+    /// lanes taken as 0: what Rust's saturating `as u32` casts give, for the range that matters.
+    #[inline]
+    fn truncated3(v: Vec3A, max: f32) -> Vec3A {
+        let v = Vec3A::select(v.cmpeq(v), v, Vec3A::ZERO);
+        v.max(Vec3A::ZERO).min(Vec3A::splat(max)).trunc()
+    }
+
+    #[test]
+    fn lane_encoder_matches_the_per_slot_one() {
+        let mut rng = SplitMix64::new(31);
+        for it in 0..20_000 {
+            let boxes = random_boxes(&mut rng, it);
+            let mut got = WideNode::default();
+            encode_boxes(&mut got, &boxes, 0b1010_0101);
+            let mut want = WideNode::default();
+            encode_boxes_by_slot(&mut want, &boxes, 0b1010_0101);
+            assert_eq!(got, want, "case {it}: {boxes:?}");
+        }
     }
 
     #[test]
@@ -616,9 +868,77 @@ mod tests {
                 .collect();
             let slots = assign_slots(Vec3A::ZERO, &centres);
             for (c, &o) in octants[..n].iter().enumerate() {
-                assert_eq!(slots[o], Some(c), "octants {:?}", &octants[..n]);
+                assert_eq!(slots[o], Some(c as u8), "octants {:?}", &octants[..n]);
             }
             assert_eq!(slots.iter().flatten().count(), n);
+        }
+    }
+
+    /// The slot assignment as its documentation states it, one scalar step at a time.
+    fn slots_by_definition(parent: Vec3A, centres: &[Vec3A]) -> [Option<u8>; WIDTH] {
+        let offsets: Vec<Vec3A> = centres
+            .iter()
+            .map(|&c| {
+                let o = c - parent;
+                if o.is_finite() { o } else { Vec3A::ZERO }
+            })
+            .collect();
+        let strength: Vec<f32> = offsets
+            .iter()
+            .map(|o| o.x.abs() + o.y.abs() + o.z.abs())
+            .collect();
+        // Strongest first; a stable sort keeps ties in child order.
+        let mut order: Vec<usize> = (0..centres.len()).collect();
+        order.sort_by(|&a, &b| strength[b].total_cmp(&strength[a]));
+        let mut slots = [None; WIDTH];
+        for c in order {
+            let o = offsets[c];
+            let sign = |slot: usize, bit: usize| if slot & bit != 0 { 1.0 } else { -1.0 };
+            let score = |s: usize| (sign(s, 1) * o.x + sign(s, 2) * o.y) + sign(s, 4) * o.z;
+            let mut best: Option<usize> = None;
+            for s in (0..WIDTH).filter(|&s| slots[s].is_none()) {
+                if best.is_none_or(|b| score(s) > score(b)) {
+                    best = Some(s);
+                }
+            }
+            slots[best.unwrap()] = Some(c as u8);
+        }
+        slots
+    }
+
+    #[test]
+    fn slot_assignment_matches_its_definition() {
+        let mut rng = SplitMix64::new(21);
+        for it in 0..20_000 {
+            let n = 1 + rng.below(WIDTH);
+            let parent = Vec3A::new(rng.range(-1.0, 1.0), 0.5, rng.range(-3.0, 3.0));
+            let centres: Vec<Vec3A> = (0..n)
+                .map(|_| match it % 4 {
+                    // Few distinct values: equal strengths and equal scores.
+                    0 => Vec3A::new(
+                        rng.below(3) as f32 - 1.0,
+                        rng.below(3) as f32 - 1.0,
+                        rng.below(3) as f32 - 1.0,
+                    ),
+                    // Offsets that overflow the scores to infinity, or are not finite at all.
+                    1 => Vec3A::new(
+                        [3e38, -3e38, 1.0, f32::INFINITY][rng.below(4)],
+                        [3e38, -3e38, 2.0][rng.below(3)],
+                        [3e38, f32::NAN, -1.0][rng.below(3)],
+                    ),
+                    _ => Vec3A::new(
+                        rng.range(-10.0, 10.0),
+                        rng.range(-10.0, 10.0),
+                        rng.range(-10.0, 10.0),
+                    ),
+                })
+                .collect();
+            let parent = if it % 4 == 0 { Vec3A::ZERO } else { parent };
+            assert_eq!(
+                assign_slots(parent, &centres),
+                slots_by_definition(parent, &centres),
+                "parent {parent:?}, centres {centres:?}"
+            );
         }
     }
 
@@ -633,9 +953,9 @@ mod tests {
                 .collect();
             let slots = assign_slots(Vec3A::ZERO, &centres);
             let mut seen = [false; WIDTH];
-            for c in slots.iter().flatten() {
-                assert!(!seen[*c], "child {c} twice");
-                seen[*c] = true;
+            for &c in slots.iter().flatten() {
+                assert!(!seen[c as usize], "child {c} twice");
+                seen[c as usize] = true;
             }
             assert_eq!(seen.iter().filter(|&&s| s).count(), n);
         }

@@ -145,3 +145,128 @@ fn builder_and_one_shot_build_give_the_same_tlas() {
     }
     assert_eq!(first.stats.instances, all.len());
 }
+
+/// Builds with `builder` and with a fresh one, and checks the two TLAS are identical.
+fn same_as_cold(
+    builder: &mut TlasBuilder,
+    instances: &[Instance],
+    selected: &[u32],
+    blases: &[Blas],
+    frame: &str,
+) -> Tlas {
+    let warm = builder.build(instances, selected, blases).unwrap();
+    let cold = TlasBuilder::default()
+        .build(instances, selected, blases)
+        .unwrap();
+    assert!(warm.nodes == cold.nodes, "{frame}: nodes differ");
+    assert!(
+        warm.instances == cold.instances,
+        "{frame}: instance records differ"
+    );
+    assert_eq!(warm.stats, cold.stats, "{frame}");
+    assert_eq!(warm.bounds, cold.bounds, "{frame}");
+    warm
+}
+
+#[test]
+fn kept_instance_data_gives_the_tlas_of_a_cold_build() {
+    let (meshes, mut blases, mut instances) = village(500);
+    let mut rng = SplitMix64::new(8);
+    let all: Vec<u32> = (0..instances.len() as u32).collect();
+    let mut builder = TlasBuilder::default();
+    same_as_cold(&mut builder, &instances, &all, &blases, "first frame");
+
+    // Some instances move, by a little (one ulp) or a lot; one gets a mirrored transform.
+    for inst in instances.iter_mut().step_by(7) {
+        inst.transform.translation.x = f32::from_bits(inst.transform.translation.x.to_bits() + 1);
+    }
+    for inst in instances.iter_mut().skip(3).step_by(11) {
+        inst.transform.translation += glam::Vec3A::new(rng.range(-5.0, 5.0), 0.0, 2.0);
+    }
+    instances[10].transform.matrix3.x_axis = -instances[10].transform.matrix3.x_axis;
+    same_as_cold(&mut builder, &instances, &all, &blases, "moved");
+
+    // Some become invalid, others switch BLAS.
+    let singular = Affine3A::from_scale(Vec3::new(0.0, 1.0, 1.0));
+    let saved = (instances[20].transform, instances[21].transform);
+    instances[20].transform = singular;
+    instances[21].transform.translation.y = f32::NAN;
+    instances[30].blas = (instances[30].blas + 1) % blases.len() as u32;
+    let t = same_as_cold(&mut builder, &instances, &all, &blases, "invalid");
+    assert_eq!(t.stats.skipped_invalid, 2);
+    // And come back.
+    (instances[20].transform, instances[21].transform) = saved;
+    same_as_cold(&mut builder, &instances, &all, &blases, "valid again");
+
+    // A BLAS is refit (its box grows) while instances of it are culled for a few frames: when
+    // they come back, their world boxes must be the refit BLAS's.
+    let culled: Vec<u32> = all
+        .iter()
+        .copied()
+        .filter(|&i| instances[i as usize].blas != 0)
+        .collect();
+    same_as_cold(&mut builder, &instances, &culled, &blases, "culled");
+    let grown: Vec<Vec3> = meshes[0].positions.iter().map(|p| *p * 1.5).collect();
+    blases[0].refit(&grown).unwrap();
+    same_as_cold(
+        &mut builder,
+        &instances,
+        &culled,
+        &blases,
+        "refit, still culled",
+    );
+    same_as_cold(
+        &mut builder,
+        &instances,
+        &culled,
+        &blases,
+        "refit, still culled again",
+    );
+    let t = same_as_cold(
+        &mut builder,
+        &instances,
+        &all,
+        &blases,
+        "back after the refit",
+    );
+
+    // The rebuilt TLAS traces the refit geometry.
+    let moved: Vec<Mesh> = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            if i == 0 {
+                Mesh::new(grown.clone(), m.indices.clone())
+            } else {
+                m.clone()
+            }
+        })
+        .collect();
+    let rays = random_rays(&mut rng, 150, 30.0);
+    check(&moved, &blases, &instances, &all, &t, &rays);
+
+    // A different, shorter BLAS list (box of BLAS 1 changed, BLAS 2 gone), then the old one.
+    let fewer: Vec<Blas> = vec![blases[0].clone(), blases[2].clone()];
+    let some: Vec<u32> = all
+        .iter()
+        .copied()
+        .filter(|&i| instances[i as usize].blas < 2)
+        .collect();
+    same_as_cold(&mut builder, &instances, &some, &fewer, "other BLAS list");
+    same_as_cold(
+        &mut builder,
+        &instances,
+        &all,
+        &blases,
+        "first BLAS list again",
+    );
+
+    // More instances than the builder keeps data for: derived afresh each build.
+    let mut many = instances.clone();
+    while many.len() <= 70_000 {
+        many.extend_from_slice(&instances);
+    }
+    let spread: Vec<u32> = (0..many.len() as u32).step_by(97).collect();
+    same_as_cold(&mut builder, &many, &spread, &blases, "long instance list");
+    same_as_cold(&mut builder, &instances, &all, &blases, "short list again");
+}
