@@ -214,8 +214,9 @@
 //! top-down directly, with no binary tree. A node's range of that order is split where the SAH
 //! cost is lowest (every position for up to 24 instances; else the best boundary of at most 32
 //! equal chunks, then every position around it), the child with the largest box first, until
-//! the node has 8 children or none holds more than 8 instances; a child of one instance is a
-//! leaf slot (one instance per slot). Slots and quantization as in step 3. What a rebuild
+//! the node has 8 children or none holds more than 8 instances; free slots then take the
+//! instances of small children directly, and a child of one instance is a leaf slot (one
+//! instance per slot). Slots and quantization as in step 3. What a rebuild
 //! derives from each instance (world-to-object matrix, world box) is kept and derived again only
 //! for instances whose transform, BLAS index or BLAS box changed.
 //!
