@@ -2,10 +2,11 @@
 //! compare the BVH traversal against these; they share only the triangle test and the
 //! world-to-object transform with it.
 
+use crate::blas::Blas;
 use crate::layout::{Hit, InstanceRecord, Ray};
 use crate::mesh::Mesh;
 use crate::rng::SplitMix64;
-use crate::tlas::{Instance, world_to_object};
+use crate::tlas::{Instance, Tlas, world_to_object};
 use crate::traverse::to_object_space;
 use crate::triangle::{PreparedRay, intersect, is_degenerate};
 use glam::{Vec3, Vec3A};
@@ -175,4 +176,32 @@ pub fn same_hit(got: Option<Hit>, want: Option<Hit>) -> Result<(), String> {
             }
         }
     }
+}
+
+/// Traces every ray through `tlas` (built over `selected` of `instances`) and against brute
+/// force, closest and any hit; panics naming the first ray that disagrees. Returns the number
+/// of rays that hit something.
+pub fn assert_tlas_matches_brute_force(
+    tlas: &Tlas,
+    meshes: &[Mesh],
+    blases: &[Blas],
+    instances: &[Instance],
+    selected: &[u32],
+    rays: &[Ray],
+) -> usize {
+    let mut hits = 0;
+    for (i, ray) in rays.iter().enumerate() {
+        let want = closest_hit_instances(meshes, instances, Some(selected), ray);
+        if let Err(e) = same_hit(tlas.closest_hit(blases, ray), want) {
+            panic!("{} instances, ray {i} {ray:?}: {e}", selected.len());
+        }
+        hits += want.is_some() as usize;
+        assert_eq!(
+            tlas.any_hit(blases, ray),
+            any_hit_instances(meshes, instances, Some(selected), ray),
+            "{} instances: any hit disagrees on ray {i} {ray:?}",
+            selected.len()
+        );
+    }
+    hits
 }

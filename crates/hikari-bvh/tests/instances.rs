@@ -4,8 +4,8 @@
 use hikari_bvh::reference as common;
 
 use glam::{Affine3A, Quat, Vec3};
-use hikari_bvh::reference::{any_hit_instances, closest_hit_instances};
-use hikari_bvh::reference::{random_rays, same_hit};
+use hikari_bvh::reference::assert_tlas_matches_brute_force;
+use hikari_bvh::reference::random_rays;
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Instance, Mesh, Ray, Tlas};
 
@@ -59,21 +59,7 @@ fn check(
     rays: &[Ray],
 ) -> usize {
     let tlas = Tlas::build(instances, selected, blases).unwrap();
-    let mut hits = 0;
-    for (i, ray) in rays.iter().enumerate() {
-        let want = closest_hit_instances(meshes, instances, Some(selected), ray);
-        let got = tlas.closest_hit(blases, ray);
-        if let Err(e) = same_hit(got, want) {
-            panic!("ray {i} {ray:?}: {e}");
-        }
-        hits += want.is_some() as usize;
-        assert_eq!(
-            tlas.any_hit(blases, ray),
-            any_hit_instances(meshes, instances, Some(selected), ray),
-            "any-hit disagrees on ray {i} {ray:?}"
-        );
-    }
-    hits
+    assert_tlas_matches_brute_force(&tlas, meshes, blases, instances, selected, rays)
 }
 
 #[test]

@@ -5,9 +5,8 @@
 
 use glam::{Affine3A, Quat, Vec3};
 use hikari_bvh::layout::SlotKind;
-use hikari_bvh::reference::{
-    any_hit_instances, closest_hit_instances, random_dir, random_rays, same_hit,
-};
+use hikari_bvh::reference::assert_tlas_matches_brute_force;
+use hikari_bvh::reference::{random_dir, random_rays};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::tlas::TlasBuilder;
 use hikari_bvh::{Blas, BuildOptions, Instance, Mesh, Ray, Tlas};
@@ -90,31 +89,6 @@ fn check_shape(tlas: &Tlas) -> u32 {
     depth
 }
 
-fn check_hits(
-    meshes: &[Mesh],
-    blases: &[Blas],
-    instances: &[Instance],
-    selected: &[u32],
-    tlas: &Tlas,
-    rays: &[Ray],
-) -> usize {
-    let mut hits = 0;
-    for (i, ray) in rays.iter().enumerate() {
-        let want = closest_hit_instances(meshes, instances, Some(selected), ray);
-        if let Err(e) = same_hit(tlas.closest_hit(blases, ray), want) {
-            panic!("{} instances, ray {i} {ray:?}: {e}", selected.len());
-        }
-        hits += want.is_some() as usize;
-        assert_eq!(
-            tlas.any_hit(blases, ray),
-            any_hit_instances(meshes, instances, Some(selected), ray),
-            "{} instances: any hit disagrees on ray {i} {ray:?}",
-            selected.len()
-        );
-    }
-    hits
-}
-
 /// Builds over all of `instances`, checks shape and hits, returns the TLAS.
 fn build_and_check(name: &str, instances: &[Instance], extent: f32, min_hits: usize) -> Tlas {
     let (meshes, blases) = meshes();
@@ -123,7 +97,7 @@ fn build_and_check(name: &str, instances: &[Instance], extent: f32, min_hits: us
     check_shape(&tlas);
     let mut rng = SplitMix64::new(99);
     let rays = rays(&mut rng, instances, extent);
-    let hits = check_hits(&meshes, &blases, instances, &all, &tlas, &rays);
+    let hits = assert_tlas_matches_brute_force(&tlas, &meshes, &blases, instances, &all, &rays);
     assert!(hits >= min_hits, "{name}: only {hits} hits");
     tlas
 }
@@ -262,7 +236,9 @@ fn invalid_and_missing_instances_are_skipped_and_counted() {
     check_shape(&tlas);
     let valid: Vec<u32> = (0..300).collect();
     let rays = rays(&mut rng, &instances, 25.0);
-    assert!(check_hits(&meshes, &blases, &instances, &valid, &tlas, &rays) > 50);
+    assert!(
+        assert_tlas_matches_brute_force(&tlas, &meshes, &blases, &instances, &valid, &rays) > 50
+    );
 }
 
 #[test]

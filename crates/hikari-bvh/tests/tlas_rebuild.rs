@@ -5,7 +5,8 @@
 //! small-input build.
 
 use glam::{Affine3A, Quat, Vec3};
-use hikari_bvh::reference::{any_hit_instances, closest_hit_instances, random_rays, same_hit};
+use hikari_bvh::reference::assert_tlas_matches_brute_force;
+use hikari_bvh::reference::random_rays;
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::tlas::TlasBuilder;
 use hikari_bvh::{Blas, BuildOptions, Instance, Mesh, Ray, Tlas};
@@ -57,32 +58,6 @@ fn village(count: usize) -> (Vec<Mesh>, Vec<Blas>, Vec<Instance>) {
     (meshes, blases, instances)
 }
 
-/// Checks every ray against brute force; returns the number of hits.
-fn check(
-    meshes: &[Mesh],
-    blases: &[Blas],
-    instances: &[Instance],
-    selected: &[u32],
-    tlas: &Tlas,
-    rays: &[Ray],
-) -> usize {
-    let mut hits = 0;
-    for (i, ray) in rays.iter().enumerate() {
-        let want = closest_hit_instances(meshes, instances, Some(selected), ray);
-        if let Err(e) = same_hit(tlas.closest_hit(blases, ray), want) {
-            panic!("{} instances, ray {i} {ray:?}: {e}", selected.len());
-        }
-        hits += want.is_some() as usize;
-        assert_eq!(
-            tlas.any_hit(blases, ray),
-            any_hit_instances(meshes, instances, Some(selected), ray),
-            "{} instances: any-hit disagrees on ray {i} {ray:?}",
-            selected.len()
-        );
-    }
-    hits
-}
-
 #[test]
 fn reused_builder_matches_brute_force_frame_after_frame() {
     let (meshes, blases, mut instances) = village(600);
@@ -111,14 +86,15 @@ fn reused_builder_matches_brute_force_frame_after_frame() {
     for selected in frames {
         let tlas = builder.build(&instances, selected, &blases).unwrap();
         assert_eq!(tlas.stats.instances, selected.len());
-        total_hits += check(&meshes, &blases, &instances, selected, &tlas, &rays);
+        total_hits +=
+            assert_tlas_matches_brute_force(&tlas, &meshes, &blases, &instances, selected, &rays);
     }
     for inst in instances.iter_mut().step_by(3) {
         inst.transform.translation += glam::Vec3A::new(0.5, 1.0, -0.25);
     }
     let tlas = builder.build(&instances, &all, &blases).unwrap();
     assert!(tlas.stats.depth >= 3, "depth {}", tlas.stats.depth);
-    total_hits += check(&meshes, &blases, &instances, &all, &tlas, &rays);
+    total_hits += assert_tlas_matches_brute_force(&tlas, &meshes, &blases, &instances, &all, &rays);
     // Rays that miss everything would pass trivially.
     assert!(total_hits > 100, "{total_hits} hits");
 }
@@ -243,7 +219,7 @@ fn kept_instance_data_gives_the_tlas_of_a_cold_build() {
         })
         .collect();
     let rays = random_rays(&mut rng, 150, 30.0);
-    check(&moved, &blases, &instances, &all, &t, &rays);
+    assert_tlas_matches_brute_force(&t, &moved, &blases, &instances, &all, &rays);
 
     // A different, shorter BLAS list (box of BLAS 1 changed, BLAS 2 gone), then the old one.
     let fewer: Vec<Blas> = vec![blases[0].clone(), blases[2].clone()];

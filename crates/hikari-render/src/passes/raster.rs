@@ -6,8 +6,9 @@
 //! Pass 1 (`{technique}.rasterize`) runs a thread a triangle: small triangles are rasterised by
 //! their thread, larger ones split into 32x32 tiles queued for pass 2
 //! (`{technique}.rasterize_tiles`), where a workgroup covers a tile; triangles spanning more
-//! than 256 tiles are listed whole for pass 3 (`{technique}.rasterize_large`), where every
-//! workgroup takes its share of each one's tiles, so no thread walks thousands of tiles alone.
+//! than 256 tiles are listed whole, with their tile rectangle, for pass 3
+//! (`{technique}.rasterize_large`), which deals all their tiles to its workgroups in turn; a
+//! workgroup sets up only the triangles it draws tiles of.
 //! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/raster.rs).
 
 use bytemuck::{Pod, Zeroable};
