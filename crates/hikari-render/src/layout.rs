@@ -73,7 +73,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             raster::RasterParams,
             "raster/triangles.wgsl",
-            [view_proj, viewport, config, slices]
+            [view_proj, viewport, config, slices, limits]
         ),
         gpu_layout!(
             sun_shadows::ShadowParams,

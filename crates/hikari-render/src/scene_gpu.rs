@@ -52,12 +52,47 @@ pub struct InstanceGpu {
     /// Last frame's model matrix, for motion vectors.
     pub prev_model: [[f32; 4]; 4],
     pub material: u32,
-    /// Bit 0: double-sided.
+    /// `INSTANCE_*` bits.
     pub flags: u32,
     pub pad: [u32; 2],
 }
 
 pub const INSTANCE_DOUBLE_SIDED: u32 = 1;
+/// The model matrix is not a rotation with uniform scale, so normals need `normal_model` (for
+/// the others the model's 3x3 gives the same directions once normalised, and the resolve skips
+/// loading a matrix).
+pub const INSTANCE_OWN_NORMAL_MATRIX: u32 = 2;
+/// `prev_model` differs from `model` (otherwise the resolve does not load it).
+pub const INSTANCE_MOVED: u32 = 4;
+
+/// Flags of an instance with this model and last frame's model.
+pub fn instance_flags(model: Mat4, prev_model: Mat4, double_sided: bool) -> u32 {
+    let mut flags = 0;
+    if double_sided {
+        flags |= INSTANCE_DOUBLE_SIDED;
+    }
+    if !is_rotation_with_uniform_scale(Mat3::from_mat4(model)) {
+        flags |= INSTANCE_OWN_NORMAL_MATRIX;
+    }
+    if model != prev_model {
+        flags |= INSTANCE_MOVED;
+    }
+    flags
+}
+
+/// Whether m = s R for a scale s and an orthogonal R (mirrors included): then its inverse
+/// transpose is m / s^2.
+fn is_rotation_with_uniform_scale(m: Mat3) -> bool {
+    let g = m.transpose() * m;
+    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+    let tolerance = 1e-5 * s2;
+    s2 > 0.0
+        && s2.is_finite()
+        && (g - Mat3::from_diagonal(Vec3::splat(s2)))
+            .to_cols_array()
+            .iter()
+            .all(|d| d.abs() <= tolerance)
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -227,11 +262,7 @@ impl SceneCpu {
                 normal_model: normal.to_cols_array_2d(),
                 prev_model: inst.transform.to_cols_array_2d(),
                 material: inst.material as u32,
-                flags: if mat.double_sided {
-                    INSTANCE_DOUBLE_SIDED
-                } else {
-                    0
-                },
+                flags: instance_flags(inst.transform, inst.transform, mat.double_sided),
                 pad: [0; 2],
             });
             let triangles = scene.meshes[inst.mesh].indices.len() as u32 / 3;
@@ -421,5 +452,52 @@ impl SceneGpu {
             bounds,
             cpu,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Quat;
+
+    #[test]
+    fn only_non_conformal_transforms_need_their_own_normal_matrix() {
+        let rotation = Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0);
+        let conformal = [
+            Mat4::IDENTITY,
+            Mat4::from_scale_rotation_translation(
+                Vec3::splat(3.5),
+                rotation,
+                Vec3::new(100.0, 2.0, -40.0),
+            ),
+            Mat4::from_scale_rotation_translation(Vec3::new(-0.2, 0.2, 0.2), rotation, Vec3::ZERO),
+        ];
+        for m in conformal {
+            assert_eq!(instance_flags(m, m, false), 0, "{m}");
+            // What the resolve relies on: the inverse transpose is the 3x3 up to a scale.
+            let n = Mat3::from_mat4(m).inverse().transpose();
+            let v = Vec3::new(0.3, -0.8, 0.52).normalize();
+            assert!(((n * v).normalize() - (Mat3::from_mat4(m) * v).normalize()).length() < 1e-5);
+        }
+        let sheared = [
+            Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)),
+            Mat4::from_scale_rotation_translation(Vec3::new(1.0, 1.0, 1.001), rotation, Vec3::ZERO),
+            Mat4::from_cols_array(&[
+                1.0, 0.5, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+            ]),
+            Mat4::from_scale(Vec3::ZERO),
+        ];
+        for m in sheared {
+            assert_eq!(
+                instance_flags(m, m, false),
+                INSTANCE_OWN_NORMAL_MATRIX,
+                "{m}"
+            );
+        }
+        let moved = Mat4::from_translation(Vec3::X);
+        assert_eq!(
+            instance_flags(moved, Mat4::IDENTITY, true),
+            INSTANCE_MOVED | INSTANCE_DOUBLE_SIDED
+        );
     }
 }

@@ -168,21 +168,54 @@ fn brdf_material_diffuse_albedo(m: BrdfMaterial) -> vec3<f32> {
     return saturate(m.base_color) * (1.0 - saturate(m.metalness));
 }
 
-// BRDF * n.l, 1/sr, per RGB channel; 0 when v or l is at or below the surface.
-fn brdf_evaluate(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
-    let v_local = vec3<f32>(dot(t, v), dot(b, v), dot(n, v));
-    let l_local = vec3<f32>(dot(t, l), dot(b, l), dot(n, l));
-    if v_local.z <= 0.0 || l_local.z <= 0.0 {
+// What brdf_evaluate derives from the material and the view direction alone: computed once
+// a pixel for all the lights that shade it.
+struct BrdfView {
+    t: vec3<f32>,
+    b: vec3<f32>,
+    n: vec3<f32>,
+    v_local: vec3<f32>,
+    alphas: vec2<f32>,
+    // Fresnel reflectance at normal incidence.
+    f_normal: vec3<f32>,
+    // Lambert times the view side's Fresnel transmission 1 - F(n.v).
+    diffuse: vec3<f32>,
+    // |v_local * (alpha_x, alpha_y, 1)|: the view's half of the height-correlated visibility.
+    v_stretched: f32,
+}
+
+fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<f32>) -> BrdfView {
+    var p: BrdfView;
+    p.t = t;
+    p.b = b;
+    p.n = n;
+    p.v_local = vec3<f32>(dot(t, v), dot(b, v), dot(n, v));
+    p.alphas = brdf_anisotropic_alphas(m.perceptual_roughness, m.anisotropy);
+    p.f_normal = brdf_material_f0(m);
+    p.diffuse = brdf_lambert(brdf_material_diffuse_albedo(m)) * (vec3<f32>(1.0) - brdf_fresnel_schlick(p.f_normal, p.v_local.z));
+    p.v_stretched = length(p.v_local * vec3<f32>(p.alphas, 1.0));
+    return p;
+}
+
+// brdf_evaluate for a prepared view: BRDF * n.l, 0 when v or l is at or below the surface.
+fn brdf_evaluate_view(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
+    let l_local = vec3<f32>(dot(p.t, l), dot(p.b, l), dot(p.n, l));
+    if p.v_local.z <= 0.0 || l_local.z <= 0.0 {
         return vec3<f32>(0.0);
     }
-    let h_local = normalize(v_local + l_local);
-    let alphas = brdf_anisotropic_alphas(m.perceptual_roughness, m.anisotropy);
-    let f0 = brdf_material_f0(m);
-    let spec = brdf_ggx_ndf_aniso(h_local, alphas.x, alphas.y)
-        * brdf_visibility_aniso(v_local, l_local, alphas.x, alphas.y)
-        * brdf_fresnel_schlick(f0, dot(v_local, h_local));
-    let diff = brdf_fresnel_weighted_lambert(brdf_material_diffuse_albedo(m), f0, v_local.z, l_local.z);
+    let h_local = normalize(p.v_local + l_local);
+    // brdf_visibility_aniso with the view's half precomputed.
+    let visibility = 0.5 / (l_local.z * p.v_stretched + p.v_local.z * length(l_local * vec3<f32>(p.alphas, 1.0)));
+    let spec = brdf_ggx_ndf_aniso(h_local, p.alphas.x, p.alphas.y) * visibility
+        * brdf_fresnel_schlick(p.f_normal, dot(p.v_local, h_local));
+    // brdf_fresnel_weighted_lambert with the view's half precomputed.
+    let diff = p.diffuse * (vec3<f32>(1.0) - brdf_fresnel_schlick(p.f_normal, l_local.z));
     return (spec + diff) * l_local.z;
+}
+
+// BRDF * n.l, 1/sr, per RGB channel; 0 when v or l is at or below the surface.
+fn brdf_evaluate(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    return brdf_evaluate_view(brdf_view(m, n, t, b, v), l);
 }
 
 // brdf_evaluate without a tangent frame; anisotropy is ignored.

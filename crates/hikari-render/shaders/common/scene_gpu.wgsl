@@ -48,5 +48,7 @@ struct LightGpu {
 const CHUNK_TRIANGLES: u32 = 64u;
 const NO_TEXTURE: u32 = 0xffffffffu;
 const INSTANCE_DOUBLE_SIDED: u32 = 1u;
+const INSTANCE_OWN_NORMAL_MATRIX: u32 = 2u;
+const INSTANCE_MOVED: u32 = 4u;
 const EXTRA_BITANGENT_NEGATIVE: u32 = 0x10000u;
 const EXTRA_HAS_TANGENT: u32 = 0x20000u;

@@ -6,7 +6,7 @@
 
 #import hikari::view::{View, view_ray, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::brdf::{BrdfMaterial, brdf_evaluate, brdf_fresnel_schlick, brdf_material_f0}
+#import hikari::brdf::{BrdfMaterial, brdf_view, brdf_evaluate_view, brdf_fresnel_schlick, brdf_material_f0}
 #import hikari::scene_gpu::LightGpu
 #import hikari::sun_shadows::sun_visibility
 
@@ -52,6 +52,8 @@ var<workgroup> bounds_lo: array<vec3<f32>, 256>;
 var<workgroup> bounds_hi: array<vec3<f32>, 256>;
 var<workgroup> tile_count: atomic<u32>;
 var<workgroup> tile_lights: array<u32, MAX_TILE_LIGHTS>;
+// 1 / range^2 of each listed light, found once a tile rather than once a pixel.
+var<workgroup> tile_inv_range2: array<f32, MAX_TILE_LIGHTS>;
 const FAR: f32 = 3.0e38;
 
 fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
@@ -82,12 +84,11 @@ fn light_range(light: LightGpu) -> f32 {
     return max(min(light.position_range.w, sqrt(peak / params.cutoff.x)), 1e-3);
 }
 
-// Illuminance factor of a punctual light at distance^2 `d2`: inverse square, windowed to 0 at
-// the range (the smooth window glTF's KHR_lights_punctual recommends), times the spot cone.
-fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
-    let range = light_range(light);
-    let x = d2 / (range * range);
-    let window = clamp(1.0 - x * x, 0.0, 1.0);
+// Illuminance factor of a punctual light at distance^2 `d2`, `x` = d2 / range^2: inverse
+// square, windowed to 0 at the range (the smooth window glTF's KHR_lights_punctual
+// recommends), times the spot cone.
+fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32, x: f32) -> f32 {
+    let window = max(1.0 - x * x, 0.0);
     var a = window * window / max(d2, 1e-4);
     if light.direction_kind.w > 0.5 {
         let cos_angle = dot(-l, light.direction_kind.xyz);
@@ -145,6 +146,7 @@ fn main(
                 let slot = atomicAdd(&tile_count, 1u);
                 if slot < MAX_TILE_LIGHTS {
                     tile_lights[slot] = i;
+                    tile_inv_range2[slot] = 1.0 / (range * range);
                 }
             }
         }
@@ -169,18 +171,22 @@ fn main(
         let albedo = textureLoad(gbuffer_albedo, pixel, 0);
         let mat = textureLoad(gbuffer_material, pixel, 0);
         let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
+        let brdf = brdf_view(m, n, t, b, v);
         radiance = vec3<f32>(0.0);
         if (flags & LIGHTING_SUN) != 0u && params.direction_lux.w > 0.0 {
             let l = params.direction_lux.xyz;
             let vis = sun_visibility(world, n);
-            radiance += brdf_evaluate(m, n, t, b, v, l) * params.color.rgb * (params.direction_lux.w * vis);
+            radiance += brdf_evaluate_view(brdf, l) * params.color.rgb * (params.direction_lux.w * vis);
         }
         for (var k = 0u; k < tile_lights_n; k++) {
             let light = lights[tile_lights[k]];
             let to_light = light.position_range.xyz - world;
             let d2 = dot(to_light, to_light);
+            // No branch for pixels out of range or facing away (the window and the BRDF give
+            // them 0): lanes of a warp diverging there cost more than the lighting they skip.
+            let x = d2 * tile_inv_range2[k];
             let l = to_light * inverseSqrt(max(d2, 1e-8));
-            radiance += brdf_evaluate(m, n, t, b, v, l) * light.intensity.rgb * light_attenuation(light, l, d2);
+            radiance += brdf_evaluate_view(brdf, l) * light.intensity.rgb * light_attenuation(light, l, d2, x);
         }
         if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
             let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);

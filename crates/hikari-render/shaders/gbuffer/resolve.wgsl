@@ -5,7 +5,7 @@
 
 #import hikari::view::View
 #import hikari::octahedral::oct_encode
-#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT}
+#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, INSTANCE_OWN_NORMAL_MATRIX, INSTANCE_MOVED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<storage, read> visibility: array<vec2<u32>>;
@@ -149,15 +149,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let id = vis.x;
     let chunk = chunks[id / CHUNK_TRIANGLES];
     let tri = chunk.first_triangle + id % CHUNK_TRIANGLES;
-    let inst = instances[chunk.instance];
-    let mat = materials[inst.material];
+    // Fields read one by one: the two matrices most instances need not are then not loaded.
+    let ci = chunk.instance;
+    let model = instances[ci].model;
+    let inst_flags = instances[ci].flags;
+    let mat = materials[instances[ci].material];
     let i = vec3<u32>(indices[tri * 3u], indices[tri * 3u + 1u], indices[tri * 3u + 2u]);
     let q0 = positions[i.x].xyz;
     let q1 = positions[i.y].xyz;
     let q2 = positions[i.z].xyz;
-    let p0 = (inst.model * vec4<f32>(q0, 1.0)).xyz;
-    let e1 = (inst.model * vec4<f32>(q1, 1.0)).xyz - p0;
-    let e2 = (inst.model * vec4<f32>(q2, 1.0)).xyz - p0;
+    let p0 = (model * vec4<f32>(q0, 1.0)).xyz;
+    let e1 = (model * vec4<f32>(q1, 1.0)).xyz - p0;
+    let e2 = (model * vec4<f32>(q2, 1.0)).xyz - p0;
 
     let o = view.position.xyz;
     let centre = vec2<f32>(px) + 0.5;
@@ -187,13 +190,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     // Frames: geometric normal faces the camera on double-sided surfaces (single-sided back
     // faces were culled); shading normal and tangent follow it.
-    let normal_model = mat3_of(inst.normal_model);
+    // A rotation with uniform scale (most instances) has its own 3x3 as the normal matrix up to
+    // a scale, which the normalisation removes.
+    var normal_model = mat3_of(model);
+    if (inst_flags & INSTANCE_OWN_NORMAL_MATRIX) != 0u {
+        normal_model = mat3_of(instances[ci].normal_model);
+    }
     var ng = normalize(cross(e1, e2));
     var n = normalize(normal_model * (unpack_oct(a0.normal) * w.x + unpack_oct(a1.normal) * w.y + unpack_oct(a2.normal) * w.z));
-    let facing = select(1.0, -1.0, dot(ng, d) > 0.0 && (inst.flags & INSTANCE_DOUBLE_SIDED) != 0u);
+    let facing = select(1.0, -1.0, dot(ng, d) > 0.0 && (inst_flags & INSTANCE_DOUBLE_SIDED) != 0u);
     n *= facing;
     ng *= facing;
-    let model3 = mat3_of(inst.model);
+    let model3 = mat3_of(model);
     var t = model3 * (unpack_oct(a0.tangent) * w.x + unpack_oct(a1.tangent) * w.y + unpack_oct(a2.tangent) * w.z);
     t = t - n * dot(n, t);
     if (a0.extra & EXTRA_HAS_TANGENT) == 0u || dot(t, t) < 1e-12 {
@@ -241,8 +249,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     // Motion: where this surface point was last frame, minus where it is now, in pixels.
     let q = q0 * w.x + q1 * w.y + q2 * w.z;
-    let prev = project_to_pixel(view.prev_view_proj, inst.prev_model * vec4<f32>(q, 1.0));
     let world = p0 + e1 * b.x + e2 * b.y;
+    var prev_world = vec4<f32>(world, 1.0);
+    if (inst_flags & INSTANCE_MOVED) != 0u {
+        prev_world = instances[ci].prev_model * vec4<f32>(q, 1.0);
+    }
+    let prev = project_to_pixel(view.prev_view_proj, prev_world);
     let view_depth = dot(world - o, view.forward_near.xyz);
 
     textureStore(out_depth, px, vec4<f32>(bitcast<f32>(vis.y), 0.0, 0.0, 0.0));

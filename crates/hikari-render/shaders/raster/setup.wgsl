@@ -12,23 +12,29 @@
 #import hikari::scene_gpu::{InstanceGpu, Chunk, CHUNK_TRIANGLES, INSTANCE_DOUBLE_SIDED}
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
-@group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> indices: array<u32>;
-@group(0) @binding(3) var<storage, read> instances: array<InstanceGpu>;
-@group(0) @binding(4) var<storage, read> chunks: array<Chunk>;
 #ifdef DEPTH_ONLY
 // One u32 a texel per view: the bits of the NDC depth, whose order is the order of the depths.
-@group(0) @binding(5) var<storage, read_write> target_texels: array<atomic<u32>>;
+@group(0) @binding(1) var<storage, read_write> target_texels: array<atomic<u32>>;
 #else
 // One u64 a pixel: NDC depth bits above the visibility id, so atomicMax keeps the nearest.
-@group(0) @binding(5) var<storage, read_write> target_texels: array<atomic<u64>>;
+@group(0) @binding(1) var<storage, read_write> target_texels: array<atomic<u64>>;
 #endif
-// Tile queue: (visibility id, tile x | tile y << 12 | view << 24) in the first `config.y`
-// entries, then up to LARGE_CAPACITY large triangles as (visibility id, view) followed by
-// their tile rectangle (x | y << 16 of the first and of the last tile).
-@group(0) @binding(6) var<storage, read_write> queue: array<vec2<u32>>;
-// [0]: tile entries, [1]: large triangles (both keep counting past their capacity).
-@group(0) @binding(7) var<storage, read_write> queue_count: array<atomic<u32>>;
+// Tile queue: (triangle record, tile x | tile y << 12) in the first `config.y` entries, then
+// up to LARGE_CAPACITY large triangles as (triangle record, view) followed by their tile
+// rectangle (x | y << 16 of the first and of the last tile).
+@group(0) @binding(2) var<storage, read_write> queue: array<vec2<u32>>;
+// [0]: tile entries, [1]: large triangles, [2]: triangle records (all keep counting past
+// their capacity, so a readback can tell an overflow).
+@group(0) @binding(3) var<storage, read_write> queue_count: array<atomic<u32>>;
+// Triangles set up once by the triangle pass for the tile and large passes, which would
+// otherwise each fetch and set up their triangle again for every tile (a chain of five
+// dependent loads, then the clip and the edge equations, in every workgroup).
+@group(0) @binding(4) var<storage, read_write> records: array<TriRecord>;
+// The scene, read by the triangle pass only (the later passes bind 0 to 4).
+@group(0) @binding(5) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> indices: array<u32>;
+@group(0) @binding(7) var<storage, read> instances: array<InstanceGpu>;
+@group(0) @binding(8) var<storage, read> chunks: array<Chunk>;
 
 // The views one dispatch rasterises into (the camera, or up to four shadow cascades).
 struct RasterParams {
@@ -40,6 +46,18 @@ struct RasterParams {
     config: vec4<u32>,
     // Per view: the slice of the target (of width * height texels) it draws into.
     slices: vec4<u32>,
+    // x: capacity of `records`.
+    limits: vec4<u32>,
+}
+
+// A set-up triangle: its edge equations and depth plane (xyz, as f32 bits), with the
+// visibility id, the owned edges (bits 0-2) and view (bits 8-15), and the first and last
+// pixel of its clamped rectangle (x | y << 16) in w.
+struct TriRecord {
+    edge_a: vec4<u32>,
+    edge_b: vec4<u32>,
+    edge_c: vec4<u32>,
+    depth: vec4<u32>,
 }
 
 // Up to four screen-space vertices (xy in pixels, z the NDC depth): the triangle, or the
@@ -267,6 +285,65 @@ fn raster_tile(setup: Setup, rect: PixelRect, tile: vec2<u32>, view: u32, id: u3
             write_pixel(view, px, d, id);
         }
     }
+}
+
+// The same for one triangle of a setup (a quad's two are rasterised as separate records).
+fn raster_tile_tri(t: TriSetup, rect: PixelRect, tile: vec2<u32>, view: u32, id: u32, lane: u32, threads: u32) {
+    let origin = vec2<i32>(tile * TILE_SIZE);
+    for (var i = lane; i < TILE_SIZE * TILE_SIZE; i += threads) {
+        let px = origin + vec2<i32>(vec2<u32>(i % TILE_SIZE, i / TILE_SIZE));
+        if any(px < rect.lo) || any(px > rect.hi) {
+            continue;
+        }
+        let d = tri_depth(t, vec3<f32>(vec2<f32>(px) + 0.5, 1.0));
+        if d > 0.0 {
+            write_pixel(view, px, d, id);
+        }
+    }
+}
+
+// Whether triangle t may cover a pixel centre of `tile` within `rect`.
+fn tile_touched_tri(t: TriSetup, rect: PixelRect, tile: vec2<u32>) -> bool {
+    let lo = max(vec2<i32>(tile * TILE_SIZE), rect.lo);
+    let hi = min(vec2<i32>(tile * TILE_SIZE + TILE_SIZE - 1u), rect.hi);
+    return tri_touches(t, vec2<f32>(lo) + 0.5, vec2<f32>(hi) + 0.5);
+}
+
+fn pack_pixel(p: vec2<i32>) -> u32 {
+    return u32(p.x) | (u32(p.y) << 16u);
+}
+
+fn unpack_pixel(bits: u32) -> vec2<i32> {
+    return vec2<i32>(vec2<u32>(bits & 0xffffu, bits >> 16u));
+}
+
+fn store_record(slot: u32, t: TriSetup, id: u32, view: u32, rect: PixelRect) {
+    let own = select(0u, 1u, t.own.x) | select(0u, 2u, t.own.y) | select(0u, 4u, t.own.z);
+    records[slot] = TriRecord(
+        vec4<u32>(bitcast<vec3<u32>>(t.edge_a), id),
+        vec4<u32>(bitcast<vec3<u32>>(t.edge_b), own | (view << 8u)),
+        vec4<u32>(bitcast<vec3<u32>>(t.edge_c), pack_pixel(rect.lo)),
+        vec4<u32>(bitcast<vec3<u32>>(t.depth), pack_pixel(rect.hi)),
+    );
+}
+
+struct Record {
+    tri: TriSetup,
+    id: u32,
+    view: u32,
+    rect: PixelRect,
+}
+
+fn load_record(slot: u32) -> Record {
+    let r = records[slot];
+    var t: TriSetup;
+    t.edge_a = bitcast<vec3<f32>>(r.edge_a.xyz);
+    t.edge_b = bitcast<vec3<f32>>(r.edge_b.xyz);
+    t.edge_c = bitcast<vec3<f32>>(r.edge_c.xyz);
+    t.depth = bitcast<vec3<f32>>(r.depth.xyz);
+    let bits = r.edge_b.w;
+    t.own = vec3<bool>((bits & 1u) != 0u, (bits & 2u) != 0u, (bits & 4u) != 0u);
+    return Record(t, r.edge_a.w, (bits >> 8u) & 0xffu, PixelRect(unpack_pixel(r.edge_c.w), unpack_pixel(r.depth.w)));
 }
 
 fn poly_rect(poly: Poly, size: vec2<f32>) -> PixelRect {

@@ -1,8 +1,9 @@
 // Compute rasteriser, pass 2. `main`: the tiles queued by `raster/triangles.wgsl`, one
 // workgroup a tile at a time, workgroups looping over the queue. `large`: the triangles too
-// large to queue tile by tile; every workgroup takes its share of each one's tiles.
+// large to queue tile by tile; every workgroup takes its share of each one's tiles. Both
+// read the triangles' records set up by the triangle pass.
 
-#import hikari::raster::setup::{params, queue, queue_count, id_poly, poly_rect, poly_setup, raster_tile, tile_touched, TILE_SIZE, LARGE_CAPACITY}
+#import hikari::raster::setup::{params, queue, queue_count, load_record, raster_tile_tri, tile_touched_tri, LARGE_CAPACITY}
 
 const THREADS: u32 = 64u;
 
@@ -13,17 +14,11 @@ fn main(
     @builtin(local_invocation_index) lane: u32,
 ) {
     let count = min(atomicLoad(&queue_count[0]), params.config.y);
-    let size = params.viewport.xy;
     for (var e = wg.x; e < count; e += groups.x) {
         let entry = queue[e];
-        let id = entry.x;
-        let view = entry.y >> 24u;
-        let tile = vec2<u32>(entry.y & 0xfffu, (entry.y >> 12u) & 0xfffu);
-        let poly = id_poly(id, view);
-        if poly.count == 0u {
-            continue;
-        }
-        raster_tile(poly_setup(poly), poly_rect(poly, size), tile, view, id, lane, THREADS);
+        let r = load_record(entry.x);
+        let tile = vec2<u32>(entry.y & 0xfffu, entry.y >> 12u);
+        raster_tile_tri(r.tri, r.rect, tile, r.view, r.id, lane, THREADS);
     }
 }
 
@@ -34,11 +29,9 @@ fn large(
     @builtin(local_invocation_index) lane: u32,
 ) {
     let count = min(atomicLoad(&queue_count[1]), LARGE_CAPACITY);
-    let size = params.viewport.xy;
     // The tiles of all large triangles, one after the other, are dealt to the workgroups in
     // turn: `first_slot` is where this triangle's first tile falls in that deal. A workgroup
-    // sets up only the triangles it draws tiles of (setting up each in every workgroup cost
-    // more than drawing them).
+    // reads the records only of the triangles it draws tiles of.
     var first_slot = 0u;
     for (var e = 0u; e < count; e++) {
         let at = params.config.y + e * 2u;
@@ -52,19 +45,11 @@ fn large(
         if mine >= tiles {
             continue;
         }
-        let entry = queue[at];
-        let id = entry.x;
-        let view = entry.y;
-        let poly = id_poly(id, view);
-        if poly.count == 0u {
-            continue;
-        }
-        let rect = poly_rect(poly, size);
-        let setup = poly_setup(poly);
+        let r = load_record(queue[at].x);
         for (var t = mine; t < tiles; t += groups.x) {
             let tile = t_lo + vec2<u32>(t % span.x, t / span.x);
-            if tile_touched(setup, rect, tile) {
-                raster_tile(setup, rect, tile, view, id, lane, THREADS);
+            if tile_touched_tri(r.tri, r.rect, tile) {
+                raster_tile_tri(r.tri, r.rect, tile, r.view, r.id, lane, THREADS);
             }
         }
     }

@@ -1,9 +1,10 @@
 // Compute rasteriser, pass 1: one thread a triangle. Small triangles are rasterised here by
-// their thread; larger ones are split into TILE_SIZE tiles queued for `raster/tiles.wgsl`
-// (`main`), and the largest are listed whole for its `large` entry point.
+// their thread; larger ones are set up into a record and split into TILE_SIZE tiles queued
+// for `raster/tiles.wgsl` (`main`), and the largest are listed whole for its `large` entry
+// point.
 // Dispatch: x * y workgroups cover the chunks, z is the view.
 
-#import hikari::raster::setup::{params, chunks, chunk_outside, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, setup_touches, write_pixel, tile_touched, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
+#import hikari::raster::setup::{params, chunks, chunk_outside, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, write_pixel, tile_touched_tri, store_record, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
 #import hikari::scene_gpu::CHUNK_TRIANGLES
 
 @compute @workgroup_size(64, 1, 1)
@@ -47,33 +48,55 @@ fn main(
     let t_lo = vec2<u32>(rect.lo) / TILE_SIZE;
     let t_hi = vec2<u32>(rect.hi) / TILE_SIZE;
     let span = t_hi - t_lo + 1u;
-    if span.x * span.y > LARGE_TRIANGLE_TILES {
-        let slot = atomicAdd(&queue_count[1], 1u);
-        if slot < LARGE_CAPACITY {
-            // Its tile rectangle beside it, so that the large pass sets it up only in the
-            // workgroups that draw some of its tiles.
-            queue[params.config.y + slot * 2u] = vec2<u32>(id, view);
-            queue[params.config.y + slot * 2u + 1u] = vec2<u32>(t_lo.x | (t_lo.y << 16u), t_hi.x | (t_hi.y << 16u));
+    let large = span.x * span.y > LARGE_TRIANGLE_TILES;
+    // A quad left by near clipping becomes two records, each rasterised on its own.
+    for (var k = 0u; k < setup.tris; k++) {
+        var tri = setup.first;
+        if k == 1u {
+            tri = setup.second;
         }
-        return;
-    }
-    // Queue only the tiles the polygon touches (thin triangles have mostly empty boxes): count
-    // them, reserve the slots with one atomic, then write them.
-    var touched = 0u;
-    for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
-        for (var tx = t_lo.x; tx <= t_hi.x; tx++) {
-            touched += select(0u, 1u, tile_touched(setup, rect, vec2<u32>(tx, ty)));
+        if large {
+            // Every listed large triangle must have its record: the record first.
+            let record = atomicAdd(&queue_count[2], 1u);
+            if record >= params.limits.x {
+                continue;
+            }
+            let slot = atomicAdd(&queue_count[1], 1u);
+            if slot < LARGE_CAPACITY {
+                store_record(record, tri, id, view, rect);
+                // Its tile rectangle beside it, so that the large pass reads the record only
+                // in the workgroups that draw some of its tiles.
+                queue[params.config.y + slot * 2u] = vec2<u32>(record, view);
+                queue[params.config.y + slot * 2u + 1u] = vec2<u32>(t_lo.x | (t_lo.y << 16u), t_hi.x | (t_hi.y << 16u));
+            }
+            continue;
         }
-    }
-    let first = atomicAdd(&queue_count[0], touched);
-    let capacity = params.config.y;
-    var slot = first;
-    for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
-        for (var tx = t_lo.x; tx <= t_hi.x; tx++) {
-            // Overflow: queue_count keeps growing past the capacity, so a readback can tell.
-            if slot < capacity && tile_touched(setup, rect, vec2<u32>(tx, ty)) {
-                queue[slot] = vec2<u32>(id, tx | (ty << 12u) | (view << 24u));
-                slot++;
+        // Queue only the tiles the triangle touches (thin triangles have mostly empty boxes):
+        // count them, reserve the slots with one atomic, then write them.
+        var touched = 0u;
+        for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
+            for (var tx = t_lo.x; tx <= t_hi.x; tx++) {
+                touched += select(0u, 1u, tile_touched_tri(tri, rect, vec2<u32>(tx, ty)));
+            }
+        }
+        if touched == 0u {
+            continue;
+        }
+        let record = atomicAdd(&queue_count[2], 1u);
+        if record >= params.limits.x {
+            continue;
+        }
+        store_record(record, tri, id, view, rect);
+        let first = atomicAdd(&queue_count[0], touched);
+        let capacity = params.config.y;
+        var slot = first;
+        for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
+            for (var tx = t_lo.x; tx <= t_hi.x; tx++) {
+                // Overflow: queue_count keeps growing past the capacity, so a readback can tell.
+                if slot < capacity && tile_touched_tri(tri, rect, vec2<u32>(tx, ty)) {
+                    queue[slot] = vec2<u32>(record, tx | (ty << 12u));
+                    slot++;
+                }
             }
         }
     }

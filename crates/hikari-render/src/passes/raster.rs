@@ -4,11 +4,12 @@
 //! fixed-function path on the GPUs we measure on (BENCHMARKS.md: the H200 fills ~7 Gpixel/s).
 //!
 //! Pass 1 (`{technique}.rasterize`) runs a thread a triangle: small triangles are rasterised by
-//! their thread, larger ones split into 32x32 tiles queued for pass 2
-//! (`{technique}.rasterize_tiles`), where a workgroup covers a tile; triangles spanning more
-//! than 256 tiles are listed whole, with their tile rectangle, for pass 3
-//! (`{technique}.rasterize_large`), which deals all their tiles to its workgroups in turn; a
-//! workgroup sets up only the triangles it draws tiles of.
+//! their thread; larger ones are set up once into a triangle record (edge equations, depth
+//! plane, id, rectangle; a quad left by near clipping gives two) and split into 32x32 tiles
+//! queued for pass 2 (`{technique}.rasterize_tiles`), where a workgroup covers a tile;
+//! triangles spanning more than 256 tiles are listed whole, with their tile rectangle, for
+//! pass 3 (`{technique}.rasterize_large`), which deals all their tiles to its workgroups in
+//! turn; a workgroup reads the records only of the triangles it draws tiles of.
 //! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/raster.rs).
 
 use bytemuck::{Pod, Zeroable};
@@ -35,6 +36,8 @@ pub struct RasterParams {
     pub config: [u32; 4],
     /// Per view: which slice of the target (of `width * height` texels) it draws into.
     pub slices: [u32; 4],
+    /// x: capacity of the triangle records.
+    pub limits: [u32; 4],
 }
 
 /// Whether a target keeps the triangle id beside the depth.
@@ -68,6 +71,8 @@ pub struct RasterJob<'a> {
 
 /// Large triangles the queue holds after its tile entries (`LARGE_CAPACITY` in the shader).
 const LARGE_CAPACITY: u64 = 65536;
+/// `TriRecord` in the shader: a triangle's edge equations, depth plane, id, view and rectangle.
+const TRIANGLE_RECORD_BYTES: u64 = 64;
 
 pub struct Rasterizer {
     /// triangles, tiles, large
@@ -122,6 +127,14 @@ impl Rasterizer {
             (capacity as u64 + 2 * LARGE_CAPACITY) * 8,
         )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
+        // Every record has at least one tile entry or one large entry (a large quad two).
+        let binding_limit = g.ctx().limits.max_storage_buffer_binding_size as u64;
+        let record_capacity = (capacity as u64 + 2 * LARGE_CAPACITY)
+            .min(binding_limit / TRIANGLE_RECORD_BYTES) as u32;
+        let records = g.buffer(
+            &format!("{t}.triangle_records"),
+            record_capacity as u64 * TRIANGLE_RECORD_BYTES,
+        )?;
         assert_eq!(job.slices.len(), views, "one slice a view");
         let slice_bytes = w as u64 * h as u64 * kind.bytes_per_texel();
         let slices: Vec<u32> = job.slices.to_vec();
@@ -154,6 +167,7 @@ impl Rasterizer {
                 scene.chunk_count,
             ],
             slices: slice_of_view,
+            limits: [record_capacity, 0, 0, 0],
         };
         let SceneInFrame {
             positions,
@@ -176,16 +190,23 @@ impl Rasterizer {
             ("rasterize_large", [TILE_WORKGROUPS, 1, 1]),
         ];
         for ((stage, dispatch), pipeline) in stages.into_iter().zip(pipelines) {
-            g.pass(&format!("{t}.{stage}"))
+            let pass = g
+                .pass(&format!("{t}.{stage}"))
                 .constants(&params)
-                .read(positions)
-                .read(indices)
-                .read(instances)
-                .read(chunks)
                 .write(target)
                 .write(queue)
                 .write(count)
-                .dispatch(pipeline, dispatch)?;
+                .write(records);
+            // Only the triangle pass reads the scene; the others read its records.
+            let pass = if stage == "rasterize" {
+                pass.read(positions)
+                    .read(indices)
+                    .read(instances)
+                    .read(chunks)
+            } else {
+                pass
+            };
+            pass.dispatch(pipeline, dispatch)?;
         }
         Ok(())
     }
