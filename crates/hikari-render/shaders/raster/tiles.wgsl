@@ -3,9 +3,20 @@
 // large to queue tile by tile; every workgroup takes its share of each one's tiles. Both
 // read the triangles' records set up by the triangle pass.
 
-#import hikari::raster::setup::{params, queue, queue_count, load_record, raster_tile_tri, tile_touched_tri, LARGE_CAPACITY}
+#import hikari::raster::setup::{params, queue, queue_count, load_record, raster_tile_tri, tile_touched_tri, tri_touches, tri_depth, write_pixel, TILE_SIZE, LARGE_CAPACITY}
 
 const THREADS: u32 = 64u;
+// A tile is drawn as 4x4 blocks of 8x8 pixels, one pixel a thread, and only the blocks the
+// triangle touches: most queued triangles cover a small part of their tiles, and testing
+// every pixel of them cost more than drawing.
+const BLOCK: u32 = 8u;
+const BLOCKS_PER_SIDE: u32 = 4u;
+
+var<workgroup> entry_count: u32;
+// Which blocks the current entry touches. Three masks in turn: iteration i sets mask i % 3,
+// reads it after the barrier, and clears mask (i + 1) % 3, whose last readers passed the
+// previous iteration's barrier and whose next writers wait for this one's.
+var<workgroup> block_masks: array<atomic<u32>, 3>;
 
 @compute @workgroup_size(64, 1, 1)
 fn main(
@@ -13,12 +24,45 @@ fn main(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    let count = min(atomicLoad(&queue_count[0]), params.config.y);
+    if lane == 0u {
+        entry_count = min(atomicLoad(&queue_count[0]), params.config.y);
+        for (var k = 0u; k < 3u; k++) {
+            atomicStore(&block_masks[k], 0u);
+        }
+    }
+    let count = workgroupUniformLoad(&entry_count);
+    var slot = 0u;
     for (var e = wg.x; e < count; e += groups.x) {
         let entry = queue[e];
         let r = load_record(entry.x);
-        let tile = vec2<u32>(entry.y & 0xfffu, entry.y >> 12u);
-        raster_tile_tri(r.tri, r.rect, tile, r.view, r.id, lane, THREADS);
+        let origin = vec2<i32>(vec2<u32>(entry.y & 0xfffu, entry.y >> 12u) * TILE_SIZE);
+        let next = (slot + 1u) % 3u;
+        if lane == 0u {
+            atomicStore(&block_masks[next], 0u);
+        }
+        if lane < BLOCKS_PER_SIDE * BLOCKS_PER_SIDE {
+            let corner = origin + vec2<i32>(vec2<u32>(lane % BLOCKS_PER_SIDE, lane / BLOCKS_PER_SIDE) * BLOCK);
+            let lo = max(corner, r.rect.lo);
+            let hi = min(corner + i32(BLOCK) - 1, r.rect.hi);
+            if all(lo <= hi) && tri_touches(r.tri, vec2<f32>(lo) + 0.5, vec2<f32>(hi) + 0.5) {
+                atomicOr(&block_masks[slot], 1u << lane);
+            }
+        }
+        workgroupBarrier();
+        var blocks = atomicLoad(&block_masks[slot]);
+        slot = next;
+        let in_block = vec2<i32>(vec2<u32>(lane % BLOCK, lane / BLOCK));
+        while blocks != 0u {
+            let b = firstTrailingBit(blocks);
+            blocks &= blocks - 1u;
+            let px = origin + vec2<i32>(vec2<u32>(b % BLOCKS_PER_SIDE, b / BLOCKS_PER_SIDE) * BLOCK) + in_block;
+            if all(px >= r.rect.lo) && all(px <= r.rect.hi) {
+                let d = tri_depth(r.tri, vec3<f32>(vec2<f32>(px) + 0.5, 1.0));
+                if d > 0.0 {
+                    write_pixel(r.view, px, d, r.id);
+                }
+            }
+        }
     }
 }
 

@@ -184,12 +184,15 @@ impl Rasterizer {
         let n = scene.chunk_count.max(1);
         let groups = [n.min(max), n.div_ceil(max), views as u32];
         // The three passes bind the same resources; they differ in entry point and dispatch.
+        // Large before tiles: the near walls and floors that take the large path then hide
+        // what lies behind them from the tile pass's atomics (its plain load rejects them).
+        let [triangles, tiles, large] = pipelines;
         let stages = [
-            ("rasterize", groups),
-            ("rasterize_tiles", [TILE_WORKGROUPS, 1, 1]),
-            ("rasterize_large", [TILE_WORKGROUPS, 1, 1]),
+            ("rasterize", groups, triangles),
+            ("rasterize_large", [TILE_WORKGROUPS, 1, 1], large),
+            ("rasterize_tiles", [TILE_WORKGROUPS, 1, 1], tiles),
         ];
-        for ((stage, dispatch), pipeline) in stages.into_iter().zip(pipelines) {
+        for (stage, dispatch, pipeline) in stages {
             let pass = g
                 .pass(&format!("{t}.{stage}"))
                 .constants(&params)
