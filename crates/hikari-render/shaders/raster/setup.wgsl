@@ -258,36 +258,37 @@ fn tri_touches(t: TriSetup, p0: vec2<f32>, p1: vec2<f32>) -> bool {
     return dot(t.edge_a, c0) >= 0.0 && dot(t.edge_b, c1) >= 0.0 && dot(t.edge_c, c2) >= 0.0;
 }
 
-// Whether the polygon may cover a pixel centre in the inclusive pixel rectangle [lo, hi].
-fn setup_touches(s: Setup, lo: vec2<i32>, hi: vec2<i32>) -> bool {
-    let p0 = vec2<f32>(lo) + 0.5;
-    let p1 = vec2<f32>(hi) + 0.5;
-    return tri_touches(s.first, p0, p1) || (s.tris == 2u && tri_touches(s.second, p0, p1));
+// The tile pass draws a tile as 4x4 blocks of 8x8 pixels by 64 threads, one pixel a thread,
+// and only the blocks the triangle touches: most queued triangles cover a small part of their
+// tiles, and testing every pixel of them cost more than drawing.
+const BLOCK: u32 = 8u;
+const BLOCKS_PER_SIDE: u32 = 4u;
+
+// Top-left pixel of block `b` (0 to 15, row by row) of the tile at pixel `origin`.
+fn block_corner(origin: vec2<i32>, b: u32) -> vec2<i32> {
+    return origin + vec2<i32>(vec2<u32>(b % BLOCKS_PER_SIDE, b / BLOCKS_PER_SIDE) * BLOCK);
 }
 
-// Whether the polygon may cover a pixel centre of `tile` (in TILE_SIZE units) within `rect`.
-fn tile_touched(setup: Setup, rect: PixelRect, tile: vec2<u32>) -> bool {
-    let lo = max(vec2<i32>(tile * TILE_SIZE), rect.lo);
-    let hi = min(vec2<i32>(tile * TILE_SIZE + TILE_SIZE - 1u), rect.hi);
-    return setup_touches(setup, lo, hi);
+// Whether triangle t may cover a pixel centre of the block at `corner` within `rect`.
+fn block_touched(t: TriSetup, rect: PixelRect, corner: vec2<i32>) -> bool {
+    let lo = max(corner, rect.lo);
+    let hi = min(corner + i32(BLOCK) - 1, rect.hi);
+    return all(lo <= hi) && tri_touches(t, vec2<f32>(lo) + 0.5, vec2<f32>(hi) + 0.5);
 }
 
-// Rasterises the part of `rect` inside `tile`, the workgroup's threads sharing its pixels.
-fn raster_tile(setup: Setup, rect: PixelRect, tile: vec2<u32>, view: u32, id: u32, lane: u32, threads: u32) {
-    let origin = vec2<i32>(tile * TILE_SIZE);
-    for (var i = lane; i < TILE_SIZE * TILE_SIZE; i += threads) {
-        let px = origin + vec2<i32>(vec2<u32>(i % TILE_SIZE, i / TILE_SIZE));
-        if any(px < rect.lo) || any(px > rect.hi) {
-            continue;
-        }
-        let d = setup_depth(setup, vec2<f32>(px) + 0.5);
+// Draws this thread's pixel (lane % 8, lane / 8) of the block at `corner`.
+fn raster_block_pixel(t: TriSetup, rect: PixelRect, corner: vec2<i32>, lane: u32, view: u32, id: u32) {
+    let px = corner + vec2<i32>(vec2<u32>(lane % BLOCK, lane / BLOCK));
+    if all(px >= rect.lo) && all(px <= rect.hi) {
+        let d = tri_depth(t, vec3<f32>(vec2<f32>(px) + 0.5, 1.0));
         if d > 0.0 {
             write_pixel(view, px, d, id);
         }
     }
 }
 
-// The same for one triangle of a setup (a quad's two are rasterised as separate records).
+// Every pixel of `tile` within `rect` that triangle t covers, drawn by `threads` threads. For
+// triangles that cover whole tiles (the large pass): there the block tests only add work.
 fn raster_tile_tri(t: TriSetup, rect: PixelRect, tile: vec2<u32>, view: u32, id: u32, lane: u32, threads: u32) {
     let origin = vec2<i32>(tile * TILE_SIZE);
     for (var i = lane; i < TILE_SIZE * TILE_SIZE; i += threads) {

@@ -3,14 +3,7 @@
 // large to queue tile by tile; every workgroup takes its share of each one's tiles. Both
 // read the triangles' records set up by the triangle pass.
 
-#import hikari::raster::setup::{params, queue, queue_count, load_record, raster_tile_tri, tile_touched_tri, tri_touches, tri_depth, write_pixel, TILE_SIZE, LARGE_CAPACITY}
-
-const THREADS: u32 = 64u;
-// A tile is drawn as 4x4 blocks of 8x8 pixels, one pixel a thread, and only the blocks the
-// triangle touches: most queued triangles cover a small part of their tiles, and testing
-// every pixel of them cost more than drawing.
-const BLOCK: u32 = 8u;
-const BLOCKS_PER_SIDE: u32 = 4u;
+#import hikari::raster::setup::{params, queue, queue_count, load_record, raster_tile_tri, raster_block_pixel, block_corner, block_touched, tile_touched_tri, TILE_SIZE, BLOCKS_PER_SIDE, LARGE_CAPACITY}
 
 var<workgroup> entry_count: u32;
 // Which blocks the current entry touches. Three masks in turn: iteration i sets mask i % 3,
@@ -40,28 +33,17 @@ fn main(
         if lane == 0u {
             atomicStore(&block_masks[next], 0u);
         }
-        if lane < BLOCKS_PER_SIDE * BLOCKS_PER_SIDE {
-            let corner = origin + vec2<i32>(vec2<u32>(lane % BLOCKS_PER_SIDE, lane / BLOCKS_PER_SIDE) * BLOCK);
-            let lo = max(corner, r.rect.lo);
-            let hi = min(corner + i32(BLOCK) - 1, r.rect.hi);
-            if all(lo <= hi) && tri_touches(r.tri, vec2<f32>(lo) + 0.5, vec2<f32>(hi) + 0.5) {
-                atomicOr(&block_masks[slot], 1u << lane);
-            }
+        // The 16 block tests shared out: one lane each, rather than each lane all 16.
+        if lane < BLOCKS_PER_SIDE * BLOCKS_PER_SIDE && block_touched(r.tri, r.rect, block_corner(origin, lane)) {
+            atomicOr(&block_masks[slot], 1u << lane);
         }
         workgroupBarrier();
         var blocks = atomicLoad(&block_masks[slot]);
         slot = next;
-        let in_block = vec2<i32>(vec2<u32>(lane % BLOCK, lane / BLOCK));
         while blocks != 0u {
             let b = firstTrailingBit(blocks);
             blocks &= blocks - 1u;
-            let px = origin + vec2<i32>(vec2<u32>(b % BLOCKS_PER_SIDE, b / BLOCKS_PER_SIDE) * BLOCK) + in_block;
-            if all(px >= r.rect.lo) && all(px <= r.rect.hi) {
-                let d = tri_depth(r.tri, vec3<f32>(vec2<f32>(px) + 0.5, 1.0));
-                if d > 0.0 {
-                    write_pixel(r.view, px, d, r.id);
-                }
-            }
+            raster_block_pixel(r.tri, r.rect, block_corner(origin, b), lane, r.view, r.id);
         }
     }
 }
@@ -93,7 +75,7 @@ fn large(
         for (var t = mine; t < tiles; t += groups.x) {
             let tile = t_lo + vec2<u32>(t % span.x, t / span.x);
             if tile_touched_tri(r.tri, r.rect, tile) {
-                raster_tile_tri(r.tri, r.rect, tile, r.view, r.id, lane, THREADS);
+                raster_tile_tri(r.tri, r.rect, tile, r.view, r.id, lane, 64u);
             }
         }
     }
