@@ -128,7 +128,7 @@ impl Rasterizer {
         )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
         // Every record has at least one tile entry or one large entry (a large quad two).
-        let binding_limit = g.ctx().limits.max_storage_buffer_binding_size as u64;
+        let binding_limit = g.ctx().limits.max_storage_buffer_binding_size;
         let record_capacity = (capacity as u64 + 2 * LARGE_CAPACITY)
             .min(binding_limit / TRIANGLE_RECORD_BYTES) as u32;
         let records = g.buffer(
