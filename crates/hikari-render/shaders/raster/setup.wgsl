@@ -81,8 +81,9 @@ struct PixelRect {
 
 const TILE_SIZE: u32 = 32u;
 // Triangles whose box spans more tiles are rasterised by every workgroup of the large pass
-// together, rather than by one thread queueing all their tiles. Every workgroup sets up every
-// large triangle, so the threshold keeps them few: only the near-screen-filling ones.
+// together, rather than by one thread queueing all their tiles. Every workgroup walks the list
+// of large triangles to find its share of their tiles, so the threshold keeps them few: only
+// the near-screen-filling ones.
 const LARGE_TRIANGLE_TILES: u32 = 256u;
 const LARGE_CAPACITY: u32 = 65536u;
 // Triangles whose clamped bounding box holds more pixels go to the tile queue.
