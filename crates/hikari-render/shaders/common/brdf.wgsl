@@ -132,9 +132,13 @@ fn brdf_visibility_aniso(v_local: vec3<f32>, l_local: vec3<f32>, alpha_x: f32, a
         return 0.0;
     }
     let stretch = vec3<f32>(alpha_x, alpha_y, 1.0);
-    let lv = l_local.z * length(v_local * stretch);
-    let vl = v_local.z * length(l_local * stretch);
-    return 0.5 / (lv + vl);
+    return brdf_visibility_stretched(v_local.z, length(v_local * stretch), l_local.z, length(l_local * stretch));
+}
+
+// brdf_visibility_aniso from each side's cosine and stretched length |w_local * (ax, ay, 1)|,
+// so that a caller can compute the view's half once for many lights.
+fn brdf_visibility_stretched(v_z: f32, v_stretched: f32, l_z: f32, l_stretched: f32) -> f32 {
+    return 0.5 / (l_z * v_stretched + v_z * l_stretched);
 }
 
 fn brdf_schlick_weight(cos_theta: f32) -> f32 {
@@ -204,8 +208,7 @@ fn brdf_evaluate_view(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let h_local = normalize(p.v_local + l_local);
-    // brdf_visibility_aniso with the view's half precomputed.
-    let visibility = 0.5 / (l_local.z * p.v_stretched + p.v_local.z * length(l_local * vec3<f32>(p.alphas, 1.0)));
+    let visibility = brdf_visibility_stretched(p.v_local.z, p.v_stretched, l_local.z, length(l_local * vec3<f32>(p.alphas, 1.0)));
     let spec = brdf_ggx_ndf_aniso(h_local, p.alphas.x, p.alphas.y) * visibility
         * brdf_fresnel_schlick(p.f_normal, dot(p.v_local, h_local));
     // brdf_fresnel_weighted_lambert with the view's half precomputed.
