@@ -186,6 +186,10 @@ struct BrdfView {
     diffuse: vec3<f32>,
     // |v_local * (alpha_x, alpha_y, 1)|: the view's half of the height-correlated visibility.
     v_stretched: f32,
+    // 1 / alpha_x, 1 / alpha_y: multiplications, not divisions, for every light's D.
+    inv_alphas: vec2<f32>,
+    // 1 / (2 pi alpha_x alpha_y): D's normalisation times V's 1/2.
+    spec_scale: f32,
 }
 
 fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<f32>) -> BrdfView {
@@ -198,22 +202,41 @@ fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<
     p.f_normal = brdf_material_f0(m);
     p.diffuse = brdf_lambert(brdf_material_diffuse_albedo(m)) * (vec3<f32>(1.0) - brdf_fresnel_schlick(p.f_normal, p.v_local.z));
     p.v_stretched = length(p.v_local * vec3<f32>(p.alphas, 1.0));
+    p.inv_alphas = 1.0 / p.alphas;
+    p.spec_scale = 1.0 / (2.0 * BRDF_PI * p.alphas.x * p.alphas.y);
     return p;
 }
 
-// brdf_evaluate for a prepared view: BRDF * n.l, 0 when v or l is at or below the surface.
-fn brdf_evaluate_view(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
+// The light-dependent factors of brdf_evaluate_view, scalars, such that
+//   brdf_evaluate_view(p, l) = f_normal * w.x + (1 - f_normal) * (w.y + diffuse * w.z):
+// w.x = D V n.l, w.y = D V n.l Schlick(v.h), w.z = (1 - Schlick(n.l)) n.l, from F = f0 +
+// (1 - f0) Schlick. A caller summing many lights sums their weighted light colours and applies
+// the material's colours once (brdf_apply_weights), rather than three colour products a light.
+fn brdf_light_weights(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
     let l_local = vec3<f32>(dot(p.t, l), dot(p.b, l), dot(p.n, l));
     if p.v_local.z <= 0.0 || l_local.z <= 0.0 {
         return vec3<f32>(0.0);
     }
     let h_local = normalize(p.v_local + l_local);
-    let visibility = brdf_visibility_stretched(p.v_local.z, p.v_stretched, l_local.z, length(l_local * vec3<f32>(p.alphas, 1.0)));
-    let spec = brdf_ggx_ndf_aniso(h_local, p.alphas.x, p.alphas.y) * visibility
-        * brdf_fresnel_schlick(p.f_normal, dot(p.v_local, h_local));
-    // brdf_fresnel_weighted_lambert with the view's half precomputed.
-    let diff = p.diffuse * (vec3<f32>(1.0) - brdf_fresnel_schlick(p.f_normal, l_local.z));
-    return (spec + diff) * l_local.z;
+    // D (brdf_ggx_ndf_aniso) times V (brdf_visibility_stretched) over one division: with both
+    // sides above the surface h is too, and the denominators are positive.
+    let s = vec3<f32>(h_local.xy * p.inv_alphas, h_local.z);
+    let dd = dot(s, s);
+    let vis_den = l_local.z * p.v_stretched + p.v_local.z * length(l_local * vec3<f32>(p.alphas, 1.0));
+    let spec = l_local.z * p.spec_scale / (dd * dd * vis_den);
+    return vec3<f32>(spec, spec * brdf_schlick_weight(dot(p.v_local, h_local)), (1.0 - brdf_schlick_weight(l_local.z)) * l_local.z);
+}
+
+// Radiance from light weights summed with their colours: a = sum c w.x, b = sum c w.y,
+// c = sum c w.z (see brdf_light_weights).
+fn brdf_apply_weights(p: BrdfView, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
+    return p.f_normal * a + (vec3<f32>(1.0) - p.f_normal) * (b + p.diffuse * c);
+}
+
+// brdf_evaluate for a prepared view: BRDF * n.l, 0 when v or l is at or below the surface.
+fn brdf_evaluate_view(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
+    let w = brdf_light_weights(p, l);
+    return brdf_apply_weights(p, vec3<f32>(w.x), vec3<f32>(w.y), vec3<f32>(w.z));
 }
 
 // BRDF * n.l, 1/sr, per RGB channel; 0 when v or l is at or below the surface.

@@ -6,7 +6,7 @@
 
 #import hikari::view::{View, view_ray, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::brdf::{BrdfMaterial, brdf_view, brdf_evaluate_view, brdf_fresnel_schlick, brdf_material_f0}
+#import hikari::brdf::{BrdfMaterial, brdf_view, brdf_light_weights, brdf_apply_weights, brdf_fresnel_schlick, brdf_material_f0}
 #import hikari::scene_gpu::LightGpu
 #import hikari::sun_shadows::sun_visibility
 
@@ -84,12 +84,12 @@ fn light_range(light: LightGpu) -> f32 {
     return max(min(light.position_range.w, sqrt(peak / params.cutoff.x)), 1e-3);
 }
 
-// Illuminance factor of a punctual light at distance^2 `d2`, `x` = d2 / range^2: inverse
-// square, windowed to 0 at the range (the smooth window glTF's KHR_lights_punctual
-// recommends), times the spot cone.
-fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32, x: f32) -> f32 {
+// Illuminance factor of a punctual light at 1 / distance^2 `inv_d2`, `x` = distance^2 /
+// range^2: inverse square (held below 1e4, a light 1 cm away), windowed to 0 at the range (the
+// smooth window glTF's KHR_lights_punctual recommends), times the spot cone.
+fn light_attenuation(light: LightGpu, l: vec3<f32>, inv_d2: f32, x: f32) -> f32 {
     let window = max(1.0 - x * x, 0.0);
-    var a = window * window / max(d2, 1e-4);
+    var a = window * window * min(inv_d2, 1e4);
     if light.direction_kind.w > 0.5 {
         let cos_angle = dot(-l, light.direction_kind.xyz);
         let s = clamp(cos_angle * light.spot.x + light.spot.y, 0.0, 1.0);
@@ -172,11 +172,18 @@ fn main(
         let mat = textureLoad(gbuffer_material, pixel, 0);
         let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
         let brdf = brdf_view(m, n, t, b, v);
-        radiance = vec3<f32>(0.0);
+        // Every light's colour times its three BRDF weights, summed; the material's colours
+        // are applied once after the loop.
+        var sum_a = vec3<f32>(0.0);
+        var sum_b = vec3<f32>(0.0);
+        var sum_c = vec3<f32>(0.0);
         if (flags & LIGHTING_SUN) != 0u && params.direction_lux.w > 0.0 {
             let l = params.direction_lux.xyz;
-            let vis = sun_visibility(world, n);
-            radiance += brdf_evaluate_view(brdf, l) * params.color.rgb * (params.direction_lux.w * vis);
+            let e = params.color.rgb * (params.direction_lux.w * sun_visibility(world, n));
+            let w = brdf_light_weights(brdf, l);
+            sum_a += e * w.x;
+            sum_b += e * w.y;
+            sum_c += e * w.z;
         }
         for (var k = 0u; k < tile_lights_n; k++) {
             let light = lights[tile_lights[k]];
@@ -185,9 +192,15 @@ fn main(
             // No branch for pixels out of range or facing away (the window and the BRDF give
             // them 0): lanes of a warp diverging there cost more than the lighting they skip.
             let x = d2 * tile_inv_range2[k];
-            let l = to_light * inverseSqrt(max(d2, 1e-8));
-            radiance += brdf_evaluate_view(brdf, l) * light.intensity.rgb * light_attenuation(light, l, d2, x);
+            let inv_d = inverseSqrt(max(d2, 1e-8));
+            let l = to_light * inv_d;
+            let e = light.intensity.rgb * light_attenuation(light, l, inv_d * inv_d, x);
+            let w = brdf_light_weights(brdf, l);
+            sum_a += e * w.x;
+            sum_b += e * w.y;
+            sum_c += e * w.z;
         }
+        radiance = brdf_apply_weights(brdf, sum_a, sum_b, sum_c);
         if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
             let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);
             radiance += (diffuse + specular_placeholder(m, n, v)) * mat.w;
