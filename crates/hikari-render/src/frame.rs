@@ -9,7 +9,7 @@ use crate::graph::{FrameGraph, Tex};
 use crate::passes::direct_lighting::{DirectLighting, LightingParams};
 use crate::passes::gbuffer::{GBuffer, GBufferPass};
 use crate::passes::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
-use crate::passes::raster::Rasterizer;
+use crate::passes::raster::{RasterQueues, Rasterizer};
 use crate::passes::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
@@ -58,6 +58,7 @@ impl FrameSettings {
 #[derive(Clone, Debug, Default)]
 pub struct FrameState {
     pub shadow_cache: sun_shadows::ShadowCache,
+    pub raster_queues: RasterQueues,
 }
 
 /// Every technique's pipelines, built once.
@@ -127,10 +128,13 @@ pub fn record<'r>(
         aspect,
         to_sun,
         &s.settings.shadows,
+        &mut state.raster_queues,
     )?;
 
     // 8. G-buffer.
-    let gbuffer = t.gbuffer.record(g, &t.raster, scene, &view, size)?;
+    let gbuffer = t
+        .gbuffer
+        .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
 
     // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
 

@@ -6,6 +6,7 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::frame::{self, FrameOutputs, FrameSettings, FrameState, Techniques};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
+use crate::passes::raster::RasterQueues;
 use crate::scene_gpu::SceneGpu;
 
 /// A rendered frame: timings, and the images if they were asked for.
@@ -14,6 +15,10 @@ pub struct RenderedFrame {
     pub hdr: Option<ImageRgba32>,
     pub ldr: Option<ImageRgba32>,
 }
+
+/// Frames drawn again at most after their rasteriser queues overflowed; each try grows the
+/// queues to 1.5 times what the last one asked for, so one is nearly always enough.
+const MAX_QUEUE_RETRIES: usize = 4;
 
 pub struct Renderer {
     pub ctx: GpuContext,
@@ -40,6 +45,11 @@ impl Renderer {
         &self.scene
     }
 
+    /// The rasteriser's queue sizes, which grow by themselves; for tests and tuning.
+    pub fn raster_queues(&mut self) -> &mut RasterQueues {
+        &mut self.state.raster_queues
+    }
+
     /// Renders one frame; with `read_images`, copies the HDR and LDR results back.
     pub fn render(&mut self, settings: &FrameSettings, read_images: bool) -> Result<RenderedFrame> {
         let mut result = self.render_reading(settings, |out| {
@@ -55,11 +65,13 @@ impl Renderer {
     }
 
     /// Renders one frame and copies back whatever `pick` names of its resources (G-buffer
-    /// textures, shadow maps...); they appear in the result under their graph names.
+    /// textures, shadow maps...); they appear in the result under their graph names. A frame
+    /// whose rasteriser queues overflowed is drawn again with larger ones, so that no
+    /// triangle is ever lost.
     pub fn render_reading(
         &mut self,
         settings: &FrameSettings,
-        pick: impl FnOnce(&FrameOutputs) -> Vec<Res>,
+        pick: impl Fn(&FrameOutputs) -> Vec<Res>,
     ) -> Result<FrameResult> {
         settings
             .settings
@@ -75,17 +87,33 @@ impl Renderer {
                 });
             }
         }
-        let mut g = self.runtime.begin_frame(&self.ctx);
-        let out = frame::record(
-            &mut g,
-            &self.techniques,
-            &self.scene,
-            settings,
-            &mut self.state,
-        )?;
-        for r in pick(&out) {
-            g.readback(r);
+        let binding_limit = self.ctx.limits.max_storage_buffer_binding_size;
+        for _ in 0..MAX_QUEUE_RETRIES {
+            let mut g = self.runtime.begin_frame(&self.ctx);
+            let out = frame::record(
+                &mut g,
+                &self.techniques,
+                &self.scene,
+                settings,
+                &mut self.state,
+            )?;
+            for r in pick(&out) {
+                g.readback(r);
+            }
+            let result = g.execute()?;
+            if self
+                .state
+                .raster_queues
+                .grow(&result, binding_limit)?
+                .is_empty()
+            {
+                return Ok(result);
+            }
+            // Cascades drawn into an overflowing queue lack triangles: draw them all again.
+            self.state.shadow_cache = Default::default();
         }
-        g.execute()
+        Err(RenderError::Graph(format!(
+            "the rasteriser's queues still overflowed after {MAX_QUEUE_RETRIES} tries"
+        )))
     }
 }

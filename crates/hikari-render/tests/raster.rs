@@ -7,6 +7,7 @@ mod common;
 use glam::{Mat4, Vec3, Vec4};
 use hikari_bvh::reference::closest_hit_instances;
 use hikari_bvh::{Instance, Mesh, Ray};
+use hikari_render::passes::raster::QueueSizes;
 use hikari_render::passes::sun_shadows;
 use hikari_render::reference::gbuffer::{decode_id, pixel_ray};
 use hikari_render::{FrameSettings, Renderer};
@@ -97,6 +98,56 @@ fn visibility_matches_rays_through_pixel_centres() {
             "worst relative depth error {worst_depth}"
         );
     }
+}
+
+#[test]
+fn a_frame_whose_queues_overflow_is_drawn_again_without_losing_triangles() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let scene = hikari_scene::builtin::boxes();
+    let s = frame_settings(&scene, 256, 160);
+    let visibility = |tiny: bool| {
+        let mut renderer = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
+        if tiny {
+            for t in ["gbuffer", "sun_shadows"] {
+                renderer.raster_queues().set(
+                    t,
+                    QueueSizes {
+                        entries: 4,
+                        records: 2,
+                    },
+                );
+            }
+        }
+        let r = renderer
+            .render_reading(&s, |out| {
+                vec![out.gbuffer.visibility.into(), out.shadows.texels.into()]
+            })
+            .unwrap();
+        let grown = renderer.raster_queues().sizes("gbuffer", 0);
+        let bytes = |n: &str| r.buffer(n).unwrap().to_vec();
+        (
+            bytes("gbuffer.visibility"),
+            bytes("sun_shadows.texels"),
+            grown,
+        )
+    };
+    let (want_vis, want_shadow, _) = visibility(false);
+    let (vis, shadow, grown) = visibility(true);
+    assert!(
+        grown.entries > 4 && grown.records > 2,
+        "queues not grown: {grown:?}"
+    );
+    assert!(want_vis.iter().any(|&b| b != 0), "nothing drawn");
+    assert!(
+        vis == want_vis,
+        "the G-buffer lost triangles to the overflow"
+    );
+    assert!(
+        shadow == want_shadow,
+        "the shadow maps lost triangles to the overflow"
+    );
 }
 
 /// A unit sphere of `rings` x `segments` quads, outward-facing, sharing its vertices.

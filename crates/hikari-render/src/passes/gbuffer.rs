@@ -1,7 +1,7 @@
 //! G-buffer: the compute rasteriser writes a visibility buffer, then `gbuffer.resolve` turns it
 //! into the G-buffer textures. CPU twin: [`crate::reference::gbuffer`].
 
-use super::raster::{RasterJob, RasterTarget, Rasterizer};
+use super::raster::{RasterJob, RasterQueues, RasterTarget, Rasterizer};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
@@ -59,6 +59,7 @@ impl GBufferPass {
         scene: &SceneInFrame,
         view: &View,
         [width, height]: [u32; 2],
+        queues: &mut RasterQueues,
     ) -> Result<GBuffer> {
         let tex = |g: &mut FrameGraph<'r>, name: &str, format| {
             g.texture(name, TextureDesc::d2(width, height, format))
@@ -85,6 +86,7 @@ impl GBufferPass {
             },
             RasterTarget::Visibility,
             gb.visibility,
+            queues,
         )?;
         g.pass("gbuffer.resolve")
             .constants(view)

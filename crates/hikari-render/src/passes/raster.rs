@@ -17,7 +17,7 @@ use glam::Mat4;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::graph::{Buf, FrameGraph};
+use crate::graph::{Buf, FrameGraph, FrameResult};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
@@ -71,6 +71,94 @@ pub struct RasterJob<'a> {
 
 /// Large triangles the queue holds after its tile entries (`LARGE_CAPACITY` in the shader).
 const LARGE_CAPACITY: u64 = 65536;
+
+/// Room in one technique's queues: tile entries and triangle records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct QueueSizes {
+    pub entries: u32,
+    pub records: u32,
+}
+
+/// The rasteriser's queue sizes, per technique, kept across frames. How many tile entries and
+/// records a frame needs depends on the scene and the views, not only on the target size, so
+/// every frame reads its counts back ([`RasterQueues::grow`]): a frame whose queues
+/// overflowed lost triangles, and the renderer draws it again with larger queues.
+#[derive(Clone, Debug, Default)]
+pub struct RasterQueues {
+    sizes: std::collections::HashMap<String, QueueSizes>,
+}
+
+impl RasterQueues {
+    /// The sizes `technique` draws with; a first guess from its tile count until a frame
+    /// has shown what it needs.
+    pub fn sizes(&mut self, technique: &str, tiles: u64) -> QueueSizes {
+        *self.sizes.entry(technique.into()).or_insert_with(|| {
+            let entries = (tiles * 16).clamp(1 << 17, 1 << 22) as u32;
+            QueueSizes {
+                entries,
+                records: entries / 2,
+            }
+        })
+    }
+
+    /// Sets the sizes `technique` draws with from now on (tests use tiny ones to force the
+    /// overflow path).
+    pub fn set(&mut self, technique: &str, sizes: QueueSizes) {
+        self.sizes.insert(technique.into(), sizes);
+    }
+
+    /// Reads the counts of a finished frame (the `{technique}.tile_count` buffers) and grows
+    /// the queues that overflowed to 1.5 times what was asked; returns the names of those
+    /// techniques (empty when nothing was lost). Errors when a queue would not fit in one
+    /// storage buffer binding of this device.
+    pub fn grow(&mut self, result: &FrameResult, binding_limit: u64) -> Result<Vec<String>> {
+        let mut overflowed = Vec::new();
+        for (name, sizes) in &mut self.sizes {
+            let Some(bytes) = result.buffer(&format!("{name}.tile_count")) else {
+                continue;
+            };
+            let count = |i: usize| {
+                bytes
+                    .get(i * 4..i * 4 + 4)
+                    .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            };
+            let (entries, large, records) = (count(0), count(1), count(2));
+            if large as u64 > LARGE_CAPACITY {
+                return Err(RenderError::Limit {
+                    what: format!("{name}: triangles covering more than 256 tiles"),
+                    requested: large as u64,
+                    limit: LARGE_CAPACITY,
+                });
+            }
+            if entries <= sizes.entries && records <= sizes.records {
+                continue;
+            }
+            let more = |n: u32, have: u32| have.max((n as u64 * 3 / 2).min(u32::MAX as u64) as u32);
+            let grown = QueueSizes {
+                entries: more(entries, sizes.entries),
+                records: more(records, sizes.records),
+            };
+            let queue_bytes = (grown.entries as u64 + 2 * LARGE_CAPACITY) * 8;
+            let record_bytes = grown.records as u64 * TRIANGLE_RECORD_BYTES;
+            for (what, bytes) in [
+                ("tile queue", queue_bytes),
+                ("triangle records", record_bytes),
+            ] {
+                if bytes > binding_limit {
+                    return Err(RenderError::Limit {
+                        what: format!("{name}: rasteriser {what} in bytes"),
+                        requested: bytes,
+                        limit: binding_limit,
+                    });
+                }
+            }
+            *sizes = grown;
+            overflowed.push(name.clone());
+        }
+        overflowed.sort();
+        Ok(overflowed)
+    }
+}
 /// `TriRecord` in the shader: a triangle's edge equations, depth plane, id, view and rectangle.
 const TRIANGLE_RECORD_BYTES: u64 = 64;
 
@@ -112,25 +200,26 @@ impl Rasterizer {
         job: &RasterJob<'_>,
         kind: RasterTarget,
         target: Buf,
+        queues: &mut RasterQueues,
     ) -> Result<()> {
         let views = job.view_proj.len();
         assert!((1..=MAX_VIEWS).contains(&views), "1 to {MAX_VIEWS} views");
         let [w, h] = job.size;
         let tiles = (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as u64 * views as u64;
-        // Room for every tile covered eight times over by large triangles; beyond that, large
-        // triangles lose tiles (the overflow shows as holes, and `queue_count` tells).
-        let capacity = (tiles * 8).clamp(1 << 16, 1 << 22) as u32;
         let t = job.technique;
+        // Past its capacity a queue drops triangles (holes), and its count keeps growing: the
+        // count is read back so that the renderer can grow the queue and draw again.
+        let QueueSizes {
+            entries: capacity,
+            records: record_capacity,
+        } = queues.sizes(t, tiles);
         // A large triangle takes two entries: its id and view, then its tile rectangle.
         let queue = g.buffer(
             &format!("{t}.tile_queue"),
             (capacity as u64 + 2 * LARGE_CAPACITY) * 8,
         )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
-        // Every record has at least one tile entry or one large entry (a large quad two).
-        let binding_limit = g.ctx().limits.max_storage_buffer_binding_size;
-        let record_capacity = (capacity as u64 + 2 * LARGE_CAPACITY)
-            .min(binding_limit / TRIANGLE_RECORD_BYTES) as u32;
+        g.readback(count);
         let records = g.buffer(
             &format!("{t}.triangle_records"),
             record_capacity as u64 * TRIANGLE_RECORD_BYTES,
@@ -212,5 +301,67 @@ impl Rasterizer {
             pass.dispatch(pipeline, dispatch)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn counts(name: &str, c: [u32; 4]) -> FrameResult {
+        FrameResult {
+            buffers: vec![(
+                format!("{name}.tile_count"),
+                bytemuck::cast_slice(&c).to_vec(),
+            )],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn queues_grow_only_when_a_frame_overflowed_them() {
+        let mut q = RasterQueues::default();
+        let start = q.sizes("gbuffer", 100);
+        assert_eq!(start.entries, 1 << 17, "the floor for a small target");
+        let fits = counts("gbuffer", [start.entries, 3, start.records, 0]);
+        assert!(q.grow(&fits, u64::MAX).unwrap().is_empty());
+        assert_eq!(q.sizes("gbuffer", 100), start);
+        // A count past the capacity: grown to 1.5 times the count, the other queue kept.
+        let over = counts("gbuffer", [start.entries * 2, 0, 10, 0]);
+        assert_eq!(
+            q.grow(&over, u64::MAX).unwrap(),
+            vec!["gbuffer".to_string()]
+        );
+        let grown = q.sizes("gbuffer", 100);
+        assert_eq!(grown.entries, start.entries * 3);
+        assert_eq!(grown.records, start.records);
+        // Techniques whose counts the frame did not read back are left alone.
+        assert!(
+            q.grow(&counts("other", [u32::MAX; 4]), u64::MAX)
+                .unwrap()
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn a_queue_beyond_the_binding_limit_is_an_error_naming_it() {
+        let mut q = RasterQueues::default();
+        q.sizes("sun_shadows", 100);
+        let err = q
+            .grow(&counts("sun_shadows", [1 << 24, 0, 0, 0]), 1 << 20)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("sun_shadows") && err.contains("tile queue"),
+            "{err}"
+        );
+        let err = q
+            .grow(
+                &counts("sun_shadows", [0, LARGE_CAPACITY as u32 + 1, 0, 0]),
+                u64::MAX,
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("256 tiles"), "{err}");
     }
 }

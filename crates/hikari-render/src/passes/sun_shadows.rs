@@ -21,7 +21,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use hikari_scene::Camera;
 
-use super::raster::{MAX_VIEWS, RasterJob, RasterTarget, Rasterizer};
+use super::raster::{MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, Rasterizer};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, Tex, TextureDesc};
@@ -284,6 +284,7 @@ impl SunShadows {
         aspect: f32,
         to_sun: Vec3,
         s: &ShadowSettings,
+        queues: &mut RasterQueues,
     ) -> Result<SunShadowMaps> {
         let bounds = match scene.bounds {
             Some(b) if s.enabled && to_sun.length_squared() > 0.0 => b,
@@ -330,6 +331,7 @@ impl SunShadows {
                 },
                 RasterTarget::Depth,
                 texels,
+                queues,
             )?;
             let mut layers = [0u32; 4];
             layers[..stale.len()].copy_from_slice(&stale);
