@@ -155,11 +155,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .dump_dir
         .clone()
         .unwrap_or_else(|| png.parent().map(PathBuf::from).unwrap_or_default());
-    for img in &frame.result.images {
+    // Only what `--dump` asked for: the renderer reads back a few buffers of its own.
+    let asked = |name: &str| args.dumps.iter().any(|d| d == name);
+    for img in frame.result.images.iter().filter(|i| asked(&i.name)) {
         let p = output::write_dump(&dump_dir, img)?;
         println!("wrote {}", p.display());
     }
-    for (name, bytes) in &frame.result.buffers {
+    for (name, bytes) in frame.result.buffers.iter().filter(|(n, _)| asked(n)) {
         let p = dump_dir.join(format!("{name}.bin"));
         output::write_atomically(&p, |tmp| {
             std::fs::write(tmp, bytes).map_err(|e| hikari_render::RenderError::Output {

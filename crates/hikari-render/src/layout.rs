@@ -73,12 +73,12 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             raster::RasterParams,
             "raster/triangles.wgsl",
-            [view_proj, viewport, config, slices, limits]
+            [view_proj, viewport, config, views, limits]
         ),
         gpu_layout!(
             sun_shadows::ShadowParams,
             "direct_lighting/shade.wgsl",
-            [light_view_proj, texel_world, config, depth_bias]
+            [light_view_proj, texel_world, config, depth_bias, origin]
         ),
         gpu_layout!(
             direct_lighting::LightingParams,

@@ -32,14 +32,10 @@ pub struct ShadowSettings {
     pub depth_bias_texels: f32,
     /// Receiver offset along its normal, in texels of the cascade's world-space size.
     pub normal_bias_texels: f32,
-    /// Keep each cascade's map across frames and redraw it only when its projection changes
-    /// (the camera moved by a texel or more, the sun moved, the settings changed): in a still
-    /// view the maps cost nothing. Off: every cascade is redrawn every frame.
+    /// Keep the maps across frames: a still view draws nothing, a moving one only the strips
+    /// its cascades uncover as they scroll; a cascade is drawn whole when the sun or the
+    /// settings change its shape. Off: every cascade is drawn whole every frame.
     pub cache: bool,
-    /// With the cache: most cascades redrawn in one frame of a moving view, those drifted
-    /// farthest (relative to their size) first, 1 to 4. A cascade is redrawn regardless once
-    /// it drifts by a tenth of its radius, or when the sun moves.
-    pub cascades_per_frame: u32,
 }
 
 impl Default for ShadowSettings {
@@ -54,7 +50,6 @@ impl Default for ShadowSettings {
             depth_bias_texels: 1.0,
             normal_bias_texels: 1.5,
             cache: true,
-            cascades_per_frame: 1,
         }
     }
 }
@@ -125,13 +120,6 @@ impl Settings {
                 field: "shadows.resolution".into(),
                 value: s.resolution.to_string(),
                 allowed: "a power of two from 64 to 8192".into(),
-            });
-        }
-        if !(1..=4).contains(&s.cascades_per_frame) {
-            return Err(SettingError {
-                field: "shadows.cascades_per_frame".into(),
-                value: s.cascades_per_frame.to_string(),
-                allowed: "1 to 4".into(),
             });
         }
         range("shadows.max_distance_m", s.max_distance_m, 1.0, 100_000.0)?;

@@ -36,16 +36,20 @@
 @group(0) @binding(7) var<storage, read> instances: array<InstanceGpu>;
 @group(0) @binding(8) var<storage, read> chunks: array<Chunk>;
 
-// The views one dispatch rasterises into (the camera, or up to four shadow cascades).
+// The views one dispatch rasterises into (the camera, or the shadow cascades, whole or the
+// strips a scrolled cascade uncovers).
 struct RasterParams {
-    view_proj: array<mat4x4<f32>, 4>,
+    view_proj: array<mat4x4<f32>, 8>,
     // width, height, 1 / width, 1 / height of each view's target, in pixels.
     viewport: vec4<f32>,
     // x: 1 to cull back faces of single-sided instances; y: capacity of the tile queue in
     // entries; z: number of views; w: number of chunks.
     config: vec4<u32>,
-    // Per view: the slice of the target (of width * height texels) it draws into.
-    slices: vec4<u32>,
+    // Per view: x the slice of the target (of width * height texels) it draws into; y the
+    // origin, where its pixel (0, 0) is stored (DEPTH_ONLY: pixel p lands at (p + origin)
+    // mod size, sizes powers of two); z, w the first pixel and the end (exclusive) of the
+    // window it draws. Points packed as x | y << 16.
+    views: array<vec4<u32>, 8>,
     // x: capacity of `records`.
     limits: vec4<u32>,
 }
@@ -348,7 +352,7 @@ fn load_record(slot: u32) -> Record {
     return Record(t, r.edge_a.w, (bits >> 8u) & 0xffu, PixelRect(unpack_pixel(r.edge_c.w), unpack_pixel(r.depth.w)));
 }
 
-fn poly_rect(poly: Poly, size: vec2<f32>) -> PixelRect {
+fn poly_rect(poly: Poly, window: PixelRect) -> PixelRect {
     var lo = min(min(poly.va.xy, poly.vb.xy), poly.vc.xy);
     var hi = max(max(poly.va.xy, poly.vb.xy), poly.vc.xy);
     if poly.count == 4u {
@@ -356,57 +360,87 @@ fn poly_rect(poly: Poly, size: vec2<f32>) -> PixelRect {
         hi = max(hi, poly.vd.xy);
     }
     // Pixel i has its centre at i + 0.5.
-    let first = clamp(ceil(lo - 0.5), vec2<f32>(0.0), size);
-    let last = clamp(floor(hi - 0.5), vec2<f32>(-1.0), size - 1.0);
+    let w_lo = vec2<f32>(window.lo);
+    let w_hi = vec2<f32>(window.hi);
+    let first = clamp(ceil(lo - 0.5), w_lo, w_hi + 1.0);
+    let last = clamp(floor(hi - 0.5), w_lo - 1.0, w_hi);
     return PixelRect(vec2<i32>(first), vec2<i32>(last));
 }
 
-// Polygon of visibility id `id` in view `view`, and whether the instance is double-sided.
-fn id_poly(id: u32, view: u32) -> Poly {
-    var none: Poly;
-    none.count = 0u;
+// The pixels view `view` draws, inclusive.
+fn view_window(view: u32) -> PixelRect {
+    let v = params.views[view];
+    return PixelRect(unpack_pixel(v.z), unpack_pixel(v.w) - 1);
+}
+
+// A triangle of the scene in world space, fetched once for all the views that draw it.
+struct WorldTri {
+    valid: bool,
+    cull_back: bool,
+    // Vertices, homogeneous.
+    va: vec4<f32>,
+    vb: vec4<f32>,
+    vc: vec4<f32>,
+}
+
+// The triangle of visibility id `id`; invalid past its chunk's last triangle.
+fn world_tri(id: u32) -> WorldTri {
+    var t: WorldTri;
     let chunk = chunks[id / CHUNK_TRIANGLES];
     let lane = id % CHUNK_TRIANGLES;
-    if lane >= chunk.count {
-        return none;
+    t.valid = lane < chunk.count;
+    if !t.valid {
+        return t;
     }
     let inst = instances[chunk.instance];
     let tri = chunk.first_triangle + lane;
-    let m = params.view_proj[view] * inst.model;
-    let c0 = m * vec4<f32>(positions[indices[tri * 3u]].xyz, 1.0);
-    let c1 = m * vec4<f32>(positions[indices[tri * 3u + 1u]].xyz, 1.0);
-    let c2 = m * vec4<f32>(positions[indices[tri * 3u + 2u]].xyz, 1.0);
-    let cull_back = params.config.x != 0u && (inst.flags & INSTANCE_DOUBLE_SIDED) == 0u;
-    return triangle_poly(c0, c1, c2, params.viewport.xy, cull_back);
+    t.va = inst.model * vec4<f32>(positions[indices[tri * 3u]].xyz, 1.0);
+    t.vb = inst.model * vec4<f32>(positions[indices[tri * 3u + 1u]].xyz, 1.0);
+    t.vc = inst.model * vec4<f32>(positions[indices[tri * 3u + 2u]].xyz, 1.0);
+    t.cull_back = params.config.x != 0u && (inst.flags & INSTANCE_DOUBLE_SIDED) == 0u;
+    return t;
 }
 
-// Whether every point of a chunk's bounds is outside one plane of the view's frustum (a side,
-// or in front of the near plane): then none of its triangles can be seen.
-fn chunk_outside(chunk: Chunk, view: u32) -> bool {
-    let m = params.view_proj[view] * instances[chunk.instance].model;
-    var all_l = true;
-    var all_r = true;
-    var all_b = true;
-    var all_t = true;
-    var all_near = true;
-    for (var k = 0u; k < 8u; k++) {
-        let p = select(chunk.bounds_lo.xyz, chunk.bounds_hi.xyz, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
-        let c = m * vec4<f32>(p, 1.0);
-        all_l = all_l && c.x < -c.w;
-        all_r = all_r && c.x > c.w;
-        all_b = all_b && c.y < -c.w;
-        all_t = all_t && c.y > c.w;
-        all_near = all_near && c.w - c.z < 0.0;
-    }
-    return all_l || all_r || all_b || all_t || all_near;
+// The polygon of `t` in view `view`.
+fn view_poly(t: WorldTri, view: u32) -> Poly {
+    let m = params.view_proj[view];
+    return triangle_poly(m * t.va, m * t.vb, m * t.vc, params.viewport.xy, t.cull_back);
+}
+
+// Which planes of view `view`'s frustum corner `corner` (0 to 7) of a chunk's bounds is
+// outside of, as bits: the sides narrowed to the view's window (left, right, bottom, top),
+// then the near plane. A chunk whose eight corners share a bit is unseen.
+fn chunk_corner_outside(chunk: Chunk, view: u32, corner: u32) -> u32 {
+    // The window's edges in NDC (y up); exactly -1 and 1 for a whole view.
+    let win = view_window(view);
+    let ndc_lo = vec2<f32>(win.lo) * params.viewport.zw * 2.0 - 1.0;
+    let ndc_hi = vec2<f32>(win.hi + 1) * params.viewport.zw * 2.0 - 1.0;
+    let p = select(chunk.bounds_lo.xyz, chunk.bounds_hi.xyz, vec3<bool>((corner & 1u) != 0u, (corner & 2u) != 0u, (corner & 4u) != 0u));
+    let c = params.view_proj[view] * (instances[chunk.instance].model * vec4<f32>(p, 1.0));
+    return select(0u, 1u, c.x < ndc_lo.x * c.w)
+        | select(0u, 2u, c.x > ndc_hi.x * c.w)
+        | select(0u, 4u, c.y < -ndc_hi.y * c.w)
+        | select(0u, 8u, c.y > -ndc_lo.y * c.w)
+        | select(0u, 16u, c.w - c.z < 0.0);
+}
+
+// Index in `target_texels` of pixel `px` of view `view`.
+fn texel_index(view: u32, px: vec2<i32>) -> u32 {
+    let size = vec2<u32>(params.viewport.xy);
+    let v = params.views[view];
+#ifdef DEPTH_ONLY
+    let at = (vec2<u32>(px) + vec2<u32>(unpack_pixel(v.y))) & (size - 1u);
+#else
+    let at = vec2<u32>(px);
+#endif
+    return v.x * size.x * size.y + at.y * size.x + at.x;
 }
 
 fn write_pixel(view: u32, px: vec2<i32>, depth: f32, id: u32) {
     if depth <= 0.0 {
         return;
     }
-    let w = u32(params.viewport.x);
-    let i = params.slices[view] * w * u32(params.viewport.y) + u32(px.y) * w + u32(px.x);
+    let i = texel_index(view, px);
     // A plain load first: most occluded fragments then skip the atomic.
 #ifdef DEPTH_ONLY
     let value = bitcast<u32>(depth);

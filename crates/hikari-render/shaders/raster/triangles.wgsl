@@ -2,33 +2,20 @@
 // their thread; larger ones are set up into a record and split into TILE_SIZE tiles queued
 // for `raster/tiles.wgsl` (`main`), and the largest are listed whole for its `large` entry
 // point.
-// Dispatch: x * y workgroups cover the chunks, z is the view.
+// Dispatch: x * y workgroups cover the chunks; each draws its chunk into every view that may
+// see it.
 
-#import hikari::raster::setup::{params, chunks, chunk_outside, queue, queue_count, id_poly, poly_rect, poly_setup, setup_depth, write_pixel, tile_touched_tri, store_record, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
+#import hikari::raster::setup::{params, chunks, chunk_corner_outside, queue, queue_count, world_tri, view_poly, WorldTri, poly_rect, view_window, poly_setup, setup_depth, write_pixel, tile_touched_tri, store_record, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
 #import hikari::scene_gpu::CHUNK_TRIANGLES
 
-@compute @workgroup_size(64, 1, 1)
-fn main(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    let chunk = wg.y * groups.x + wg.x;
-    if chunk >= params.config.w {
-        return;
-    }
-    let view = wg.z;
-    // The same answer for the whole workgroup: a chunk outside the view costs one test.
-    if chunk_outside(chunks[chunk], view) {
-        return;
-    }
-    let id = chunk * CHUNK_TRIANGLES + lane;
-    let poly = id_poly(id, view);
+// Draws triangle `t` (visibility id `id`) into view `view`: small ones here, larger ones set
+// up into records for the tile and large passes.
+fn draw_triangle(t: WorldTri, id: u32, view: u32) {
+    let poly = view_poly(t, view);
     if poly.count == 0u {
         return;
     }
-    let size = params.viewport.xy;
-    let rect = poly_rect(poly, size);
+    let rect = poly_rect(poly, view_window(view));
     let extent = rect.hi - rect.lo + 1;
     if extent.x <= 0 || extent.y <= 0 {
         return;
@@ -98,6 +85,48 @@ fn main(
                     slot++;
                 }
             }
+        }
+    }
+}
+
+// Per view: the frustum planes that every corner of this workgroup's chunk is outside of.
+var<workgroup> chunk_outside: array<atomic<u32>, 8>;
+
+@compute @workgroup_size(64, 1, 1)
+fn main(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let chunk = wg.y * groups.x + wg.x;
+    if chunk >= params.config.w {
+        return;
+    }
+    let views = params.config.z;
+    if lane < 8u {
+        atomicStore(&chunk_outside[lane], 0x1fu);
+    }
+    workgroupBarrier();
+    // Lane k tests corner k % 8 of the chunk's bounds in view k / 8: one transform a lane,
+    // rather than all eight corners in every lane of a workgroup a view.
+    if lane / 8u < views {
+        atomicAnd(&chunk_outside[lane / 8u], chunk_corner_outside(chunks[chunk], lane / 8u, lane % 8u));
+    }
+    workgroupBarrier();
+    let id = chunk * CHUNK_TRIANGLES + lane;
+    var t: WorldTri;
+    var fetched = false;
+    for (var view = 0u; view < views; view++) {
+        if atomicLoad(&chunk_outside[view]) != 0u {
+            continue;
+        }
+        // Fetched once, for the first view that may see the chunk.
+        if !fetched {
+            t = world_tri(id);
+            fetched = true;
+        }
+        if t.valid {
+            draw_triangle(t, id, view);
         }
     }
 }

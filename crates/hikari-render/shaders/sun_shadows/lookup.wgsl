@@ -2,8 +2,9 @@
 
 // Sun shadow lookup: cascade selection and 3x3 bilinear PCF over the compute-rasterised
 // shadow maps (`passes/sun_shadows.rs`). CPU twin: reference::sun_shadows. A shader that
-// imports this module binds the parameters, the maps and a nearest sampler at bindings 9 to
-// 11, after its own.
+// imports this module binds the parameters, the maps and a nearest, repeating sampler at
+// bindings 9 to 11, after its own. The maps scroll: texel t of cascade c is stored at
+// (t + origin[c]) mod resolution.
 
 struct ShadowParams {
     light_view_proj: array<mat4x4<f32>, 4>,
@@ -11,6 +12,8 @@ struct ShadowParams {
     // cascades, resolution, PCF tap spacing in texels, normal bias in texels.
     config: vec4<f32>,
     depth_bias: vec4<f32>,
+    // Per cascade: where its texel (0, 0) is stored, x | y << 16.
+    origin: vec4<u32>,
 }
 
 @group(0) @binding(9) var<uniform> shadow: ShadowParams;
@@ -29,13 +32,13 @@ fn lit4(depth_bits: vec4<u32>, receiver: f32) -> vec4<f32> {
 
 // Fraction of a bilinear footprint whose casters are no nearer the sun than `receiver`
 // (reverse depth: larger is nearer the sun).
-fn bilinear_lit(layer: u32, res: i32, st: vec2<f32>, receiver: f32) -> f32 {
+fn bilinear_lit(layer: u32, res: i32, origin: vec2<i32>, st: vec2<f32>, receiver: f32) -> f32 {
     let p = floor(st);
     let f = st - p;
-    let i = vec2<i32>(p);
+    let i = vec2<i32>(p) + origin;
     var lit = vec4<f32>(0.0);
     for (var k = 0; k < 4; k++) {
-        let c = clamp(i + vec2<i32>(k & 1, k >> 1), vec2<i32>(0), vec2<i32>(res - 1));
+        let c = (i + vec2<i32>(k & 1, k >> 1)) & vec2<i32>(res - 1);
         lit[k] = select(0.0, 1.0, shadow_depth(layer, c) <= receiver);
     }
     return mix(mix(lit.x, lit.y, f.x), mix(lit.z, lit.w, f.x), f.y);
@@ -44,13 +47,13 @@ fn bilinear_lit(layer: u32, res: i32, st: vec2<f32>, receiver: f32) -> f32 {
 // The nine bilinear taps one texel apart, as the 4x4 texels they touch with tent weights
 // (1 - f, 1, 1, f) / 3 along each axis: the same sum from four 2x2 gathers instead of 36
 // loads. A gather at the corner shared by texels (x, y) and (x + 1, y + 1) returns them as
-// ((x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y)); the clamp-to-edge sampler repeats edge
-// texels as the twin's clamped indices do.
-fn tent_lit(layer: u32, res: f32, st: vec2<f32>, receiver: f32) -> f32 {
+// ((x, y + 1), (x + 1, y + 1), (x + 1, y), (x, y)); the repeating sampler wraps the
+// coordinates as the twin's indices do.
+fn tent_lit(layer: u32, res: f32, origin: vec2<f32>, st: vec2<f32>, receiver: f32) -> f32 {
     let p = floor(st);
     let f = st - p;
     // The block starts at texel p - 1: its first 2x2 share the corner at p.
-    let corner = p / res;
+    let corner = (p + origin) / res;
     let step = 2.0 / res;
     let top_left = lit4(textureGather(0, shadow_map, shadow_sampler, corner, layer), receiver);
     let top_right = lit4(textureGather(0, shadow_map, shadow_sampler, corner + vec2<f32>(step, 0.0), layer), receiver);
@@ -80,13 +83,15 @@ fn sun_visibility(world: vec3<f32>, n: vec3<f32>) -> f32 {
         if all(uv > vec2<f32>(margin)) && all(uv < vec2<f32>(1.0 - margin)) {
             let receiver = s.z + shadow.depth_bias[c];
             let st = uv * res - 0.5;
+            let bits = shadow.origin[c];
+            let origin = vec2<u32>(bits & 0xffffu, bits >> 16u);
             if spacing == 1.0 {
-                return tent_lit(c, res, st, receiver);
+                return tent_lit(c, res, vec2<f32>(origin), st, receiver);
             }
             var sum = 0.0;
             for (var y = -1; y <= 1; y++) {
                 for (var x = -1; x <= 1; x++) {
-                    sum += bilinear_lit(c, i32(res), st + vec2<f32>(f32(x), f32(y)) * spacing, receiver);
+                    sum += bilinear_lit(c, i32(res), vec2<i32>(origin), st + vec2<f32>(f32(x), f32(y)) * spacing, receiver);
                 }
             }
             return sum / 9.0;

@@ -43,6 +43,7 @@ use resources::{PhysicalBuffer, PhysicalTexture};
 pub enum SamplerKind {
     LinearClamp,
     NearestClamp,
+    NearestRepeat,
     LinearRepeat,
     /// Depth comparison (greater-or-equal, for reverse-Z shadow maps), linear.
     ShadowCompare,

@@ -272,6 +272,9 @@ impl GraphRuntime {
                         wgpu::AddressMode::ClampToEdge,
                         None,
                     ),
+                    SamplerKind::NearestRepeat => {
+                        (wgpu::FilterMode::Nearest, wgpu::AddressMode::Repeat, None)
+                    }
                     SamplerKind::LinearRepeat => {
                         (wgpu::FilterMode::Linear, wgpu::AddressMode::Repeat, None)
                     }

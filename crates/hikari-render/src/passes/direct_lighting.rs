@@ -129,7 +129,7 @@ impl DirectLighting {
             .write(radiance)
             .constants(&shadows.params)
             .read(shadows.map)
-            .sampler(SamplerKind::NearestClamp)
+            .sampler(SamplerKind::NearestRepeat)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(radiance)
     }

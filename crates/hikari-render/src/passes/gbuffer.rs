@@ -1,7 +1,7 @@
 //! G-buffer: the compute rasteriser writes a visibility buffer, then `gbuffer.resolve` turns it
 //! into the G-buffer textures. CPU twin: [`crate::reference::gbuffer`].
 
-use super::raster::{RasterJob, RasterQueues, RasterTarget, Rasterizer};
+use super::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
@@ -79,8 +79,7 @@ impl GBufferPass {
             scene,
             &RasterJob {
                 technique: "gbuffer",
-                view_proj: &[view.view_proj()],
-                slices: &[0],
+                views: &[RasterView::full(view.view_proj(), 0, [width, height])],
                 size: [width, height],
                 cull_back_faces: true,
             },

@@ -26,7 +26,8 @@ use naga_oil::compose::ShaderDefValue;
 pub const TILE_SIZE: u32 = 32;
 /// Workgroups of the tile pass; each loops over the queue.
 const TILE_WORKGROUPS: u32 = 4096;
-pub const MAX_VIEWS: usize = 4;
+/// Views a dispatch draws at most: four shadow cascades, each scrolled in two strips.
+pub const MAX_VIEWS: usize = 8;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -34,10 +35,45 @@ pub struct RasterParams {
     pub view_proj: [[[f32; 4]; 4]; MAX_VIEWS],
     pub viewport: [f32; 4],
     pub config: [u32; 4],
-    /// Per view: which slice of the target (of `width * height` texels) it draws into.
-    pub slices: [u32; 4],
+    /// Per view: slice of the target, origin, first pixel and end (exclusive) of the window,
+    /// points packed as x | y << 16 (see [`RasterView`]).
+    pub views: [[u32; 4]; MAX_VIEWS],
     /// x: capacity of the triangle records.
     pub limits: [u32; 4],
+}
+
+/// One view of a raster job.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RasterView {
+    pub view_proj: Mat4,
+    /// The slice of the target (of `width * height` texels) it draws into.
+    pub slice: u32,
+    /// The pixels it draws (and clears first): x0, y0, x1, y1, the ends exclusive.
+    pub window: [u32; 4],
+    /// Where pixel (0, 0) is stored: pixel (x, y) lands at ((x + ox) mod width, (y + oy) mod
+    /// height) of its slice, so that a shadow map can scroll with the camera and draw only
+    /// what it uncovers. Depth targets of power-of-two sizes only.
+    pub origin: [u32; 2],
+}
+
+impl RasterView {
+    /// All of a `size` target, stored as drawn.
+    pub fn full(view_proj: Mat4, slice: u32, [w, h]: [u32; 2]) -> Self {
+        Self {
+            view_proj,
+            slice,
+            window: [0, 0, w, h],
+            origin: [0, 0],
+        }
+    }
+
+    fn covers(&self, [w, h]: [u32; 2]) -> bool {
+        self.window == [0, 0, w, h]
+    }
+}
+
+fn pack_point(x: u32, y: u32) -> u32 {
+    x | (y << 16)
 }
 
 /// Whether a target keeps the triangle id beside the depth.
@@ -62,9 +98,7 @@ impl RasterTarget {
 pub struct RasterJob<'a> {
     /// Technique name; the passes are `{technique}.clear`, `.rasterize`, `.rasterize_tiles`.
     pub technique: &'a str,
-    pub view_proj: &'a [Mat4],
-    /// Per view, the slice of the target it draws into (and clears first).
-    pub slices: &'a [u32],
+    pub views: &'a [RasterView],
     pub size: [u32; 2],
     pub cull_back_faces: bool,
 }
@@ -163,9 +197,9 @@ impl RasterQueues {
 const TRIANGLE_RECORD_BYTES: u64 = 64;
 
 pub struct Rasterizer {
-    /// triangles, tiles, large
-    visibility: [ComputePipeline; 3],
-    depth: [ComputePipeline; 3],
+    /// triangles, tiles, large, window clear
+    visibility: [ComputePipeline; 4],
+    depth: [ComputePipeline; 4],
 }
 
 impl Rasterizer {
@@ -183,16 +217,18 @@ impl Rasterizer {
                 ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &[])?,
                 ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &[])?,
                 ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "large", &[])?,
+                ComputePipeline::new(ctx, lib, "raster/clear.wgsl", "main", &[])?,
             ],
             depth: [
                 ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &depth_only)?,
                 ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &depth_only)?,
                 ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "large", &depth_only)?,
+                ComputePipeline::new(ctx, lib, "raster/clear.wgsl", "main", &depth_only)?,
             ],
         })
     }
 
-    /// Clears the views' slices of `target` and rasterises every scene triangle into them.
+    /// Clears the views' windows of `target` and rasterises every scene triangle into them.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
@@ -202,9 +238,22 @@ impl Rasterizer {
         target: Buf,
         queues: &mut RasterQueues,
     ) -> Result<()> {
-        let views = job.view_proj.len();
+        let views = job.views.len();
         assert!((1..=MAX_VIEWS).contains(&views), "1 to {MAX_VIEWS} views");
         let [w, h] = job.size;
+        for v in job.views {
+            let [x0, y0, x1, y1] = v.window;
+            assert!(
+                x0 < x1 && x1 <= w && y0 < y1 && y1 <= h,
+                "window {:?} in {w}x{h}",
+                v.window
+            );
+            assert!(
+                v.origin == [0, 0]
+                    || (kind == RasterTarget::Depth && w.is_power_of_two() && h.is_power_of_two()),
+                "stored with an origin: depth targets of power-of-two sizes only"
+            );
+        }
         let tiles = (w.div_ceil(TILE_SIZE) * h.div_ceil(TILE_SIZE)) as u64 * views as u64;
         let t = job.technique;
         // Past its capacity a queue drops triangles (holes), and its count keeps growing: the
@@ -224,14 +273,19 @@ impl Rasterizer {
             &format!("{t}.triangle_records"),
             record_capacity as u64 * TRIANGLE_RECORD_BYTES,
         )?;
-        assert_eq!(job.slices.len(), views, "one slice a view");
         let slice_bytes = w as u64 * h as u64 * kind.bytes_per_texel();
-        let slices: Vec<u32> = job.slices.to_vec();
+        // Whole slices are cleared by the copy engine, windows by the clear pass below.
+        let whole: Vec<u32> = job
+            .views
+            .iter()
+            .filter(|v| v.covers(job.size))
+            .map(|v| v.slice)
+            .collect();
         g.pass(&format!("{t}.clear"))
             .uses(target, true)
             .uses(count, true)
             .encode(move |enc, res| {
-                for &s in &slices {
+                for &s in &whole {
                     enc.clear_buffer(
                         res.buffer(target),
                         s as u64 * slice_bytes,
@@ -241,11 +295,17 @@ impl Rasterizer {
                 enc.clear_buffer(res.buffer(count), 0, None);
             })?;
         let mut view_proj = [[[0.0; 4]; 4]; MAX_VIEWS];
-        for (dst, m) in view_proj.iter_mut().zip(job.view_proj) {
-            *dst = m.to_cols_array_2d();
+        let mut view_params = [[0u32; 4]; MAX_VIEWS];
+        for (i, v) in job.views.iter().enumerate() {
+            let [x0, y0, x1, y1] = v.window;
+            view_proj[i] = v.view_proj.to_cols_array_2d();
+            view_params[i] = [
+                v.slice,
+                pack_point(v.origin[0], v.origin[1]),
+                pack_point(x0, y0),
+                pack_point(x1, y1),
+            ];
         }
-        let mut slice_of_view = [0u32; MAX_VIEWS];
-        slice_of_view[..views].copy_from_slice(job.slices);
         let params = RasterParams {
             view_proj,
             viewport: [w as f32, h as f32, 1.0 / w as f32, 1.0 / h as f32],
@@ -255,9 +315,28 @@ impl Rasterizer {
                 views as u32,
                 scene.chunk_count,
             ],
-            slices: slice_of_view,
+            views: view_params,
             limits: [record_capacity, 0, 0, 0],
         };
+        let pipelines = match kind {
+            RasterTarget::Visibility => &self.visibility,
+            RasterTarget::Depth => &self.depth,
+        };
+        let [triangles, tiles, large, clear] = pipelines;
+        let windowed = job
+            .views
+            .iter()
+            .filter(|v| !v.covers(job.size))
+            .map(|v| (v.window[2] - v.window[0]) * (v.window[3] - v.window[1]))
+            .max();
+        let max = g.ctx().limits.max_compute_workgroups_per_dimension;
+        if let Some(texels) = windowed {
+            let n = texels.div_ceil(256);
+            g.pass(&format!("{t}.clear_windows"))
+                .constants(&params)
+                .write(target)
+                .dispatch(clear, [n.min(max), n.div_ceil(max), views as u32])?;
+        }
         let SceneInFrame {
             positions,
             indices,
@@ -265,17 +344,11 @@ impl Rasterizer {
             chunks,
             ..
         } = *scene;
-        let pipelines = match kind {
-            RasterTarget::Visibility => &self.visibility,
-            RasterTarget::Depth => &self.depth,
-        };
-        let max = g.ctx().limits.max_compute_workgroups_per_dimension;
         let n = scene.chunk_count.max(1);
-        let groups = [n.min(max), n.div_ceil(max), views as u32];
+        let groups = [n.min(max), n.div_ceil(max), 1];
         // The three passes bind the same resources; they differ in entry point and dispatch.
         // Large before tiles: the near walls and floors that take the large path then hide
         // what lies behind them from the tile pass's atomics (its plain load rejects them).
-        let [triangles, tiles, large] = pipelines;
         let stages = [
             ("rasterize", groups, triangles),
             ("rasterize_large", [TILE_WORKGROUPS, 1, 1], large),

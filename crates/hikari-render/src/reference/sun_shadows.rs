@@ -5,12 +5,20 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::passes::sun_shadows::ShadowParams;
 
-fn bilinear_lit(texels: &[f32], base: usize, res: i32, st: Vec2, receiver: f32) -> f32 {
+/// `origin`: where texel (0, 0) is stored; texel t is at (t + origin) mod res.
+fn bilinear_lit(
+    texels: &[f32],
+    base: usize,
+    res: i32,
+    origin: [i32; 2],
+    st: Vec2,
+    receiver: f32,
+) -> f32 {
     let p = st.floor();
     let f = st - p;
     let lit = |dx: i32, dy: i32| {
-        let x = (p.x as i32 + dx).clamp(0, res - 1);
-        let y = (p.y as i32 + dy).clamp(0, res - 1);
+        let x = (p.x as i32 + dx + origin[0]).rem_euclid(res);
+        let y = (p.y as i32 + dy + origin[1]).rem_euclid(res);
         if texels[base + (y * res + x) as usize] <= receiver {
             1.0
         } else {
@@ -23,7 +31,7 @@ fn bilinear_lit(texels: &[f32], base: usize, res: i32, st: Vec2, receiver: f32) 
 }
 
 /// Sun visibility in [0, 1] at `world` with unit normal `n`; `texels` are the depths of all
-/// cascades, cascade-major.
+/// cascades, cascade-major, each scrolled by its origin.
 pub fn visibility(p: &ShadowParams, texels: &[f32], world: Vec3, n: Vec3) -> f32 {
     let cascades = p.config[0] as usize;
     let res = p.config[1];
@@ -37,11 +45,12 @@ pub fn visibility(p: &ShadowParams, texels: &[f32], world: Vec3, n: Vec3) -> f32
             let receiver = s.z + p.depth_bias[c];
             let st = uv * res - 0.5;
             let base = c * (res as usize) * (res as usize);
+            let origin = [(p.origin[c] & 0xffff) as i32, (p.origin[c] >> 16) as i32];
             let mut sum = 0.0;
             for y in -1..=1 {
                 for x in -1..=1 {
                     let o = Vec2::new(x as f32, y as f32) * spacing;
-                    sum += bilinear_lit(texels, base, res as i32, st + o, receiver);
+                    sum += bilinear_lit(texels, base, res as i32, origin, st + o, receiver);
                 }
             }
             return sum / 9.0;
