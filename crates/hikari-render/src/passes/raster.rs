@@ -1,6 +1,6 @@
 //! hikari's compute rasteriser, shared by the G-buffer (visibility: depth and triangle id a
-//! pixel, in 64-bit atomics) and the sun's shadow maps (depth only, up to four views a
-//! dispatch). It exists because rasterising in compute is several times faster than the
+//! pixel, in 64-bit atomics) and the sun's shadow maps (depth only, up to eight views a
+//! dispatch, each drawing a window of its slice: a whole cascade or a strip of a scrolled one). It exists because rasterising in compute is several times faster than the
 //! fixed-function path on the GPUs we measure on (BENCHMARKS.md: the H200 fills ~7 Gpixel/s).
 //!
 //! Pass 1 (`{technique}.rasterize`) runs a thread a triangle: small triangles are rasterised by
