@@ -67,12 +67,25 @@ impl RasterView {
         }
     }
 
-    fn covers(&self, [w, h]: [u32; 2]) -> bool {
+    /// Whether it draws all of a `size` target.
+    pub fn covers(&self, [w, h]: [u32; 2]) -> bool {
         self.window == [0, 0, w, h]
+    }
+
+    /// Slice, origin, window start and end, points packed as x | y << 16: how the
+    /// rasteriser's and the shadow copy's shaders read a view.
+    pub fn packed(&self) -> [u32; 4] {
+        let [x0, y0, x1, y1] = self.window;
+        [
+            self.slice,
+            pack_point(self.origin[0], self.origin[1]),
+            pack_point(x0, y0),
+            pack_point(x1, y1),
+        ]
     }
 }
 
-fn pack_point(x: u32, y: u32) -> u32 {
+pub(crate) fn pack_point(x: u32, y: u32) -> u32 {
     x | (y << 16)
 }
 
@@ -297,14 +310,8 @@ impl Rasterizer {
         let mut view_proj = [[[0.0; 4]; 4]; MAX_VIEWS];
         let mut view_params = [[0u32; 4]; MAX_VIEWS];
         for (i, v) in job.views.iter().enumerate() {
-            let [x0, y0, x1, y1] = v.window;
             view_proj[i] = v.view_proj.to_cols_array_2d();
-            view_params[i] = [
-                v.slice,
-                pack_point(v.origin[0], v.origin[1]),
-                pack_point(x0, y0),
-                pack_point(x1, y1),
-            ];
+            view_params[i] = v.packed();
         }
         let params = RasterParams {
             view_proj,

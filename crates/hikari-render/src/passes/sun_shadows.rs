@@ -25,7 +25,9 @@ use glam::{IVec2, Mat4, Vec3, Vec4};
 
 use hikari_scene::Camera;
 
-use super::raster::{MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
+use super::raster::{
+    MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer, pack_point,
+};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, Tex, TextureDesc};
@@ -186,7 +188,7 @@ impl ShadowParams {
             p.texel_world[i] = c.texel_world;
             p.depth_bias[i] = s.depth_bias_texels * c.texel_world / depth_range;
             let [ox, oy] = c.origin(s.resolution);
-            p.origin[i] = ox | (oy << 16);
+            p.origin[i] = pack_point(ox, oy);
         }
         p.config = [
             cascades.len() as f32,
@@ -394,13 +396,7 @@ impl SunShadows {
                 config: [s.resolution, views.len() as u32, 0, 0],
             };
             for (dst, v) in copy.regions.iter_mut().zip(&views) {
-                let [x0, y0, x1, y1] = v.window;
-                *dst = [
-                    v.slice,
-                    v.origin[0] | (v.origin[1] << 16),
-                    x0 | (y0 << 16),
-                    x1 | (y1 << 16),
-                ];
+                *dst = v.packed();
             }
             // Items: a whole layer's are four texels each, a strip's one; rows of res / 4.
             let res = s.resolution;
@@ -409,7 +405,7 @@ impl SunShadows {
                 .map(|v| {
                     let [x0, y0, x1, y1] = v.window;
                     let texels = (x1 - x0) * (y1 - y0);
-                    if texels == res * res {
+                    if v.covers([res, res]) {
                         texels / 4
                     } else {
                         texels
