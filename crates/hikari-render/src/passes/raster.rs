@@ -225,17 +225,34 @@ impl Rasterizer {
             )));
         }
         let depth_only = [("DEPTH_ONLY", ShaderDefValue::Bool(true))];
+        // Without wgpu's runtime checks: 0.02-0.04 ms a frame at 4K (BENCHMARKS.md, session 6).
+        let hot = |lib: &mut ShaderLibrary, path: &str, entry: &str, defs: &[_]| {
+            // SAFETY: what the raster kernels index, they index in range: chunks below the
+            // chunk count; vertices and positions through the scene's indices, which
+            // `Scene::validate` checked before upload, in chunks `SceneGpu` built; views below
+            // the view count (at most MAX_VIEWS, asserted in `record`) or as stored in the
+            // records by the triangle pass; queue slots, large slots and records below the
+            // capacities they are checked against before every write, and read below the
+            // counts clamped to those capacities; target texels at pixels of a rectangle
+            // clamped to the view's window (DEPTH_ONLY wraps them into the power-of-two map);
+            // the clip polygon's four corners at most; workgroup masks below 3 and 8. Every
+            // loop runs to a bound: pixel and tile rectangles clamped to the window (clip
+            // space w is at least the near distance, so no NaN reaches them), counts clamped
+            // to capacities. Divisors are non-zero constants or counts of a non-empty
+            // dispatch. Workgroup memory is written, then a barrier, before it is read.
+            unsafe { ComputePipeline::new_unchecked(ctx, lib, path, entry, defs) }
+        };
         Ok(Self {
             visibility: [
-                ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &[])?,
-                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &[])?,
-                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "large", &[])?,
+                hot(lib, "raster/triangles.wgsl", "main", &[])?,
+                hot(lib, "raster/tiles.wgsl", "main", &[])?,
+                hot(lib, "raster/tiles.wgsl", "large", &[])?,
                 ComputePipeline::new(ctx, lib, "raster/clear.wgsl", "main", &[])?,
             ],
             depth: [
-                ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &depth_only)?,
-                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &depth_only)?,
-                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "large", &depth_only)?,
+                hot(lib, "raster/triangles.wgsl", "main", &depth_only)?,
+                hot(lib, "raster/tiles.wgsl", "main", &depth_only)?,
+                hot(lib, "raster/tiles.wgsl", "large", &depth_only)?,
                 ComputePipeline::new(ctx, lib, "raster/clear.wgsl", "main", &depth_only)?,
             ],
         })
