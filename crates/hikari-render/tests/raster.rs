@@ -103,14 +103,14 @@ fn crowded_tiles_keep_the_nearest_of_hundreds_of_overlapping_triangles() {
 /// centre.
 fn visibility_agrees_with_rays(scene: &Scene, w: u32, h: u32) {
     let Some(ctx) = common::gpu() else { return };
-    let s = frame_settings(&scene, w, h);
-    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let s = frame_settings(scene, w, h);
+    let mut renderer = Renderer::new(ctx, scene).unwrap();
     let r = renderer
         .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
         .unwrap();
     let vis: &[u32] = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap());
-    let (meshes, instances) = bvh_scene(&scene);
-    let firsts = mesh_first_triangles(&scene);
+    let (meshes, instances) = bvh_scene(scene);
+    let firsts = mesh_first_triangles(scene);
     let view = hikari_render::view::View::new(&s.camera, w, h);
     let inv = Mat4::from_cols_array_2d(&view.inv_view_proj);
     let vp = view.view_proj();
