@@ -452,3 +452,74 @@ fn scrolled_shadow_maps_hold_what_a_full_redraw_draws() {
         "a still view keeps its maps"
     );
 }
+
+#[test]
+fn views_with_non_finite_or_huge_matrices_stay_inside_their_target() {
+    // The raster kernels run without wgpu's index checks. A view given NaN, infinite or huge
+    // matrices through the library must end (no endless loop) and write nothing outside its
+    // slice, beside a sane view drawing into the next slice. (On lavapipe a NaN corner also
+    // fails every depth test; the integer clamp in `poly_rect` is what bounds the loops on
+    // drivers that turn NaN into other integers.)
+    use hikari_render::graph::GraphRuntime;
+    use hikari_render::passes::raster::{
+        RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer,
+    };
+    use hikari_render::scene_gpu::SceneGpu;
+    use hikari_render::shader::{self, ShaderLibrary};
+    let Some(ctx) = common::gpu() else { return };
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let raster = Rasterizer::new(&ctx, &mut lib).unwrap();
+    let scene = hikari_scene::builtin::boxes();
+    let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();
+    let size = [64u32, 48];
+    let slice = (size[0] * size[1]) as u64 * 8;
+    let sane = frame_settings(&scene, size[0], size[1]);
+    let sane = hikari_render::view::View::new(&sane.camera, size[0], size[1]).view_proj();
+    for bad in [
+        Mat4::from_cols_array(&[f32::NAN; 16]),
+        Mat4::from_cols_array(&[f32::INFINITY; 16]),
+        sane * Mat4::from_scale(Vec3::splat(1e30)),
+        Mat4::from_cols(Vec4::ONE, Vec4::NEG_ONE, Vec4::ONE, Vec4::splat(1e-30)),
+    ] {
+        let mut rt = GraphRuntime::new();
+        let mut g = rt.begin_frame(&ctx);
+        let scene_in = scene_gpu.import(&mut g);
+        // Slice 0: the bad view; slice 1: the sane one; slice 2: a guard that must stay zero.
+        let target = g.buffer("t.target", 3 * slice).unwrap();
+        let views = [
+            RasterView::full(bad, 0, size),
+            RasterView::full(sane, 1, size),
+        ];
+        let job = RasterJob {
+            technique: "t",
+            views: &views,
+            size,
+            cull_back_faces: false,
+        };
+        let mut queues = RasterQueues::default();
+        raster
+            .record(
+                &mut g,
+                &scene_in,
+                &job,
+                RasterTarget::Visibility,
+                target,
+                &mut queues,
+            )
+            .unwrap();
+        g.readback(target);
+        let r = g.execute().unwrap();
+        let bytes = r.buffer("t.target").unwrap();
+        let [_, drawn, guard] =
+            [0, 1, 2].map(|k| &bytes[k * slice as usize..(k + 1) * slice as usize]);
+        assert!(
+            guard.iter().all(|&b| b == 0),
+            "a view with matrix {bad:?} wrote outside the target's slices"
+        );
+        let seen = drawn.chunks(8).filter(|p| p[4..] != [0; 4]).count();
+        assert!(
+            seen * 2 > (size[0] * size[1]) as usize,
+            "the sane view beside it drew {seen} pixels"
+        );
+    }
+}

@@ -364,7 +364,9 @@ fn poly_rect(poly: Poly, window: PixelRect) -> PixelRect {
     let w_hi = vec2<f32>(window.hi);
     let first = clamp(ceil(lo - 0.5), w_lo, w_hi + 1.0);
     let last = clamp(floor(hi - 0.5), w_lo - 1.0, w_hi);
-    return PixelRect(vec2<i32>(first), vec2<i32>(last));
+    // Clamped again as integers: a NaN corner (from a view matrix given through the library)
+    // survives the float clamp, and the kernels run without index checks.
+    return PixelRect(clamp(vec2<i32>(first), window.lo, window.hi + 1), clamp(vec2<i32>(last), window.lo - 1, window.hi));
 }
 
 // The pixels view `view` draws, inclusive.

@@ -234,12 +234,13 @@ impl Rasterizer {
             // records by the triangle pass; queue slots, large slots and records below the
             // capacities they are checked against before every write, and read below the
             // counts clamped to those capacities; target texels at pixels of a rectangle
-            // clamped to the view's window (DEPTH_ONLY wraps them into the power-of-two map);
-            // the clip polygon's four corners at most; workgroup masks below 3 and 8. Every
-            // loop runs to a bound: pixel and tile rectangles clamped to the window (clip
-            // space w is at least the near distance, so no NaN reaches them), counts clamped
-            // to capacities. Divisors are non-zero constants or counts of a non-empty
-            // dispatch. Workgroup memory is written, then a barrier, before it is read.
+            // clamped to the view's window (DEPTH_ONLY wraps them into the power-of-two map),
+            // in slices that `record` asserts lie in the target; the clip polygon's four
+            // corners at most; workgroup masks below 3 and 8. Every loop runs to a bound:
+            // pixel and tile rectangles are clamped, as integers, to the window (`poly_rect`,
+            // whatever the view matrices hold), counts to capacities. Divisors are non-zero
+            // constants, workgroup counts, or spans of non-empty tile rectangles. Workgroup
+            // memory is written, then a barrier, before it is read.
             unsafe { ComputePipeline::new_unchecked(ctx, lib, path, entry, defs) }
         };
         Ok(Self {
@@ -304,6 +305,15 @@ impl Rasterizer {
             record_capacity as u64 * TRIANGLE_RECORD_BYTES,
         )?;
         let slice_bytes = w as u64 * h as u64 * kind.bytes_per_texel();
+        // The kernels write without index checks: every view's slice must lie in the target.
+        let target_bytes = g.buffer_size(target).unwrap_or(0);
+        for v in job.views {
+            assert!(
+                (v.slice as u64 + 1) * slice_bytes <= target_bytes,
+                "view slice {} beyond a target of {target_bytes} bytes",
+                v.slice
+            );
+        }
         // Whole slices are cleared by the copy engine, windows by the clear pass below.
         let whole: Vec<u32> = job
             .views
