@@ -675,12 +675,8 @@ mod tests {
     }
 
     /// The encoder as it was before slots became lanes (all axes of one slot per SIMD operation):
-    /// the reference the lane version must match bit for bit.
-    /// Writes origin, exponents, imask and the quantized child planes. Every decoded child box
-    /// (`origin + q * step`, evaluated in f32 as the kernel does) contains the exact child box.
-    ///
-    /// The three axes are quantized together in SIMD lanes (every node of every TLAS rebuild comes
-    /// through here); each lane computes exactly what a scalar loop per axis would.
+    /// the reference the lane version must match bit for bit. It writes origin, exponents, imask
+    /// and the quantized child planes, as the lane version does.
     fn encode_boxes_by_slot(node: &mut WideNode, boxes: &[Option<Aabb>; WIDTH], imask: u8) {
         let mut all = Aabb::EMPTY;
         for b in boxes.iter().flatten() {
