@@ -438,18 +438,40 @@ fn texel_index(view: u32, px: vec2<i32>) -> u32 {
     return v.x * size.x * size.y + at.y * size.x + at.x;
 }
 
+// Keeps the nearest fragment of a texel. Nothing waits for the atomic's result, so a thread
+// issues it and goes on; a plain load first, to let occluded fragments skip the atomic, stalls
+// the thread on the load instead, and was slower in the tile and large passes (H200, 4K:
+// 15-20 %; BENCHMARKS.md, session 7).
 fn write_pixel(view: u32, px: vec2<i32>, depth: f32, id: u32) {
-    if depth <= 0.0 {
-        return;
-    }
-    let i = texel_index(view, px);
-    // A plain load first: most occluded fragments then skip the atomic.
-#ifdef DEPTH_ONLY
-    let value = bitcast<u32>(depth);
-#else
-    let value = (u64(bitcast<u32>(depth)) << 32u) | u64(id);
-#endif
-    if value > atomicLoad(&target_texels[i]) {
-        atomicMax(&target_texels[i], value);
+    if depth > 0.0 {
+        atomicMax(&target_texels[texel_index(view, px)], texel_value(depth, id));
     }
 }
+
+// write_pixel with that plain load first, for the small triangles the triangle pass draws
+// thread by thread into the visibility buffer: there many fragments land on the same texels
+// (small objects behind one another), and skipping their atomics pays. Shadow maps draw
+// without it, which was faster there too.
+fn write_pixel_tested(view: u32, px: vec2<i32>, depth: f32, id: u32) {
+#ifdef DEPTH_ONLY
+    write_pixel(view, px, depth, id);
+#else
+    if depth > 0.0 {
+        let i = texel_index(view, px);
+        let value = texel_value(depth, id);
+        if value > atomicLoad(&target_texels[i]) {
+            atomicMax(&target_texels[i], value);
+        }
+    }
+#endif
+}
+
+#ifdef DEPTH_ONLY
+fn texel_value(depth: f32, id: u32) -> u32 {
+    return bitcast<u32>(depth);
+}
+#else
+fn texel_value(depth: f32, id: u32) -> u64 {
+    return (u64(bitcast<u32>(depth)) << 32u) | u64(id);
+}
+#endif

@@ -5,7 +5,7 @@
 // Dispatch: x * y workgroups cover the chunks; each draws its chunk into every view that may
 // see it.
 
-#import hikari::raster::setup::{params, chunks, chunk_corner_outside, queue, queue_count, world_tri, view_poly, WorldTri, poly_rect, view_window, poly_setup, setup_depth, write_pixel, tile_touched_tri, store_record, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
+#import hikari::raster::setup::{params, chunks, chunk_corner_outside, queue, queue_count, world_tri, view_poly, WorldTri, poly_rect, view_window, poly_setup, setup_depth, write_pixel_tested, tile_touched_tri, store_record, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
 #import hikari::scene_gpu::CHUNK_TRIANGLES
 
 // Draws triangle `t` (visibility id `id`) into view `view`: small ones here, larger ones set
@@ -26,7 +26,7 @@ fn draw_triangle(t: WorldTri, id: u32, view: u32) {
             for (var x = rect.lo.x; x <= rect.hi.x; x++) {
                 let d = setup_depth(setup, vec2<f32>(f32(x), f32(y)) + 0.5);
                 if d > 0.0 {
-                    write_pixel(view, vec2<i32>(x, y), d, id);
+                    write_pixel_tested(view, vec2<i32>(x, y), d, id);
                 }
             }
         }

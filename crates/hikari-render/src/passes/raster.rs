@@ -381,8 +381,8 @@ impl Rasterizer {
         let n = scene.chunk_count.max(1);
         let groups = [n.min(max), n.div_ceil(max), 1];
         // The three passes bind the same resources; they differ in entry point and dispatch.
-        // Large before tiles: the near walls and floors that take the large path then hide
-        // what lies behind them from the tile pass's atomics (its plain load rejects them).
+        // Large before tiles, so that the near walls and floors that take the large path are
+        // in the target before the many smaller triangles behind them.
         let stages = [
             ("rasterize", groups, triangles),
             ("rasterize_large", [TILE_WORKGROUPS, 1, 1], large),
