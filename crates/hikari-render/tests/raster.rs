@@ -203,6 +203,57 @@ fn a_frame_whose_queues_overflow_is_drawn_again_without_losing_triangles() {
     );
 }
 
+#[test]
+fn any_number_of_tile_and_large_workgroups_draws_the_same() {
+    // The tile and large passes get as many workgroups as the last frame's counts suggest;
+    // counts that call for the fewest (256 each: no large triangle last frame) and the most
+    // must draw what the first frame draws with its defaults. At 768x480 the boxes queue
+    // more tile entries than 256 workgroups; at 1024x640 the ground's large triangles span
+    // more tiles than that.
+    for (w, h) in [(768, 480), (1024, 640)] {
+        workgroup_counts_draw_the_same(w, h);
+    }
+}
+
+fn workgroup_counts_draw_the_same(w: u32, h: u32) {
+    if common::gpu().is_none() {
+        return;
+    }
+    let scene = hikari_scene::builtin::boxes();
+    let s = frame_settings(&scene, w, h);
+    let draw = |last: Option<[u32; 2]>| {
+        let mut renderer = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
+        if let Some([entries, large]) = last {
+            for t in ["gbuffer", "sun_shadows"] {
+                renderer.raster_queues().sizes(t, 0);
+                let counts = hikari_render::graph::FrameResult {
+                    buffers: vec![(
+                        format!("{t}.tile_count"),
+                        bytemuck::cast_slice(&[entries, large, 0, 0]).to_vec(),
+                    )],
+                    ..Default::default()
+                };
+                renderer.raster_queues().grow(&counts, u64::MAX).unwrap();
+            }
+        }
+        let r = renderer
+            .render_reading(&s, |out| {
+                vec![out.gbuffer.visibility.into(), out.shadows.texels.into()]
+            })
+            .unwrap();
+        ["gbuffer.visibility", "sun_shadows.texels"].map(|n| r.buffer(n).unwrap().to_vec())
+    };
+    let want = draw(None);
+    assert!(want[0].chunks(8).any(|p| p[4..] != [0; 4]), "nothing drawn");
+    for last in [[1, 0], [1 << 17, 1]] {
+        assert!(
+            draw(Some(last)) == want,
+            "{w}x{h} drawn differently after a frame that queued {last:?} (entries, large \
+             triangles)"
+        );
+    }
+}
+
 /// A unit sphere of `rings` x `segments` quads, outward-facing, sharing its vertices.
 fn uv_sphere(segments: u32, rings: u32) -> hikari_scene::Mesh {
     let mut m = hikari_scene::Mesh {
@@ -237,7 +288,8 @@ fn uv_sphere(segments: u32, rings: u32) -> hikari_scene::Mesh {
 fn a_closed_mesh_has_no_cracks_or_holes() {
     // A camera inside a closed, finely tessellated sphere: every pixel must see it. A crack
     // between triangles (a pixel centre claimed by neither) shows as sky.
-    // Fine tessellation: per-thread and tile passes; coarse: the large-triangle pass.
+    // Fine tessellation: per-thread and tile passes; coarse: the large-triangle pass too (at
+    // 1024x768 their faces span more than 256 tiles).
     for (segments, rings) in [(96, 48), (6, 3), (4, 2)] {
         sphere_has_no_holes(segments, rings);
     }
@@ -264,7 +316,7 @@ fn sphere_has_no_holes(segments: u32, rings: u32) {
         near: 0.1,
         up: Vec3::Y,
     });
-    let s = frame_settings(&scene, 640, 480);
+    let s = frame_settings(&scene, 1024, 768);
     let mut renderer = Renderer::new(ctx, &scene).unwrap();
     let r = renderer
         .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
