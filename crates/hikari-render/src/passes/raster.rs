@@ -415,11 +415,10 @@ impl Rasterizer {
         } = *scene;
         let n = scene.chunk_count.max(1);
         let groups = [n.min(max), n.div_ceil(max), 1];
+        let [tile_groups, large_groups] = queues.workgroups(t).map(|n| n.min(max));
         // The three passes bind the same resources; they differ in entry point and dispatch.
         // Large before tiles, so that the near walls and floors that take the large path are
         // in the target before the many smaller triangles behind them.
-        let [tile_groups, large_groups] = queues.workgroups(t).map(|n| n.min(max));
-
         let stages = [
             ("rasterize", groups, triangles),
             ("rasterize_large", [large_groups, 1, 1], large),
