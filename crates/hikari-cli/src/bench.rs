@@ -6,8 +6,8 @@ use std::time::Instant;
 use clap::{Args, Subcommand};
 use serde_json::json;
 
+use hikari_render::checks::graph_check::{EmptyParams, GraphCheck};
 use hikari_render::graph::{FrameResult, GraphRuntime, TimestampMode};
-use hikari_render::passes::graph_check::{EmptyParams, GraphCheck};
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::{ContextOptions, GpuContext, Renderer};
 

@@ -23,10 +23,10 @@ use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{
     Blas, BuildOptions, Hit, Instance, Mesh, Ray, RefitScheduler, ThrottleSettings, Tlas,
 };
-use hikari_render::graph::{GraphRuntime, TimestampMode};
-use hikari_render::passes::bvh_trace::{
+use hikari_render::bvh_trace::{
     BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, Refill, TraceConfig, TraceMode,
 };
+use hikari_render::graph::{GraphRuntime, TimestampMode};
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::wgpu;
 use hikari_render::wgpu::util::DeviceExt;

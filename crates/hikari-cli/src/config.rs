@@ -1,38 +1,56 @@
-//! `--config FILE`: a TOML file with the frame's settings (see docs/config.example.toml). Command-line
-//! flags win over the file, the file over the defaults.
+//! `--config FILE`: a TOML file with what to render and the frame's settings (see
+//! docs/config.example.toml). Command-line flags win over the file, the file over the preset.
+//! The settings tables follow hikari-render's settings structs by themselves: a technique that
+//! registers its settings is readable here, and by `--set`, with no change to this file.
 
 use std::path::Path;
 
 use anyhow::Context;
 use serde::Deserialize;
 
-use hikari_render::Settings;
-use hikari_render::settings::{ExposureSettings, LightingSettings, ShadowSettings};
+use hikari_render::{Preset, Settings};
+
+/// What the file says besides the technique tables.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Head {
+    scene: Option<String>,
+    camera: Option<String>,
+    /// "HH:MM".
+    time: Option<String>,
+    width: Option<u32>,
+    height: Option<u32>,
+}
 
 /// The file: what to render, and the renderer's settings.
-#[derive(Debug, Default, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Default)]
 pub struct ConfigFile {
     pub scene: Option<String>,
     pub camera: Option<String>,
-    /// "HH:MM".
     pub time: Option<String>,
     pub width: Option<u32>,
     pub height: Option<u32>,
-    // Spelled out rather than flattened from `Settings`: serde's flatten would lose the
-    // position of type errors and could not refuse unknown keys.
-    pub shadows: ShadowSettings,
-    pub lighting: LightingSettings,
-    pub exposure: ExposureSettings,
+    /// The technique tables and `preset`, as written.
+    tables: toml::Table,
+    settings: Settings,
 }
 
+const HEAD_KEYS: [&str; 5] = ["scene", "camera", "time", "width", "height"];
+
 impl ConfigFile {
+    /// The settings the file gives: its preset (default `high`) and its tables.
     pub fn settings(&self) -> Settings {
-        Settings {
-            shadows: self.shadows.clone(),
-            lighting: self.lighting.clone(),
-            exposure: self.exposure.clone(),
-        }
+        self.settings.clone()
+    }
+
+    /// The settings with a preset from the command line (which wins over the file's) and
+    /// `--set table.key=value` overrides (which win over everything).
+    pub fn settings_with(
+        &self,
+        preset: Option<Preset>,
+        overrides: &[(String, String)],
+    ) -> anyhow::Result<Settings> {
+        Ok(Settings::from_toml(preset, self.tables.clone(), overrides)?)
     }
 }
 
@@ -44,9 +62,34 @@ pub fn load(path: &Path) -> anyhow::Result<ConfigFile> {
 }
 
 pub fn parse(text: &str) -> anyhow::Result<ConfigFile> {
-    let file: ConfigFile = toml::from_str(text).map_err(|e| anyhow::anyhow!("{e}"))?;
-    file.settings().validate()?;
-    Ok(file)
+    let mut tables: toml::Table = text.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut head = toml::Table::new();
+    for k in HEAD_KEYS {
+        if let Some(v) = tables.remove(k) {
+            head.insert(k.into(), v);
+        }
+    }
+    let head: Head = toml::Value::Table(head)
+        .try_into()
+        .map_err(|e: toml::de::Error| anyhow::anyhow!("{}", e.message().trim()))?;
+    let settings = Settings::from_toml(None, tables.clone(), &[])?;
+    Ok(ConfigFile {
+        scene: head.scene,
+        camera: head.camera,
+        time: head.time,
+        width: head.width,
+        height: head.height,
+        tables,
+        settings,
+    })
+}
+
+/// Parses `table.key=value` as `--set` takes it.
+pub fn parse_override(s: &str) -> anyhow::Result<(String, String)> {
+    let (k, v) = s
+        .split_once('=')
+        .with_context(|| format!("--set {s:?}: expected table.key=value"))?;
+    Ok((k.trim().to_string(), v.trim().to_string()))
 }
 
 #[cfg(test)]
@@ -60,15 +103,46 @@ mod tests {
         assert_eq!(f.scene.as_deref(), Some("village"));
     }
 
+    /// The example names every key of every technique's settings, so a new setting cannot be
+    /// left out of it.
+    #[test]
+    fn the_documented_example_names_every_setting() {
+        let example: toml::Table = include_str!("../../../docs/config.example.toml")
+            .parse()
+            .unwrap();
+        let defaults = toml::Value::try_from(Settings::default()).unwrap();
+        for (table, keys) in defaults.as_table().unwrap() {
+            let in_example = example
+                .get(table)
+                .and_then(|t| t.as_table())
+                .unwrap_or_else(|| panic!("docs/config.example.toml lacks [{table}]"));
+            for key in keys.as_table().unwrap().keys() {
+                assert!(
+                    in_example.contains_key(key),
+                    "docs/config.example.toml lacks {table}.{key}"
+                );
+            }
+        }
+        // Optional keys (absent from the defaults) are written commented out in the example.
+        let text = include_str!("../../../docs/config.example.toml");
+        for (field, _) in Settings::fields() {
+            let key = field.rsplit('.').next().unwrap();
+            assert!(
+                text.contains(&format!("{key} =")),
+                "docs/config.example.toml does not mention {field}"
+            );
+        }
+    }
+
     #[test]
     fn an_out_of_range_value_names_the_field_and_the_range() {
-        let e = parse("[shadows]\ncascades = 7\n").unwrap_err();
+        let e = parse("[sun_shadows]\ncascades = 7\n").unwrap_err();
         let msg = format!("{e:#}");
         assert!(
-            msg.contains("shadows.cascades") && msg.contains("1 to 4"),
+            msg.contains("sun_shadows.cascades") && msg.contains("1 to 4"),
             "{msg}"
         );
-        let e = parse("[shadows]\nresolution = 1000\n").unwrap_err();
+        let e = parse("[sun_shadows]\nresolution = 1000\n").unwrap_err();
         assert!(format!("{e:#}").contains("power of two"), "{e:#}");
         let e = parse("[exposure]\nev100 = 99.0\n").unwrap_err();
         assert!(format!("{e:#}").contains("exposure.ev100"), "{e:#}");
@@ -76,10 +150,38 @@ mod tests {
 
     #[test]
     fn unknown_fields_and_wrong_types_are_errors_that_name_them() {
-        let e = parse("[shadows]\ncascade = 2\n").unwrap_err();
+        let e = parse("[sun_shadows]\ncascade = 2\n").unwrap_err();
         assert!(format!("{e:#}").contains("cascade"), "{e:#}");
-        let e = parse("[lighting]\nsun = \"yes\"\n").unwrap_err();
-        assert!(format!("{e:#}").contains("sun"), "{e:#}");
+        let e = parse("[direct_lighting]\nsun = \"yes\"\n").unwrap_err();
+        assert!(
+            format!("{e:#}").contains("sun") || format!("{e:#}").contains("bool"),
+            "{e:#}"
+        );
         assert!(parse("width = -3\n").is_err());
+        let e = parse("[shadows]\ncascades = 2\n").unwrap_err();
+        assert!(format!("{e:#}").contains("shadows"), "{e:#}");
+    }
+
+    #[test]
+    fn the_preset_sets_values_the_file_and_overrides_win_over() {
+        let f = parse("preset = \"low\"\n[sun_shadows]\ncascades = 3\n").unwrap();
+        let s = f.settings();
+        assert_eq!(
+            s.sun_shadows.resolution,
+            Settings::preset(Preset::Low).sun_shadows.resolution
+        );
+        assert_eq!(s.sun_shadows.cascades, 3, "the file wins over the preset");
+        let s = f
+            .settings_with(
+                Some(Preset::Ultra),
+                &[("sun_shadows.cascades".into(), "2".into())],
+            )
+            .unwrap();
+        assert_eq!(
+            s.sun_shadows.resolution, 4096,
+            "the command line's preset wins"
+        );
+        assert_eq!(s.sun_shadows.cascades, 2, "--set wins over all");
+        assert!(parse("preset = \"extreme\"\n").is_err());
     }
 }

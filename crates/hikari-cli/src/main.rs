@@ -93,7 +93,7 @@ fn info() -> anyhow::Result<()> {
 }
 
 mod wgpu_fmt {
-    pub use hikari_render::passes::direct_lighting::RADIANCE_FORMAT as RGBA16F;
+    pub use hikari_render::techniques::direct_lighting::RADIANCE_FORMAT as RGBA16F;
     pub const RG11B10: hikari_render::wgpu::TextureFormat =
         hikari_render::wgpu::TextureFormat::Rg11b10Ufloat;
 }

@@ -6,14 +6,14 @@ use hikari_scene::{Camera, Sun};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{FrameGraph, Tex};
-use crate::passes::direct_lighting::{DirectLighting, LightingParams};
-use crate::passes::gbuffer::{GBuffer, GBufferPass};
-use crate::passes::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
-use crate::passes::raster::{RasterQueues, Rasterizer};
-use crate::passes::sun_shadows::{self, SunShadowMaps, SunShadows};
+use crate::raster::{RasterQueues, Rasterizer};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
+use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
+use crate::techniques::gbuffer::{GBuffer, GBufferPass};
+use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
+use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::view::View;
 
 /// What a frame depends on besides the scene.
@@ -127,7 +127,7 @@ pub fn record<'r>(
         &s.camera,
         aspect,
         to_sun,
-        &s.settings.shadows,
+        &s.settings.sun_shadows,
         &mut state.raster_queues,
     )?;
 
@@ -143,7 +143,7 @@ pub fn record<'r>(
         s.sun.as_ref(),
         scene.light_count,
         s.metered_lux(),
-        &s.settings.lighting,
+        &s.settings.direct_lighting,
     );
     let hdr = t
         .direct_lighting

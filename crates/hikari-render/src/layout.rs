@@ -27,10 +27,10 @@ macro_rules! gpu_layout {
 
 /// Every GPU struct of the crate.
 pub fn all() -> Vec<StructLayout> {
-    use crate::passes::{
-        direct_lighting, graph_check, math_check, placeholder_tonemap, raster, sun_shadows,
-    };
+    use crate::checks::{graph_check, math_check};
+    use crate::raster;
     use crate::scene_gpu;
+    use crate::techniques::{direct_lighting, placeholder_tonemap, sun_shadows};
     use crate::view;
     vec![
         gpu_layout!(
@@ -105,7 +105,7 @@ pub fn all() -> Vec<StructLayout> {
             [count, pad_a, pad_b, pad_c]
         ),
         gpu_layout!(
-            crate::passes::bvh_trace::TraceParams,
+            crate::bvh_trace::TraceParams,
             "bvh/trace.wgsl",
             [count, image_width, pad0, pad1]
         ),

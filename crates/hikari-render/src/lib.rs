@@ -1,15 +1,17 @@
 //! hikari-render: the wgpu side of hikari. The GPU context, the frame graph, the shader system,
-//! one module per technique under `passes/` with its CPU twin under `reference/`, and
-//! `frame.rs`, where one frame reads top to bottom.
+//! the compute rasteriser (`raster/`), one folder per technique under `techniques/` (passes,
+//! WGSL, CPU twin, settings), and `frame.rs`, where one frame reads top to bottom.
 
+pub mod bvh_trace;
+pub mod checks;
 pub mod context;
 pub mod error;
 pub mod frame;
 pub mod graph;
 pub mod layout;
 pub mod output;
-pub mod passes;
 pub mod pipeline;
+pub mod raster;
 pub mod reference;
 pub mod renderer;
 pub mod scene_bvh;
@@ -17,11 +19,12 @@ pub mod scene_gpu;
 pub mod scene_textures;
 pub mod settings;
 pub mod shader;
+pub mod techniques;
 pub mod view;
 
 pub use context::{ContextOptions, GpuContext};
 pub use error::{RenderError, Result};
 pub use frame::FrameSettings;
 pub use renderer::{RenderedFrame, Renderer};
-pub use settings::Settings;
+pub use settings::{Preset, Settings};
 pub use wgpu;

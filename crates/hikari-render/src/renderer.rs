@@ -6,7 +6,7 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::frame::{self, FrameOutputs, FrameSettings, FrameState, Techniques};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
-use crate::passes::raster::RasterQueues;
+use crate::raster::RasterQueues;
 use crate::scene_gpu::SceneGpu;
 
 /// A rendered frame: timings, and the images if they were asked for.

@@ -1,90 +1,134 @@
-//! What a user may tune about a frame, with the ranges each value must lie in. The CLI reads
-//! these from a TOML file (`--config`, see docs/config.example.toml); `validate` names the offending
-//! field and its allowed range.
+//! What a user may tune about a frame. Each technique owns its settings struct
+//! (`techniques/<name>/settings.rs`) with its ranges declared once, as data
+//! ([`TechniqueSettings::fields`]), and its values for each [`Preset`]; [`Settings`] registers
+//! them, one line each, under the technique's name, which is also the table's name in the
+//! settings file (docs/config.example.toml).
+//!
+//! Settings are read as TOML: a preset gives every value, the file's tables override it key by
+//! key, and `--set table.key=value` overrides both. Unknown keys, wrong types and values out of
+//! range are errors that name the field and its allowed range.
 
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-/// Every tunable of the frame.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct Settings {
-    pub shadows: ShadowSettings,
-    pub lighting: LightingSettings,
-    pub exposure: ExposureSettings,
+pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
+pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
+pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
+
+/// Named quality levels, as game renderers offer them: each sets the resolutions, ray and
+/// sample counts and update budgets of every technique. `High` is the default.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Preset {
+    Low,
+    Medium,
+    #[default]
+    High,
+    Ultra,
 }
 
-/// Cascaded shadow maps of the sun (or moon).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ShadowSettings {
-    pub enabled: bool,
-    /// Number of cascades, 1 to 4.
-    pub cascades: u32,
-    /// Texels along each side of a cascade, a power of two from 64 to 8192.
-    pub resolution: u32,
-    /// Distance from the camera the last cascade reaches, in metres.
-    pub max_distance_m: f32,
-    /// Blend of logarithmic (1) and uniform (0) cascade splits.
-    pub split_lambda: f32,
-    /// Spacing of the 3x3 bilinear PCF taps in texels; 0 gives one hard bilinear tap.
-    pub filter_radius_texels: f32,
-    /// Depth bias, in texels of the cascade's world-space size.
-    pub depth_bias_texels: f32,
-    /// Receiver offset along its normal, in texels of the cascade's world-space size.
-    pub normal_bias_texels: f32,
-    /// Keep the maps across frames: a still view draws nothing, a moving one only the strips
-    /// its cascades uncover as they scroll; a cascade is drawn whole when the sun or the
-    /// settings change its shape. Off: every cascade is drawn whole every frame.
-    pub cache: bool,
-}
+impl Preset {
+    pub const ALL: [Preset; 4] = [Preset::Low, Preset::Medium, Preset::High, Preset::Ultra];
 
-impl Default for ShadowSettings {
-    fn default() -> Self {
-        Self {
-            enabled: true,
-            cascades: 4,
-            resolution: 2048,
-            max_distance_m: 250.0,
-            split_lambda: 0.85,
-            filter_radius_texels: 1.0,
-            depth_bias_texels: 1.0,
-            normal_bias_texels: 1.5,
-            cache: true,
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Low => "low",
+            Preset::Medium => "medium",
+            Preset::High => "high",
+            Preset::Ultra => "ultra",
         }
     }
 }
 
-/// Which direct lights the deferred lighting adds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct LightingSettings {
-    pub sun: bool,
-    /// Point and spot lights.
-    pub punctual: bool,
-    pub emissive: bool,
-    /// The placeholder sky and ambient light that the atmosphere and probe issues replace.
-    pub placeholder_ambient: bool,
+impl std::str::FromStr for Preset {
+    type Err = SettingError;
+    fn from_str(s: &str) -> Result<Self, SettingError> {
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| SettingError {
+                field: "preset".into(),
+                value: format!("{s:?}"),
+                allowed: "low, medium, high or ultra".into(),
+            })
+    }
 }
 
-impl Default for LightingSettings {
-    fn default() -> Self {
-        Self {
-            sun: true,
-            punctual: true,
-            emissive: true,
-            placeholder_ambient: true,
+/// The range a numeric field must lie in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Range {
+    /// An integer from `lo` to `hi`.
+    Int { lo: i64, hi: i64 },
+    /// A power of two from `lo` to `hi`.
+    PowerOfTwo { lo: i64, hi: i64 },
+    /// A finite number from `lo` to `hi`.
+    Float { lo: f64, hi: f64 },
+}
+
+impl Range {
+    fn describe(&self) -> String {
+        match *self {
+            Range::Int { lo, hi } => format!("{lo} to {hi}"),
+            Range::PowerOfTwo { lo, hi } => format!("a power of two from {lo} to {hi}"),
+            Range::Float { lo, hi } => format!("{lo} to {hi}"),
+        }
+    }
+
+    fn admits(&self, v: &toml::Value) -> bool {
+        match (*self, v) {
+            (Range::Int { lo, hi }, toml::Value::Integer(i)) => (lo..=hi).contains(i),
+            (Range::PowerOfTwo { lo, hi }, toml::Value::Integer(i)) => {
+                (lo..=hi).contains(i) && (*i as u64).is_power_of_two()
+            }
+            (Range::Float { lo, hi }, toml::Value::Float(f)) => {
+                f.is_finite() && (lo..=hi).contains(f)
+            }
+            (Range::Float { lo, hi }, toml::Value::Integer(i)) => (lo..=hi).contains(&(*i as f64)),
+            _ => false,
         }
     }
 }
 
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ExposureSettings {
-    /// Exposure value at ISO 100 of the placeholder exposure; `None`: chosen from the sun.
-    pub ev100: Option<f32>,
+/// A bounded field of a technique's settings: its key in the technique's table and its range.
+/// An optional field that is absent is not checked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Field {
+    pub key: &'static str,
+    pub range: Range,
 }
 
-/// A setting outside its allowed range.
+/// What each technique's settings struct provides.
+pub trait TechniqueSettings:
+    Clone + Default + PartialEq + Serialize + DeserializeOwned + std::fmt::Debug
+{
+    /// Every bounded field, with its range, declared once.
+    fn fields() -> &'static [Field];
+
+    /// The values of a preset; `Preset::High` gives `Default::default()`.
+    fn preset(p: Preset) -> Self;
+
+    /// Checks every field of [`Self::fields`]; `table` names the technique in errors.
+    fn validate(&self, table: &str) -> Result<(), SettingError> {
+        let value = toml::Value::try_from(self).map_err(|e| SettingError {
+            field: table.into(),
+            value: "?".into(),
+            allowed: format!("a value TOML can hold ({e})"),
+        })?;
+        for f in Self::fields() {
+            let Some(v) = value.get(f.key) else { continue };
+            if !f.range.admits(v) {
+                return Err(SettingError {
+                    field: format!("{table}.{}", f.key),
+                    value: v.to_string(),
+                    allowed: f.range.describe(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A setting outside its allowed range, of the wrong type, or unknown.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("`{field}` is {value}; allowed: {allowed}")]
 pub struct SettingError {
@@ -93,53 +137,137 @@ pub struct SettingError {
     pub allowed: String,
 }
 
-fn range(field: &str, v: f32, lo: f32, hi: f32) -> Result<(), SettingError> {
-    if v.is_finite() && (lo..=hi).contains(&v) {
-        Ok(())
-    } else {
-        Err(SettingError {
-            field: field.into(),
-            value: v.to_string(),
-            allowed: format!("{lo} to {hi}"),
-        })
-    }
+/// Registers each technique's settings under its name: one line a technique.
+macro_rules! register_settings {
+    ($($name:ident: $ty:ty),* $(,)?) => {
+        /// Every tunable of the frame, one table per technique.
+        #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct Settings {
+            $(pub $name: $ty,)*
+        }
+
+        impl Settings {
+            /// Every technique's values for `preset`.
+            pub fn preset(preset: Preset) -> Self {
+                Self { $($name: <$ty as TechniqueSettings>::preset(preset),)* }
+            }
+
+            /// Checks every technique's fields; the error names the first field out of range.
+            pub fn validate(&self) -> Result<(), SettingError> {
+                $(self.$name.validate(stringify!($name))?;)*
+                Ok(())
+            }
+
+            /// Every bounded field as `table.key` with its range, for documentation and tests.
+            pub fn fields() -> Vec<(String, Range)> {
+                let mut out = Vec::new();
+                $(for f in <$ty as TechniqueSettings>::fields() {
+                    out.push((format!("{}.{}", stringify!($name), f.key), f.range));
+                })*
+                out
+            }
+        }
+    };
+}
+
+register_settings! {
+    sun_shadows: SunShadowsSettings,
+    direct_lighting: DirectLightingSettings,
+    exposure: ExposureSettings,
 }
 
 impl Settings {
-    pub fn validate(&self) -> Result<(), SettingError> {
-        let s = &self.shadows;
-        if !(1..=4).contains(&s.cascades) {
-            return Err(SettingError {
-                field: "shadows.cascades".into(),
-                value: s.cascades.to_string(),
-                allowed: "1 to 4".into(),
-            });
+    /// Reads settings from TOML tables (one a technique): a preset gives every value (`preset`,
+    /// else the table's `preset = "..."` key, else `High`), `table` overrides it key by key,
+    /// `overrides` (`("sun_shadows.resolution", "4096")`, values in TOML syntax) override both.
+    /// Then validates.
+    pub fn from_toml(
+        preset: Option<Preset>,
+        mut table: toml::Table,
+        overrides: &[(String, String)],
+    ) -> Result<Self, SettingError> {
+        let in_table = match table.remove("preset") {
+            None => None,
+            Some(toml::Value::String(s)) => Some(s.parse::<Preset>()?),
+            Some(v) => {
+                return Err(SettingError {
+                    field: "preset".into(),
+                    value: v.to_string(),
+                    allowed: "\"low\", \"medium\", \"high\" or \"ultra\"".into(),
+                });
+            }
+        };
+        let preset = preset.or(in_table).unwrap_or_default();
+        let base = toml::Value::try_from(Self::preset(preset)).map_err(|e| SettingError {
+            field: "settings".into(),
+            value: "?".into(),
+            allowed: e.to_string(),
+        })?;
+        let mut merged = match base {
+            toml::Value::Table(t) => t,
+            _ => unreachable!("a struct serialises to a table"),
+        };
+        merge(&mut merged, table);
+        for (key, value) in overrides {
+            set_path(&mut merged, key, value)?;
         }
-        if !s.resolution.is_power_of_two() || !(64..=8192).contains(&s.resolution) {
-            return Err(SettingError {
-                field: "shadows.resolution".into(),
-                value: s.resolution.to_string(),
-                allowed: "a power of two from 64 to 8192".into(),
-            });
-        }
-        range("shadows.max_distance_m", s.max_distance_m, 1.0, 100_000.0)?;
-        range("shadows.split_lambda", s.split_lambda, 0.0, 1.0)?;
-        range(
-            "shadows.filter_radius_texels",
-            s.filter_radius_texels,
-            0.0,
-            8.0,
-        )?;
-        range("shadows.depth_bias_texels", s.depth_bias_texels, 0.0, 16.0)?;
-        range(
-            "shadows.normal_bias_texels",
-            s.normal_bias_texels,
-            0.0,
-            16.0,
-        )?;
-        if let Some(ev) = self.exposure.ev100 {
-            range("exposure.ev100", ev, -10.0, 30.0)?;
-        }
-        Ok(())
+        let settings: Settings =
+            toml::Value::Table(merged)
+                .try_into()
+                .map_err(|e: toml::de::Error| SettingError {
+                    field: "settings".into(),
+                    value: "?".into(),
+                    allowed: e.message().trim().to_string(),
+                })?;
+        settings.validate()?;
+        Ok(settings)
     }
+
+    /// The settings as a TOML document, as the settings file spells them.
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+}
+
+/// Copies `over` into `base`, table by table, key by key.
+fn merge(base: &mut toml::Table, over: toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(&k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, v) => {
+                base.insert(k, v);
+            }
+        }
+    }
+}
+
+/// Sets `table.key` (dotted) to `value`, parsed as a TOML value.
+fn set_path(root: &mut toml::Table, key: &str, value: &str) -> Result<(), SettingError> {
+    let err = |allowed: String| SettingError {
+        field: key.into(),
+        value: format!("{value:?}"),
+        allowed,
+    };
+    let parsed: toml::Table = format!("v = {value}")
+        .parse()
+        .map_err(|_| err("a TOML value: a number, true or false, or a \"string\"".into()))?;
+    let v = parsed
+        .get("v")
+        .cloned()
+        .ok_or_else(|| err("a value".into()))?;
+    let parts: Vec<&str> = key.split('.').collect();
+    let (last, tables) = parts.split_last().ok_or_else(|| err("table.key".into()))?;
+    let mut t = root;
+    for p in tables {
+        t = match t
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(Default::default()))
+        {
+            toml::Value::Table(t) => t,
+            _ => return Err(err(format!("`{p}` is a value, not a table"))),
+        };
+    }
+    t.insert(last.to_string(), v);
+    Ok(())
 }

@@ -1,10 +1,11 @@
-//! The shader system: WGSL files under `shaders/`, composed from shared modules by import
-//! path with naga_oil, validated by naga.
+//! The shader system: WGSL files (shared modules under `shaders/`, each technique's own beside
+//! its code under `src/`), composed from shared modules by import path with naga_oil,
+//! validated by naga.
 //!
 //! A file that starts with `#define_import_path hikari::name` is a module other shaders import
 //! with `#import hikari::name`; any other file is an entry shader that pipelines are made from.
 //! All files are embedded at build time (see `build.rs`); set `HIKARI_SHADER_DIR` to the
-//! `shaders/` folder to read them from disk instead while editing.
+//! hikari-render crate folder to read them from disk instead while editing.
 
 use std::collections::{HashMap, HashSet};
 
@@ -19,7 +20,7 @@ mod embedded {
     include!(concat!(env!("OUT_DIR"), "/shader_files.rs"));
 }
 
-/// One WGSL file: its path relative to `shaders/` and its text.
+/// One WGSL file: its key (see `build.rs`: `common/sh.wgsl`, `gbuffer/resolve.wgsl`) and its text.
 #[derive(Clone, Debug)]
 pub struct ShaderFile {
     pub path: String,
@@ -29,15 +30,15 @@ pub struct ShaderFile {
     pub imports: Vec<String>,
 }
 
-/// Every shader file, embedded or read from `HIKARI_SHADER_DIR`.
+/// Every shader file, embedded or read from the crate folder `HIKARI_SHADER_DIR` names.
 pub fn shader_files() -> Result<Vec<ShaderFile>> {
     let raw: Vec<(String, String)> = match std::env::var_os("HIKARI_SHADER_DIR") {
         Some(dir) => embedded::SHADER_FILES
             .iter()
-            .map(|(p, _)| {
-                let full = std::path::Path::new(&dir).join(p);
+            .map(|(key, rel, _)| {
+                let full = std::path::Path::new(&dir).join(rel);
                 std::fs::read_to_string(&full)
-                    .map(|s| (p.to_string(), s))
+                    .map(|s| (key.to_string(), s))
                     .map_err(|e| RenderError::Shader {
                         path: full.display().to_string(),
                         message: e.to_string(),
@@ -46,7 +47,7 @@ pub fn shader_files() -> Result<Vec<ShaderFile>> {
             .collect::<Result<_>>()?,
         None => embedded::SHADER_FILES
             .iter()
-            .map(|(p, s)| (p.to_string(), s.to_string()))
+            .map(|(key, _, s)| (key.to_string(), s.to_string()))
             .collect(),
     };
     Ok(raw

@@ -11,10 +11,8 @@ use hikari_bvh::reference::{
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
 use hikari_render::GpuContext;
+use hikari_render::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode};
 use hikari_render::graph::GraphRuntime;
-use hikari_render::passes::bvh_trace::{
-    BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode,
-};
 use hikari_render::shader::{self, ShaderLibrary};
 use wgpu::util::DeviceExt;
 

@@ -1,11 +1,12 @@
-//! `gbuffer.resolve` against its CPU twin (`reference::gbuffer::resolve`): interpolated
+//! `gbuffer.resolve` against its CPU twin (`gbuffer::reference::resolve`): interpolated
 //! normals, vertex colours, per-vertex interior mask, sampled textures, material factors,
 //! motion vectors under camera motion, view depth and instance ids.
 
 mod common;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use hikari_render::reference::{self, gbuffer::ResolvedTexel};
+use hikari_render::techniques::gbuffer;
+use hikari_render::techniques::gbuffer::reference::ResolvedTexel;
 use hikari_render::{FrameSettings, Renderer, Settings};
 use hikari_scene::{Material, Mesh, Scene, Texture, TextureRef, Wrap};
 
@@ -156,13 +157,13 @@ fn resolve_matches_its_cpu_twin() {
                 continue;
             }
             let want: ResolvedTexel =
-                reference::gbuffer::resolve(&scene, cpu, &view, [x, y], vis[2 * i]).unwrap();
+                gbuffer::reference::resolve(&scene, cpu, &view, [x, y], vis[2 * i]).unwrap();
             checked += 1;
             if want.instance == textured_instance {
                 textured += 1;
             }
             let nv = normal.pixel(x, y);
-            let n = reference::octahedral::decode(Vec2::new(nv[0], nv[1]));
+            let n = hikari_render::reference::octahedral::decode(Vec2::new(nv[0], nv[1]));
             let a = albedo.pixel(x, y);
             let m = material.pixel(x, y);
             let mv = motion.pixel(x, y);

@@ -4,8 +4,8 @@
 mod common;
 
 use hikari_render::RenderError;
+use hikari_render::checks::graph_check::{FillParams, GraphCheck};
 use hikari_render::graph::{GraphRuntime, TextureDesc, TimestampMode};
-use hikari_render::passes::graph_check::{FillParams, GraphCheck};
 use hikari_render::shader::{self, ShaderLibrary};
 
 const F16: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

@@ -27,7 +27,7 @@ use hikari_math::sh::dering::{
 };
 use hikari_math::sh::ycocg::{ShL1YCoCg, rgb_to_ycocg, ycocg_to_rgb};
 use hikari_math::sh::{ShL1, ShL2, ShL2Rgb, window, zonal};
-use hikari_render::passes::math_check::{Kernel, MathCheck};
+use hikari_render::checks::math_check::{Kernel, MathCheck};
 use hikari_render::shader::{self, ShaderLibrary};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};

@@ -7,9 +7,8 @@ mod common;
 use glam::{Mat4, Vec3, Vec4};
 use hikari_bvh::reference::closest_hit_instances;
 use hikari_bvh::{Instance, Mesh, Ray};
-use hikari_render::passes::raster::QueueSizes;
-use hikari_render::passes::sun_shadows;
-use hikari_render::reference::gbuffer::{decode_id, pixel_ray};
+use hikari_render::raster::QueueSizes;
+use hikari_render::techniques::gbuffer::reference::{decode_id, pixel_ray};
 use hikari_render::{FrameSettings, Renderer};
 use hikari_scene::Scene;
 
@@ -330,182 +329,6 @@ fn sphere_has_no_holes(segments: u32, rings: u32) {
 }
 
 #[test]
-fn shadow_maps_match_rays_from_the_sun() {
-    let Some(ctx) = common::gpu() else { return };
-    let scene = hikari_scene::builtin::boxes();
-    let s = frame_settings(&scene, 64, 48);
-    let mut renderer = Renderer::new(ctx, &scene).unwrap();
-    let r = renderer
-        .render_reading(&s, |out| vec![out.shadows.texels.into()])
-        .unwrap();
-    let texels: &[f32] = bytemuck::cast_slice(r.buffer("sun_shadows.texels").unwrap());
-    let sun = scene.sun.clone().unwrap();
-    let cascades = sun_shadows::fit_cascades(
-        &s.camera,
-        64.0 / 48.0,
-        sun.direction,
-        renderer.scene().bounds.unwrap(),
-        &s.settings.shadows,
-    );
-    let (meshes, instances) = bvh_scene(&scene);
-    let res = s.settings.shadows.resolution;
-    let (mut agree, mut differ, mut covered) = (0, 0, 0);
-    for (c, cascade) in cascades.iter().enumerate() {
-        // The maps scroll: texel (x, y) is stored at (x, y) + origin, wrapped.
-        let [ox, oy] = cascade.origin(res);
-        let inv = cascade.view_proj.inverse();
-        let vp = cascade.view_proj;
-        for y in 0..res {
-            for x in 0..res {
-                let ndc = |z: f32| {
-                    let u = (x as f32 + 0.5) / res as f32;
-                    let v = (y as f32 + 0.5) / res as f32;
-                    let p = inv * Vec4::new(u * 2.0 - 1.0, 1.0 - v * 2.0, z, 1.0);
-                    p.truncate() / p.w
-                };
-                let (from, to) = (ndc(1.0), ndc(0.0));
-                let dir = (to - from).normalize();
-                let ray = Ray::new(from, dir, 0.0, (to - from).length());
-                let want = closest_hit_instances(&meshes, &instances, None, &ray)
-                    .map(|h| (vp * (from + dir * h.t).extend(1.0)).z)
-                    .unwrap_or(0.0);
-                let at = ((y + oy) % res) * res + (x + ox) % res;
-                let got = texels[(c as u32 * res * res + at) as usize];
-                if want > 0.0 {
-                    covered += 1;
-                }
-                if (got - want).abs() <= 1e-5 {
-                    agree += 1;
-                } else {
-                    differ += 1;
-                }
-            }
-        }
-    }
-    assert!(covered > 1000, "the maps see the scene ({covered} texels)");
-    assert!(
-        differ * 200 <= agree,
-        "{differ} texels differ from the rays, {agree} agree"
-    );
-}
-
-#[test]
-fn scrolled_shadow_maps_hold_what_a_full_redraw_draws() {
-    let scene = hikari_scene::builtin::boxes();
-    let first = frame_settings(&scene, 96, 64);
-    // Moves of a few texels in each cascade, in x, y and both.
-    let path = [
-        Vec3::new(0.37, 0.05, -0.21),
-        Vec3::new(0.61, 0.02, -0.05),
-        Vec3::new(0.2, -0.11, 0.43),
-    ];
-    let drew = |r: &hikari_render::graph::FrameResult, pass: &str| {
-        r.timings.iter().any(|t| t.name == pass)
-    };
-    let texels = |r: &hikari_render::graph::FrameResult| -> Vec<f32> {
-        bytemuck::cast_slice(r.buffer("sun_shadows.texels").unwrap()).to_vec()
-    };
-    let read = |out: &hikari_render::frame::FrameOutputs| {
-        vec![
-            out.shadows.texels.into(),
-            out.shadows.map.into(),
-            out.hdr.into(),
-        ]
-    };
-
-    let Some(ctx) = common::gpu() else { return };
-    let mut scrolled = Renderer::new(ctx, &scene).unwrap();
-    let mut fresh = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
-    let a = scrolled.render_reading(&first, read).unwrap();
-    assert!(drew(&a, "sun_shadows.rasterize"), "new maps are drawn");
-    assert!(
-        !drew(&a, "sun_shadows.clear_windows"),
-        "new maps are drawn whole"
-    );
-    let res = first.settings.shadows.resolution as usize;
-    for (step, offset) in path.iter().enumerate() {
-        let mut moved = first.clone();
-        moved.camera.position += *offset;
-        moved.camera.target += *offset;
-        let got = scrolled.render_reading(&moved, read).unwrap();
-        assert!(
-            drew(&got, "sun_shadows.clear_windows"),
-            "step {step}: a moved view draws strips"
-        );
-        let mut whole = moved.clone();
-        whole.settings.shadows.cache = false;
-        let want = fresh.render_reading(&whole, read).unwrap();
-        // The lit images, through the copies into the lookup's layers and its wrap-around:
-        // equal but where a flipped texel or a depth within rounding of a receiver's changes
-        // one PCF tap.
-        let hdr = |r: &hikari_render::graph::FrameResult| {
-            r.image("direct_lighting.radiance").unwrap().rgba.clone()
-        };
-        let (got_hdr, want_hdr) = (hdr(&got), hdr(&want));
-        let off = got_hdr
-            .iter()
-            .zip(&want_hdr)
-            .filter(|(g, w)| (0..3).any(|c| (g[c] - w[c]).abs() > 0.01 * w[c].abs() + 1e-3))
-            .count();
-        assert!(
-            off * 200 <= got_hdr.len(),
-            "step {step}: {off} pixels differ"
-        );
-        // Texels kept from earlier frames were projected with the earlier centre: the same
-        // depths up to rounding, and a texel centre within rounding of an edge may flip.
-        // The lookup's layers hold what the buffer holds, texel for texel (the strips copied
-        // through the wrap-around). Read back as f32 of the u32 bits: equal bits, equal value.
-        let map = got.image("sun_shadows.map").unwrap();
-        let buffer = texels(&got);
-        let stale = buffer
-            .iter()
-            .zip(&map.rgba)
-            .filter(|(b, m)| b.to_bits() as f32 != m[0])
-            .count();
-        assert_eq!(stale, 0, "step {step}: layers differ from the buffer");
-        let (got, want) = (buffer, texels(&want));
-        let (mut flipped, mut worst) = (0, 0f32);
-        for (g, w) in got.iter().zip(&want) {
-            if (*g == 0.0) != (*w == 0.0) {
-                flipped += 1;
-            } else {
-                worst = worst.max((g - w).abs());
-            }
-        }
-        assert!(
-            flipped * 1000 <= got.len(),
-            "step {step}: {flipped} texels flipped"
-        );
-        // Against the lookup's depth bias (which a difference must stay well inside).
-        let sun = scene.sun.clone().unwrap();
-        let shadows = &moved.settings.shadows;
-        let bounds = scrolled.scene().bounds.unwrap();
-        let cascades =
-            sun_shadows::fit_cascades(&moved.camera, 1.5, sun.direction, bounds, shadows);
-        let range = sun_shadows::depth_range(sun.direction, bounds);
-        let params = sun_shadows::ShadowParams::new(&cascades, range, shadows);
-        let bias = params.depth_bias[..cascades.len()]
-            .iter()
-            .copied()
-            .fold(f32::MAX, f32::min);
-        assert!(
-            worst < 0.05 * bias,
-            "step {step}: depths differ by {worst}, the smallest depth bias is {bias}"
-        );
-        assert!(got.len() >= 2 * res * res && got.iter().any(|&d| d > 0.0));
-    }
-    // A still view draws nothing.
-    let mut last = first.clone();
-    last.camera.position += path[2];
-    last.camera.target += path[2];
-    let still = scrolled.render_reading(&last, read).unwrap();
-    assert!(
-        !drew(&still, "sun_shadows.rasterize"),
-        "a still view keeps its maps"
-    );
-}
-
-#[test]
 fn views_with_non_finite_or_huge_matrices_stay_inside_their_target() {
     // The raster kernels run without wgpu's index checks. A view given NaN, infinite or huge
     // matrices through the library must end (no endless loop) and write nothing outside its
@@ -513,9 +336,7 @@ fn views_with_non_finite_or_huge_matrices_stay_inside_their_target() {
     // fails every depth test; the integer clamp in `poly_rect` is what bounds the loops on
     // drivers that turn NaN into other integers.)
     use hikari_render::graph::GraphRuntime;
-    use hikari_render::passes::raster::{
-        RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer,
-    };
+    use hikari_render::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
     use hikari_render::scene_gpu::SceneGpu;
     use hikari_render::shader::{self, ShaderLibrary};
     let Some(ctx) = common::gpu() else { return };

@@ -28,21 +28,26 @@ fn every_entry_shader_composes_and_validates() {
 
 #[test]
 fn every_wgsl_file_on_disk_is_embedded() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    // Shared modules under shaders/, each technique's own beside its code under src/; keys
+    // as build.rs gives them (src/techniques/x/y.wgsl is x/y.wgsl).
+    let crate_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut on_disk = Vec::new();
-    let mut stack = vec![root.clone()];
-    while let Some(dir) = stack.pop() {
-        for e in std::fs::read_dir(dir).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.extension().is_some_and(|x| x == "wgsl") {
-                on_disk.push(
-                    p.strip_prefix(&root)
+    for root in ["shaders", "src"] {
+        let root = crate_dir.join(root);
+        let mut stack = vec![root.clone()];
+        while let Some(dir) = stack.pop() {
+            for e in std::fs::read_dir(dir).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.extension().is_some_and(|x| x == "wgsl") {
+                    let rel = p
+                        .strip_prefix(&root)
                         .unwrap()
                         .to_string_lossy()
-                        .replace('\\', "/"),
-                );
+                        .replace('\\', "/");
+                    on_disk.push(rel.strip_prefix("techniques/").unwrap_or(&rel).to_string());
+                }
             }
         }
     }
@@ -111,5 +116,5 @@ fn bvh_stack_size_matches_the_kernel() {
         .trim_end_matches('u')
         .parse()
         .unwrap();
-    assert_eq!(value, hikari_render::passes::bvh_trace::STACK_SIZE);
+    assert_eq!(value, hikari_render::bvh_trace::STACK_SIZE);
 }

@@ -33,7 +33,7 @@ fn snapshot_at(name: &str, scene: &str, camera: Option<&str>, time: Option<&str>
     });
     let mut settings = Settings::default();
     // Small maps keep the CPU driver fast; the cascades still cover the view.
-    settings.shadows.resolution = 512;
+    settings.sun_shadows.resolution = 512;
     let s = FrameSettings {
         width: SIZE.0,
         height: SIZE.1,

@@ -1,7 +1,4 @@
-//! CPU twins of the GPU passes, named as the passes are. Tests hold each pass to its twin.
+//! CPU twins of the shared WGSL modules under `shaders/common/`. A technique's own twin is
+//! `techniques/<name>/reference.rs`.
 
-pub mod direct_lighting;
-pub mod gbuffer;
 pub mod octahedral;
-pub mod placeholder_tonemap;
-pub mod sun_shadows;

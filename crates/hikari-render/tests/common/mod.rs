@@ -56,9 +56,9 @@ pub fn small_frame_settings(
     h: u32,
 ) -> hikari_render::FrameSettings {
     let mut settings = hikari_render::Settings::default();
-    settings.shadows.resolution = 256;
-    settings.shadows.cascades = 2;
-    settings.shadows.max_distance_m = 40.0;
+    settings.sun_shadows.resolution = 256;
+    settings.sun_shadows.cascades = 2;
+    settings.sun_shadows.max_distance_m = 40.0;
     hikari_render::FrameSettings {
         width: w,
         height: h,

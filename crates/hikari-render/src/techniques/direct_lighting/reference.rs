@@ -4,12 +4,12 @@
 use glam::{Vec3, Vec4};
 use hikari_math::brdf::{self, Material};
 
-use super::octahedral;
-use crate::passes::direct_lighting::{
+use crate::reference::octahedral;
+use crate::scene_gpu::LightGpu;
+use crate::techniques::direct_lighting::{
     LIGHTING_EMISSIVE, LIGHTING_PLACEHOLDER_AMBIENT, LIGHTING_PUNCTUAL, LIGHTING_SUN,
     LightingParams,
 };
-use crate::scene_gpu::LightGpu;
 
 const MAX_RADIANCE: f32 = 65000.0;
 

@@ -1,6 +1,9 @@
 //! Deferred direct lighting: sun with cascaded shadows, point and spot lights, emissive
 //! surfaces, and placeholder sky and ambient light. CPU twin:
-//! [`crate::reference::direct_lighting`].
+//! [`crate::techniques::direct_lighting::reference`].
+
+pub mod reference;
+pub mod settings;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -14,7 +17,7 @@ use crate::error::Result;
 use crate::graph::{FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
-use crate::settings::LightingSettings;
+use crate::settings::DirectLightingSettings;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
@@ -59,7 +62,7 @@ impl LightingParams {
         sun: Option<&Sun>,
         light_count: u32,
         metered_lux: f32,
-        s: &LightingSettings,
+        s: &DirectLightingSettings,
     ) -> Self {
         let (dir, lux, color) = match sun {
             Some(s) => (s.direction.normalize(), s.illuminance_lux, s.color),

@@ -1,6 +1,6 @@
 //! Cascaded shadow maps of the sun (or moon), rasterised in compute (`passes/raster.rs`) into
 //! one u32 depth a texel, looked up with 3x3 bilinear PCF by the deferred lighting
-//! (`shaders/sun_shadows/lookup.wgsl`; CPU twin [`crate::reference::sun_shadows`]).
+//! (`shaders/sun_shadows/lookup.wgsl`; CPU twin [`crate::techniques::sun_shadows::reference`]).
 //!
 //! Stability under camera motion: each cascade is the bounding sphere of its slice of the view
 //! frustum, whose radius depends only on the slice distances and the field of view (not on the
@@ -12,7 +12,7 @@
 //! the camera moves and a cascade's centre moves by whole texels, only the strips it uncovers
 //! are drawn ([`ShadowCache`]); every cascade is always where the camera wants it. The whole
 //! cascade is drawn when it is new or when the sun or the settings change its shape
-//! (`shadows.cache = false`: every frame). The rasteriser's atomics need a buffer; what was
+//! (`sun_shadows.cache = false`: every frame). The rasteriser's atomics need a buffer; what was
 //! drawn is then copied into a layer of an R32Uint texture array, which the lookup gathers
 //! 2x2 texels at a time from (a quarter of the loads, and a texture cache laid out for 2D
 //! neighbourhoods), through a repeating sampler that does the wrap-around.
@@ -20,20 +20,23 @@
 //! Depth convention as the camera's: 1 nearest the sun, 0 farthest (the cleared value), over
 //! the scene's extent along the sun direction, so every caster is inside the depth range.
 
+pub mod reference;
+pub mod settings;
+
 use bytemuck::{Pod, Zeroable};
 use glam::{IVec2, Mat4, Vec3, Vec4};
 
 use hikari_scene::Camera;
 
-use super::raster::{
-    MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer, pack_point,
-};
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
+use crate::raster::{
+    MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer, pack_point,
+};
 use crate::scene_gpu::SceneInFrame;
-use crate::settings::ShadowSettings;
+use crate::settings::SunShadowsSettings;
 use crate::shader::ShaderLibrary;
 
 /// Cascades at most.
@@ -119,7 +122,7 @@ pub fn fit_cascades(
     aspect: f32,
     to_sun: Vec3,
     scene_bounds: (Vec3, Vec3),
-    s: &ShadowSettings,
+    s: &SunShadowsSettings,
 ) -> Vec<Cascade> {
     let (lx, ly, lz) = light_basis(to_sun);
     let (lo, hi) = scene_bounds;
@@ -181,7 +184,7 @@ impl ShadowParams {
         Self::zeroed()
     }
 
-    pub fn new(cascades: &[Cascade], depth_range: f32, s: &ShadowSettings) -> Self {
+    pub fn new(cascades: &[Cascade], depth_range: f32, s: &SunShadowsSettings) -> Self {
         let mut p = Self::zeroed();
         for (i, c) in cascades.iter().enumerate() {
             p.light_view_proj[i] = c.view_proj.to_cols_array_2d();
@@ -278,7 +281,7 @@ impl ShadowCache {
         &mut self,
         cascades: &[Cascade],
         fresh: bool,
-        s: &ShadowSettings,
+        s: &SunShadowsSettings,
     ) -> Vec<CascadeRegion> {
         if fresh || !s.cache || self.drawn.len() != cascades.len() {
             self.drawn = vec![None; cascades.len()];
@@ -332,7 +335,7 @@ impl SunShadows {
         camera: &Camera,
         aspect: f32,
         to_sun: Vec3,
-        s: &ShadowSettings,
+        s: &SunShadowsSettings,
         queues: &mut RasterQueues,
     ) -> Result<SunShadowMaps> {
         let bounds = match scene.bounds {
@@ -484,7 +487,7 @@ mod tests {
 
     #[test]
     fn cascades_keep_their_size_when_the_camera_turns_and_their_texels_when_it_moves() {
-        let s = ShadowSettings::default();
+        let s = SunShadowsSettings::default();
         let bounds = (Vec3::splat(-200.0), Vec3::splat(200.0));
         let sun = Vec3::new(-0.4, 0.8, 0.3).normalize();
         let base = fit_cascades(
@@ -564,7 +567,7 @@ mod tests {
 
     #[test]
     fn scrolled_maps_hold_every_texel_of_the_wanted_cascades() {
-        let s = ShadowSettings {
+        let s = SunShadowsSettings {
             resolution: 64,
             ..Default::default()
         };

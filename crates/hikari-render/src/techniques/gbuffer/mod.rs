@@ -1,11 +1,13 @@
 //! G-buffer: the compute rasteriser writes a visibility buffer, then `gbuffer.resolve` turns it
-//! into the G-buffer textures. CPU twin: [`crate::reference::gbuffer`].
+//! into the G-buffer textures. CPU twin: [`crate::techniques::gbuffer::reference`].
 
-use super::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
+pub mod reference;
+
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
+use crate::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
 use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use crate::view::View;

@@ -1,5 +1,8 @@
 //! PLACEHOLDER exposure and tonemap, until the tonemapping issue replaces it.
-//! CPU twin: [`crate::reference::placeholder_tonemap`].
+//! CPU twin: [`crate::techniques::placeholder_tonemap::reference`].
+
+pub mod reference;
+pub mod settings;
 
 use bytemuck::{Pod, Zeroable};
 
@@ -21,7 +24,7 @@ impl TonemapParams {
     pub fn from_ev100(ev100: f32) -> Self {
         Self {
             exposure: [
-                crate::reference::placeholder_tonemap::exposure_from_ev100(ev100),
+                crate::techniques::placeholder_tonemap::reference::exposure_from_ev100(ev100),
                 0.0,
                 0.0,
                 0.0,

@@ -3,7 +3,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::passes::sun_shadows::ShadowParams;
+use crate::techniques::sun_shadows::ShadowParams;
 
 /// `origin`: where texel (0, 0) is stored; texel t is at (t + origin) mod res.
 fn bilinear_lit(

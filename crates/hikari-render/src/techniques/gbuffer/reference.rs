@@ -173,8 +173,9 @@ pub fn resolve(
     let lerp3 = |f: &dyn Fn(&crate::scene_gpu::VertexAttr) -> DVec3| {
         f(attr[0]) * w.x + f(attr[1]) * w.y + f(attr[2]) * w.z
     };
-    let decode =
-        |p: u32| super::octahedral::decode(crate::scene_gpu::unpack_snorm16x2(p)).as_dvec3();
+    let decode = |p: u32| {
+        crate::reference::octahedral::decode(crate::scene_gpu::unpack_snorm16x2(p)).as_dvec3()
+    };
     let normal_model = glam::DMat3::from_mat4(model).inverse().transpose();
     let mut n = (normal_model * lerp3(&|a| decode(a.normal))).normalize();
     if material.double_sided && ng.dot(dir) > 0.0 {

@@ -1,0 +1,9 @@
+//! One folder per technique: its passes (`mod.rs`), its WGSL, its CPU twin (`reference.rs`)
+//! and its settings (`settings.rs`), under one name. The technique `sun_shadows` labels its
+//! passes `sun_shadows.*`, names its dumps `sun_shadows.*`, and is tested in
+//! `tests/sun_shadows.rs`.
+
+pub mod direct_lighting;
+pub mod gbuffer;
+pub mod placeholder_tonemap;
+pub mod sun_shadows;
