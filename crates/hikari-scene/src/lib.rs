@@ -69,10 +69,11 @@ pub mod gltf;
 pub mod model;
 pub mod shapes;
 pub mod time_of_day;
+pub mod validation;
 pub mod village;
 
 pub use deformation::Deformation;
 pub use model::{
-    Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh, Scene,
+    AlphaMode, Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh, Scene,
     SceneError, Sun, Texture, TextureRef, Wrap,
 };
