@@ -12,7 +12,8 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use crate::{
-    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef, Wrap,
+    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef,
+    Wrap,
 };
 
 /// Extensions whose content is read. Others in `extensionsUsed` give a warning; others in
@@ -63,8 +64,9 @@ pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded
     // A last line of defence: the checks in `load_unguarded` should leave nothing for a
     // dependency to panic on, but a malformed file must never take the process down. Tests call
     // `load_unguarded` directly so that a panic there fails them instead of hiding here.
-    let result =
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| load_unguarded(path, options)));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        load_unguarded(path, options)
+    }));
     result.unwrap_or_else(|panic| {
         let msg = panic
             .downcast_ref::<String>()
@@ -610,24 +612,30 @@ impl<'o> Loader<'o> {
         let mut images = Vec::new();
         for image in self.doc.images() {
             let i = image.index();
-            if let gltf::image::Source::Uri { uri, .. } = image.source() {
-                check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
-            }
+            // Where the image comes from, for messages.
+            let (file, source) = match image.source() {
+                gltf::image::Source::Uri { uri, .. } => {
+                    let file = check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
+                    let source = file
+                        .as_ref()
+                        .map_or_else(|| "data URI".to_owned(), |f| format!("`{}`", f.display()));
+                    (file, source)
+                }
+                gltf::image::Source::View { view, .. } => {
+                    (None, format!("buffer view {}", view.index()))
+                }
+            };
             let data =
                 gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
-                    .map_err(|e| match (&e, image.source()) {
-                        (gltf::Error::Io(io), gltf::image::Source::Uri { uri, .. }) => {
-                            format!(
-                                "image {i}: cannot read `{}`: {io}",
-                                self.base.join(uri).display()
-                            )
+                    .map_err(|e| match (&e, &file) {
+                        (gltf::Error::Io(io), Some(file)) => {
+                            format!("image {i}: cannot read `{}`: {io}", file.display())
                         }
-                        _ => format!("image {i}: {}", describe(&e)),
+                        _ => format!("image {i} ({source}): {}", describe(&e)),
                     })?;
-            images.push(
-                to_rgba8(&data)
-                    .ok_or_else(|| format!("image {i}: decoded pixel data has the wrong size"))?,
-            );
+            images.push(to_rgba8(&data).ok_or_else(|| {
+                format!("image {i} ({source}): decoded pixel data has the wrong size")
+            })?);
         }
         let mut textures = Vec::new();
         for t in self.doc.textures() {
@@ -1005,7 +1013,10 @@ impl<'o> Loader<'o> {
                 let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
                 let position = world.transform_point3(Vec3::ZERO);
                 check_light(&light, direction).map_err(|e| {
-                    format!("light `{name}` (KHR_lights_punctual lights[{}]): {e}", light.index())
+                    format!(
+                        "light `{name}` (KHR_lights_punctual lights[{}]): {e}",
+                        light.index()
+                    )
                 })?;
                 match light.kind() {
                     gltf::khr_lights_punctual::Kind::Directional => {

@@ -237,20 +237,8 @@ mod tests {
                 },
                 "vfov_deg 180",
             ),
-            (
-                Camera {
-                    near: 0.0,
-                    ..c()
-                },
-                "near 0",
-            ),
-            (
-                Camera {
-                    near: -1.0,
-                    ..c()
-                },
-                "near -1",
-            ),
+            (Camera { near: 0.0, ..c() }, "near 0"),
+            (Camera { near: -1.0, ..c() }, "near -1"),
             (
                 Camera {
                     near: f32::INFINITY,
