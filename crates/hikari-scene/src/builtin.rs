@@ -6,10 +6,10 @@
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 
-use crate::{Camera, Instance, Material, Mesh, Scene, Sun, shapes};
+use crate::{AlphaMode, Camera, Instance, Material, Mesh, Scene, Sun, Texture, Wrap, shapes};
 
 /// Names of the built-in scenes, for the CLI.
-pub const NAMES: &[&str] = &["village", "boxes", "cornell", "terrain"];
+pub const NAMES: &[&str] = &["village", "boxes", "cornell", "terrain", "cutout"];
 
 pub fn by_name(name: &str) -> Option<Scene> {
     match name {
@@ -17,6 +17,7 @@ pub fn by_name(name: &str) -> Option<Scene> {
         "boxes" => Some(boxes()),
         "cornell" => Some(cornell()),
         "terrain" => Some(terrain()),
+        "cutout" => Some(cutout()),
         _ => None,
     }
 }
@@ -445,6 +446,153 @@ pub fn terrain() -> Scene {
             up: Vec3::Y,
         }],
         sun: Some(Sun::default()),
+        ..Default::default()
+    }
+}
+
+/// Side of the [`cutout`] scene's textures in texels.
+pub const CUTOUT_TEXTURE_SIZE: u32 = 64;
+/// Checker cells along each side of the [`cutout`] scene's checker texture.
+pub const CUTOUT_CHECKER_CELLS: u32 = 8;
+/// Alpha cut-off of the [`cutout`] scene's ramp quad (the checker uses glTF's default 0.5).
+pub const CUTOUT_RAMP_CUTOFF: f32 = 0.25;
+
+/// Whether the checker quad of [`cutout`] is covered at texture coordinate `uv` (in [0, 1]²):
+/// cells where the column plus row is even are opaque (alpha 1), the others empty (alpha 0).
+/// Exact away from cell edges, where texture filtering blends the two.
+pub fn cutout_checker_covered(uv: Vec2) -> bool {
+    let cell = (uv * CUTOUT_CHECKER_CELLS as f32).floor();
+    (cell.x as i64 + cell.y as i64).rem_euclid(2) == 0
+}
+
+/// Alpha of the ramp quad of [`cutout`] at `u` in [0, 1]: the texel column's centre, so it
+/// rises from 1/128 at the left edge to 127/128 at the right (constant down each column),
+/// stored in 8 bits (within 1/510 of that).
+pub fn cutout_ramp_alpha(u: f32) -> f32 {
+    let n = CUTOUT_TEXTURE_SIZE as f32;
+    let column = (u * n).floor().clamp(0.0, n - 1.0);
+    (column + 0.5) / n
+}
+
+/// A `size`² RGBA8 texture with white RGB and the alpha `alpha(u, v)` at each texel centre.
+fn alpha_texture(name: &str, alpha: impl Fn(Vec2) -> f32) -> Texture {
+    let n = CUTOUT_TEXTURE_SIZE;
+    let mut data = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let uv = (Vec2::new(x as f32, y as f32) + 0.5) / n as f32;
+            let a = (alpha(uv).clamp(0.0, 1.0) * 255.0).round() as u8;
+            data.extend_from_slice(&[255, 255, 255, a]);
+        }
+    }
+    Texture {
+        name: name.into(),
+        width: n,
+        height: n,
+        data,
+        wrap_s: Wrap::ClampToEdge,
+        wrap_t: Wrap::ClampToEdge,
+    }
+}
+
+/// A 2 m square facing +Z, standing on the ground centred at x = `x`, with UVs 0 to 1 across it
+/// ((0, 0) at its top left seen from the front, as glTF's UVs).
+fn standing_quad(name: &str, x: f32) -> Mesh {
+    let (lo, hi) = (Vec3::new(x - 1.0, 0.25, 0.0), Vec3::new(x + 1.0, 2.25, 0.0));
+    Mesh {
+        name: name.into(),
+        positions: vec![
+            Vec3::new(lo.x, hi.y, 0.0),
+            Vec3::new(hi.x, hi.y, 0.0),
+            Vec3::new(hi.x, lo.y, 0.0),
+            Vec3::new(lo.x, lo.y, 0.0),
+        ],
+        normals: vec![Vec3::Z; 4],
+        uvs: vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(1.0, 1.0),
+            Vec2::new(0.0, 1.0),
+        ],
+        // +u along +x; +v (down the image) along -y = w cross(+z, +x) = w (+y), so w = -1.
+        tangents: vec![Vec3::X.extend(-1.0); 4],
+        indices: vec![0, 2, 1, 0, 3, 2],
+        ..Default::default()
+    }
+}
+
+/// Alpha-tested geometry for renderer tests: two double-sided 2 m squares standing 0.25 m
+/// above a 12 m ground plane, under the default sun, so their cut-outs show both in the image
+/// and in their shadows on the ground.
+///
+/// - Mesh 1, material `checker cut-out`: [`AlphaMode::Mask`] at the default cut-off 0.5, base
+///   colour texture 0 (white, alpha a checker of [`CUTOUT_CHECKER_CELLS`]² cells, see
+///   [`cutout_checker_covered`]); centred at x = -1.25.
+/// - Mesh 2, material `ramp cut-out`: [`AlphaMode::Mask`] at [`CUTOUT_RAMP_CUTOFF`], base
+///   colour texture 1 (white, alpha [`cutout_ramp_alpha`] rising left to right); centred at
+///   x = 1.25. Covered right of u ≈ 0.25, so a renderer that ignores the material's cut-off
+///   and uses 0.5 shows a narrower quad.
+///
+/// Both quads lie in the plane z = 0 facing +Z, spanning y from 0.25 to 2.25 m. Camera `main`
+/// looks at them from the front; camera `behind` from the back (the double-sided faces).
+pub fn cutout() -> Scene {
+    let checker = Material {
+        base_color_texture: Some(crate::TextureRef::new(0)),
+        alpha_mode: AlphaMode::mask(),
+        double_sided: true,
+        ..Material::diffuse("checker cut-out", Vec3::new(0.8, 0.45, 0.1))
+    };
+    let ramp = Material {
+        base_color_texture: Some(crate::TextureRef::new(1)),
+        alpha_mode: AlphaMode::Mask {
+            cutoff: CUTOUT_RAMP_CUTOFF,
+        },
+        double_sided: true,
+        ..Material::diffuse("ramp cut-out", Vec3::new(0.1, 0.35, 0.8))
+    };
+    let textures = vec![
+        alpha_texture("checker alpha", |uv| {
+            if cutout_checker_covered(uv) { 1.0 } else { 0.0 }
+        }),
+        alpha_texture("ramp alpha", |uv| cutout_ramp_alpha(uv.x)),
+    ];
+    let instance = |mesh, material| Instance {
+        mesh,
+        material,
+        transform: Mat4::IDENTITY,
+    };
+    Scene {
+        meshes: vec![
+            shapes::plane(12.0),
+            standing_quad("checker quad", -1.25),
+            standing_quad("ramp quad", 1.25),
+        ],
+        materials: vec![
+            Material::diffuse("ground", Vec3::new(0.5, 0.5, 0.5)),
+            checker,
+            ramp,
+        ],
+        instances: vec![instance(0, 0), instance(1, 1), instance(2, 2)],
+        cameras: vec![
+            Camera {
+                name: "main".into(),
+                position: Vec3::new(0.0, 1.8, 6.0),
+                target: Vec3::new(0.0, 1.0, 0.0),
+                vfov_deg: 45.0,
+                near: 0.1,
+                up: Vec3::Y,
+            },
+            Camera {
+                name: "behind".into(),
+                position: Vec3::new(0.0, 1.8, -6.0),
+                target: Vec3::new(0.0, 1.0, 0.0),
+                vfov_deg: 45.0,
+                near: 0.1,
+                up: Vec3::Y,
+            },
+        ],
+        sun: Some(Sun::default()),
+        textures,
         ..Default::default()
     }
 }

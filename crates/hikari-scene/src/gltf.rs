@@ -12,7 +12,8 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use crate::{
-    Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef, Wrap,
+    AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef,
+    Wrap,
 };
 
 /// Extensions whose content is read. Others in `extensionsUsed` give a warning; others in
@@ -60,31 +61,40 @@ pub fn load(path: impl AsRef<Path>) -> Result<Loaded, GltfError> {
 
 pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded, GltfError> {
     let path = path.as_ref();
-    let err = |what: String| GltfError {
-        path: path.to_path_buf(),
-        what,
-    };
-    // A last line of defence: the checks below should leave nothing for a dependency to panic
-    // on, but a malformed file must never take the process down.
+    // A last line of defence: the checks in `load_unguarded` should leave nothing for a
+    // dependency to panic on, but a malformed file must never take the process down. Tests call
+    // `load_unguarded` directly so that a panic there fails them instead of hiding here.
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        Loader::new(path, options).and_then(Loader::run)
+        load_unguarded(path, options)
     }));
-    match result {
-        Ok(Ok(loaded)) => {
+    result.unwrap_or_else(|panic| {
+        let msg = panic
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| panic.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown");
+        Err(GltfError {
+            path: path.to_path_buf(),
+            what: format!("malformed file (the reader failed: {msg})"),
+        })
+    })
+}
+
+/// [`load_with`] without its `catch_unwind`: a panic propagates. For tests that must see one;
+/// use [`load`] or [`load_with`] otherwise.
+#[doc(hidden)]
+pub fn load_unguarded(path: &Path, options: &GltfOptions) -> Result<Loaded, GltfError> {
+    match Loader::new(path, options).and_then(Loader::run) {
+        Ok(loaded) => {
             for w in &loaded.warnings {
                 log::warn!("{}: {w}", path.display());
             }
             Ok(loaded)
         }
-        Ok(Err(what)) => Err(err(what)),
-        Err(panic) => {
-            let msg = panic
-                .downcast_ref::<String>()
-                .map(String::as_str)
-                .or_else(|| panic.downcast_ref::<&str>().copied())
-                .unwrap_or("unknown");
-            Err(err(format!("malformed file (the reader failed: {msg})")))
-        }
+        Err(what) => Err(GltfError {
+            path: path.to_path_buf(),
+            what,
+        }),
     }
 }
 
@@ -92,6 +102,73 @@ type Res<T> = Result<T, String>;
 
 /// Largest element count accepted for an accessor without a buffer view.
 const MAX_VIEWLESS_ELEMENTS: usize = 1 << 24;
+
+/// Most nodes the flattened hierarchy may hold. A node listed as a child by several parents is
+/// repeated under each, so a few dozen nodes that each list the next twice would otherwise
+/// expand to billions of instances.
+pub const MAX_NODE_VISITS: usize = 1 << 22;
+
+/// A perspective camera's numbers as glTF constrains them: `yfov` in (0, pi), `znear` > 0,
+/// `zfar` > `znear` when given, `aspectRatio` > 0 when given, all finite.
+fn check_perspective(p: &gltf::camera::Perspective) -> Res<()> {
+    let yfov = p.yfov();
+    if !(yfov > 0.0 && yfov < std::f32::consts::PI) {
+        return Err(format!("yfov {yfov} rad is outside (0, pi)"));
+    }
+    let znear = p.znear();
+    if !(znear > 0.0 && znear.is_finite()) {
+        return Err(format!("znear {znear} must be positive and finite"));
+    }
+    if let Some(zfar) = p.zfar()
+        && !(zfar > znear && zfar.is_finite())
+    {
+        return Err(format!(
+            "zfar {zfar} must be finite and greater than znear {znear}"
+        ));
+    }
+    if let Some(aspect) = p.aspect_ratio()
+        && !(aspect > 0.0 && aspect.is_finite())
+    {
+        return Err(format!("aspectRatio {aspect} must be positive and finite"));
+    }
+    Ok(())
+}
+
+/// A KHR_lights_punctual light's numbers as the extension constrains them, and a node
+/// transform that gives directional and spot lights a direction.
+fn check_light(light: &gltf::khr_lights_punctual::Light, direction: Vec3) -> Res<()> {
+    use gltf::khr_lights_punctual::Kind;
+    let intensity = light.intensity();
+    if !(intensity >= 0.0 && intensity.is_finite()) {
+        return Err(format!(
+            "intensity {intensity} must be finite and non-negative"
+        ));
+    }
+    let color = Vec3::from(light.color());
+    if !(color.is_finite() && color.min_element() >= 0.0) {
+        return Err(format!("color {color} must be finite and non-negative"));
+    }
+    if let Some(range) = light.range()
+        && !(range > 0.0 && range.is_finite())
+    {
+        return Err(format!("range {range} must be positive and finite"));
+    }
+    let kind = light.kind();
+    if let Kind::Spot {
+        inner_cone_angle: inner,
+        outer_cone_angle: outer,
+    } = kind
+        && !(0.0 <= inner && inner < outer && outer <= std::f32::consts::FRAC_PI_2)
+    {
+        return Err(format!(
+            "innerConeAngle {inner} and outerConeAngle {outer} rad must satisfy 0 <= inner < outer <= pi/2"
+        ));
+    }
+    if !matches!(kind, Kind::Point) && direction == Vec3::ZERO {
+        return Err("the node's transform is degenerate: it gives the light no direction".into());
+    }
+    Ok(())
+}
 
 struct Loader<'o> {
     base: PathBuf,
@@ -174,8 +251,26 @@ fn check_uri(base: &Path, uri: &str) -> Res<Option<PathBuf>> {
     Ok(Some(base.join(percent_decode(uri)?)))
 }
 
-/// The `gltf` crate's validation indexes the POSITION accessor before checking it exists.
-fn check_position_accessors(root: &gltf::json::Root) -> Res<()> {
+/// What the `gltf` crate's validation misses and its accessors would later `unwrap`: it
+/// indexes attribute accessors before checking they exist, and accepts a camera whose `type`
+/// names a projection the camera does not have.
+fn check_before_validation(root: &gltf::json::Root) -> Res<()> {
+    use gltf::json::camera::Type;
+    use gltf::json::validation::Checked;
+    for (c, cam) in root.cameras.iter().enumerate() {
+        let missing = match cam.type_ {
+            Checked::Valid(Type::Perspective) => cam.perspective.is_none().then_some("perspective"),
+            Checked::Valid(Type::Orthographic) => {
+                cam.orthographic.is_none().then_some("orthographic")
+            }
+            Checked::Invalid => None, // reported by validation
+        };
+        if let Some(member) = missing {
+            return Err(format!(
+                "invalid glTF: cameras[{c}] has type \"{member}\" but no `{member}` member"
+            ));
+        }
+    }
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
             for (semantic, index) in &prim.attributes {
@@ -217,7 +312,7 @@ impl<'o> Loader<'o> {
         let gltf::Gltf { document, blob } =
             gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| describe(&e))?;
         let root = document.into_json();
-        check_position_accessors(&root)?;
+        check_before_validation(&root)?;
         let doc = gltf::Document::from_json(root).map_err(|e| describe(&e))?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let mut loader = Loader {
@@ -237,15 +332,26 @@ impl<'o> Loader<'o> {
 
     fn load_buffers(&mut self, blob: Option<Vec<u8>>) -> Res<()> {
         let mut blob = blob;
+        let mut bin_user = None;
         for buffer in self.doc.buffers() {
             let i = buffer.index();
             let data = match buffer.source() {
-                gltf::buffer::Source::Bin => {
-                    let bin = blob.take();
-                    bin.ok_or_else(|| {
-                        format!("buffer {i} refers to the .glb BIN chunk, which is missing")
-                    })?
-                }
+                gltf::buffer::Source::Bin => match (blob.take(), bin_user) {
+                    (Some(bin), _) => {
+                        bin_user = Some(i);
+                        bin
+                    }
+                    (None, Some(first)) => {
+                        return Err(format!(
+                            "buffer {i} has no uri, so it refers to the .glb BIN chunk, but buffer {first} already uses it (only the first buffer may)"
+                        ));
+                    }
+                    (None, None) => {
+                        return Err(format!(
+                            "buffer {i} has no uri, so it refers to the .glb BIN chunk, which is missing"
+                        ));
+                    }
+                },
                 gltf::buffer::Source::Uri(uri) => {
                     let file =
                         check_uri(&self.base, uri).map_err(|e| format!("buffer {i}: {e}"))?;
@@ -363,43 +469,54 @@ impl<'o> Loader<'o> {
                 "has no buffer view and {count} elements; at most {MAX_VIEWLESS_ELEMENTS} are supported"
             )));
         }
+        // Every range is checked before `out` is allocated, so a huge count in a small file is
+        // an error rather than an attempt to allocate it.
+        let data = match acc.view() {
+            Some(view) => {
+                let bytes = self.view_bytes(&view);
+                let stride = view.stride().unwrap_or(elem);
+                Some((
+                    bytes,
+                    gather(bytes, acc.offset(), stride, count, elem, "data")?,
+                ))
+            }
+            None => None,
+        };
+        let sparse = match acc.sparse() {
+            Some(sparse) => {
+                let n = sparse.count();
+                let isize = sparse.indices().index_type().size();
+                let ibytes = self.view_bytes(&sparse.indices().view());
+                let idx = gather(
+                    ibytes,
+                    sparse.indices().offset(),
+                    isize,
+                    n,
+                    isize,
+                    "sparse indices",
+                )?;
+                let vbytes = self.view_bytes(&sparse.values().view());
+                let vals = gather(
+                    vbytes,
+                    sparse.values().offset(),
+                    elem,
+                    n,
+                    elem,
+                    "sparse values",
+                )?;
+                Some((ibytes, idx, vbytes, vals, isize))
+            }
+            None => None,
+        };
         let mut out = vec![0.0f64; total];
-        if let Some(view) = acc.view() {
-            let bytes = self.view_bytes(&view);
-            let stride = view.stride().unwrap_or(elem);
-            for (e, start) in gather(bytes, acc.offset(), stride, count, elem, "data")?
-                .into_iter()
-                .enumerate()
-            {
+        if let Some((bytes, starts)) = data {
+            for (e, start) in starts.into_iter().enumerate() {
                 for c in 0..comps {
                     out[e * comps + c] = decode(&bytes[start + c * csize..]);
                 }
             }
         }
-        if let Some(sparse) = acc.sparse() {
-            let n = sparse.count();
-            let iv = sparse.indices().view();
-            let it = sparse.indices().index_type();
-            let isize = it.size();
-            let ibytes = self.view_bytes(&iv);
-            let idx = gather(
-                ibytes,
-                sparse.indices().offset(),
-                isize,
-                n,
-                isize,
-                "sparse indices",
-            )?;
-            let vv = sparse.values().view();
-            let vbytes = self.view_bytes(&vv);
-            let vals = gather(
-                vbytes,
-                sparse.values().offset(),
-                elem,
-                n,
-                elem,
-                "sparse values",
-            )?;
+        if let Some((ibytes, idx, vbytes, vals, isize)) = sparse {
             for (ipos, vpos) in idx.into_iter().zip(vals) {
                 let b = &ibytes[ipos..];
                 let target = match isize {
@@ -468,7 +585,7 @@ impl<'o> Loader<'o> {
             textures: self.load_textures()?,
             ..Default::default()
         };
-        scene.materials = self.load_materials(scene.textures.len());
+        scene.materials = self.load_materials(scene.textures.len())?;
         let meshes = self.load_meshes(&mut scene)?;
         self.load_nodes(&mut scene, &meshes)?;
         if scene.cameras.is_empty() {
@@ -495,24 +612,30 @@ impl<'o> Loader<'o> {
         let mut images = Vec::new();
         for image in self.doc.images() {
             let i = image.index();
-            if let gltf::image::Source::Uri { uri, .. } = image.source() {
-                check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
-            }
+            // Where the image comes from, for messages.
+            let (file, source) = match image.source() {
+                gltf::image::Source::Uri { uri, .. } => {
+                    let file = check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
+                    let source = file
+                        .as_ref()
+                        .map_or_else(|| "data URI".to_owned(), |f| format!("`{}`", f.display()));
+                    (file, source)
+                }
+                gltf::image::Source::View { view, .. } => {
+                    (None, format!("buffer view {}", view.index()))
+                }
+            };
             let data =
                 gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
-                    .map_err(|e| match (&e, image.source()) {
-                        (gltf::Error::Io(io), gltf::image::Source::Uri { uri, .. }) => {
-                            format!(
-                                "image {i}: cannot read `{}`: {io}",
-                                self.base.join(uri).display()
-                            )
+                    .map_err(|e| match (&e, &file) {
+                        (gltf::Error::Io(io), Some(file)) => {
+                            format!("image {i}: cannot read `{}`: {io}", file.display())
                         }
-                        _ => format!("image {i}: {}", describe(&e)),
+                        _ => format!("image {i} ({source}): {}", describe(&e)),
                     })?;
-            images.push(
-                to_rgba8(&data)
-                    .ok_or_else(|| format!("image {i}: decoded pixel data has the wrong size"))?,
-            );
+            images.push(to_rgba8(&data).ok_or_else(|| {
+                format!("image {i} ({source}): decoded pixel data has the wrong size")
+            })?);
         }
         let mut textures = Vec::new();
         for t in self.doc.textures() {
@@ -538,7 +661,7 @@ impl<'o> Loader<'o> {
         Ok(textures)
     }
 
-    fn load_materials(&self, texture_count: usize) -> Vec<Material> {
+    fn load_materials(&self, texture_count: usize) -> Res<Vec<Material>> {
         let mut out = Vec::new();
         let docs: Vec<_> = self.doc.materials().collect();
         for m in docs {
@@ -562,7 +685,27 @@ impl<'o> Loader<'o> {
             let strength = m.emissive_strength().unwrap_or(1.0);
             let normal = m.normal_texture();
             let occlusion = m.occlusion_texture();
+            let alpha_mode = match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => {
+                    let cutoff = m.alpha_cutoff().unwrap_or(AlphaMode::DEFAULT_CUTOFF);
+                    if !(0.0..=1.0).contains(&cutoff) {
+                        return Err(format!(
+                            "material `{name}`: alphaCutoff {cutoff} is outside [0, 1]"
+                        ));
+                    }
+                    AlphaMode::Mask { cutoff }
+                }
+                gltf::material::AlphaMode::Blend => {
+                    self.warn(format!(
+                        "material `{name}`: alpha mode BLEND is drawn as a cut-out at alpha {} (transparency is not supported yet)",
+                        AlphaMode::BLEND_AS_MASK_CUTOFF
+                    ));
+                    AlphaMode::Blend
+                }
+            };
             let mat = Material {
+                alpha_mode,
                 base_color: Vec3::new(r, g, b),
                 alpha: a.clamp(0.0, 1.0),
                 roughness: pbr.roughness_factor().clamp(0.0, 1.0),
@@ -601,16 +744,9 @@ impl<'o> Loader<'o> {
                 name,
                 ..Default::default()
             };
-            if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
-                self.warn(format!(
-                    "material `{}`: alpha mode {:?} is drawn opaque",
-                    mat.name,
-                    m.alpha_mode()
-                ));
-            }
             out.push(mat);
         }
-        out
+        Ok(out)
     }
 
     /// Loads every primitive; returns, per glTF mesh, its (scene mesh, scene material) pairs.
@@ -802,11 +938,18 @@ impl<'o> Loader<'o> {
             .rev()
             .map(|n| (n, Mat4::IDENTITY, 0))
             .collect();
+        let mut total_visits = 0usize;
         while let Some((node, parent, depth)) = stack.pop() {
             if depth > node_count {
                 return Err(format!(
                     "node {} is its own ancestor: the node hierarchy has a cycle",
                     node.index()
+                ));
+            }
+            total_visits += 1;
+            if total_visits > MAX_NODE_VISITS {
+                return Err(format!(
+                    "the node hierarchy expands to more than {MAX_NODE_VISITS} nodes (nodes shared by several parents are repeated for each)"
                 ));
             }
             visits[node.index()] += 1;
@@ -832,6 +975,9 @@ impl<'o> Loader<'o> {
                     .unwrap_or_else(|| format!("camera{}", cam.index()));
                 match cam.projection() {
                     gltf::camera::Projection::Perspective(p) => {
+                        check_perspective(&p).map_err(|e| {
+                            format!("camera `{name}` (cameras[{}]): {e}", cam.index())
+                        })?;
                         let position = world.transform_point3(Vec3::ZERO);
                         let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
                         let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
@@ -866,6 +1012,12 @@ impl<'o> Loader<'o> {
                 let color = Vec3::from(light.color());
                 let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
                 let position = world.transform_point3(Vec3::ZERO);
+                check_light(&light, direction).map_err(|e| {
+                    format!(
+                        "light `{name}` (KHR_lights_punctual lights[{}]): {e}",
+                        light.index()
+                    )
+                })?;
                 match light.kind() {
                     gltf::khr_lights_punctual::Kind::Directional => {
                         if scene.sun.is_some() {

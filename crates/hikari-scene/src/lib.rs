@@ -16,7 +16,25 @@
 //!
 //! # Built-in scenes ([`builtin`])
 //!
-//! `village` (generated from a seed by [`village`]), `boxes`, `cornell` and `terrain`.
+//! `village` (generated from a seed by [`village`]), `boxes`, `cornell`, `terrain` and
+//! `cutout` ([`builtin::cutout`]: two alpha-tested quads over a ground plane, for renderer
+//! tests of cut-outs in the image and in shadows).
+//!
+//! # Alpha
+//!
+//! [`Material::alpha_mode`] follows glTF's `alphaMode`: [`AlphaMode::Opaque`] (alpha ignored),
+//! [`AlphaMode::Mask`] (a cut-out: covered where the base colour alpha, texture A times factor,
+//! is at least the cut-off, glTF's `alphaCutoff`, default 0.5) and [`AlphaMode::Blend`], which
+//! is drawn as a cut-out at 0.5 until transparency exists (the loader warns, naming the
+//! material). Renderers read [`Material::alpha_cutoff`]: `None` for opaque, else the cut-off.
+//! The built-in village's materials are all opaque.
+//!
+//! # Validation
+//!
+//! [`Scene::validate`] checks everything a GPU would trust blindly. [`Camera::validate`]
+//! (and [`Camera::validate_projection`] with the image's aspect ratio), [`Sun::validate`] and
+//! [`Light::validate`] check single objects, for renderers handed them outside a scene; every
+//! error names the object and the field.
 //!
 //! # glTF 2.0 support ([`gltf::load`])
 //!
@@ -33,9 +51,10 @@
 //!   [`Instance`]s with world transforms; a mesh used by several nodes is shared.
 //! - Metallic-roughness materials with all five textures (base colour, metallic-roughness,
 //!   normal with scale, emissive, occlusion with strength), texture samplers' wrap modes,
-//!   `doubleSided`, base colour alpha.
+//!   `doubleSided`, base colour alpha and `alphaMode` with `alphaCutoff` (see Alpha above).
 //! - Perspective cameras, with their names (the camera's, else the node's, else `cameraN`),
-//!   world position, view direction (-Z) and up (+Y) of the node, `yfov` and `znear`.
+//!   world position, view direction (-Z) and up (+Y) of the node, `yfov` and `znear`
+//!   (checked, with `zfar` and `aspectRatio`, against the ranges glTF allows).
 //! - `KHR_lights_punctual`: point and spot lights with their intensity in candela, as the
 //!   extension defines it; the first directional light becomes the [`Sun`], its intensity
 //!   taken as lux (also the extension's unit).
@@ -45,10 +64,12 @@
 //!   is needed. Files written for display-referred viewers, where emissive 1 means "white",
 //!   look dim under daylight exposure unless that option is raised.
 //!
+//! Approximated, with a warning: `BLEND` materials, drawn as cut-outs at alpha 0.5.
+//!
 //! Ignored, with a warning in [`gltf::Loaded::warnings`] (also logged with `log::warn!`):
 //! non-triangle primitives (points, lines, strips, fans), orthographic cameras, further
 //! directional lights, animations, skins, morph targets, texture coordinate sets other than 0,
-//! alpha modes other than opaque (drawn opaque), scenes other than the default one, and any
+//! scenes other than the default one, and any
 //! extension other than the two above listed in `extensionsUsed`. An extension in
 //! `extensionsRequired` that is not supported is an error. Also ignored silently: `zfar` and
 //! `aspectRatio` of cameras (the renderer uses an infinite far plane and the image's aspect
@@ -61,7 +82,11 @@
 //! panic: unreadable or truncated files, bad JSON, glTF validation failures (indices of
 //! missing objects, unsupported required extensions), missing or short buffers and images,
 //! buffer views and accessors reading out of range, attributes of the wrong type or count,
-//! indices out of range, non-finite numbers (through [`Scene::validate`]).
+//! indices out of range, counts too large for the file (checked before anything is
+//! allocated), node hierarchies with cycles or that expand past [`gltf::MAX_NODE_VISITS`]
+//! nodes, undecodable images, camera and light numbers outside glTF's ranges, alpha cut-offs
+//! outside [0, 1], non-finite numbers (through [`Scene::validate`]). `tests/malformed.rs` holds
+//! a case for each of these.
 
 pub mod builtin;
 pub mod deformation;
@@ -69,10 +94,11 @@ pub mod gltf;
 pub mod model;
 pub mod shapes;
 pub mod time_of_day;
+pub mod validation;
 pub mod village;
 
 pub use deformation::Deformation;
 pub use model::{
-    Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh, Scene,
-    SceneError, Sun, Texture, TextureRef, Wrap,
+    AlphaMode, Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh,
+    Scene, SceneError, Sun, Texture, TextureRef, Wrap,
 };

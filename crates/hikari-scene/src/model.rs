@@ -130,6 +130,36 @@ pub struct Anisotropy {
     pub rotation: f32,
 }
 
+/// How a material's alpha (the base colour factor's alpha times the base colour texture's A,
+/// times vertex colour A) decides coverage, as glTF's `alphaMode`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// Alpha is ignored: fully covered.
+    #[default]
+    Opaque,
+    /// Cut-out: covered where alpha >= `cutoff`, absent elsewhere. `cutoff` in [0, 1];
+    /// glTF's default is [`AlphaMode::DEFAULT_CUTOFF`].
+    Mask { cutoff: f32 },
+    /// Alpha blending. Transparency is not drawn yet: renderers treat it as a
+    /// [`AlphaMode::Mask`] at [`AlphaMode::BLEND_AS_MASK_CUTOFF`] (see
+    /// [`Material::alpha_cutoff`]).
+    Blend,
+}
+
+impl AlphaMode {
+    /// glTF's `alphaCutoff` when a MASK material gives none.
+    pub const DEFAULT_CUTOFF: f32 = 0.5;
+    /// The cut-off at which [`AlphaMode::Blend`] materials are drawn until transparency exists.
+    pub const BLEND_AS_MASK_CUTOFF: f32 = 0.5;
+
+    /// A cut-out at glTF's default cut-off, 0.5.
+    pub fn mask() -> Self {
+        AlphaMode::Mask {
+            cutoff: Self::DEFAULT_CUTOFF,
+        }
+    }
+}
+
 /// Metallic-roughness material; colours are linear Rec.709.
 ///
 /// Each factor multiplies its texture where there is one, as in glTF: the base colour texture
@@ -145,8 +175,12 @@ pub struct Material {
     pub metalness: f32,
     /// Emitted luminance in nits (cd/m²).
     pub emissive_nits: Vec3,
-    /// Base colour alpha (coverage); 1 is opaque.
+    /// Base colour alpha (coverage) in [0, 1], multiplied by the base colour texture's A;
+    /// used as [`Material::alpha_mode`] says (ignored when opaque).
     pub alpha: f32,
+    pub alpha_mode: AlphaMode,
+    /// Both faces are drawn and lit (the back face with the flipped normal); otherwise back
+    /// faces are culled.
     pub double_sided: bool,
     pub base_color_texture: Option<TextureRef>,
     pub metallic_roughness_texture: Option<TextureRef>,
@@ -169,6 +203,7 @@ impl Default for Material {
             metalness: 0.0,
             emissive_nits: Vec3::ZERO,
             alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
             double_sided: false,
             base_color_texture: None,
             metallic_roughness_texture: None,
@@ -202,6 +237,17 @@ impl Material {
             roughness: 1.0,
             emissive_nits: nits,
             ..Default::default()
+        }
+    }
+
+    /// The coverage test a renderer applies: `None` when opaque (draw every fragment), else
+    /// `Some(c)`: discard fragments whose alpha is below `c`. [`AlphaMode::Blend`] gives
+    /// [`AlphaMode::BLEND_AS_MASK_CUTOFF`] until transparency exists.
+    pub fn alpha_cutoff(&self) -> Option<f32> {
+        match self.alpha_mode {
+            AlphaMode::Opaque => None,
+            AlphaMode::Mask { cutoff } => Some(cutoff),
+            AlphaMode::Blend => Some(AlphaMode::BLEND_AS_MASK_CUTOFF),
         }
     }
 
@@ -529,6 +575,13 @@ impl Scene {
                     return Err(err(format!("{what} {v} is outside [0, 1]")));
                 }
             }
+            if let AlphaMode::Mask { cutoff } = m.alpha_mode
+                && !(0.0..=1.0).contains(&cutoff)
+            {
+                return Err(err(format!(
+                    "alpha cutoff {cutoff} is outside [0, 1] (or not a number)"
+                )));
+            }
             if !m.normal_scale.is_finite() || !m.anisotropy.is_none_or(|a| a.rotation.is_finite()) {
                 return Err(err(
                     "normal scale and anisotropy rotation must be finite".into()
@@ -545,42 +598,7 @@ impl Scene {
             }
         }
         for l in &self.lights {
-            let err = |what: String| SceneError::Light {
-                light: l.name.clone(),
-                what,
-            };
-            if !(l.position.is_finite() && l.direction.is_finite() && l.color.is_finite()) {
-                return Err(err("position, direction and colour must be finite".into()));
-            }
-            if !(l.intensity_cd >= 0.0 && l.intensity_cd.is_finite()) {
-                return Err(err(format!(
-                    "intensity {} cd must be finite and non-negative",
-                    l.intensity_cd
-                )));
-            }
-            if l.range.is_some_and(|r| r.is_nan() || r <= 0.0) {
-                return Err(err(format!("range {:?} must be positive", l.range)));
-            }
-            if let LightKind::Spot {
-                inner_cone,
-                outer_cone,
-            } = l.kind
-            {
-                if (l.direction.length() - 1.0).abs() > 1e-3 {
-                    return Err(err(format!(
-                        "spot direction {} is not a unit vector",
-                        l.direction
-                    )));
-                }
-                if !(0.0 <= inner_cone
-                    && inner_cone < outer_cone
-                    && outer_cone <= std::f32::consts::FRAC_PI_2 + 1e-6)
-                {
-                    return Err(err(format!(
-                        "cone angles {inner_cone} and {outer_cone} rad must satisfy 0 <= inner < outer <= pi/2"
-                    )));
-                }
-            }
+            l.validate()?;
         }
         for (index, inst) in self.instances.iter().enumerate() {
             let err = |what: String| SceneError::Instance { index, what };
@@ -599,42 +617,10 @@ impl Scene {
             }
         }
         for c in &self.cameras {
-            let err = |what: String| SceneError::Camera {
-                camera: c.name.clone(),
-                what,
-            };
-            if !(c.vfov_deg > 0.0 && c.vfov_deg < 180.0) {
-                return Err(err(format!(
-                    "vertical field of view {} is outside (0, 180) degrees",
-                    c.vfov_deg
-                )));
-            }
-            if !(c.near > 0.0 && c.near.is_finite()) {
-                return Err(err(format!("near plane {} must be positive", c.near)));
-            }
-            if !(c.position.is_finite() && c.target.is_finite()) || c.position == c.target {
-                return Err(err("position and target must be finite and distinct".into()));
-            }
-            if !c.up.is_finite()
-                || c.up.cross(c.target - c.position).length_squared()
-                    <= 1e-12 * c.up.length_squared() * (c.target - c.position).length_squared()
-            {
-                return Err(err(format!(
-                    "up vector {} is zero or parallel to the view direction",
-                    c.up
-                )));
-            }
+            c.validate()?;
         }
-        if let Some(s) = &self.sun
-            && (!s.direction.is_finite()
-                || s.direction.length() < 0.5
-                || s.illuminance_lux.is_nan()
-                || s.illuminance_lux < 0.0
-                || !s.color.is_finite())
-        {
-            return Err(SceneError::Sun(format!(
-                "{s:?} has a non-unit direction or a negative or non-finite value"
-            )));
+        if let Some(s) = &self.sun {
+            s.validate()?;
         }
         Ok(())
     }

@@ -221,3 +221,60 @@ fn cornell_camera_is_the_published_one_and_sees_the_whole_box() {
         );
     }
 }
+
+/// The cut-out scene's textures and materials against their documented description, checked
+/// at hand-picked texels rather than through the helpers that built them.
+#[test]
+fn cutout_scene_has_the_documented_alpha() {
+    use hikari_scene::AlphaMode;
+    let s = builtin::by_name("cutout").unwrap();
+    s.validate().unwrap();
+    let alpha = |t: usize, x: u32, y: u32| s.textures[t].data[((y * 64 + x) * 4 + 3) as usize];
+    // Checker: 8 cells of 8 texels; cell (0, 0) opaque, its neighbours empty.
+    assert_eq!(
+        [
+            alpha(0, 0, 0),
+            alpha(0, 7, 7),
+            alpha(0, 8, 0),
+            alpha(0, 0, 8),
+            alpha(0, 8, 8)
+        ],
+        [255, 255, 0, 0, 255]
+    );
+    assert_eq!(alpha(0, 63, 63), 255);
+    assert_eq!(alpha(0, 63, 0), 0);
+    // Ramp: column x holds (x + 0.5) / 64, constant down the column.
+    assert_eq!(alpha(1, 0, 0), 2); // 0.5 / 64 * 255 = 1.99
+    assert_eq!(alpha(1, 63, 40), 253); // 63.5 / 64 * 255 = 253.0
+    assert_eq!(alpha(1, 15, 0), alpha(1, 15, 63));
+    // With the cut-off 0.25, columns 16 and up are covered (16.5 / 64 = 0.258).
+    let cut = (0.25f32 * 255.0) as u8;
+    assert!(alpha(1, 15, 0) < cut && alpha(1, 16, 0) > cut);
+
+    let by_name = |n: &str| s.materials.iter().find(|m| m.name == n).unwrap();
+    assert_eq!(by_name("ground").alpha_cutoff(), None);
+    let checker = by_name("checker cut-out");
+    assert_eq!(checker.alpha_mode, AlphaMode::Mask { cutoff: 0.5 });
+    assert!(checker.double_sided);
+    assert_eq!(by_name("ramp cut-out").alpha_cutoff(), Some(0.25));
+    assert!(builtin::cutout_checker_covered(glam::Vec2::new(0.01, 0.01)));
+    assert!(!builtin::cutout_checker_covered(glam::Vec2::new(
+        0.13, 0.01
+    )));
+    assert!((builtin::cutout_ramp_alpha(0.5) - 32.5 / 64.0).abs() < 1e-6);
+
+    // The quads face +Z (counter-clockwise seen from there) and UV (0, 0) is the top-left
+    // corner seen from the front.
+    for name in ["checker quad", "ramp quad"] {
+        let m = mesh(&s, name);
+        for t in m.indices.chunks_exact(3) {
+            let p: Vec<_> = t.iter().map(|&i| m.positions[i as usize]).collect();
+            assert!((p[1] - p[0]).cross(p[2] - p[0]).z > 0.0, "{name}");
+        }
+        let top_left = m.uvs.iter().position(|uv| *uv == glam::Vec2::ZERO).unwrap();
+        let others = m.positions.iter().filter(|p| **p != m.positions[top_left]);
+        for p in others {
+            assert!(p.x >= m.positions[top_left].x && p.y <= m.positions[top_left].y);
+        }
+    }
+}
