@@ -5,7 +5,11 @@ use glam::Vec3;
 use hikari_atmosphere::{Atmosphere, AtmosphereParams, ColorSpace};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let space = if std::env::args().any(|a| a == "rec709") { ColorSpace::Rec709 } else { ColorSpace::LmsRayleigh };
+    let space = if std::env::args().any(|a| a == "rec709") {
+        ColorSpace::Rec709
+    } else {
+        ColorSpace::LmsRayleigh
+    };
     let a = Atmosphere::new(AtmosphereParams::earth(space))?;
     println!("build: {:.0} ms", a.report.build_ms);
     for (i, c) in a.report.order_contributions.iter().enumerate() {
@@ -17,7 +21,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let e = a.sun_illuminance_at_ground(z);
         let sky = a.sky_irradiance(0.0, z, a.solar_illuminance());
         let zen = a.sky_radiance(0.0, Vec3::Y, sun, a.solar_illuminance());
-        println!("sun {zenith_deg:>4}°: direct normal {e:.0} lux, sky on horizontal {sky:.0} lux, zenith {zen:.0} nits");
+        println!(
+            "sun {zenith_deg:>4}°: direct normal {e:.0} lux, sky on horizontal {sky:.0} lux, zenith {zen:.0} nits"
+        );
     }
     Ok(())
 }

@@ -40,18 +40,37 @@ impl Atmosphere {
     }
 
     /// The same with chosen table sizes.
-    pub fn with_sizes(params: AtmosphereParams, sizes: TableSizes) -> Result<Self, AtmosphereError> {
+    pub fn with_sizes(
+        params: AtmosphereParams,
+        sizes: TableSizes,
+    ) -> Result<Self, AtmosphereError> {
         params.validate()?;
         for (field, ok) in [
-            ("sizes.transmittance", sizes.transmittance.iter().all(|&n| (2..=4096).contains(&n))),
+            (
+                "sizes.transmittance",
+                sizes.transmittance.iter().all(|&n| (2..=4096).contains(&n)),
+            ),
             (
                 "sizes.scattering",
-                sizes.scattering.iter().all(|&n| (2..=1024).contains(&n)) && sizes.scattering[0] % 2 == 0,
+                sizes.scattering.iter().all(|&n| (2..=1024).contains(&n))
+                    && sizes.scattering[0].is_multiple_of(2),
             ),
-            ("sizes.density", sizes.density.iter().all(|&n| (2..=1024).contains(&n))),
-            ("sizes.ground_irradiance", sizes.ground_irradiance.iter().all(|&n| (2..=4096).contains(&n))),
+            (
+                "sizes.density",
+                sizes.density.iter().all(|&n| (2..=1024).contains(&n)),
+            ),
+            (
+                "sizes.ground_irradiance",
+                sizes
+                    .ground_irradiance
+                    .iter()
+                    .all(|&n| (2..=4096).contains(&n)),
+            ),
             ("sizes.ray_steps", (1..=10_000).contains(&sizes.ray_steps)),
-            ("sizes.sphere", sizes.sphere.iter().all(|&n| (1..=1024).contains(&n))),
+            (
+                "sizes.sphere",
+                sizes.sphere.iter().all(|&n| (1..=1024).contains(&n)),
+            ),
         ] {
             if !ok {
                 return Err(AtmosphereError::OutOfRange {
@@ -62,8 +81,17 @@ impl Atmosphere {
             }
         }
         let (tables, report) = build(&params, sizes);
-        let (to709, from709) = (params.color_space.to_rec709(), params.color_space.from_rec709());
-        Ok(Self { params, tables, report, to709, from709 })
+        let (to709, from709) = (
+            params.color_space.to_rec709(),
+            params.color_space.from_rec709(),
+        );
+        Ok(Self {
+            params,
+            tables,
+            report,
+            to709,
+            from709,
+        })
     }
 
     fn ctx(&self) -> Ctx<'_> {
@@ -93,7 +121,11 @@ impl Atmosphere {
     /// working-space channel (0 where the ray hits the ground). Bilinear in the table.
     pub fn transmittance(&self, altitude_km: f32, cos_zenith: f32) -> [f64; 3] {
         let r = self.radius(altitude_km);
-        self.ctx().trans_sun(&self.tables.transmittance, r, f64::from(cos_zenith).clamp(-1.0, 1.0))
+        self.ctx().trans_sun(
+            &self.tables.transmittance,
+            r,
+            f64::from(cos_zenith).clamp(-1.0, 1.0),
+        )
     }
 
     /// `light_rec709` (lux or nits, linear Rec.709) after the path from `altitude_km` to space
@@ -127,7 +159,13 @@ impl Atmosphere {
     /// `sun_illuminance` (linear Rec.709 lux). The sun's disk and the ground's own reflected light
     /// are not included. Trilinear in the tables; the phase functions at the true angle between
     /// view and sun. A camera above the atmosphere is moved to where the view ray enters it.
-    pub fn sky_radiance(&self, altitude_km: f32, view_dir: Vec3, sun_dir: Vec3, sun_illuminance: Vec3) -> Vec3 {
+    pub fn sky_radiance(
+        &self,
+        altitude_km: f32,
+        view_dir: Vec3,
+        sun_dir: Vec3,
+        sun_illuminance: Vec3,
+    ) -> Vec3 {
         let [rgb, _, _] = self.sky_radiance_parts(altitude_km, view_dir, sun_dir);
         let e = self.to_working(sun_illuminance);
         self.to_rec709(std::array::from_fn(|c| rgb[c] * e[c]))
@@ -135,7 +173,12 @@ impl Atmosphere {
 
     /// Working-space sky radiance per unit sun illuminance, and the Rayleigh and Mie table values
     /// (divided by their phases) it came from.
-    pub fn sky_radiance_parts(&self, altitude_km: f32, view_dir: Vec3, sun_dir: Vec3) -> [[f64; 3]; 3] {
+    pub fn sky_radiance_parts(
+        &self,
+        altitude_km: f32,
+        view_dir: Vec3,
+        sun_dir: Vec3,
+    ) -> [[f64; 3]; 3] {
         let v = view_dir.as_dvec3().normalize_or_zero();
         let s = sun_dir.as_dvec3().normalize_or_zero();
         if v == glam::DVec3::ZERO || s == glam::DVec3::ZERO {
@@ -164,28 +207,48 @@ impl Atmosphere {
         let (a, b, c) = ctx.scat_uvw(r, mu, mu_s);
         let ray = self.tables.rayleigh.sample(a, b, c);
         let mie = self.tables.mie.sample(a, b, c);
-        let (pr, pm) = (phase::rayleigh(nu), phase::cornette_shanks(nu, self.params.mie_g));
+        let (pr, pm) = (
+            phase::rayleigh(nu),
+            phase::cornette_shanks(nu, self.params.mie_g),
+        );
         [std::array::from_fn(|k| ray[k] * pr + mie[k] * pm), ray, mie]
     }
 
     /// The talk's "irradiance" tables at a point: light that Rayleigh and Mie scatter toward
     /// `view_dir` divided by their phases, before density (working space, per unit sun
     /// illuminance, lux per lux). Multiply by `β ρ(h) p(ν)` and the sun's illuminance.
-    pub fn scattering_irradiance(&self, altitude_km: f32, view_dir: Vec3, sun_dir: Vec3) -> ([f64; 3], [f64; 3]) {
+    pub fn scattering_irradiance(
+        &self,
+        altitude_km: f32,
+        view_dir: Vec3,
+        sun_dir: Vec3,
+    ) -> ([f64; 3], [f64; 3]) {
         let ctx = self.ctx();
         let r = self.radius(altitude_km).min(self.params.top_radius_km);
         let v = view_dir.as_dvec3().normalize_or_zero();
         let s = sun_dir.as_dvec3().normalize_or_zero();
         let (a, b, c) = ctx.scat_uvw(r, v.y, s.y);
-        (self.tables.irradiance_rayleigh.sample(a, b, c), self.tables.irradiance_mie.sample(a, b, c))
+        (
+            self.tables.irradiance_rayleigh.sample(a, b, c),
+            self.tables.irradiance_mie.sample(a, b, c),
+        )
     }
 
     /// Sky irradiance (no direct sun) on a horizontal plane at `altitude_km`, linear Rec.709 lux,
     /// for a sun `sun_zenith_rad` from the zenith whose extraterrestrial illuminance is
     /// `sun_illuminance` (Rec.709 lux).
-    pub fn sky_irradiance(&self, altitude_km: f32, sun_zenith_rad: f32, sun_illuminance: Vec3) -> Vec3 {
+    pub fn sky_irradiance(
+        &self,
+        altitude_km: f32,
+        sun_zenith_rad: f32,
+        sun_illuminance: Vec3,
+    ) -> Vec3 {
         let r = self.radius(altitude_km).min(self.params.top_radius_km);
-        let e = self.ctx().ground_irradiance(&self.tables.ground_irradiance, r, f64::from(sun_zenith_rad.cos()));
+        let e = self.ctx().ground_irradiance(
+            &self.tables.ground_irradiance,
+            r,
+            f64::from(sun_zenith_rad.cos()),
+        );
         let l = self.to_working(sun_illuminance);
         self.to_rec709(std::array::from_fn(|c| e[c] * l[c]))
     }

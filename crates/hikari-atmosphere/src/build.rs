@@ -111,7 +111,11 @@ impl Ctx<'_> {
 
     /// Transmittance to the sun (a point source): zero once the Earth hides it.
     pub fn trans_sun(&self, t: &Table, r: f64, mu_s: f64) -> [f64; 3] {
-        if self.shell.hits_ground(r, mu_s) { [0.0; 3] } else { self.trans_top(t, r, mu_s) }
+        if self.shell.hits_ground(r, mu_s) {
+            [0.0; 3]
+        } else {
+            self.trans_top(t, r, mu_s)
+        }
     }
 
     /// Transmittance over `d` km from (`r`, `mu`), as a ratio of two table lookups.
@@ -122,17 +126,26 @@ impl Ctx<'_> {
         } else {
             (self.trans_top(t, r, mu), self.trans_top(t, rd, mud))
         };
-        std::array::from_fn(|c| if b[c] > 0.0 { (a[c] / b[c]).min(1.0) } else { 0.0 })
+        std::array::from_fn(|c| {
+            if b[c] > 0.0 {
+                (a[c] / b[c]).min(1.0)
+            } else {
+                0.0
+            }
+        })
     }
 
     pub fn scat_uvw(&self, r: f64, mu: f64, mu_s: f64) -> (f64, f64, f64) {
         let hits = self.shell.hits_ground(r, mu);
-        self.shell.scattering_uvw(r, mu, mu_s, hits, self.sizes.scattering)
+        self.shell
+            .scattering_uvw(r, mu, mu_s, hits, self.sizes.scattering)
     }
 
     fn density_uvw(&self, r: f64, mu: f64, mu_s: f64) -> (f64, f64, f64) {
         let [nmu, nmus, nr] = self.sizes.density;
-        let rho = (r * r - self.shell.bottom * self.shell.bottom).max(0.0).sqrt();
+        let rho = (r * r - self.shell.bottom * self.shell.bottom)
+            .max(0.0)
+            .sqrt();
         (
             coord_from_unit(0.5 * (mu + 1.0), nmu),
             coord_from_unit(self.shell.x_mu_s(mu_s), nmus),
@@ -194,7 +207,10 @@ impl Ctx<'_> {
         let (u, v, w) = self.scat_uvw(r, mu, mu_s);
         match prev {
             Previous::Single { rayleigh, mie } => {
-                let (pr, pm) = (phase::rayleigh(nu), phase::cornette_shanks(nu, self.p.mie_g));
+                let (pr, pm) = (
+                    phase::rayleigh(nu),
+                    phase::cornette_shanks(nu, self.p.mie_g),
+                );
                 let (a, b) = (rayleigh.sample(u, v, w), mie.sample(u, v, w));
                 std::array::from_fn(|c| a[c] * pr + b[c] * pm)
             }
@@ -273,7 +289,8 @@ impl Ctx<'_> {
         let s = self.shell;
         Table::from_fn([nmus, nr, 1], |x, y, _| {
             let mu_s = -0.2 + 1.2 * unit_from_coord((x as f64 + 0.5) / nmus as f64, nmus);
-            let r = s.bottom + (s.top - s.bottom) * unit_from_coord((y as f64 + 0.5) / nr as f64, nr);
+            let r =
+                s.bottom + (s.top - s.bottom) * unit_from_coord((y as f64 + 0.5) / nr as f64, nr);
             self.hemisphere_irradiance(prev, r, mu_s)
         })
     }
@@ -287,7 +304,9 @@ impl Ctx<'_> {
             nmu,
             nr,
         );
-        let mu_s = self.shell.mu_s_from_x(unit_from_coord((y as f64 + 0.5) / nmus as f64, nmus));
+        let mu_s = self
+            .shell
+            .mu_s_from_x(unit_from_coord((y as f64 + 0.5) / nmus as f64, nmus));
         (r, mu, mu_s, hits)
     }
 
@@ -331,7 +350,12 @@ fn luminance_sum(table: &Table, to_rec709: &[[f64; 3]; 3], scale: impl Fn(usize)
 /// Builds every table for validated parameters.
 pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
     let start = std::time::Instant::now();
-    let ctx = Ctx { p, shell: Shell::new(p.bottom_radius_km, p.top_radius_km), sizes, rayleigh: p.rayleigh() };
+    let ctx = Ctx {
+        p,
+        shell: Shell::new(p.bottom_radius_km, p.top_radius_km),
+        sizes,
+        rayleigh: p.rayleigh(),
+    };
     let [tmu, tr] = sizes.transmittance;
     let transmittance = Table::from_fn([tmu, tr, 1], |x, y, _| {
         let (r, mu) = ctx.shell.transmittance_r_mu(
@@ -356,7 +380,10 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
             )
         })
     });
-    let as_table = |v: Vec<[f64; 3]>| Table { size: ss, data: v.into_iter().map(|a| a.map(|x| x as f32)).collect() };
+    let as_table = |v: Vec<[f64; 3]>| Table {
+        size: ss,
+        data: v.into_iter().map(|a| a.map(|x| x as f32)).collect(),
+    };
     let rayleigh_single = as_table(single.iter().map(|s| s.0).collect());
     let mie = as_table(single.iter().map(|s| s.1).collect());
     let nu0 = |i: usize| {
@@ -367,7 +394,10 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
     let single_lum = luminance_sum(&rayleigh_single, &to709, |i| phase::rayleigh(nu0(i)))
         + luminance_sum(&mie, &to709, |i| phase::cornette_shanks(nu0(i), p.mie_g));
 
-    let first = Previous::Single { rayleigh: &rayleigh_single, mie: &mie };
+    let first = Previous::Single {
+        rayleigh: &rayleigh_single,
+        mie: &mie,
+    };
     let mut ground_orders = vec![ctx.ground_table(&first)];
     let mut multiple_sum = vec![[0.0f64; 3]; ss.iter().product()];
     let sd = sizes.density;
@@ -378,14 +408,23 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
     let mut delta: Option<Table> = None;
     for order in 2..=p.max_scattering_orders as usize {
         let prev = match &delta {
-            None => Previous::Single { rayleigh: &rayleigh_single, mie: &mie },
+            None => Previous::Single {
+                rayleigh: &rayleigh_single,
+                mie: &mie,
+            },
             Some(d) => Previous::Multiple(d),
         };
-        let ground = if order == 2 { GroundLight::DirectSun } else { GroundLight::Sky(&ground_orders[order - 3]) };
+        let ground = if order == 2 {
+            GroundLight::DirectSun
+        } else {
+            GroundLight::Sky(&ground_orders[order - 3])
+        };
         let light = crate::parallel::map(sd.iter().product(), |i| {
             let (x, y, z) = (i % sd[0], (i / sd[0]) % sd[1], i / (sd[0] * sd[1]));
             let mu = 2.0 * unit_from_coord((x as f64 + 0.5) / sd[0] as f64, sd[0]) - 1.0;
-            let mu_s = ctx.shell.mu_s_from_x(unit_from_coord((y as f64 + 0.5) / sd[1] as f64, sd[1]));
+            let mu_s = ctx
+                .shell
+                .mu_s_from_x(unit_from_coord((y as f64 + 0.5) / sd[1] as f64, sd[1]));
             let rho = ctx.shell.h * unit_from_coord((z as f64 + 0.5) / sd[2] as f64, sd[2]);
             let r = (rho * rho + p.bottom_radius_km * p.bottom_radius_km).sqrt();
             ctx.scattered_light(t, &prev, &ground, r, mu, mu_s)
@@ -394,8 +433,14 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
             add(&mut light_r[i], *a, 1.0);
             add(&mut light_m[i], *b, 1.0);
         }
-        let jr = Table { size: sd, data: light.iter().map(|l| l.0.map(|v| v as f32)).collect() };
-        let jm = Table { size: sd, data: light.iter().map(|l| l.1.map(|v| v as f32)).collect() };
+        let jr = Table {
+            size: sd,
+            data: light.iter().map(|l| l.0.map(|v| v as f32)).collect(),
+        };
+        let jm = Table {
+            size: sd,
+            data: light.iter().map(|l| l.1.map(|v| v as f32)).collect(),
+        };
         let radiance = crate::parallel::map(ss.iter().product(), |i| {
             let texel = ctx.scat_texel(i % ss[0], (i / ss[0]) % ss[1], i / (ss[0] * ss[1]));
             ctx.integrate_ray(t, texel, |rd, mud, mu_s_d| {
@@ -403,7 +448,9 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
                 let [dr, dm, _] = p.densities(h(rd));
                 let (a, b) = (jr.sample(u, v, w), jm.sample(u, v, w));
                 (
-                    std::array::from_fn(|c| a[c] * dr * ctx.rayleigh[c] + b[c] * dm * p.mie_scattering_per_km),
+                    std::array::from_fn(|c| {
+                        a[c] * dr * ctx.rayleigh[c] + b[c] * dm * p.mie_scattering_per_km
+                    }),
                     [0.0; 3],
                 )
             })
@@ -414,7 +461,11 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
             add(acc, v.map(f64::from), 1.0);
         }
         let lum = luminance_sum(&d, &to709, |_| 1.0);
-        contributions.push(if total_lum > 0.0 { lum / total_lum } else { 0.0 });
+        contributions.push(if total_lum > 0.0 {
+            lum / total_lum
+        } else {
+            0.0
+        });
         total_lum += lum;
         ground_orders.push(ctx.ground_table(&Previous::Multiple(&d)));
         delta = Some(d);
@@ -433,8 +484,14 @@ pub fn build(p: &AtmosphereParams, sizes: TableSizes) -> (Tables, BuildReport) {
             })
             .collect(),
     };
-    let jr_sum = Table { size: sd, data: light_r.iter().map(|v| v.map(|x| x as f32)).collect() };
-    let jm_sum = Table { size: sd, data: light_m.iter().map(|v| v.map(|x| x as f32)).collect() };
+    let jr_sum = Table {
+        size: sd,
+        data: light_r.iter().map(|v| v.map(|x| x as f32)).collect(),
+    };
+    let jm_sum = Table {
+        size: sd,
+        data: light_m.iter().map(|v| v.map(|x| x as f32)).collect(),
+    };
     let irradiance = |sum: &Table, phase_fn: &(dyn Fn(f64) -> f64 + Sync)| {
         Table::from_fn(ss, |x, y, z| {
             let (r, mu, mu_s, _) = ctx.scat_texel(x, y, z);

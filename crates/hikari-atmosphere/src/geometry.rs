@@ -39,7 +39,11 @@ fn safe_sqrt(x: f64) -> f64 {
 impl Shell {
     /// The shell for the given radii, km.
     pub fn new(bottom: f64, top: f64) -> Self {
-        Self { bottom, top, h: safe_sqrt(top * top - bottom * bottom) }
+        Self {
+            bottom,
+            top,
+            h: safe_sqrt(top * top - bottom * bottom),
+        }
     }
 
     /// Distance from `r` along `mu` to the top sphere (the far intersection), km.
@@ -80,8 +84,15 @@ impl Shell {
         let rho = safe_sqrt(r * r - self.bottom * self.bottom);
         let d = self.distance_to_top(r, mu);
         let (d_min, d_max) = (self.top - r, rho + self.h);
-        let x_mu = if d_max > d_min { (d - d_min) / (d_max - d_min) } else { 0.0 };
-        (coord_from_unit(x_mu.clamp(0.0, 1.0), nmu), coord_from_unit(rho / self.h, nr))
+        let x_mu = if d_max > d_min {
+            (d - d_min) / (d_max - d_min)
+        } else {
+            0.0
+        };
+        (
+            coord_from_unit(x_mu.clamp(0.0, 1.0), nmu),
+            coord_from_unit(rho / self.h, nr),
+        )
     }
 
     /// Inverse of [`Shell::transmittance_uv`] at texel centres: `(r, mu)`.
@@ -90,7 +101,11 @@ impl Shell {
         let r = safe_sqrt(rho * rho + self.bottom * self.bottom);
         let (d_min, d_max) = (self.top - r, rho + self.h);
         let d = d_min + x_mu * (d_max - d_min);
-        let mu = if d == 0.0 { 1.0 } else { (self.h * self.h - rho * rho - d * d) / (2.0 * r * d) };
+        let mu = if d == 0.0 {
+            1.0
+        } else {
+            (self.h * self.h - rho * rho - d * d) / (2.0 * r * d)
+        };
         (r, mu.clamp(-1.0, 1.0))
     }
 
@@ -112,7 +127,11 @@ impl Shell {
         let u_mu = if hits_ground {
             let d = -r_mu - safe_sqrt(disc);
             let (d_min, d_max) = (r - self.bottom, rho);
-            let x = if d_max == d_min { 0.0 } else { ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0) };
+            let x = if d_max == d_min {
+                0.0
+            } else {
+                ((d - d_min) / (d_max - d_min)).clamp(0.0, 1.0)
+            };
             0.5 - 0.5 * coord_from_unit(x, half)
         } else {
             let d = -r_mu + safe_sqrt(disc + self.h * self.h);
@@ -159,13 +178,21 @@ impl Shell {
             let x = unit_from_coord(1.0 - 2.0 * u_mu, half);
             let (d_min, d_max) = (r - self.bottom, rho);
             let d = d_min + x * (d_max - d_min);
-            let mu = if d == 0.0 { -1.0 } else { -(rho * rho + d * d) / (2.0 * r * d) };
+            let mu = if d == 0.0 {
+                -1.0
+            } else {
+                -(rho * rho + d * d) / (2.0 * r * d)
+            };
             (r, mu.clamp(-1.0, 1.0), true)
         } else {
             let x = unit_from_coord(2.0 * u_mu - 1.0, half);
             let (d_min, d_max) = (self.top - r, rho + self.h);
             let d = d_min + x * (d_max - d_min);
-            let mu = if d == 0.0 { 1.0 } else { (self.h * self.h - rho * rho - d * d) / (2.0 * r * d) };
+            let mu = if d == 0.0 {
+                1.0
+            } else {
+                (self.h * self.h - rho * rho - d * d) / (2.0 * r * d)
+            };
             (r, mu.clamp(-1.0, 1.0), false)
         }
     }

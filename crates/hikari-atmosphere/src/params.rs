@@ -165,7 +165,11 @@ impl AtmosphereParams {
             if value.is_finite() && ok(value) {
                 Ok(())
             } else {
-                Err(AtmosphereError::OutOfRange { field, value, allowed })
+                Err(AtmosphereError::OutOfRange {
+                    field,
+                    value,
+                    allowed,
+                })
             }
         }
         let nonneg = |v: f64| v >= 0.0;
@@ -183,7 +187,12 @@ impl AtmosphereParams {
             "finite, between bottom_radius_km + 1 and bottom_radius_km + 1000 km",
         )?;
         for v in self.rayleigh() {
-            check("rayleigh_scattering_per_km", v, nonneg, "finite and >= 0 km^-1")?;
+            check(
+                "rayleigh_scattering_per_km",
+                v,
+                nonneg,
+                "finite and >= 0 km^-1",
+            )?;
         }
         let positive_height = |v: f64| v >= 0.01;
         check(
@@ -192,7 +201,12 @@ impl AtmosphereParams {
             positive_height,
             "finite and >= 0.01 km",
         )?;
-        check("mie_scattering_per_km", self.mie_scattering_per_km, nonneg, "finite and >= 0 km^-1")?;
+        check(
+            "mie_scattering_per_km",
+            self.mie_scattering_per_km,
+            nonneg,
+            "finite and >= 0 km^-1",
+        )?;
         check(
             "mie_extinction_per_km",
             self.mie_extinction_per_km,
@@ -205,18 +219,38 @@ impl AtmosphereParams {
             positive_height,
             "finite and >= 0.01 km",
         )?;
-        check("mie_g", self.mie_g, |v| v.abs() <= 0.999, "in [-0.999, 0.999]")?;
+        check(
+            "mie_g",
+            self.mie_g,
+            |v| v.abs() <= 0.999,
+            "in [-0.999, 0.999]",
+        )?;
         for v in self.ozone() {
-            check("ozone_absorption_per_km", v, nonneg, "finite and >= 0 km^-1")?;
+            check(
+                "ozone_absorption_per_km",
+                v,
+                nonneg,
+                "finite and >= 0 km^-1",
+            )?;
         }
-        check("ozone_center_km", self.ozone_center_km, nonneg, "finite and >= 0 km")?;
+        check(
+            "ozone_center_km",
+            self.ozone_center_km,
+            nonneg,
+            "finite and >= 0 km",
+        )?;
         check(
             "ozone_half_width_km",
             self.ozone_half_width_km,
             |v| v >= 0.01,
             "finite and >= 0.01 km",
         )?;
-        check("ground_albedo", self.ground_albedo, |v| (0.0..=1.0).contains(&v), "in [0, 1]")?;
+        check(
+            "ground_albedo",
+            self.ground_albedo,
+            |v| (0.0..=1.0).contains(&v),
+            "in [0, 1]",
+        )?;
         check(
             "solar_illuminance_lux",
             self.solar_illuminance_lux,

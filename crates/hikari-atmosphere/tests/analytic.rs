@@ -2,10 +2,18 @@
 //! parameter validation.
 
 use glam::Vec3;
-use hikari_atmosphere::{Atmosphere, AtmosphereError, AtmosphereParams, TableSizes, phase, transmittance_to_top};
+use hikari_atmosphere::{
+    Atmosphere, AtmosphereError, AtmosphereParams, TableSizes, phase, transmittance_to_top,
+};
 
 fn small() -> TableSizes {
-    TableSizes { scattering: [32, 16, 8], density: [16, 16, 8], sphere: [8, 8], ray_steps: 20, ..TableSizes::default() }
+    TableSizes {
+        scattering: [32, 16, 8],
+        density: [16, 16, 8],
+        sphere: [8, 8],
+        ray_steps: 20,
+        ..TableSizes::default()
+    }
 }
 
 fn rayleigh_only() -> AtmosphereParams {
@@ -34,9 +42,17 @@ fn vertical_transmittance_matches_closed_form() {
         for c in 0..3 {
             let exact = (-closed_form(beta[c], h, 60.0)).exp();
             // Trapezoid rule, 500 steps of 0.12 km: error ≈ τ Δ² / (12 H²) ≈ 1e-6.
-            assert!((direct[c] - exact).abs() < 4e-6 * exact, "integrator h={h} c={c}: {} vs {exact}", direct[c]);
+            assert!(
+                (direct[c] - exact).abs() < 4e-6 * exact,
+                "integrator h={h} c={c}: {} vs {exact}",
+                direct[c]
+            );
             // The table interpolates linearly in sqrt(r² − bottom²) between 64 rows.
-            assert!((table[c] - exact).abs() < 2e-3 * exact, "table h={h} c={c}: {} vs {exact}", table[c]);
+            assert!(
+                (table[c] - exact).abs() < 2e-3 * exact,
+                "table h={h} c={c}: {} vs {exact}",
+                table[c]
+            );
         }
     }
 }
@@ -53,7 +69,11 @@ fn phase_functions_integrate_to_one() {
         }
         let w = 2.0 * std::f64::consts::PI * 2.0 / n as f64;
         assert!((r * w - 1.0).abs() < 1e-6, "rayleigh {}", r * w);
-        assert!((m * w - 1.0).abs() < 1e-4, "cornette-shanks g={g}: {}", m * w);
+        assert!(
+            (m * w - 1.0).abs() < 1e-4,
+            "cornette-shanks g={g}: {}",
+            m * w
+        );
     }
 }
 
@@ -65,12 +85,19 @@ fn no_scattering_no_inscatter() {
         ..AtmosphereParams::default()
     };
     let a = Atmosphere::with_sizes(p, small()).unwrap();
-    for t in [&a.tables.rayleigh, &a.tables.mie, &a.tables.ground_irradiance] {
+    for t in [
+        &a.tables.rayleigh,
+        &a.tables.mie,
+        &a.tables.ground_irradiance,
+    ] {
         assert!(t.data.iter().all(|v| *v == [0.0; 3]));
     }
     let sun = Vec3::new(0.3, 0.9, 0.1).normalize();
     for v in [Vec3::Y, Vec3::X, Vec3::new(0.2, -0.3, 0.9).normalize()] {
-        assert_eq!(a.sky_radiance(0.5, v, sun, a.solar_illuminance()), Vec3::ZERO);
+        assert_eq!(
+            a.sky_radiance(0.5, v, sun, a.solar_illuminance()),
+            Vec3::ZERO
+        );
     }
 }
 
@@ -89,13 +116,55 @@ fn clear_noon_near_100_klux() {
 #[test]
 fn bad_parameters_name_the_field() {
     let cases: Vec<(AtmosphereParams, &str)> = vec![
-        (AtmosphereParams { mie_scattering_per_km: f64::NAN, ..Default::default() }, "mie_scattering_per_km"),
-        (AtmosphereParams { rayleigh_scattering_per_km: Some([1e-3, -1.0, 0.0]), ..Default::default() }, "rayleigh_scattering_per_km"),
-        (AtmosphereParams { top_radius_km: 6000.0, ..Default::default() }, "top_radius_km"),
-        (AtmosphereParams { mie_g: 1.0, ..Default::default() }, "mie_g"),
-        (AtmosphereParams { ground_albedo: 1.5, ..Default::default() }, "ground_albedo"),
-        (AtmosphereParams { ozone_absorption_per_km: Some([f64::INFINITY, 0.0, 0.0]), ..Default::default() }, "ozone_absorption_per_km"),
-        (AtmosphereParams { mie_extinction_per_km: 1e-3, ..Default::default() }, "mie_extinction_per_km"),
+        (
+            AtmosphereParams {
+                mie_scattering_per_km: f64::NAN,
+                ..Default::default()
+            },
+            "mie_scattering_per_km",
+        ),
+        (
+            AtmosphereParams {
+                rayleigh_scattering_per_km: Some([1e-3, -1.0, 0.0]),
+                ..Default::default()
+            },
+            "rayleigh_scattering_per_km",
+        ),
+        (
+            AtmosphereParams {
+                top_radius_km: 6000.0,
+                ..Default::default()
+            },
+            "top_radius_km",
+        ),
+        (
+            AtmosphereParams {
+                mie_g: 1.0,
+                ..Default::default()
+            },
+            "mie_g",
+        ),
+        (
+            AtmosphereParams {
+                ground_albedo: 1.5,
+                ..Default::default()
+            },
+            "ground_albedo",
+        ),
+        (
+            AtmosphereParams {
+                ozone_absorption_per_km: Some([f64::INFINITY, 0.0, 0.0]),
+                ..Default::default()
+            },
+            "ozone_absorption_per_km",
+        ),
+        (
+            AtmosphereParams {
+                mie_extinction_per_km: 1e-3,
+                ..Default::default()
+            },
+            "mie_extinction_per_km",
+        ),
     ];
     for (p, field) in cases {
         match Atmosphere::with_sizes(p, small()) {
