@@ -29,7 +29,7 @@ pub(super) struct AnimationReport {
 }
 
 /// Frames played at 60 Hz for the animation report.
-pub(super) const ANIMATION_FRAMES: usize = 120;
+const ANIMATION_FRAMES: usize = 120;
 
 pub(super) fn animate(
     scene: &hikari_scene::Scene,

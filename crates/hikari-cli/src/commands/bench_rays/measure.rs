@@ -14,10 +14,12 @@ use hikari_render::passes::bvh_trace::{
 use hikari_render::wgpu;
 
 use super::RaysArgs;
+use super::rays::{RaySource, coherent_size};
 
 /// Untimed trace passes run for at least this long (and at least two) before the timed ones.
-pub(super) const WARM_UP_S: f64 = 0.3;
+const WARM_UP_S: f64 = 0.3;
 
+/// One set of rays and how the kernel traces them.
 pub(super) struct Workload {
     pub name: &'static str,
     pub mode: TraceMode,
@@ -27,6 +29,55 @@ pub(super) struct Workload {
     pub note: String,
 }
 
+/// `t_max` of the ambient-occlusion (any hit) rays, metres.
+const AO_T_MAX: f32 = 5.0;
+
+/// The four workloads of about `n` rays each: incoherent closest and any hit, and a coherent
+/// image traced as an image and in buffer order.
+pub(super) fn workloads(source: &RaySource, n: usize) -> [Workload; 4] {
+    let incoherent = source.incoherent(n);
+    let ao: Vec<Ray> = incoherent
+        .iter()
+        .map(|r| Ray {
+            t_max: AO_T_MAX,
+            ..*r
+        })
+        .collect();
+    let (w, h) = coherent_size(n);
+    let coherent = source.coherent(w, h);
+    [
+        Workload {
+            name: "incoherent closest hit",
+            mode: TraceMode::Closest,
+            order: RayOrder::Incoherent,
+            rays: incoherent,
+            note: "surface points, cosine directions".into(),
+        },
+        Workload {
+            name: "incoherent any hit (AO, t_max 5)",
+            mode: TraceMode::Any,
+            order: RayOrder::Incoherent,
+            rays: ao,
+            note: "same rays".into(),
+        },
+        Workload {
+            name: "coherent closest hit",
+            mode: TraceMode::Closest,
+            order: RayOrder::Image { width: w },
+            rays: coherent.clone(),
+            note: format!("{w}x{h} pinhole, row-major, traced as an image (8x8 tiles)"),
+        },
+        Workload {
+            name: "coherent closest hit, buffer order",
+            mode: TraceMode::Closest,
+            order: RayOrder::Coherent,
+            rays: coherent,
+            note: "same rays, traced in buffer order (32-pixel row strips per warp)".into(),
+        },
+    ]
+}
+
+/// One workload traced by one kernel variant: times in milliseconds, hits and the CPU check.
 pub(super) struct Measured {
     pub variant: String,
     /// The kernel configuration that traced it.
@@ -170,7 +221,7 @@ pub(super) fn ray_bytes(rays: &[Ray]) -> Vec<u8> {
 }
 
 /// hikari-bvh's `Hit` records (32 bytes, little-endian).
-pub(super) fn hits_from_bytes(bytes: &[u8]) -> Vec<Hit> {
+fn hits_from_bytes(bytes: &[u8]) -> Vec<Hit> {
     bytes
         .chunks_exact(HIT_BYTES as usize)
         .map(|c| {

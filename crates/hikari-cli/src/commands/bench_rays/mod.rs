@@ -25,11 +25,9 @@ use std::time::Instant;
 use anyhow::{Context, ensure};
 use clap::Args;
 
-use hikari_bvh::{Ray, Tlas};
+use hikari_bvh::Tlas;
 use hikari_render::graph::{GraphRuntime, TimestampMode};
-use hikari_render::passes::bvh_trace::{
-    BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode,
-};
+use hikari_render::passes::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, TraceConfig};
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::wgpu;
 use hikari_render::wgpu::util::DeviceExt;
@@ -37,9 +35,8 @@ use hikari_render::{ContextOptions, GpuContext};
 
 use crate::args::JsonArgs;
 
-use measure::{Measured, Workload, measure, median_min, ray_bytes};
+use measure::{Measured, measure, median_min, ray_bytes, workloads};
 use quality::TlasQuality;
-use rays::coherent_size;
 use report::Report;
 use variants::parse_variant;
 
@@ -74,9 +71,6 @@ pub struct RaysArgs {
     #[arg(long, default_value = "auto", hide = true)]
     pub variants: String,
 }
-
-/// `t_max` of the ambient-occlusion (any hit) rays, metres.
-const AO_T_MAX: f32 = 5.0;
 
 pub fn run(args: RaysArgs) -> anyhow::Result<()> {
     ensure!(args.rays > 0, "--rays must be at least 1");
@@ -117,47 +111,7 @@ pub fn run(args: RaysArgs) -> anyhow::Result<()> {
     let quality = TlasQuality::measure(&scene, &tlas);
 
     // Workloads, uploaded once and shared by every variant.
-    let n = args.rays as usize;
-    let incoherent = scene.rays.incoherent(n);
-    let ao: Vec<Ray> = incoherent
-        .iter()
-        .map(|r| Ray {
-            t_max: AO_T_MAX,
-            ..*r
-        })
-        .collect();
-    let (w, h) = coherent_size(n);
-    let coherent = scene.rays.coherent(w, h);
-    let workloads = [
-        Workload {
-            name: "incoherent closest hit",
-            mode: TraceMode::Closest,
-            order: RayOrder::Incoherent,
-            rays: incoherent,
-            note: "surface points, cosine directions".into(),
-        },
-        Workload {
-            name: "incoherent any hit (AO, t_max 5)",
-            mode: TraceMode::Any,
-            order: RayOrder::Incoherent,
-            rays: ao,
-            note: "same rays".into(),
-        },
-        Workload {
-            name: "coherent closest hit",
-            mode: TraceMode::Closest,
-            order: RayOrder::Image { width: w },
-            rays: coherent.clone(),
-            note: format!("{w}x{h} pinhole, row-major, traced as an image (8x8 tiles)"),
-        },
-        Workload {
-            name: "coherent closest hit, buffer order",
-            mode: TraceMode::Closest,
-            order: RayOrder::Coherent,
-            rays: coherent,
-            note: "same rays, traced in buffer order (32-pixel row strips per warp)".into(),
-        },
-    ];
+    let workloads = workloads(&scene.rays, args.rays as usize);
     let ray_buffers: Vec<wgpu::Buffer> = workloads
         .iter()
         .map(|wl| {

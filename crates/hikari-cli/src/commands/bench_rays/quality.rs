@@ -8,7 +8,7 @@ use super::rays::coherent_size;
 use super::scene::BenchScene;
 
 /// Rays per workload traced on the CPU for the TLAS quality figures.
-pub(super) const QUALITY_RAYS: usize = 4096;
+const QUALITY_RAYS: usize = 4096;
 
 /// How good the TLAS is, independent of the GPU: its SAH cost, and the work closest-hit rays
 /// do in it when traced on the CPU (the twin of the kernel, so the same visits).

@@ -11,8 +11,9 @@ use hikari_bvh::{Mesh, Ray};
 pub(super) const TERRAIN_SIDE: usize = 708;
 pub(super) const SEED: u64 = 0x5EED_0005;
 /// Surface rays start this far off the surface.
-pub(super) const SURFACE_OFFSET: f32 = 0.01;
+const SURFACE_OFFSET: f32 = 0.01;
 
+/// Where a scene's rays come from.
 pub(super) enum RaySource {
     /// Issue 5's terrain: points over the height field, the issue's camera.
     Terrain(Mesh),
@@ -61,7 +62,7 @@ impl RaySource {
 
 /// Height of the triangulated terrain (not the analytic formula, which the flat triangles
 /// depart from by about a centimetre between vertices) at `x`, `z`.
-pub(super) fn mesh_height(mesh: &Mesh, x: f32, z: f32) -> f32 {
+fn mesh_height(mesh: &Mesh, x: f32, z: f32) -> f32 {
     let n = TERRAIN_SIDE;
     let cell = 200.0 / (n - 1) as f32;
     let fx = (x + 100.0) / cell;
@@ -82,7 +83,7 @@ pub(super) fn mesh_height(mesh: &Mesh, x: f32, z: f32) -> f32 {
 }
 
 /// A cosine-distributed direction around `n` (Malley's method) from two uniform numbers.
-pub(super) fn cosine_dir(n: Vec3, r1: f32, r2: f32) -> Vec3 {
+fn cosine_dir(n: Vec3, r1: f32, r2: f32) -> Vec3 {
     let r = r1.sqrt();
     let phi = std::f32::consts::TAU * r2;
     let (t, b) = n.any_orthonormal_pair();
@@ -91,7 +92,7 @@ pub(super) fn cosine_dir(n: Vec3, r1: f32, r2: f32) -> Vec3 {
 
 /// Terrain workloads 1 and 2: uniformly random surface points with x, z in [-90, 90], 1 cm
 /// above the surface, cosine-distributed directions around +y (Malley's method).
-pub(super) fn terrain_rays(mesh: &Mesh, n: usize) -> Vec<Ray> {
+fn terrain_rays(mesh: &Mesh, n: usize) -> Vec<Ray> {
     let mut rng = SplitMix64::new(SEED);
     (0..n)
         .map(|_| {
@@ -109,7 +110,7 @@ pub(super) fn terrain_rays(mesh: &Mesh, n: usize) -> Vec<Ray> {
 
 /// Scene workloads 1 and 2: points on world-space triangles picked by area, 1 cm off the front
 /// face (counter-clockwise), cosine-distributed around its normal.
-pub(super) fn surface_rays(triangles: &[[Vec3; 3]], cdf: &[f64], n: usize) -> Vec<Ray> {
+fn surface_rays(triangles: &[[Vec3; 3]], cdf: &[f64], n: usize) -> Vec<Ray> {
     let mut rng = SplitMix64::new(SEED);
     let total = *cdf.last().unwrap_or(&0.0);
     (0..n)
@@ -138,7 +139,7 @@ pub(super) fn coherent_size(n: usize) -> (u32, u32) {
 /// Row-major rays of a `w` x `h` pinhole camera at `origin` looking along `forward`; the image
 /// plane at distance 1 spans `half_height` above and below the axis and `half_height * w / h`
 /// to each side.
-pub(super) fn pinhole_rays(
+fn pinhole_rays(
     origin: Vec3,
     forward: Vec3,
     up: Vec3,
