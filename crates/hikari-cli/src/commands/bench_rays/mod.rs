@@ -42,6 +42,8 @@ use variants::parse_variant;
 
 #[derive(Args, Debug)]
 pub struct RaysArgs {
+    // Not `args::SceneArgs`: here `terrain` means issue 5's height field, not the built-in
+    // scene of that name, and the default differs.
     /// `terrain` (issue 5's benchmark), another built-in scene (`village`, `boxes`, ...) or a
     /// .gltf/.glb file.
     #[arg(long, default_value = "terrain")]
