@@ -1,14 +1,16 @@
 //! `hikari`: render, benchmark and inspect.
 
-mod bench;
-mod bench_rays;
+mod args;
+mod commands;
 mod config;
-mod constants;
-mod render;
+mod report;
+mod scene_source;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+
+use commands::{bench_frame, bench_overhead, bench_rays, constants, info, render};
 
 #[derive(Parser)]
 #[command(
@@ -27,11 +29,22 @@ enum Command {
     Render(render::RenderArgs),
     /// Benchmarks that print per-pass GPU timings.
     #[command(subcommand)]
-    Bench(bench::BenchCommand),
+    Bench(BenchCommand),
     /// Print the derived colour, spectral and scattering constants (no GPU needed).
     Constants(constants::ConstantsArgs),
     /// Print the GPU adapter, its features and limits.
     Info,
+}
+
+/// `hikari bench ...`: benchmarks print numbers; they never pass or fail.
+#[derive(Subcommand, Debug)]
+enum BenchCommand {
+    /// Render N frames of a scene and print per-pass GPU median/min/max.
+    Frame(bench_frame::BenchFrameArgs),
+    /// Frame-graph overhead: frames of N near-empty passes, CPU and GPU cost per pass.
+    Overhead(bench_overhead::OverheadArgs),
+    /// BVH build times and GPU ray throughput (Grays/s) for closest and any hit.
+    Rays(bench_rays::RaysArgs),
 }
 
 /// Mesa's drivers complain on every start when XDG_RUNTIME_DIR is unset (containers, CI);
@@ -53,9 +66,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(args),
-        Command::Bench(cmd) => bench::run(cmd),
+        Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(args),
+        Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
+        Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
         Command::Constants(args) => constants::run(args),
-        Command::Info => info(),
+        Command::Info => info::run(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -64,36 +79,4 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-fn info() -> anyhow::Result<()> {
-    let ctx = hikari_render::GpuContext::new(&hikari_render::ContextOptions::from_env())?;
-    println!("adapter:  {}", ctx.describe());
-    println!(
-        "startup:  {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1})",
-        ctx.startup.total().as_secs_f64() * 1e3,
-        ctx.startup.instance.as_secs_f64() * 1e3,
-        ctx.startup.adapter.as_secs_f64() * 1e3,
-        ctx.startup.device.as_secs_f64() * 1e3
-    );
-    println!("features: {:?}", ctx.features);
-    for f in [wgpu_fmt::RGBA16F, wgpu_fmt::RG11B10] {
-        println!(
-            "read-write storage {f:?}: {}",
-            ctx.supports_read_write_storage(f)
-        );
-    }
-    println!(
-        "max 2D texture {}, max 3D texture {}, max storage buffer binding {} bytes",
-        ctx.limits.max_texture_dimension_2d,
-        ctx.limits.max_texture_dimension_3d,
-        ctx.limits.max_storage_buffer_binding_size
-    );
-    Ok(())
-}
-
-mod wgpu_fmt {
-    pub use hikari_render::techniques::direct_lighting::RADIANCE_FORMAT as RGBA16F;
-    pub const RG11B10: hikari_render::wgpu::TextureFormat =
-        hikari_render::wgpu::TextureFormat::Rg11b10Ufloat;
 }

@@ -222,3 +222,69 @@ fn constants_json_has_every_key_and_the_white_balance_maps_white() {
     assert_clean_failure(&["constants", "--white", "1,0,1"], "greater than 0");
     assert_clean_failure(&["constants", "--white", "1,x,1"], "not a number");
 }
+
+#[test]
+fn bench_frame_names_the_scene_camera_time_and_size_that_ran() {
+    if gpu_tests_skipped() {
+        return;
+    }
+    // The scene and time come from a config file, not from flags: the report must name what
+    // was resolved, not the default scene.
+    let dir = tmp("bench-frame");
+    let config = dir.join("bench.toml");
+    std::fs::write(&config, "scene = \"cornell\"\ntime = \"7:30\"\n").unwrap();
+    let first_camera = hikari_scene::builtin::by_name("cornell").unwrap().cameras[0]
+        .name
+        .clone();
+    let mut args = vec![
+        "bench",
+        "frame",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--config",
+        config.to_str().unwrap(),
+    ];
+    let o = hikari(&args);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    let header = String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    for want in [
+        "scene cornell (built-in)",
+        &format!("camera `{first_camera}`"),
+        "time 07:30",
+        "64x48",
+        "2 frames after 0 warm-up",
+    ] {
+        assert!(header.contains(want), "`{want}` not in the header: {t}");
+    }
+    assert!(!t.contains("village"), "{t}");
+
+    args.push("--json");
+    let o = hikari(&args);
+    assert!(o.status.success(), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        v["scene"],
+        serde_json::json!({
+            "name": "cornell",
+            "source": "built-in",
+            "camera": first_camera,
+            "camera_from": "the scene's first",
+            "time": "07:30",
+            "width": 64,
+            "height": 48,
+        })
+    );
+    assert_eq!(v["frames"], 2);
+    assert!(!v["passes"].as_array().unwrap().is_empty(), "{v}");
+}

@@ -8,14 +8,15 @@ use serde_json::json;
 
 use hikari_math::constants::DerivedConstants;
 
+use crate::args::JsonArgs;
+
 #[derive(Args, Debug)]
 pub struct ConstantsArgs {
     /// The colour white should become under white balance, linear Rec.709 (e.g. 0.9,0.95,1.1).
     #[arg(long, default_value = "1,1,1")]
     pub white: String,
-    /// Print one JSON object.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: JsonArgs,
 }
 
 fn parse_white(s: &str) -> anyhow::Result<[f64; 3]> {
@@ -57,7 +58,7 @@ pub fn run(args: ConstantsArgs) -> anyhow::Result<()> {
         "rayleigh_rec709_per_km": c.rayleigh_rec709_per_km,
         "mie_per_km": c.mie_per_km,
     });
-    if args.json {
+    if args.output.json {
         println!("{}", serde_json::to_string_pretty(&value)?);
         return Ok(());
     }

@@ -1,0 +1,35 @@
+//! `hikari info`: the GPU adapter, its features and limits.
+
+use hikari_render::{ContextOptions, GpuContext};
+
+pub fn run() -> anyhow::Result<()> {
+    let ctx = GpuContext::new(&ContextOptions::from_env())?;
+    println!("adapter:  {}", ctx.describe());
+    println!(
+        "startup:  {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1})",
+        ctx.startup.total().as_secs_f64() * 1e3,
+        ctx.startup.instance.as_secs_f64() * 1e3,
+        ctx.startup.adapter.as_secs_f64() * 1e3,
+        ctx.startup.device.as_secs_f64() * 1e3
+    );
+    println!("features: {:?}", ctx.features);
+    for f in [wgpu_fmt::RGBA16F, wgpu_fmt::RG11B10] {
+        println!(
+            "read-write storage {f:?}: {}",
+            ctx.supports_read_write_storage(f)
+        );
+    }
+    println!(
+        "max 2D texture {}, max 3D texture {}, max storage buffer binding {} bytes",
+        ctx.limits.max_texture_dimension_2d,
+        ctx.limits.max_texture_dimension_3d,
+        ctx.limits.max_storage_buffer_binding_size
+    );
+    Ok(())
+}
+
+mod wgpu_fmt {
+    pub use hikari_render::techniques::direct_lighting::RADIANCE_FORMAT as RGBA16F;
+    pub const RG11B10: hikari_render::wgpu::TextureFormat =
+        hikari_render::wgpu::TextureFormat::Rg11b10Ufloat;
+}

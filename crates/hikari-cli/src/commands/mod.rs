@@ -1,0 +1,10 @@
+//! One module per command. A command module may use the shared modules (`args`,
+//! `scene_source`, `report`, `config`) but never another command module: what two commands
+//! share moves into a shared module (`tests/command_modules.rs` checks this).
+
+pub mod bench_frame;
+pub mod bench_overhead;
+pub mod bench_rays;
+pub mod constants;
+pub mod info;
+pub mod render;

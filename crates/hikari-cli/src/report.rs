@@ -1,0 +1,223 @@
+//! Per-pass timing reports: one frame's table (`render --timings`), and the median, min and
+//! max over many frames (`bench frame`) as a table or as JSON.
+
+use std::collections::BTreeMap;
+
+use serde_json::json;
+
+use hikari_render::graph::FrameResult;
+
+/// Median, minimum and maximum of a set of samples (in whatever unit they were taken).
+#[derive(Default, Clone, Copy, Debug, PartialEq)]
+pub struct Stats {
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl Stats {
+    /// `None` for no samples. The median of an even count is the upper of the middle two.
+    pub fn of(mut v: Vec<f64>) -> Option<Self> {
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_by(|a, b| a.total_cmp(b));
+        Some(Self {
+            median: v[v.len() / 2],
+            min: v[0],
+            max: v[v.len() - 1],
+        })
+    }
+
+    pub fn json(&self) -> serde_json::Value {
+        json!({ "median": self.median, "min": self.min, "max": self.max })
+    }
+}
+
+/// Milliseconds of `d`.
+pub fn ms(d: std::time::Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// The `--timings` table of a single frame.
+pub fn print_single_frame(r: &FrameResult) {
+    println!("{:<32} {:>10} {:>10}", "pass", "GPU ms", "CPU us");
+    for t in &r.timings {
+        let gpu = t.gpu_ms.map_or("n/a".to_string(), |v| format!("{v:.4}"));
+        println!("{:<32} {:>10} {:>10.1}", t.name, gpu, t.cpu_us);
+    }
+    if let Some(s) = r.gpu_span_ms {
+        println!("{:<32} {:>10.4}", "frame (first to last pass)", s);
+    }
+}
+
+/// One pass over many frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PassRow {
+    pub name: String,
+    /// Milliseconds; `None` without timestamps.
+    pub gpu_ms: Option<Stats>,
+    /// Microseconds to record and encode it.
+    pub cpu_us: Stats,
+}
+
+/// Timings gathered frame after frame.
+#[derive(Default)]
+pub struct FrameTimings {
+    /// Per pass name: the index it first appeared at, GPU ms and CPU us samples.
+    per_pass: BTreeMap<String, (usize, Vec<f64>, Vec<f64>)>,
+    spans: Vec<f64>,
+    encode: Vec<f64>,
+}
+
+/// The summary of [`FrameTimings`].
+pub struct FrameSummary {
+    /// In the order the passes ran.
+    pub passes: Vec<PassRow>,
+    /// First to last pass on the GPU, ms; `None` without timestamps.
+    pub span_ms: Option<Stats>,
+    /// CPU encode of the whole frame, us.
+    pub encode_us: Stats,
+}
+
+impl FrameTimings {
+    pub fn add(&mut self, r: &FrameResult) {
+        for (i, t) in r.timings.iter().enumerate() {
+            let e = self
+                .per_pass
+                .entry(t.name.clone())
+                .or_insert((i, vec![], vec![]));
+            e.1.extend(t.gpu_ms);
+            e.2.push(t.cpu_us);
+        }
+        self.spans.extend(r.gpu_span_ms);
+        self.encode.push(r.cpu_encode_us);
+    }
+
+    pub fn summary(self) -> FrameSummary {
+        let mut rows: Vec<_> = self.per_pass.into_iter().collect();
+        rows.sort_by_key(|(_, (i, _, _))| *i);
+        FrameSummary {
+            passes: rows
+                .into_iter()
+                .map(|(name, (_, gpu, cpu))| PassRow {
+                    name,
+                    gpu_ms: Stats::of(gpu),
+                    cpu_us: Stats::of(cpu).unwrap_or_default(),
+                })
+                .collect(),
+            span_ms: Stats::of(self.spans),
+            encode_us: Stats::of(self.encode).unwrap_or_default(),
+        }
+    }
+}
+
+impl FrameSummary {
+    /// Per technique (the pass name before its first dot), the sum of its passes' GPU
+    /// medians in ms, in the order the techniques first ran; passes without a time add 0.
+    pub fn technique_sums(&self) -> Vec<(String, f64)> {
+        let mut techniques: Vec<(String, f64)> = Vec::new();
+        for p in &self.passes {
+            let t = p.name.split('.').next().unwrap_or(&p.name);
+            let ms = p.gpu_ms.map_or(0.0, |g| g.median);
+            match techniques.iter_mut().find(|(n, _)| n == t) {
+                Some(e) => e.1 += ms,
+                None => techniques.push((t.to_string(), ms)),
+            }
+        }
+        techniques
+    }
+
+    /// `passes` for the JSON report.
+    pub fn passes_json(&self) -> serde_json::Value {
+        self.passes
+            .iter()
+            .map(|p| {
+                json!({
+                    "name": p.name,
+                    "gpu_ms": p.gpu_ms.map(|s| s.json()),
+                    "cpu_us": p.cpu_us.json(),
+                })
+            })
+            .collect()
+    }
+
+    /// The per-pass table, the sums per technique and the whole frame.
+    pub fn print_table(&self) {
+        println!(
+            "{:<32} {:>10} {:>10} {:>10} {:>12}",
+            "pass", "GPU med ms", "min", "max", "CPU med us"
+        );
+        for p in &self.passes {
+            match p.gpu_ms {
+                Some(g) => println!(
+                    "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
+                    p.name, g.median, g.min, g.max, p.cpu_us.median
+                ),
+                None => println!(
+                    "{:<32} {:>10} {:>10} {:>10} {:>12.1}",
+                    p.name, "n/a", "", "", p.cpu_us.median
+                ),
+            }
+        }
+        for (t, ms) in self.technique_sums() {
+            println!("{:<32} {:>10.4}", format!("{t} (sum of medians)"), ms);
+        }
+        match self.span_ms {
+            Some(s) => println!(
+                "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
+                "frame (first to last pass)", s.median, s.min, s.max, self.encode_us.median
+            ),
+            None => println!(
+                "no GPU timestamps on this adapter; CPU encode median {:.1} us",
+                self.encode_us.median
+            ),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_are_the_middle_smallest_and_largest_sample() {
+        assert_eq!(Stats::of(vec![]), None);
+        let s = Stats::of(vec![5.0, 1.0, 3.0]).unwrap();
+        assert_eq!((s.median, s.min, s.max), (3.0, 1.0, 5.0));
+        let s = Stats::of(vec![4.0, 1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(s.median, 3.0);
+    }
+
+    #[test]
+    fn technique_sums_add_the_medians_of_passes_sharing_the_prefix() {
+        let row = |name: &str, ms: Option<f64>| PassRow {
+            name: name.into(),
+            gpu_ms: ms.map(|m| Stats {
+                median: m,
+                min: m,
+                max: m,
+            }),
+            cpu_us: Stats::default(),
+        };
+        let s = FrameSummary {
+            passes: vec![
+                row("gbuffer.raster", Some(1.0)),
+                row("shadows.a", Some(0.25)),
+                row("gbuffer.resolve", Some(0.5)),
+                row("shadows.b", None),
+                row("tonemap", Some(2.0)),
+            ],
+            span_ms: None,
+            encode_us: Stats::default(),
+        };
+        assert_eq!(
+            s.technique_sums(),
+            vec![
+                ("gbuffer".to_string(), 1.5),
+                ("shadows".to_string(), 0.25),
+                ("tonemap".to_string(), 2.0)
+            ]
+        );
+    }
+}

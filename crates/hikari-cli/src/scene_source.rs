@@ -1,0 +1,301 @@
+//! Turning the scene flags into what the renderer needs: the scene (built-in by name or a glTF
+//! file), the camera, the sun and the frame settings, plus a description of exactly what was
+//! chosen so that reports name what really ran.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, bail};
+use serde_json::json;
+
+use hikari_render::FrameSettings;
+use hikari_scene::{Camera, Scene};
+
+use crate::args::FrameArgs;
+
+/// The scene used when neither a flag nor the config file names one.
+pub const DEFAULT_SCENE: &str = "village";
+/// Image size used when neither a flag nor the config file gives one, in pixels.
+pub const DEFAULT_SIZE: (u32, u32) = (1280, 720);
+
+/// Where a scene comes from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SceneSource {
+    /// One of `hikari_scene::builtin::NAMES`.
+    Builtin(String),
+    /// A `.gltf` or `.glb` file.
+    Gltf(PathBuf),
+}
+
+impl SceneSource {
+    /// A built-in scene name, or a path ending in `.gltf` / `.glb` (any case).
+    pub fn parse(name: &str) -> anyhow::Result<Self> {
+        if hikari_scene::builtin::NAMES.contains(&name) {
+            return Ok(Self::Builtin(name.to_string()));
+        }
+        let lower = name.to_ascii_lowercase();
+        if lower.ends_with(".gltf") || lower.ends_with(".glb") {
+            return Ok(Self::Gltf(PathBuf::from(name)));
+        }
+        bail!(
+            "unknown scene `{name}`; built-in scenes: {}, or a path to a .gltf or .glb file",
+            hikari_scene::builtin::NAMES.join(", ")
+        )
+    }
+
+    pub fn load(&self) -> anyhow::Result<Scene> {
+        match self {
+            Self::Builtin(name) => hikari_scene::builtin::by_name(name)
+                .with_context(|| format!("built-in scene `{name}` is listed but not built")),
+            // The loader logs its warnings (ignored extensions, skipped primitives) itself.
+            Self::Gltf(path) => Ok(hikari_scene::gltf::load(path)?.scene),
+        }
+    }
+
+    /// The name as the user gave it: the built-in name or the file path.
+    pub fn name(&self) -> String {
+        match self {
+            Self::Builtin(name) => name.clone(),
+            Self::Gltf(path) => path.display().to_string(),
+        }
+    }
+
+    /// `"built-in"` or `"glTF"`.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Self::Builtin(_) => "built-in",
+            Self::Gltf(_) => "glTF",
+        }
+    }
+}
+
+/// A built-in scene by name, or a `.gltf` / `.glb` file by path.
+pub fn load_scene(name: &str) -> anyhow::Result<Scene> {
+    SceneSource::parse(name)?.load()
+}
+
+/// Where the camera's name came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraOrigin {
+    Flag,
+    ConfigFile,
+    /// Nobody named one: the scene's first camera.
+    SceneFirst,
+    /// The scene has no camera: one framing its bounds.
+    Framing,
+}
+
+impl CameraOrigin {
+    fn describe(self) -> &'static str {
+        match self {
+            Self::Flag => "--camera",
+            Self::ConfigFile => "config file",
+            Self::SceneFirst => "the scene's first",
+            Self::Framing => "framing the scene's bounds",
+        }
+    }
+}
+
+/// The named camera, or else the scene's first one; an error if there is neither.
+pub fn choose_camera(
+    scene: &Scene,
+    flag: Option<&str>,
+    config: Option<&str>,
+) -> anyhow::Result<(Camera, CameraOrigin)> {
+    if let Some(name) = flag {
+        return Ok((scene.camera(name)?.clone(), CameraOrigin::Flag));
+    }
+    if let Some(name) = config {
+        return Ok((scene.camera(name)?.clone(), CameraOrigin::ConfigFile));
+    }
+    let first = scene.cameras.first().context("the scene has no camera")?;
+    Ok((first.clone(), CameraOrigin::SceneFirst))
+}
+
+/// The scene's first camera, or one framing its bounds when it has none.
+pub fn first_or_framing_camera(
+    scene: &Scene,
+    name: &str,
+) -> anyhow::Result<(Camera, CameraOrigin)> {
+    match scene.cameras.first() {
+        Some(c) => Ok((c.clone(), CameraOrigin::SceneFirst)),
+        None => {
+            let (lo, hi) = scene.bounds().context("the scene has no geometry")?;
+            Ok((Camera::framing(name, lo, hi), CameraOrigin::Framing))
+        }
+    }
+}
+
+/// What a frame was made of, as resolved from flags, config file and defaults.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameDescription {
+    pub source: SceneSource,
+    pub camera: String,
+    pub camera_origin: CameraOrigin,
+    /// Time of day as `HH:MM`; `None` when the scene's own sun lights it.
+    pub time: Option<String>,
+    /// Pixels.
+    pub width: u32,
+    pub height: u32,
+}
+
+impl FrameDescription {
+    /// E.g. "scene village (built-in), camera `courtyard` (--camera), time 07:30, 64x64".
+    pub fn line(&self) -> String {
+        let time = match &self.time {
+            Some(t) => format!("time {t}"),
+            None => "the scene's own sun".to_string(),
+        };
+        format!(
+            "scene {} ({}), camera `{}` ({}), {time}, {}x{}",
+            self.source.name(),
+            self.source.kind(),
+            self.camera,
+            self.camera_origin.describe(),
+            self.width,
+            self.height
+        )
+    }
+
+    pub fn json(&self) -> serde_json::Value {
+        json!({
+            "name": self.source.name(),
+            "source": self.source.kind(),
+            "camera": self.camera,
+            "camera_from": self.camera_origin.describe(),
+            "time": self.time,
+            "width": self.width,
+            "height": self.height,
+        })
+    }
+}
+
+/// A scene ready to render, its frame settings and what they were made of.
+pub struct ResolvedFrame {
+    pub scene: Scene,
+    pub settings: FrameSettings,
+    pub description: FrameDescription,
+}
+
+/// `HH:MM` of `hours` in [0, 24).
+fn format_hours(hours: f32) -> String {
+    let minutes = (hours * 60.0).round() as u32 % (24 * 60);
+    format!("{:02}:{:02}", minutes / 60, minutes % 60)
+}
+
+/// The scene and the frame settings: from the flags, then the config file, then defaults.
+pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
+    let file = match &args.config.config {
+        Some(p) => crate::config::load(p)?,
+        None => crate::config::ConfigFile::default(),
+    };
+    let scene_name = args
+        .scene
+        .scene
+        .clone()
+        .or(file.scene.clone())
+        .unwrap_or_else(|| DEFAULT_SCENE.into());
+    let source = SceneSource::parse(&scene_name)?;
+    let scene = source.load()?;
+    let (camera, camera_origin) = choose_camera(
+        &scene,
+        args.camera.camera.as_deref(),
+        file.camera.as_deref(),
+    )?;
+    let (sun, time) = match args.time.time.as_deref().or(file.time.as_deref()) {
+        Some(t) => {
+            let hours = hikari_scene::time_of_day::parse_time(t).context("--time")?;
+            (
+                Some(hikari_scene::time_of_day::sun_at(hours)),
+                Some(format_hours(hours)),
+            )
+        }
+        None => (scene.sun.clone(), None),
+    };
+    let mut settings = file
+        .settings_with(args.config.preset, &args.config.overrides)
+        .context("settings")?;
+    if let Some(ev) = args.exposure.ev100 {
+        if !ev.is_finite() || !(-10.0..=30.0).contains(&ev) {
+            bail!("--ev100 {ev} is outside the range -10 to 30");
+        }
+        settings.exposure.ev100 = Some(ev);
+    }
+    settings.validate().context("settings")?;
+    let width = args.size.width.or(file.width).unwrap_or(DEFAULT_SIZE.0);
+    let height = args.size.height.or(file.height).unwrap_or(DEFAULT_SIZE.1);
+    let description = FrameDescription {
+        source,
+        camera: camera.name.clone(),
+        camera_origin,
+        time,
+        width,
+        height,
+    };
+    Ok(ResolvedFrame {
+        scene,
+        settings: FrameSettings {
+            width,
+            height,
+            camera,
+            prev_camera: None,
+            sun,
+            settings,
+        },
+        description,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_names_are_built_in_or_gltf_paths_and_anything_else_is_named_in_the_error() {
+        assert_eq!(
+            SceneSource::parse("cornell").unwrap(),
+            SceneSource::Builtin("cornell".into())
+        );
+        assert_eq!(
+            SceneSource::parse("dir/Model.GLB").unwrap(),
+            SceneSource::Gltf("dir/Model.GLB".into())
+        );
+        let e = SceneSource::parse("atlantis").unwrap_err().to_string();
+        assert!(e.contains("`atlantis`") && e.contains("village"), "{e}");
+    }
+
+    #[test]
+    fn hours_print_as_the_clock_time_they_were_parsed_from() {
+        for t in ["00:00", "07:05", "12:30", "23:59"] {
+            let h = hikari_scene::time_of_day::parse_time(t).unwrap();
+            assert_eq!(format_hours(h), t);
+        }
+    }
+
+    #[test]
+    fn the_description_names_the_config_files_scene_and_camera_not_the_default() {
+        let dir = std::env::temp_dir().join(format!("hikari-scene-source-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let config = dir.join("c.toml");
+        std::fs::write(
+            &config,
+            "scene = \"cornell\"\nwidth = 32\ntime = \"7:30\"\n",
+        )
+        .unwrap();
+        let mut args = FrameArgs::default();
+        args.config.config = Some(config);
+        args.size.height = Some(16);
+        let r = resolve(&args).unwrap();
+        let d = &r.description;
+        assert_eq!(d.source, SceneSource::Builtin("cornell".into()));
+        assert_eq!((d.width, d.height), (32, 16));
+        assert_eq!(d.time.as_deref(), Some("07:30"));
+        assert_eq!(d.camera_origin, CameraOrigin::SceneFirst);
+        assert_eq!(d.camera, r.scene.cameras[0].name);
+        assert_eq!(r.settings.camera.name, d.camera);
+        let line = d.line();
+        assert!(
+            line.contains("scene cornell (built-in)") && line.contains("time 07:30"),
+            "{line}"
+        );
+    }
+}
