@@ -1,7 +1,10 @@
 //! Pipelines whose bind group layout comes from the shader itself (naga reflection).
 //!
-//! hikari binds everything a pass needs in group 0, in binding order, so a pass reads as a
-//! chain: `.read(a).write(b).constants(c)` gives bindings 0, 1, 2. The reflected layout lets the
+//! hikari binds a pass's own resources in group 0, in binding order, so a pass reads as a
+//! chain: `.read(a).write(b).constants(c)` gives bindings 0, 1, 2. Shared WGSL modules that
+//! need bindings (the sun's shadow maps, the BVH) declare them in a group of their own,
+//! `@group(#{NAME_GROUP})`, which the shader library numbers from 1 for each pipeline; the
+//! pass binds such a set with `.set(...)`, made once by the technique that owns it. The reflected layout lets the
 //! frame graph check each chain against its shader and name the pass and binding that differ.
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -119,8 +122,20 @@ fn view_dimension(dim: naga::ImageDimension, arrayed: bool) -> wgpu::TextureView
     }
 }
 
-/// Reads group 0 of a module. Other groups are refused: the frame graph owns all bindings.
+/// Reads group 0 of a module (the pass's own bindings). Groups 1.. are the shared binding sets
+/// `sets` (see [`ShaderLibrary::binding_sets`]): use [`reflect_groups`] for them.
 pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<BindingSlot>> {
+    let mut groups = reflect_groups(path, module, &[])?;
+    Ok(groups.swap_remove(0))
+}
+
+/// Reads every group of a module: group 0, then one group per shared binding set in `sets`.
+/// Each group's bindings must be 0..n without gaps.
+pub fn reflect_groups(
+    path: &str,
+    module: &naga::Module,
+    sets: &[String],
+) -> Result<Vec<Vec<BindingSlot>>> {
     let err = |message: String| RenderError::Shader {
         path: path.into(),
         message,
@@ -132,13 +147,15 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
             naga::TypeInner::Sampler { comparison: false }
         ) && !integer_samplers.contains(&h)
     });
-    let mut slots = Vec::new();
+    let mut groups: Vec<Vec<BindingSlot>> = vec![Vec::new(); sets.len() + 1];
     for (handle, g) in module.global_variables.iter() {
         let Some(rb) = &g.binding else { continue };
         let name = g.name.clone().unwrap_or_default();
-        if rb.group != 0 {
+        if rb.group as usize >= groups.len() {
             return Err(err(format!(
-                "`{name}` uses @group({}); hikari binds pass resources in @group(0) only",
+                "`{name}` uses @group({}); group 0 holds a pass's own bindings and groups \
+                 1.. the shared binding sets it imports ({sets:?}), declared as \
+                 @group(#{{NAME_GROUP}})",
                 rb.group
             )));
         }
@@ -198,22 +215,24 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
                 )));
             }
         };
-        slots.push(BindingSlot {
+        groups[rb.group as usize].push(BindingSlot {
             binding: rb.binding,
             name,
             kind,
         });
     }
-    slots.sort_by_key(|s| s.binding);
-    for (i, s) in slots.iter().enumerate() {
-        if s.binding != i as u32 {
-            return Err(err(format!(
-                "bindings of group 0 must be 0..n without gaps; `{}` is @binding({}) but {} was expected",
-                s.name, s.binding, i
-            )));
+    for (group, slots) in groups.iter_mut().enumerate() {
+        slots.sort_by_key(|s| s.binding);
+        for (i, s) in slots.iter().enumerate() {
+            if s.binding != i as u32 {
+                return Err(err(format!(
+                    "bindings of group {group} must be 0..n without gaps; `{}` is @binding({}) but {} was expected",
+                    s.name, s.binding, i
+                )));
+            }
         }
     }
-    Ok(slots)
+    Ok(groups)
 }
 
 /// Samplers a shader uses with integer textures (`textureGather` of a `texture_2d<u32>`): a
@@ -308,33 +327,79 @@ fn layout_entries(
         .collect()
 }
 
+/// A shared binding set's group in a pipeline.
+pub struct SetLayout {
+    /// The set's name (`sun_shadows` for `#{SUN_SHADOWS_GROUP}`).
+    pub name: String,
+    /// Its `@group` index, from 1.
+    pub group: u32,
+    pub slots: Vec<BindingSlot>,
+    pub layout: wgpu::BindGroupLayout,
+    /// Identifies the layout in bind group caches.
+    pub id: u64,
+}
+
 /// What every pipeline carries for the frame graph.
 pub struct PipelineInfo {
     pub id: u64,
     pub label: String,
+    /// Group 0: the pass's own bindings, in chain order.
     pub slots: Vec<BindingSlot>,
     pub bind_group_layout: wgpu::BindGroupLayout,
+    /// Groups 1..: the shared binding sets the shader imports, in group order.
+    pub sets: Vec<SetLayout>,
 }
 
 impl PipelineInfo {
     fn new(
         ctx: &GpuContext,
         label: &str,
-        slots: Vec<BindingSlot>,
+        mut groups: Vec<Vec<BindingSlot>>,
+        set_names: Vec<String>,
         visibility: wgpu::ShaderStages,
     ) -> Self {
-        let bind_group_layout =
+        let layout = |slots: &[BindingSlot], what: &str| {
             ctx.device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                    label: Some(label),
-                    entries: &layout_entries(&slots, visibility),
-                });
+                    label: Some(&format!("{label} {what}")),
+                    entries: &layout_entries(slots, visibility),
+                })
+        };
+        let slots = groups.remove(0);
+        let bind_group_layout = layout(&slots, "group 0");
+        let sets = set_names
+            .into_iter()
+            .zip(groups)
+            .enumerate()
+            .map(|(i, (name, slots))| SetLayout {
+                layout: layout(&slots, &name),
+                name,
+                group: i as u32 + 1,
+                slots,
+                id: NEXT_PIPELINE_ID.fetch_add(1, Ordering::Relaxed),
+            })
+            .collect();
         Self {
             id: NEXT_PIPELINE_ID.fetch_add(1, Ordering::Relaxed),
             label: label.into(),
             slots,
             bind_group_layout,
+            sets,
         }
+    }
+
+    /// The pipeline layout: group 0, then each set's group.
+    fn pipeline_layout(&self, ctx: &GpuContext) -> wgpu::PipelineLayout {
+        let layouts: Vec<Option<&wgpu::BindGroupLayout>> = std::iter::once(&self.bind_group_layout)
+            .chain(self.sets.iter().map(|s| &s.layout))
+            .map(Some)
+            .collect();
+        ctx.device
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(&self.label),
+                bind_group_layouts: &layouts,
+                immediate_size: 0,
+            })
     }
 }
 
@@ -343,11 +408,22 @@ fn checked_module(
     lib: &mut ShaderLibrary,
     path: &str,
     defs: &[(&str, ShaderDefValue)],
-) -> Result<(naga::Module, Vec<BindingSlot>)> {
+) -> Result<(naga::Module, Vec<Vec<BindingSlot>>, Vec<String>)> {
     let module = lib.module(path, defs)?;
     shader::validate(path, &module, shader::capabilities_for(ctx.features))?;
-    let slots = reflect_bindings(path, &module)?;
-    Ok((module, slots))
+    let sets = lib.binding_sets(path);
+    let max = ctx.limits.max_bind_groups as usize;
+    if sets.len() + 1 > max {
+        return Err(RenderError::Shader {
+            path: path.into(),
+            message: format!(
+                "needs {} bind groups (its own and the sets {sets:?}); this device has {max}",
+                sets.len() + 1
+            ),
+        });
+    }
+    let groups = reflect_groups(path, &module, &sets)?;
+    Ok((module, groups, sets))
 }
 
 fn shader_module(ctx: &GpuContext, path: &str, module: naga::Module) -> wgpu::ShaderModule {
@@ -421,7 +497,7 @@ impl ComputePipeline {
         defs: &[(&str, ShaderDefValue)],
         unchecked: bool,
     ) -> Result<Self> {
-        let (module, slots) = checked_module(ctx, lib, path, defs)?;
+        let (module, groups, sets) = checked_module(ctx, lib, path, defs)?;
         let workgroup_size = module
             .entry_points
             .iter()
@@ -432,14 +508,8 @@ impl ComputePipeline {
                 message: format!("no compute entry point `{entry}`"),
             })?;
         let label = format!("{path}:{entry}");
-        let info = PipelineInfo::new(ctx, &label, slots, wgpu::ShaderStages::COMPUTE);
-        let layout = ctx
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(&label),
-                bind_group_layouts: &[Some(&info.bind_group_layout)],
-                immediate_size: 0,
-            });
+        let info = PipelineInfo::new(ctx, &label, groups, sets, wgpu::ShaderStages::COMPUTE);
+        let layout = info.pipeline_layout(ctx);
         let sm = if unchecked {
             // SAFETY: only reached through `new_unchecked`, whose caller vouches for the shader.
             unsafe { unchecked_shader_module(ctx, path, module) }
@@ -496,16 +566,16 @@ impl RasterPipeline {
         desc: &RasterDesc<'_>,
         defs: &[(&str, ShaderDefValue)],
     ) -> Result<Self> {
-        let (module, slots) = checked_module(ctx, lib, path, defs)?;
+        let (module, groups, sets) = checked_module(ctx, lib, path, defs)?;
         let label = format!("{path}:{}", desc.vertex_entry);
-        let info = PipelineInfo::new(ctx, &label, slots, wgpu::ShaderStages::VERTEX_FRAGMENT);
-        let layout = ctx
-            .device
-            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(&label),
-                bind_group_layouts: &[Some(&info.bind_group_layout)],
-                immediate_size: 0,
-            });
+        let info = PipelineInfo::new(
+            ctx,
+            &label,
+            groups,
+            sets,
+            wgpu::ShaderStages::VERTEX_FRAGMENT,
+        );
+        let layout = info.pipeline_layout(ctx);
         let sm = shader_module(ctx, path, module);
         let targets: Vec<Option<wgpu::ColorTargetState>> = desc
             .color_formats

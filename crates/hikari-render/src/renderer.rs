@@ -26,6 +26,7 @@ pub struct Renderer {
     techniques: Techniques,
     scene: SceneGpu,
     state: FrameState,
+    interactive: bool,
 }
 
 impl Renderer {
@@ -37,6 +38,7 @@ impl Renderer {
             techniques,
             scene: scene_gpu,
             state: FrameState::default(),
+            interactive: false,
             ctx,
         })
     }
@@ -52,31 +54,62 @@ impl Renderer {
 
     /// Renders one frame; with `read_images`, copies the HDR and LDR results back.
     pub fn render(&mut self, settings: &FrameSettings, read_images: bool) -> Result<RenderedFrame> {
+        let mut picked = None;
         let mut result = self.render_reading(settings, |out| {
+            picked = Some((out.hdr, out.ldr));
             if read_images {
                 vec![out.hdr.into(), out.ldr.into()]
             } else {
                 vec![]
             }
         })?;
-        let hdr = result.take_image("direct_lighting.radiance");
-        let ldr = result.take_image("placeholder_tonemap.ldr");
+        let (hdr, ldr) = match (read_images, picked) {
+            (true, Some((hdr, ldr))) => (result.take_image_of(hdr), result.take_image_of(ldr)),
+            _ => (None, None),
+        };
         Ok(RenderedFrame { result, hdr, ldr })
     }
 
+    /// Offline (the default): a frame whose rasteriser queues overflowed is drawn again with
+    /// larger ones before it is shown, so that no triangle is ever lost, and each frame waits
+    /// for its queue counts. Interactive: frames do not wait for each other; queues are sized
+    /// from the counts of a frame or two before, with headroom, and a frame that overflowed
+    /// is shown as it is (missing a few triangles for a frame) while the queues grow.
+    pub fn set_interactive(&mut self, interactive: bool) {
+        self.interactive = interactive;
+        self.runtime.set_wait_for_readbacks(!interactive);
+    }
+
     /// Renders one frame and copies back whatever `pick` names of its resources (G-buffer
-    /// textures, shadow maps...); they appear in the result under their graph names. A frame
-    /// whose rasteriser queues overflowed is drawn again with larger ones, so that no
-    /// triangle is ever lost.
+    /// textures, shadow maps...); they appear in the result under their graph names (or
+    /// by handle, [`FrameResult::take_image_of`]). Temporal state advances once, when the
+    /// frame is accepted: a frame drawn again after an overflow does not step it twice.
     pub fn render_reading(
         &mut self,
         settings: &FrameSettings,
-        pick: impl Fn(&FrameOutputs) -> Vec<Res>,
+        mut pick: impl FnMut(&FrameOutputs) -> Vec<Res>,
     ) -> Result<FrameResult> {
         settings
             .settings
             .validate()
             .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
+        let invalid =
+            |what: &str, e: hikari_scene::SceneError| RenderError::Graph(format!("{what}: {e}"));
+        settings
+            .camera
+            .validate()
+            .and_then(|()| {
+                settings
+                    .camera
+                    .validate_projection(settings.width as f32 / settings.height.max(1) as f32)
+            })
+            .map_err(|e| invalid("camera", e))?;
+        if let Some(prev) = &settings.prev_camera {
+            prev.validate().map_err(|e| invalid("previous camera", e))?;
+        }
+        if let Some(sun) = &settings.sun {
+            sun.validate().map_err(|e| invalid("sun", e))?;
+        }
         let limit = self.ctx.limits.max_texture_dimension_2d;
         for (what, v) in [("width", settings.width), ("height", settings.height)] {
             if v == 0 || v > limit {
@@ -100,17 +133,21 @@ impl Renderer {
             for r in pick(&out) {
                 g.readback(r);
             }
-            let result = g.execute()?;
-            if self
+            let result = g.execute_uncommitted()?;
+            let overflowed = !self
                 .state
                 .raster_queues
                 .grow(&result, binding_limit)?
-                .is_empty()
-            {
+                .is_empty();
+            if overflowed {
+                // Cascades drawn into an overflowing queue lack triangles: draw them all again.
+                self.state.shadow_cache = Default::default();
+            }
+            if !overflowed || self.interactive {
+                self.runtime.commit_frame();
                 return Ok(result);
             }
-            // Cascades drawn into an overflowing queue lack triangles: draw them all again.
-            self.state.shadow_cache = Default::default();
+            self.runtime.discard_frame();
         }
         Err(RenderError::Graph(format!(
             "the rasteriser's queues still overflowed after {MAX_QUEUE_RETRIES} tries"

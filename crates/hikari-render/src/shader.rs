@@ -130,18 +130,66 @@ impl ShaderLibrary {
         v
     }
 
-    /// Composes and validates the entry shader at `path` (relative to `shaders/`).
+    /// The shared binding sets the entry shader at `path` reaches through its imports, in
+    /// group order: the first is `@group(1)`. A shared module that needs bindings declares them
+    /// as `@group(#{NAME_GROUP}) @binding(i)`; the set is then called `name` (lower case), and
+    /// a pass binds it with `PassBuilder::set`. Each set has a group of its own, so a pass
+    /// that imports several shared modules cannot see their bindings collide.
+    pub fn binding_sets(&self, path: &str) -> Vec<String> {
+        let by_import: HashMap<&str, &ShaderFile> = self
+            .files
+            .values()
+            .filter_map(|f| f.import_path.as_deref().map(|i| (i, f)))
+            .collect();
+        let mut seen: HashSet<&str> = HashSet::new();
+        let mut stack: Vec<&ShaderFile> = self.files.get(path).into_iter().collect();
+        let mut sets: Vec<String> = Vec::new();
+        while let Some(f) = stack.pop() {
+            for token in f.source.split("#{").skip(1) {
+                if let Some(name) = token
+                    .split('}')
+                    .next()
+                    .and_then(|d| d.trim().strip_suffix("_GROUP"))
+                {
+                    sets.push(name.to_lowercase());
+                }
+            }
+            for i in &f.imports {
+                if seen.insert(i.as_str())
+                    && let Some(m) = by_import.get(i.as_str())
+                {
+                    stack.push(m);
+                }
+            }
+        }
+        sets.sort();
+        sets.dedup();
+        sets
+    }
+
+    /// Composes and validates the entry shader at `path` (its key: `common/sh.wgsl`,
+    /// `gbuffer/resolve.wgsl`). The groups of its binding sets are defined here
+    /// (`NAME_GROUP`, see [`ShaderLibrary::binding_sets`]).
     pub fn module(&mut self, path: &str, defs: &[(&str, ShaderDefValue)]) -> Result<naga::Module> {
+        let sets = self.binding_sets(path);
         let file = self.files.get(path).ok_or_else(|| RenderError::Shader {
             path: path.into(),
-            message: "no such shader file under shaders/".into(),
+            message: "no such shader".into(),
         })?;
+        let mut shader_defs: std::collections::HashMap<String, ShaderDefValue> =
+            defs.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+        for (i, set) in sets.iter().enumerate() {
+            shader_defs.insert(
+                format!("{}_GROUP", set.to_uppercase()),
+                ShaderDefValue::UInt(i as u32 + 1),
+            );
+        }
         self.composer
             .make_naga_module(NagaModuleDescriptor {
                 source: &file.source,
                 file_path: &file.path,
                 shader_type: ShaderType::Wgsl,
-                shader_defs: defs.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+                shader_defs,
                 additional_imports: &[],
             })
             .map_err(|e| RenderError::Shader {

@@ -129,6 +129,54 @@ fn history_carries_the_previous_frame_and_resets_on_resize() {
     run(4, 2.0, true, &mut rt);
 }
 
+/// A frame drawn again (as after a rasteriser overflow) must not step temporal state twice:
+/// an accumulator that adds one each frame reads N after N accepted frames, however many
+/// tries were thrown away, and the frame index counts accepted frames only.
+#[test]
+fn discarded_frames_do_not_advance_history_or_the_frame_index() {
+    let Some((ctx, check)) = setup() else { return };
+    let mut rt = GraphRuntime::new();
+    let desc = TextureDesc::d2(8, 8, F16);
+    let mut accepted = 0u64;
+    for frame in 0..6u32 {
+        // Frames 1 and 4 are tried three times, the first two thrown away.
+        let tries = if frame == 1 || frame == 4 { 3 } else { 1 };
+        for attempt in 0..tries {
+            assert_eq!(rt.frame_index(), accepted);
+            let mut g = rt.begin_frame(&ctx);
+            let one = g.texture("t.one", desc).unwrap();
+            g.pass("t.fill")
+                .write(one)
+                .constants(&fill(1.0))
+                .dispatch_threads(&check.fill, [8, 8, 1])
+                .unwrap();
+            let h = g.history_texture("t.count", desc).unwrap();
+            assert_eq!(h.valid, accepted > 0, "frame {frame} try {attempt}");
+            g.pass("t.accumulate")
+                .read(h.prev)
+                .read(one)
+                .write(h.cur)
+                .dispatch_threads(&check.add, [8, 8, 1])
+                .unwrap();
+            g.readback(h.cur);
+            let r = g.execute_uncommitted().unwrap();
+            assert_eq!(r.frame, accepted);
+            assert_eq!(
+                r.image("t.count").unwrap().pixel(3, 3)[0],
+                accepted as f32 + 1.0,
+                "frame {frame} try {attempt}"
+            );
+            if attempt + 1 == tries {
+                rt.commit_frame();
+                accepted += 1;
+            } else {
+                rt.discard_frame();
+            }
+        }
+    }
+    assert_eq!(rt.frame_index(), 6);
+}
+
 #[test]
 fn persistent_textures_are_created_once() {
     let Some((ctx, check)) = setup() else { return };

@@ -16,7 +16,8 @@ fn every_entry_shader_composes_and_validates() {
                 if let Err(e) = shader::validate(path, &module, caps) {
                     failures.push(e.to_string());
                 }
-                if let Err(e) = hikari_render::pipeline::reflect_bindings(path, &module) {
+                let sets = lib.binding_sets(path);
+                if let Err(e) = hikari_render::pipeline::reflect_groups(path, &module, &sets) {
                     failures.push(e.to_string());
                 }
             }
@@ -81,7 +82,37 @@ fn bindings_outside_group_zero_are_refused() {
     )
     .unwrap();
     let e = hikari_render::pipeline::reflect_bindings("g1.wgsl", &module).unwrap_err();
-    assert!(e.to_string().contains("@group(0)"), "{e}");
+    assert!(e.to_string().contains("@group(1)"), "{e}");
+    assert!(e.to_string().contains("binding sets"), "{e}");
+}
+
+/// A shared module's bindings get a group of their own in each pipeline that imports it, so
+/// the deferred lighting's own bindings and the shadow lookup's cannot collide.
+#[test]
+fn shared_modules_bind_in_groups_of_their_own() {
+    let caps = shader::required_capabilities();
+    let mut lib = ShaderLibrary::new(caps).unwrap();
+    assert_eq!(
+        lib.binding_sets("direct_lighting/shade.wgsl"),
+        ["sun_shadows"]
+    );
+    assert!(
+        lib.binding_sets("placeholder_tonemap/apply.wgsl")
+            .is_empty()
+    );
+    let module = lib.module("direct_lighting/shade.wgsl", &[]).unwrap();
+    let groups = hikari_render::pipeline::reflect_groups(
+        "direct_lighting/shade.wgsl",
+        &module,
+        &lib.binding_sets("direct_lighting/shade.wgsl"),
+    )
+    .unwrap();
+    assert_eq!(groups.len(), 2);
+    let names: Vec<&str> = groups[1]
+        .iter()
+        .map(|s| shader::undecorated(&s.name))
+        .collect();
+    assert_eq!(names, ["shadow", "shadow_map", "shadow_sampler"]);
 }
 
 #[test]

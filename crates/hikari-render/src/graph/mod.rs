@@ -19,6 +19,7 @@
 //! A transient texture's contents are undefined until a pass of this frame writes it: the
 //! memory may have held another texture a moment ago.
 
+mod execute;
 mod readback;
 mod resources;
 mod runtime;
@@ -35,7 +36,7 @@ use bytemuck::Pod;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::pipeline::{BindingKind, ComputePipeline, PipelineInfo, RasterPipeline};
+use crate::pipeline::{BindingKind, BindingSlot, ComputePipeline, PipelineInfo, RasterPipeline};
 use resources::{PhysicalBuffer, PhysicalTexture};
 
 /// Fixed samplers a pass can bind with [`PassBuilder::sampler`].
@@ -146,7 +147,10 @@ pub(crate) enum PassKind<'r> {
 pub(crate) struct PassNode<'r> {
     pub name: String,
     pub kind: PassKind<'r>,
+    /// Group 0.
     pub bindings: Vec<Binding>,
+    /// Groups 1..: the pipeline's binding sets, in group order.
+    pub set_bindings: Vec<Vec<Binding>>,
 }
 
 /// One frame being recorded. Made by [`GraphRuntime::begin_frame`], consumed by
@@ -159,9 +163,72 @@ pub struct FrameGraph<'r> {
     pub(crate) passes: Vec<PassNode<'r>>,
     pub(crate) constants: Vec<u8>,
     pub(crate) readbacks: Vec<Res>,
+    pub(crate) late_readbacks: Vec<Buf>,
+    pub(crate) sets: Vec<SetData>,
+}
+
+/// A shared binding set of this frame (the sun's shadow maps, the BVH), made once by the
+/// technique that owns it with [`FrameGraph::binding_set`] and bound by any pass whose shader
+/// imports its module, with [`PassBuilder::set`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BindingSet(pub(crate) u32);
+
+pub(crate) struct SetData {
+    pub name: String,
+    pub bindings: Vec<Binding>,
+    pub expect_write: Vec<Option<bool>>,
+}
+
+/// Builds a [`BindingSet`]: the resources in `@binding` order of the set's module.
+pub struct SetBuilder<'g, 'r> {
+    g: &'g mut FrameGraph<'r>,
+    data: SetData,
+}
+
+impl SetBuilder<'_, '_> {
+    fn bind(mut self, b: Binding, write: Option<bool>) -> Self {
+        self.data.bindings.push(b);
+        self.data.expect_write.push(write);
+        self
+    }
+
+    pub fn read(self, r: impl Into<Res>) -> Self {
+        self.bind(PassBuilder::res_binding(r.into()), Some(false))
+    }
+
+    pub fn write(self, r: impl Into<Res>) -> Self {
+        self.bind(PassBuilder::res_binding(r.into()), Some(true))
+    }
+
+    pub fn constants<T: Pod>(self, value: &T) -> Self {
+        let b = self.g.push_constants(value);
+        self.bind(b, None)
+    }
+
+    pub fn sampler(self, s: SamplerKind) -> Self {
+        self.bind(Binding::Sampler(s), None)
+    }
+
+    pub fn finish(self) -> BindingSet {
+        self.g.sets.push(self.data);
+        BindingSet(self.g.sets.len() as u32 - 1)
+    }
 }
 
 impl<'r> FrameGraph<'r> {
+    /// Starts the binding set `name`: the resources of a shared WGSL module that declares
+    /// them as `@group(#{NAME_GROUP}) @binding(i)`, in binding order.
+    pub fn binding_set<'g>(&'g mut self, name: &str) -> SetBuilder<'g, 'r> {
+        SetBuilder {
+            g: self,
+            data: SetData {
+                name: name.into(),
+                bindings: Vec::new(),
+                expect_write: Vec::new(),
+            },
+        }
+    }
+
     pub fn ctx(&self) -> &'r GpuContext {
         self.ctx
     }
@@ -306,11 +373,21 @@ impl<'r> FrameGraph<'r> {
         self.readbacks.push(res.into());
     }
 
+    /// Asks for a buffer to be copied back without making anyone wait for it (the
+    /// rasteriser's queue counts): while the runtime waits for read-backs (the default, for
+    /// offline renders) it behaves as [`FrameGraph::readback`]; in a runtime that does not
+    /// ([`GraphRuntime::set_wait_for_readbacks`]), the bytes appear in the
+    /// [`FrameResult::buffers`] of a later frame, once the GPU has finished this one.
+    pub fn readback_late(&mut self, b: Buf) {
+        self.late_readbacks.push(b);
+    }
+
     /// Starts a pass named `technique.stage`.
     pub fn pass<'g>(&'g mut self, name: &str) -> PassBuilder<'g, 'r> {
         PassBuilder {
             g: self,
             name: name.into(),
+            sets: Vec::new(),
             bindings: Vec::new(),
             expect_write: Vec::new(),
             uses: Vec::new(),
@@ -365,44 +442,67 @@ impl<'r> FrameGraph<'r> {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn add_pass(
         &mut self,
         name: String,
         kind: PassKind<'r>,
         bindings: Vec<Binding>,
         expect_write: Vec<Option<bool>>,
+        sets: Vec<BindingSet>,
         uses: Vec<(Res, bool)>,
         info: Option<&PipelineInfo>,
     ) -> Result<()> {
         let index = self.passes.len();
-        if let Some(info) = info {
-            self.check_bindings(&name, info, &bindings, &expect_write)?;
-        }
+        let mut set_bindings = Vec::new();
         // Reads first, so a pass that reads and writes the same resource still needs an
         // earlier writer.
         let mut touched: Vec<(Res, bool)> = Vec::new();
-        for (i, b) in bindings.iter().enumerate() {
-            let res = match b {
-                Binding::Texture(t) => Res::Tex(*t),
-                Binding::Buffer(b) => Res::Buf(*b),
-                _ => continue,
-            };
-            let writes = info
-                .map(|inf| inf.slots[i].kind.writes())
-                .unwrap_or(expect_write[i] == Some(true));
-            let reads = !writes
-                || info.is_some_and(|inf| {
-                    matches!(
-                        inf.slots[i].kind,
-                        BindingKind::StorageTexture {
-                            access: wgpu::StorageTextureAccess::ReadWrite,
-                            ..
-                        }
-                    )
-                });
-            touched.push((res, !reads));
-            if reads && writes {
-                touched.push((res, true));
+        if let Some(info) = info {
+            self.check_bindings(&name, &info.label, &info.slots, &bindings, &expect_write)?;
+            touched.extend(Self::accesses(&bindings, &info.slots));
+            for layout in &info.sets {
+                let set = sets
+                    .iter()
+                    .map(|s| &self.sets[s.0 as usize])
+                    .find(|s| s.name == layout.name)
+                    .ok_or_else(|| RenderError::Pass {
+                        pass: name.clone(),
+                        message: format!(
+                            "`{}` imports the binding set `{}` (@group({})), which the pass does not bind with `.set(...)`",
+                            info.label, layout.name, layout.group
+                        ),
+                    })?;
+                let label = format!("{} set `{}`", info.label, layout.name);
+                self.check_bindings(
+                    &name,
+                    &label,
+                    &layout.slots,
+                    &set.bindings,
+                    &set.expect_write,
+                )?;
+                touched.extend(Self::accesses(&set.bindings, &layout.slots));
+                set_bindings.push(set.bindings.clone());
+            }
+            for s in &sets {
+                let set = &self.sets[s.0 as usize];
+                if !info.sets.iter().any(|l| l.name == set.name) {
+                    return Err(RenderError::Pass {
+                        pass: name.clone(),
+                        message: format!(
+                            "binds the set `{}`, which `{}` does not import",
+                            set.name, info.label
+                        ),
+                    });
+                }
+            }
+        } else {
+            for (b, w) in bindings.iter().zip(&expect_write) {
+                match b {
+                    Binding::Texture(t) => touched.push((Res::Tex(*t), *w == Some(true))),
+                    Binding::Buffer(b) => touched.push((Res::Buf(*b), *w == Some(true))),
+                    _ => {}
+                }
             }
         }
         touched.extend(uses);
@@ -421,14 +521,43 @@ impl<'r> FrameGraph<'r> {
             name,
             kind,
             bindings,
+            set_bindings,
         });
         Ok(())
+    }
+
+    /// The resources `bindings` touch, as (resource, written) with reads first: a slot that
+    /// reads and writes gives both.
+    fn accesses(bindings: &[Binding], slots: &[BindingSlot]) -> Vec<(Res, bool)> {
+        let mut out = Vec::new();
+        for (b, slot) in bindings.iter().zip(slots) {
+            let res = match b {
+                Binding::Texture(t) => Res::Tex(*t),
+                Binding::Buffer(b) => Res::Buf(*b),
+                _ => continue,
+            };
+            let writes = slot.kind.writes();
+            let reads = !writes
+                || matches!(
+                    slot.kind,
+                    BindingKind::StorageTexture {
+                        access: wgpu::StorageTextureAccess::ReadWrite,
+                        ..
+                    }
+                );
+            out.push((res, !reads));
+            if reads && writes {
+                out.push((res, true));
+            }
+        }
+        out
     }
 
     fn check_bindings(
         &self,
         pass: &str,
-        info: &PipelineInfo,
+        label: &str,
+        slots: &[BindingSlot],
         bindings: &[Binding],
         expect_write: &[Option<bool>],
     ) -> Result<()> {
@@ -436,25 +565,21 @@ impl<'r> FrameGraph<'r> {
             pass: pass.into(),
             message,
         };
-        if bindings.len() != info.slots.len() {
-            let wanted: Vec<String> = info
-                .slots
+        if bindings.len() != slots.len() {
+            let wanted: Vec<String> = slots
                 .iter()
                 .map(|s| format!("{}: {}", s.binding, s.name))
                 .collect();
             return Err(err(format!(
                 "binds {} resources but `{}` declares {} ({})",
                 bindings.len(),
-                info.label,
-                info.slots.len(),
+                label,
+                slots.len(),
                 wanted.join(", ")
             )));
         }
-        for ((b, slot), ew) in bindings.iter().zip(&info.slots).zip(expect_write) {
-            let here = format!(
-                "@binding({}) `{}` of `{}`",
-                slot.binding, slot.name, info.label
-            );
+        for ((b, slot), ew) in bindings.iter().zip(slots).zip(expect_write) {
+            let here = format!("@binding({}) `{}` of `{}`", slot.binding, slot.name, label);
             match (b, &slot.kind) {
                 (Binding::Texture(t), BindingKind::SampledTexture { view, .. })
                 | (Binding::Texture(t), BindingKind::StorageTexture { view, .. }) => {
@@ -512,9 +637,17 @@ impl<'r> FrameGraph<'r> {
         Ok(())
     }
 
-    /// Runs the frame: allocates, encodes, submits, and reads back timings and readbacks.
+    /// Runs the frame (allocates, encodes, submits, and reads back timings and readbacks)
+    /// and commits it: temporal state advances. See [`FrameGraph::execute_uncommitted`].
     pub fn execute(self) -> Result<FrameResult> {
-        runtime::execute(self)
+        execute::execute(self, true)
+    }
+
+    /// Runs the frame without advancing temporal state: the caller then accepts it with
+    /// [`GraphRuntime::commit_frame`] or throws it away with [`GraphRuntime::discard_frame`],
+    /// so that a frame drawn twice steps history, frame index and time slices once.
+    pub fn execute_uncommitted(self) -> Result<FrameResult> {
+        execute::execute(self, false)
     }
 }
 
@@ -522,6 +655,7 @@ impl<'r> FrameGraph<'r> {
 pub struct PassBuilder<'g, 'r> {
     g: &'g mut FrameGraph<'r>,
     name: String,
+    sets: Vec<BindingSet>,
     bindings: Vec<Binding>,
     /// Per binding: `Some(true)` for `.write`, `Some(false)` for `.read`, `None` otherwise.
     expect_write: Vec<Option<bool>>,
@@ -542,6 +676,12 @@ impl<'r> PassBuilder<'_, 'r> {
             Res::Tex(t) => Binding::Texture(t),
             Res::Buf(b) => Binding::Buffer(b),
         }
+    }
+
+    /// Binds a shared binding set to the group its shader gave it.
+    pub fn set(mut self, s: BindingSet) -> Self {
+        self.sets.push(s);
+        self
     }
 
     /// Binds the next slot to a resource the pass reads.
@@ -598,6 +738,7 @@ impl<'r> PassBuilder<'_, 'r> {
             kind,
             self.bindings,
             self.expect_write,
+            self.sets,
             self.uses,
             Some(&pipeline.info),
         )
@@ -626,6 +767,7 @@ impl<'r> PassBuilder<'_, 'r> {
             kind,
             self.bindings,
             self.expect_write,
+            self.sets,
             self.uses,
             Some(&pipeline.info),
         )
@@ -647,6 +789,6 @@ impl<'r> PassBuilder<'_, 'r> {
             record: Box::new(record),
         };
         self.g
-            .add_pass(self.name, kind, vec![], vec![], self.uses, None)
+            .add_pass(self.name, kind, vec![], vec![], vec![], self.uses, None)
     }
 }

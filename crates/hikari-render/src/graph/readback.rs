@@ -10,6 +10,8 @@ use crate::error::{RenderError, Result};
 #[derive(Clone, Debug)]
 pub struct ImageRgba32 {
     pub name: String,
+    /// The texture of its frame it was read from.
+    pub texture: Option<super::Tex>,
     pub width: u32,
     pub height: u32,
     pub format: wgpu::TextureFormat,
@@ -164,6 +166,7 @@ pub(crate) fn decode_image(name: &str, desc: &TextureDesc, data: &[u8]) -> Resul
     }
     Ok(ImageRgba32 {
         name: name.into(),
+        texture: None,
         width: w,
         height: h * d,
         format: desc.format,

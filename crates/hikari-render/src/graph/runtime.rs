@@ -3,17 +3,15 @@
 
 use std::collections::HashMap;
 use std::sync::Arc;
-use std::time::Instant;
 
-use super::readback::{self, ImageRgba32};
+use super::readback::ImageRgba32;
 use super::resources::{
     PhysicalBuffer, PhysicalTexture, Pool, PoolStats, TextureDesc, ViewKey, next_id,
 };
 use super::timing::{GpuTimer, PassTiming};
-use super::{Binding, FrameGraph, PassKind, PassResources, Res, SamplerKind, Tex, TexSource};
+use super::{Binding, FrameGraph, PassResources, SamplerKind, Tex};
 use crate::context::GpuContext;
-use crate::error::{RenderError, Result};
-use crate::pipeline::{BindingKind, PipelineInfo};
+use crate::pipeline::{BindingKind, BindingSlot};
 
 /// The two textures of a temporal resource for this frame; see
 /// [`FrameGraph::history_texture`].
@@ -59,6 +57,12 @@ impl FrameResult {
 }
 
 impl FrameResult {
+    /// Removes and returns the read-back image of the texture `t` of this frame.
+    pub fn take_image_of(&mut self, t: Tex) -> Option<ImageRgba32> {
+        let i = self.images.iter().position(|i| i.texture == Some(t))?;
+        Some(self.images.remove(i))
+    }
+
     pub fn image(&self, name: &str) -> Option<&ImageRgba32> {
         self.images.iter().find(|i| i.name == name)
     }
@@ -75,18 +79,21 @@ struct HistoryEntry {
 /// Everything the frame graph keeps between frames. Make one per renderer.
 pub struct GraphRuntime {
     pub(crate) frame: u64,
-    pool: Pool,
+    pub(crate) pool: Pool,
     persistent_textures: HashMap<String, Arc<PhysicalTexture>>,
     persistent_buffers: HashMap<String, Arc<PhysicalBuffer>>,
     history: HashMap<String, HistoryEntry>,
-    imported_textures: HashMap<wgpu::Texture, (Arc<PhysicalTexture>, u64)>,
-    imported_buffers: HashMap<wgpu::Buffer, (Arc<PhysicalBuffer>, u64)>,
-    bind_groups: HashMap<Vec<u64>, wgpu::BindGroup>,
-    constants: Option<Arc<PhysicalBuffer>>,
+    pub(crate) imported_textures: HashMap<wgpu::Texture, (Arc<PhysicalTexture>, u64)>,
+    pub(crate) imported_buffers: HashMap<wgpu::Buffer, (Arc<PhysicalBuffer>, u64)>,
+    pub(crate) bind_groups: HashMap<Vec<u64>, wgpu::BindGroup>,
+    pub(crate) constants: Option<Arc<PhysicalBuffer>>,
     samplers: HashMap<SamplerKind, (u64, wgpu::Sampler)>,
-    timer: Option<GpuTimer>,
-    timestamps: TimestampMode,
-    dumps: Vec<String>,
+    pub(crate) timer: Option<GpuTimer>,
+    pub(crate) timestamps: TimestampMode,
+    pub(crate) dumps: Vec<String>,
+    pub(crate) wait_for_readbacks: bool,
+    /// Late read-backs in flight: name, staging buffer, set once it is mapped.
+    pub(crate) pending: Vec<(String, wgpu::Buffer, Arc<std::sync::atomic::AtomicBool>)>,
 }
 
 /// How much of the frame gets GPU timestamps.
@@ -128,7 +135,16 @@ impl GraphRuntime {
             timer: None,
             timestamps: TimestampMode::Pass,
             dumps: Vec::new(),
+            wait_for_readbacks: true,
+            pending: Vec::new(),
         }
+    }
+
+    /// Whether `execute` waits for [`FrameGraph::readback_late`] buffers (the default, for
+    /// offline renders that redraw a frame whose queues overflowed) or lets frames run ahead
+    /// and delivers them with a later frame (interactive use).
+    pub fn set_wait_for_readbacks(&mut self, wait: bool) {
+        self.wait_for_readbacks = wait;
     }
 
     /// How the GPU is timed (per pass by default, when the device supports timestamps).
@@ -155,6 +171,8 @@ impl GraphRuntime {
             passes: Vec::new(),
             constants: Vec::new(),
             readbacks: Vec::new(),
+            late_readbacks: Vec::new(),
+            sets: Vec::new(),
         }
     }
 
@@ -304,17 +322,23 @@ impl GraphRuntime {
             .clone()
     }
 
-    fn bind_group(
+    /// The bind group of one group of a pipeline (`layout_id` identifies its layout), cached
+    /// by the physical resources it binds.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn bind_group(
         &mut self,
         ctx: &GpuContext,
-        info: &PipelineInfo,
+        layout_id: u64,
+        label: &str,
+        layout: &wgpu::BindGroupLayout,
+        slots: &[BindingSlot],
         bindings: &[Binding],
         res: &PassResources<'_>,
     ) -> wgpu::BindGroup {
         let constants = self.constants.clone();
         let mut key: Vec<u64> = Vec::with_capacity(1 + bindings.len() * 2);
-        key.push(info.id);
-        for (b, slot) in bindings.iter().zip(&info.slots) {
+        key.push(layout_id);
+        for (b, slot) in bindings.iter().zip(slots) {
             match b {
                 Binding::Texture(t) => {
                     key.push(res.textures[t.0 as usize].physical.as_ref().unwrap().id);
@@ -338,7 +362,7 @@ impl GraphRuntime {
         }
         let mut views = Vec::new();
         let mut samplers = Vec::new();
-        for (b, slot) in bindings.iter().zip(&info.slots) {
+        for (b, slot) in bindings.iter().zip(slots) {
             match (b, &slot.kind) {
                 (Binding::Texture(t), BindingKind::SampledTexture { view, .. }) => {
                     let p = res.textures[t.0 as usize].physical.as_ref().unwrap();
@@ -361,7 +385,7 @@ impl GraphRuntime {
         let (mut vi, mut si) = (0, 0);
         let entries: Vec<wgpu::BindGroupEntry> = bindings
             .iter()
-            .zip(&info.slots)
+            .zip(slots)
             .map(|(b, slot)| wgpu::BindGroupEntry {
                 binding: slot.binding,
                 resource: match b {
@@ -390,467 +414,49 @@ impl GraphRuntime {
             })
             .collect();
         let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some(&info.label),
-            layout: &info.bind_group_layout,
+            label: Some(label),
+            layout,
             entries: &entries,
         });
         self.bind_groups.insert(key, bg.clone());
         bg
     }
-}
 
-/// Finds the resources `--dump` names; unknown names are an error that lists the known ones.
-fn dump_requests(g: &FrameGraph<'_>) -> Result<Vec<Res>> {
-    let mut out = Vec::new();
-    for want in &g.rt.dumps {
-        let t = g
-            .textures
-            .iter()
-            .position(|t| &t.name == want && t.first.is_some());
-        let b = g
-            .buffers
-            .iter()
-            .position(|b| &b.name == want && b.first.is_some());
-        match (t, b) {
-            (Some(t), _) => out.push(Res::Tex(Tex(t as u32))),
-            (None, Some(b)) => out.push(Res::Buf(super::Buf(b as u32))),
-            (None, None) => {
-                let mut names: Vec<&str> = g
-                    .textures
-                    .iter()
-                    .filter(|t| t.first.is_some())
-                    .map(|t| t.name.as_str())
-                    .chain(
-                        g.buffers
-                            .iter()
-                            .filter(|b| b.first.is_some())
-                            .map(|b| b.name.as_str()),
-                    )
-                    .collect();
-                names.sort();
-                names.dedup();
-                return Err(RenderError::Graph(format!(
-                    "--dump {want}: no resource of that name in this frame; there are: {}",
-                    names.join(", ")
-                )));
+    /// Accepts the frame just executed: temporal resources advance (what each history pass
+    /// wrote becomes next frame's `prev`), the frame index steps on, and what the pool and the
+    /// import caches no longer need is freed. A frame that is thrown away (drawn again, say)
+    /// is [`GraphRuntime::discard_frame`]d instead, and temporal state stays where it was.
+    pub fn commit_frame(&mut self) {
+        for h in self.history.values_mut() {
+            if std::mem::take(&mut h.used) {
+                h.parity = 1 - h.parity;
+                h.frames_written += 1;
             }
         }
-    }
-    Ok(out)
-}
-
-pub(crate) fn execute(mut g: FrameGraph<'_>) -> Result<FrameResult> {
-    let t_start = Instant::now();
-    let ctx = g.ctx;
-    let n = g.passes.len();
-
-    let mut copies = g.readbacks.clone();
-    copies.extend(dump_requests(&g)?);
-    copies.dedup();
-    for r in &copies {
-        let (first, last, written, name) = match *r {
-            Res::Tex(t) => {
-                let v = &mut g.textures[t.0 as usize];
-                (&mut v.first, &mut v.last, v.written, &v.name)
-            }
-            Res::Buf(b) => {
-                let v = &mut g.buffers[b.0 as usize];
-                (&mut v.first, &mut v.last, v.written, &v.name)
-            }
-        };
-        if !written {
-            return Err(RenderError::Graph(format!(
-                "read back of `{name}`, which no pass wrote"
-            )));
-        }
-        // Keep it alive to the end of the frame so nothing else is placed in its memory.
-        first.get_or_insert(n);
-        *last = Some(n);
-    }
-    for r in &copies {
-        if let Res::Tex(t) = r {
-            let v = &g.textures[t.0 as usize];
-            if readback::texel_bytes(v.desc.format).is_none() {
-                return Err(RenderError::Graph(format!(
-                    "cannot read back `{}`: format {:?}",
-                    v.name, v.desc.format
-                )));
-            }
+        self.frame += 1;
+        let f = self.frame;
+        let before = self.imported_buffers.len() + self.imported_textures.len();
+        self.imported_buffers
+            .retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
+        self.imported_textures
+            .retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
+        let pruned = before != self.imported_buffers.len() + self.imported_textures.len();
+        if self.pool.trim(f) || pruned {
+            // Cached bind groups hold their resources alive; start over so freed memory goes.
+            self.bind_groups.clear();
         }
     }
 
-    let FrameGraph {
-        rt,
-        mut textures,
-        mut buffers,
-        passes,
-        constants,
-        ..
-    } = g;
-
-    // Pass constants go up in one write before the frame's commands.
-    if !constants.is_empty() {
-        let need = (constants.len() as u64 + 256).next_power_of_two();
-        if rt.constants.as_ref().is_none_or(|c| c.size < need) {
-            rt.constants = Some(PhysicalBuffer::create(ctx, "hikari.constants", need));
-            rt.bind_groups.clear();
-        }
-        ctx.queue
-            .write_buffer(&rt.constants.as_ref().unwrap().buffer, 0, &constants);
-    }
-
-    let timed = |k: &PassKind| !matches!(k, PassKind::Encoder { .. });
-    let timed_count = passes.iter().filter(|p| timed(&p.kind)).count() as u32;
-    let mode = rt.timestamps;
-    if mode != TimestampMode::Off && rt.timer.as_ref().is_none_or(|t| t.passes() < timed_count) {
-        rt.timer = GpuTimer::new(ctx, timed_count);
-    }
-    let use_timer = mode != TimestampMode::Off && rt.timer.is_some() && timed_count > 0;
-    // Query slots for the timed pass `slot`: its own pair, or in frame mode only the frame's
-    // first begin (query 0) and last end (query 1).
-    let queries = |slot: u32| -> (Option<u32>, Option<u32>) {
-        match mode {
-            TimestampMode::Pass => (Some(2 * slot), Some(2 * slot + 1)),
-            _ => (
-                (slot == 0).then_some(0),
-                (slot + 1 == timed_count).then_some(1),
-            ),
-        }
-    };
-
-    // Lifetimes -> when each transient is taken from and given back to the pool.
-    let mut acquire_at: Vec<Vec<Res>> = vec![Vec::new(); n + 1];
-    let mut release_at: Vec<Vec<Res>> = vec![Vec::new(); n + 1];
-    for (i, t) in textures.iter().enumerate() {
-        if let (TexSource::Transient, Some(f), Some(l)) = (t.source, t.first, t.last) {
-            acquire_at[f].push(Res::Tex(Tex(i as u32)));
-            release_at[l].push(Res::Tex(Tex(i as u32)));
-        }
-    }
-    for (i, b) in buffers.iter().enumerate() {
-        if let (true, Some(f), Some(l)) = (b.transient, b.first, b.last) {
-            acquire_at[f].push(Res::Buf(super::Buf(i as u32)));
-            release_at[l].push(Res::Buf(super::Buf(i as u32)));
-        }
-    }
-    let frame = rt.frame;
-    let acquire = |rt: &mut GraphRuntime,
-                   list: &[Res],
-                   textures: &mut [super::VirtualTexture],
-                   buffers: &mut [super::VirtualBuffer]| {
-        for r in list {
-            match *r {
-                Res::Tex(t) => {
-                    let v = &mut textures[t.0 as usize];
-                    v.physical = Some(rt.pool.acquire_texture(ctx, &v.name, v.desc, frame));
-                }
-                Res::Buf(b) => {
-                    let v = &mut buffers[b.0 as usize];
-                    v.physical = Some(rt.pool.acquire_buffer(ctx, &v.name, v.size, frame));
-                }
-            }
-        }
-    };
-    let release = |rt: &mut GraphRuntime,
-                   list: &[Res],
-                   textures: &[super::VirtualTexture],
-                   buffers: &[super::VirtualBuffer]| {
-        for r in list {
-            match *r {
-                Res::Tex(t) => rt
-                    .pool
-                    .release_texture(textures[t.0 as usize].physical.as_ref().unwrap().id),
-                Res::Buf(b) => rt
-                    .pool
-                    .release_buffer(buffers[b.0 as usize].physical.as_ref().unwrap().id),
-            }
-        }
-    };
-
-    // Without per-pass timestamps, consecutive compute passes share one wgpu compute pass:
-    // wgpu still places the barriers each dispatch needs, and the GPU skips a pass boundary.
-    let merge = mode != TimestampMode::Pass;
-    let mut run_end: Vec<usize> = (0..n).collect();
-    for i in (0..n.saturating_sub(1)).rev() {
-        let both_compute = matches!(passes[i].kind, PassKind::Compute { .. })
-            && matches!(passes[i + 1].kind, PassKind::Compute { .. });
-        if merge && both_compute {
-            run_end[i] = run_end[i + 1];
+    /// Forgets the frame just executed: history stays unflipped and the frame index unchanged,
+    /// so the frame can be recorded and executed again as the same frame.
+    pub fn discard_frame(&mut self) {
+        for h in self.history.values_mut() {
+            h.used = false;
         }
     }
 
-    let mut encoder = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("hikari.frame"),
-        });
-    let mut timings = Vec::with_capacity(n);
-    let mut slot = 0u32;
-    let mut open_compute: Option<wgpu::ComputePass<'static>> = None;
-    for (i, pass) in passes.into_iter().enumerate() {
-        acquire(rt, &acquire_at[i], &mut textures, &mut buffers);
-        let tp = Instant::now();
-        let res = PassResources {
-            textures: &textures,
-            buffers: &buffers,
-        };
-        let is_timed = timed(&pass.kind);
-        if !matches!(pass.kind, PassKind::Compute { .. }) {
-            drop(open_compute.take());
-        }
-        match pass.kind {
-            PassKind::Compute { pipeline, groups } => {
-                let bg = rt.bind_group(ctx, &pipeline.info, &pass.bindings, &res);
-                if open_compute.is_none() || !merge {
-                    // The encoder accepts a new pass only once the previous one has ended.
-                    drop(open_compute.take());
-                    let last_slot = slot + (run_end[i] - i) as u32;
-                    let q = match mode {
-                        TimestampMode::Pass => queries(slot),
-                        _ => (
-                            (slot == 0).then_some(0),
-                            (last_slot + 1 == timed_count).then_some(1),
-                        ),
-                    };
-                    let timer = if use_timer { rt.timer.as_ref() } else { None };
-                    let label = if run_end[i] == i {
-                        pass.name.as_str()
-                    } else {
-                        "hikari.compute"
-                    };
-                    let cp = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                        label: Some(label),
-                        timestamp_writes: timer.and_then(|t| t.compute_writes(q)),
-                    });
-                    open_compute = Some(cp.forget_lifetime());
-                }
-                let cp = open_compute.as_mut().unwrap();
-                cp.set_pipeline(&pipeline.pipeline);
-                cp.set_bind_group(0, &bg, &[]);
-                if groups.iter().all(|&g| g > 0) {
-                    cp.dispatch_workgroups(groups[0], groups[1], groups[2]);
-                }
-            }
-            PassKind::Raster {
-                pipeline,
-                colors,
-                depth,
-                record,
-            } => {
-                let bg = rt.bind_group(ctx, &pipeline.info, &pass.bindings, &res);
-                let timer = if use_timer { rt.timer.as_ref() } else { None };
-                let attach = |t: Tex| {
-                    res.textures[t.0 as usize]
-                        .physical
-                        .as_ref()
-                        .unwrap()
-                        .view(ViewKey {
-                            dimension: wgpu::TextureViewDimension::D2,
-                            single_mip: true,
-                        })
-                };
-                let color_views: Vec<(wgpu::TextureView, Option<[f64; 4]>)> =
-                    colors.iter().map(|(t, c)| (attach(*t), *c)).collect();
-                let depth_view = depth.map(|(t, c)| (attach(t), c));
-                let color_attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = color_views
-                    .iter()
-                    .map(|(v, clear)| {
-                        Some(wgpu::RenderPassColorAttachment {
-                            view: v,
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load: match clear {
-                                    Some([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color {
-                                        r: *r,
-                                        g: *g,
-                                        b: *b,
-                                        a: *a,
-                                    }),
-                                    None => wgpu::LoadOp::Load,
-                                },
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })
-                    })
-                    .collect();
-                let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(&pass.name),
-                    color_attachments: &color_attachments,
-                    depth_stencil_attachment: depth_view.as_ref().map(|(v, clear)| {
-                        wgpu::RenderPassDepthStencilAttachment {
-                            view: v,
-                            depth_ops: Some(wgpu::Operations {
-                                load: match clear {
-                                    Some(d) => wgpu::LoadOp::Clear(*d),
-                                    None => wgpu::LoadOp::Load,
-                                },
-                                store: wgpu::StoreOp::Store,
-                            }),
-                            stencil_ops: None,
-                        }
-                    }),
-                    timestamp_writes: timer.and_then(|t| t.render_writes(queries(slot))),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                rp.set_pipeline(&pipeline.pipeline);
-                rp.set_bind_group(0, &bg, &[]);
-                record(&mut rp, &res);
-            }
-            PassKind::Encoder { record } => record(&mut encoder, &res),
-        }
-        timings.push((
-            pass.name,
-            is_timed.then_some(slot),
-            tp.elapsed().as_secs_f64() * 1e6,
-        ));
-        if is_timed {
-            slot += 1;
-        }
-        release(rt, &release_at[i], &textures, &buffers);
+    /// Index of the next frame to be recorded: the number of frames committed so far.
+    pub fn frame_index(&self) -> u64 {
+        self.frame
     }
-    drop(open_compute);
-    // Readbacks of resources no pass touched never reach here (checked above), but a
-    // persistent one could be first used at `n`: make sure it is resolved.
-    acquire(rt, &acquire_at[n], &mut textures, &mut buffers);
-
-    let mut staging = Vec::new();
-    for r in &copies {
-        match *r {
-            Res::Tex(t) => {
-                let v = &textures[t.0 as usize];
-                let row = readback::padded_row_bytes(&v.desc).unwrap();
-                let rows = v.desc.size[1] * v.desc.size[2];
-                let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("hikari.readback"),
-                    size: row as u64 * rows as u64,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
-                let aspect = if v.desc.format.is_depth_stencil_format() {
-                    wgpu::TextureAspect::DepthOnly
-                } else {
-                    wgpu::TextureAspect::All
-                };
-                encoder.copy_texture_to_buffer(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &v.physical.as_ref().unwrap().texture,
-                        mip_level: 0,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect,
-                    },
-                    wgpu::TexelCopyBufferInfo {
-                        buffer: &buf,
-                        layout: wgpu::TexelCopyBufferLayout {
-                            offset: 0,
-                            bytes_per_row: Some(row),
-                            rows_per_image: Some(v.desc.size[1]),
-                        },
-                    },
-                    v.desc.extent(),
-                );
-                staging.push((*r, buf));
-            }
-            Res::Buf(b) => {
-                let v = &buffers[b.0 as usize];
-                let p = v.physical.as_ref().unwrap();
-                let buf = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("hikari.readback"),
-                    size: p.size,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
-                encoder.copy_buffer_to_buffer(&p.buffer, 0, &buf, 0, p.size);
-                staging.push((*r, buf));
-            }
-        }
-    }
-    let query_pairs = if mode == TimestampMode::Pass { slot } else { 1 };
-    if use_timer {
-        rt.timer
-            .as_ref()
-            .unwrap()
-            .resolve(&mut encoder, query_pairs);
-    }
-    let cpu_encode_us = t_start.elapsed().as_secs_f64() * 1e6;
-    ctx.queue.submit([encoder.finish()]);
-
-    let (gpu, gpu_span_ms) = if use_timer {
-        let (pairs, span) = rt.timer.as_ref().unwrap().read(ctx, query_pairs)?;
-        match mode {
-            TimestampMode::Pass => (pairs, span),
-            _ => (vec![None; slot as usize], pairs[0]),
-        }
-    } else {
-        (vec![None; slot as usize], None)
-    };
-    let timings = timings
-        .into_iter()
-        .map(|(name, s, cpu_us)| PassTiming {
-            name,
-            gpu_ms: s.and_then(|s| gpu[s as usize]),
-            cpu_us,
-        })
-        .collect();
-
-    for (_, buf) in &staging {
-        buf.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    }
-    if !staging.is_empty() {
-        ctx.wait_idle()?;
-    }
-    let mut images = Vec::new();
-    let mut out_buffers = Vec::new();
-    for (r, buf) in staging {
-        let data = buf
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| RenderError::Gpu {
-                during: "read back".into(),
-                message: e.to_string(),
-            })?
-            .to_vec();
-        match r {
-            Res::Tex(t) => {
-                let v = &textures[t.0 as usize];
-                images.push(readback::decode_image(&v.name, &v.desc, &data)?);
-            }
-            Res::Buf(b) => out_buffers.push((buffers[b.0 as usize].name.clone(), data)),
-        }
-    }
-
-    let allocations = textures
-        .iter()
-        .filter_map(|t| t.physical.as_ref().map(|p| (t.name.clone(), p.id)))
-        .collect();
-
-    for h in rt.history.values_mut() {
-        if std::mem::take(&mut h.used) {
-            h.parity = 1 - h.parity;
-            h.frames_written += 1;
-        }
-    }
-    let result = FrameResult {
-        frame: rt.frame,
-        timings,
-        gpu_span_ms,
-        cpu_encode_us,
-        images,
-        buffers: out_buffers,
-        allocations,
-    };
-    rt.frame += 1;
-    let f = rt.frame;
-    let before = rt.imported_buffers.len() + rt.imported_textures.len();
-    rt.imported_buffers
-        .retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
-    rt.imported_textures
-        .retain(|_, (_, last)| f - *last <= IMPORT_KEEP_FRAMES);
-    let pruned = before != rt.imported_buffers.len() + rt.imported_textures.len();
-    if rt.pool.trim(f) || pruned {
-        // Cached bind groups hold their resources alive; start over so freed memory goes.
-        rt.bind_groups.clear();
-    }
-    Ok(result)
 }

@@ -334,7 +334,7 @@ impl Rasterizer {
             (capacity as u64 + 2 * LARGE_CAPACITY) * 8,
         )?;
         let count = g.buffer(&format!("{t}.tile_count"), 16)?;
-        g.readback(count);
+        g.readback_late(count);
         let records = g.buffer(
             &format!("{t}.triangle_records"),
             record_capacity as u64 * TRIANGLE_RECORD_BYTES,

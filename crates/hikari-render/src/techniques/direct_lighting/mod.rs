@@ -14,7 +14,7 @@ use super::gbuffer::GBuffer;
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{FrameGraph, SamplerKind, Tex, TextureDesc};
+use crate::graph::{FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::settings::DirectLightingSettings;
@@ -130,9 +130,7 @@ impl DirectLighting {
             .read(gb.emissive)
             .read(scene.lights)
             .write(radiance)
-            .constants(&shadows.params)
-            .read(shadows.map)
-            .sampler(SamplerKind::NearestRepeat)
+            .set(shadows.lookup)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(radiance)
     }

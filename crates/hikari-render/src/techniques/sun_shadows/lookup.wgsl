@@ -1,9 +1,9 @@
 #define_import_path hikari::sun_shadows
 
 // Sun shadow lookup: cascade selection and 3x3 bilinear PCF over the compute-rasterised
-// shadow maps (`passes/sun_shadows.rs`). CPU twin: reference::sun_shadows. A shader that
-// imports this module binds the parameters, the maps and a nearest, repeating sampler at
-// bindings 9 to 11, after its own. The maps scroll: texel t of cascade c is stored at
+// shadow maps (`techniques/sun_shadows/mod.rs`). CPU twin: `sun_shadows::reference`. Its
+// bindings are the binding set `sun_shadows` (`SunShadowMaps::lookup`), in a group of their
+// own: a pass that imports this module binds them with `.set(shadows.lookup)`. The maps scroll: texel t of cascade c is stored at
 // (t + origin[c]) mod resolution.
 
 struct ShadowParams {
@@ -16,10 +16,10 @@ struct ShadowParams {
     origin: vec4<u32>,
 }
 
-@group(0) @binding(9) var<uniform> shadow: ShadowParams;
+@group(#{SUN_SHADOWS_GROUP}) @binding(0) var<uniform> shadow: ShadowParams;
 // Depth bits, a layer a cascade.
-@group(0) @binding(10) var shadow_map: texture_2d_array<u32>;
-@group(0) @binding(11) var shadow_sampler: sampler;
+@group(#{SUN_SHADOWS_GROUP}) @binding(1) var shadow_map: texture_2d_array<u32>;
+@group(#{SUN_SHADOWS_GROUP}) @binding(2) var shadow_sampler: sampler;
 
 fn shadow_depth(layer: u32, c: vec2<i32>) -> f32 {
     return bitcast<f32>(textureLoad(shadow_map, c, layer, 0).r);

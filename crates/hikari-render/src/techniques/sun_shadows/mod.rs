@@ -30,7 +30,7 @@ use hikari_scene::Camera;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{Buf, FrameGraph, Tex, TextureDesc};
+use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::raster::{
     MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer, pack_point,
@@ -212,6 +212,17 @@ pub struct SunShadowMaps {
     /// so that its view is an array), for the lookup.
     pub map: Tex,
     pub params: ShadowParams,
+    /// The binding set `sun_shadows` of `lookup.wgsl` (params, map, sampler), for the passes
+    /// that look the maps up.
+    pub lookup: BindingSet,
+}
+
+fn lookup_set(g: &mut FrameGraph<'_>, params: &ShadowParams, map: Tex) -> BindingSet {
+    g.binding_set("sun_shadows")
+        .constants(params)
+        .read(map)
+        .sampler(SamplerKind::NearestRepeat)
+        .finish()
 }
 
 pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
@@ -349,10 +360,13 @@ impl SunShadows {
                     // Never read: no cascades means no lookup. wgpu zeroes the map.
                     .uses(map, true)
                     .encode(move |enc, res| enc.clear_buffer(res.buffer(texels), 0, None))?;
+                let params = ShadowParams::disabled();
+                let lookup = lookup_set(g, &params, map);
                 return Ok(SunShadowMaps {
                     texels,
                     map,
-                    params: ShadowParams::disabled(),
+                    params,
+                    lookup,
                 });
             }
         };
@@ -423,10 +437,13 @@ impl SunShadows {
                 .write(map)
                 .dispatch_threads(&self.copy, [threads[0], threads[1], views.len() as u32])?;
         }
+        let params = ShadowParams::new(&cascades, depth_range(to_sun, bounds), s);
+        let lookup = lookup_set(g, &params, map);
         Ok(SunShadowMaps {
             texels,
             map,
-            params: ShadowParams::new(&cascades, depth_range(to_sun, bounds), s),
+            params,
+            lookup,
         })
     }
 }
