@@ -73,6 +73,7 @@
 // Matrix and table code reads best with explicit indices, as in the papers' formulas.
 #![allow(clippy::needless_range_loop)]
 
+pub mod astro;
 pub mod brdf;
 pub mod color;
 pub mod constants;
