@@ -276,3 +276,34 @@ fn illuminance_at_the_top_of_the_atmosphere() {
         "{night:?}"
     );
 }
+
+#[test]
+fn julian_day_and_delta_t() {
+    // Meeus's example 7.a: 1957 October 4.81 UT (Sputnik 1) is JD 2436116.31.
+    let sputnik = DateTime::new(1957, 10, 4, 19, 26, 24, 0.0).unwrap();
+    assert!((sputnik.julian_day_ut() - 2436116.31).abs() < 1e-6);
+    // The same instant in another zone is the same Julian day.
+    let tokyo = DateTime::new(1957, 10, 5, 4, 26, 24, 9.0).unwrap();
+    assert!((tokyo.julian_day_ut() - sputnik.julian_day_ut()).abs() < 1e-9);
+    // J2000.0 is 2000-01-01 12:00 TT, JD 2451545.0 (TT); at 12:00 UT it is JD 2451545.0 (UT).
+    let j2000 = DateTime::new(2000, 1, 1, 12, 0, 0, 0.0).unwrap();
+    assert_eq!(j2000.julian_day_ut(), 2451545.0);
+
+    // ΔT against the observed values (seconds; Espenak & Meeus's table of historical ΔT from
+    // IERS / USNO): the polynomials fit them within a second.
+    for (year, observed) in [
+        (1900.0, -2.72),
+        (1950.0, 29.15),
+        (1980.0, 50.54),
+        (2000.0, 63.83),
+    ] {
+        let dt = delta_t_seconds(year);
+        assert!((dt - observed).abs() < 1.0, "{year}: {dt} vs {observed}");
+    }
+    // The pieces join: no jump over half a second at their boundaries (a mistyped coefficient
+    // would make one).
+    for y in [1900.0, 1920.0, 1941.0, 1961.0, 1986.0, 2005.0, 2050.0] {
+        let jump = delta_t_seconds(y + 1e-9) - delta_t_seconds(y - 1e-9);
+        assert!(jump.abs() < 0.5, "ΔT jumps by {jump} s at {y}");
+    }
+}

@@ -19,7 +19,7 @@ pub fn sun_extraterrestrial_lux(distance_au: f64) -> f64 {
 }
 
 /// The Moon's visual magnitude at the mean distance for a phase angle in degrees (0 = full),
-/// Krisciunas & Schaefer (1991, PASP 103, eq. 9, after Allen's table):
+/// Krisciunas & Schaefer (1991, PASP 103, after Allen's table):
 /// m = −12.73 + 0.026 |α| + 4·10⁻⁹ α⁴. Includes the opposition surge near full; no earthshine.
 pub fn moon_magnitude(phase_angle_deg: f64) -> f64 {
     let a = phase_angle_deg.abs().min(180.0);
