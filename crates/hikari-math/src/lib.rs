@@ -9,6 +9,7 @@
 //! | [`sh`] | real orthonormal SH up to band 2 (L1 = 4, L2 = 9 coefficients), mono (`f32`) and RGB (`Vec3`): basis, projection (quadrature, samples, cube maps), rotation, Gaunt products, zonal convolution / irradiance, windows, Ghost of Tsushima deringing and directionality boost, the Metro Exodus YCoCg + L1 encoding |
 //! | [`color`] | RGB spaces from primaries (Rec.709, ACEScg, ACES2065-1, Rec.2020, Display P3, the talk's tonemapping and LMS Rayleigh spaces), sRGB transfer, Bradford white balance, spectral tables, the Smits basis, the Purkinje shift, Rayleigh / Mie coefficients |
 //! | [`sampling`] | Hammersley, Sobol (Joe & Kuo 2008), Fibonacci sphere, hemisphere mappings, GGX VNDF sampling (Heitz 2018), void-and-cluster blue noise (and the committed 64 x 64 x 64 set), Poisson disk sets |
+//! | [`astro`] | sun (NREL SPA) and moon (Meeus ch. 47) topocentric positions, phase and illuminance above the atmosphere from date, time, UTC offset and place; world directions (docs/sun-and-moon.md) |
 //! | [`constants`] | [`DerivedConstants`]: every derived matrix and table in one plain struct (what `hikari constants --json` prints) |
 //!
 //! ## Conventions
@@ -73,6 +74,7 @@
 // Matrix and table code reads best with explicit indices, as in the papers' formulas.
 #![allow(clippy::needless_range_loop)]
 
+pub mod astro;
 pub mod brdf;
 pub mod color;
 pub mod constants;
