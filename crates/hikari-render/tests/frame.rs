@@ -1,0 +1,65 @@
+//! The frame as a whole: offline frames are drawn again until nothing was lost and count once;
+//! interactive frames never wait for their queue counts, are shown as drawn, and the queues
+//! catch up from the counts of earlier frames.
+
+mod common;
+
+use hikari_render::Renderer;
+use hikari_render::raster::QueueSizes;
+
+fn tiny_queues(renderer: &mut Renderer) {
+    for t in ["gbuffer", "sun_shadows"] {
+        renderer.raster_queues().set(
+            t,
+            QueueSizes {
+                entries: 4,
+                records: 2,
+            },
+        );
+    }
+}
+
+#[test]
+fn an_overflowing_offline_frame_is_drawn_again_but_counts_once() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = hikari_scene::builtin::boxes();
+    let s = common::small_frame_settings(&scene, 128, 80);
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    tiny_queues(&mut renderer);
+    for want in 0..3u64 {
+        let r = renderer.render(&s, false).unwrap();
+        assert_eq!(r.result.frame, want, "each shown frame steps the index once");
+    }
+    assert_eq!(renderer.runtime.frame_index(), 3);
+}
+
+#[test]
+fn interactive_frames_run_ahead_and_the_queues_catch_up() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = hikari_scene::builtin::boxes();
+    let s = common::small_frame_settings(&scene, 128, 80);
+    let reference = {
+        let mut r = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
+        r.render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
+            .unwrap()
+            .buffer("gbuffer.visibility")
+            .unwrap()
+            .to_vec()
+    };
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    renderer.set_interactive(true);
+    tiny_queues(&mut renderer);
+    let mut last = Vec::new();
+    for want in 0..8u64 {
+        let r = renderer
+            .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
+            .unwrap();
+        assert_eq!(r.frame, want, "interactive frames are shown as drawn, never redone");
+        last = r.buffer("gbuffer.visibility").unwrap().to_vec();
+        // Let the GPU finish so the late counts arrive by the next frame or the one after.
+        renderer.ctx.wait_idle().unwrap();
+    }
+    let grown = renderer.raster_queues().sizes("gbuffer", 0);
+    assert!(grown.entries > 4, "the queues never grew: {grown:?}");
+    assert!(last == reference, "after the queues grew, frames lose nothing");
+}
