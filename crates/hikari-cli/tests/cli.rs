@@ -10,10 +10,6 @@ fn hikari(args: &[&str]) -> Output {
         .expect("run hikari")
 }
 
-fn gpu_tests_skipped() -> bool {
-    std::env::var("HIKARI_SKIP_GPU_TESTS").is_ok_and(|v| v == "1")
-}
-
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hikari-cli-test-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
@@ -30,9 +26,6 @@ fn text(o: &Output) -> String {
 
 #[test]
 fn render_writes_png_exr_and_dumps() {
-    if gpu_tests_skipped() {
-        return;
-    }
     let dir = tmp("render");
     let png = dir.join("out.png");
     let o = hikari(&[
@@ -108,9 +101,6 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     );
     assert_clean_failure(&["render", "--width", "banana"], "invalid value");
     assert_clean_failure(&["bench", "frame", "--frames", "0"], "--frames");
-    if gpu_tests_skipped() {
-        return;
-    }
     let dir = tmp("bad");
     let out = dir.join("x.png");
     let config = dir.join("bad.toml");
@@ -225,9 +215,6 @@ fn constants_json_has_every_key_and_the_white_balance_maps_white() {
 
 #[test]
 fn bench_frame_names_the_scene_camera_time_and_size_that_ran() {
-    if gpu_tests_skipped() {
-        return;
-    }
     // The scene and time come from a config file, not from flags: the report must name what
     // was resolved, not the default scene.
     let dir = tmp("bench-frame");

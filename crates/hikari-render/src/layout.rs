@@ -81,6 +81,11 @@ pub fn all() -> Vec<StructLayout> {
             [light_view_proj, texel_world, config, depth_bias, origin]
         ),
         gpu_layout!(
+            sun_shadows::CopyParams,
+            "sun_shadows/copy.wgsl",
+            [regions, config]
+        ),
+        gpu_layout!(
             direct_lighting::LightingParams,
             "direct_lighting/shade.wgsl",
             [

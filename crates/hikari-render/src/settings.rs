@@ -218,6 +218,20 @@ impl Settings {
         for (key, value) in overrides {
             set_path(&mut merged, key, value)?;
         }
+        // Ranges first: a value of the wrong kind (`nan` for a count) would otherwise fail in
+        // serde, whose error does not name the field.
+        for (field, range) in Self::fields() {
+            let (table, key) = field.split_once('.').unwrap_or(("", &field));
+            if let Some(v) = merged.get(table).and_then(|t| t.get(key))
+                && !range.admits(v)
+            {
+                return Err(SettingError {
+                    field,
+                    value: v.to_string(),
+                    allowed: range.describe(),
+                });
+            }
+        }
         let settings: Settings =
             toml::Value::Table(merged)
                 .try_into()

@@ -67,14 +67,16 @@ fn srgb_to_linear(c: f64) -> f64 {
     }
 }
 
-fn wrap(x: f64, mode: hikari_scene::Wrap) -> f64 {
+/// Texel index `i` (any integer) of a row of `n` texels under `mode`, as the Vulkan spec
+/// addresses texels (repeat: modulo; mirrored: modulo 2n, reflected; clamp: to the edge).
+fn address(i: i64, n: i64, mode: hikari_scene::Wrap) -> i64 {
     match mode {
-        hikari_scene::Wrap::Repeat => x - x.floor(),
+        hikari_scene::Wrap::Repeat => i.rem_euclid(n),
         hikari_scene::Wrap::MirroredRepeat => {
-            let m = x - 2.0 * (x * 0.5).floor();
-            if m > 1.0 { 2.0 - m } else { m }
+            let m = i.rem_euclid(2 * n);
+            if m >= n { 2 * n - 1 - m } else { m }
         }
-        hikari_scene::Wrap::ClampToEdge => x.clamp(0.0, 1.0),
+        hikari_scene::Wrap::ClampToEdge => i.clamp(0, n - 1),
     }
 }
 
@@ -83,19 +85,12 @@ impl TwinTextures<'_> {
     pub fn sample(&self, index: usize, uv: glam::DVec2, srgb: bool) -> glam::DVec4 {
         let t = &self.scene.textures[index];
         let (w, h) = (t.width as i64, t.height as i64);
-        let u = wrap(uv.x, t.wrap_s) * w as f64 - 0.5;
-        let v = wrap(uv.y, t.wrap_t) * h as f64 - 0.5;
+        let u = uv.x * w as f64 - 0.5;
+        let v = uv.y * h as f64 - 0.5;
         let (x0, y0) = (u.floor(), v.floor());
         let (fx, fy) = (u - x0, v - y0);
         let texel = |x: i64, y: i64| {
-            let x = match t.wrap_s {
-                hikari_scene::Wrap::ClampToEdge => x.clamp(0, w - 1),
-                _ => x.rem_euclid(w),
-            };
-            let y = match t.wrap_t {
-                hikari_scene::Wrap::ClampToEdge => y.clamp(0, h - 1),
-                _ => y.rem_euclid(h),
-            };
+            let (x, y) = (address(x, w, t.wrap_s), address(y, h, t.wrap_t));
             let i = ((y * w + x) * 4) as usize;
             let c = |k: usize| {
                 let b = t.data[i + k] as f64 / 255.0;

@@ -64,20 +64,24 @@ fn ray_barycentrics(o: vec3<f32>, d: vec3<f32>, p0: vec3<f32>, e1: vec3<f32>, e2
     return vec2<f32>(dot(tv, pv), dot(d, qv)) * inv_det;
 }
 
-// Texture addressing the sampler cannot do per texture: 0 repeat, 1 mirrored, 2 clamp.
-fn wrap_coord(x: f32, mode: u32) -> f32 {
+// Texture addressing the sampler cannot do per texture: 0 repeat, 1 mirrored, 2 clamp. The
+// sampler repeats, so a mirrored or clamped coordinate stays half a texel (`half`, of level 0)
+// inside the edge: there both bilinear taps are the edge texel, as the modes want, and not
+// the opposite edge's. (Coarser mips still reach across in a band 2^level times as wide.)
+fn wrap_coord(x: f32, mode: u32, half: f32) -> f32 {
     if mode == 1u {
         let m = x - 2.0 * floor(x * 0.5);
-        return select(m, 2.0 - m, m > 1.0);
+        return clamp(select(m, 2.0 - m, m > 1.0), half, 1.0 - half);
     }
     if mode == 2u {
-        return clamp(x, 0.0, 1.0);
+        return clamp(x, half, 1.0 - half);
     }
     return x;
 }
 
-fn wrap_uv(uv: vec2<f32>, bits: u32) -> vec2<f32> {
-    return vec2<f32>(wrap_coord(uv.x, bits & 3u), wrap_coord(uv.y, (bits >> 2u) & 3u));
+fn wrap_uv(uv: vec2<f32>, bits: u32, size: vec2<u32>) -> vec2<f32> {
+    let half = 0.5 / vec2<f32>(size);
+    return vec2<f32>(wrap_coord(uv.x, bits & 3u, half.x), wrap_coord(uv.y, (bits >> 2u) & 3u, half.y));
 }
 
 struct UvGrad {
@@ -90,14 +94,14 @@ fn sample_color(layer: u32, wrap: u32, g: UvGrad) -> vec4<f32> {
     if layer == NO_TEXTURE {
         return vec4<f32>(1.0);
     }
-    return textureSampleGrad(color_textures, texture_sampler, wrap_uv(g.uv, wrap), layer, g.ddx, g.ddy);
+    return textureSampleGrad(color_textures, texture_sampler, wrap_uv(g.uv, wrap, textureDimensions(color_textures)), layer, g.ddx, g.ddy);
 }
 
 fn sample_data(layer: u32, wrap: u32, g: UvGrad) -> vec4<f32> {
     if layer == NO_TEXTURE {
         return vec4<f32>(1.0);
     }
-    return textureSampleGrad(data_textures, texture_sampler, wrap_uv(g.uv, wrap), layer, g.ddx, g.ddy);
+    return textureSampleGrad(data_textures, texture_sampler, wrap_uv(g.uv, wrap, textureDimensions(data_textures)), layer, g.ddx, g.ddy);
 }
 
 fn unpack_color(c: vec2<u32>) -> vec4<f32> {

@@ -316,12 +316,12 @@ impl ShadowCache {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-struct CopyParams {
+pub struct CopyParams {
     /// Per region: layer, origin, first texel and end (exclusive) of the window, points
     /// packed as x | y << 16.
-    regions: [[u32; 4]; MAX_VIEWS],
+    pub regions: [[u32; 4]; MAX_VIEWS],
     /// Resolution, regions, 0, 0.
-    config: [u32; 4],
+    pub config: [u32; 4],
 }
 
 /// The technique's pipelines (the drawing itself is the shared rasteriser's).
