@@ -274,6 +274,42 @@ impl Tlas {
         )
     }
 
+    /// [`Tlas::closest_hit`] where a hit on a non-opaque triangle counts only if
+    /// `accept(instance, primitive, u, v)` returns true (see
+    /// [`traverse::closest_hit_filtered`]).
+    pub fn closest_hit_filtered(
+        &self,
+        blases: &[Blas],
+        ray: &Ray,
+        accept: impl FnMut(u32, u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
+        traverse::closest_hit_filtered(
+            &self.nodes,
+            &self.instances,
+            blases,
+            ray,
+            &mut TraversalStacks::default(),
+            accept,
+        )
+    }
+
+    /// [`Tlas::any_hit`] with the filter of [`Tlas::closest_hit_filtered`].
+    pub fn any_hit_filtered(
+        &self,
+        blases: &[Blas],
+        ray: &Ray,
+        accept: impl FnMut(u32, u32, f32, f32) -> bool,
+    ) -> bool {
+        traverse::any_hit_filtered(
+            &self.nodes,
+            &self.instances,
+            blases,
+            ray,
+            &mut TraversalStacks::default(),
+            accept,
+        )
+    }
+
     /// Closest hits for a batch of rays on `threads` threads (0 = all cores), reusing traversal
     /// stacks; what the offline bake uses when no GPU is wanted. Misses are [`Hit::NONE`].
     pub fn closest_hits(&self, blases: &[Blas], rays: &[Ray], threads: usize) -> Vec<Hit> {
