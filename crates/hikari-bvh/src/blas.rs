@@ -1,7 +1,7 @@
 //! Bottom-level acceleration structure: one mesh, object space.
 
 use crate::aabb::Aabb;
-use crate::build_sah::parallel::{collect_pieces, map_dynamic, ranges, split_ranges};
+use crate::build_sah::parallel::{collect_pieces, map_dynamic, ranges, split_ranges, with_threads};
 use crate::build_sah::{self, PrimRef, SahParams};
 use crate::error::BvhError;
 use crate::layout::{Hit, Ray, TRIANGLE_NON_OPAQUE, TriangleRecord, WideNode};
@@ -29,8 +29,9 @@ pub struct BuildOptions {
     pub invalid: BadTriangle,
     /// Most triangles per leaf child (1..=3).
     pub max_leaf: usize,
-    /// Build threads; 0 = all available cores (at most 256 are used). The BVH is the same for
-    /// any count.
+    /// Build threads; 0 = the current rayon pool (the global one unless the caller installed
+    /// another; its size follows `RAYON_NUM_THREADS`), another count gets a pool of that many
+    /// threads for the build (at most 256). The BVH is the same for any count.
     pub threads: usize,
 }
 
@@ -42,14 +43,6 @@ impl Default for BuildOptions {
             max_leaf: 3,
             threads: 0,
         }
-    }
-}
-
-pub(crate) fn thread_count(requested: usize) -> usize {
-    if requested > 0 {
-        requested
-    } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
     }
 }
 
@@ -149,14 +142,28 @@ impl Blas {
                 max: build_sah::MAX_PRIMS,
             });
         }
+        // More threads than this only add start-up and join costs (and an absurd request
+        // could fail to start them all).
+        with_threads(options.threads.min(MAX_BUILD_THREADS), |threads| {
+            Self::build_on(name, positions, indices, non_opaque, options, threads)
+        })
+    }
+
+    /// The build proper, on the current rayon pool split `threads` ways (1 = the calling thread
+    /// alone).
+    fn build_on(
+        name: &str,
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+        non_opaque: Option<&[bool]>,
+        options: &BuildOptions,
+        threads: usize,
+    ) -> Result<Blas, BvhError> {
         let mut stats = BlasStats {
             input_triangles: indices.len(),
             ..Default::default()
         };
         let t_validate = std::time::Instant::now();
-        // More threads than this only add start-up and barrier costs (and an absurd request
-        // could fail to start them all).
-        let threads = thread_count(options.threads).min(MAX_BUILD_THREADS);
         let prims = prim_refs(name, positions, indices, options, threads, &mut stats)?;
         let max_leaf = options.max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
         stats.timings.validate = t_validate.elapsed();

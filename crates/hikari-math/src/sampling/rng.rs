@@ -120,7 +120,7 @@ mod tests {
         let mut b = SplitMix64::new(99);
         for n in [1usize, 2, 3, 7, 1000, 1 << 20] {
             let x = b.next_u64();
-            assert_eq!(a.below(n), ((x >> 32) as u128 * n as u128 >> 32) as usize);
+            assert_eq!(a.below(n), (((x >> 32) as u128 * n as u128) >> 32) as usize);
             let x = b.next_u64();
             assert_eq!(a.below_by_remainder(n), (x % n as u64) as usize);
             let x = b.next_u64();
