@@ -4,7 +4,8 @@
 //! quality and correctness.
 //!
 //! `cargo run --release -p hikari-bvh --example build_terrain [-- --threads N --runs N --rays N]`
-//! (`--rays 0` skips the rays; default 2^20).
+//! (`--rays 0` skips the rays; default 2^20). Without `--threads` the build runs on rayon's
+//! global pool: `RAYON_NUM_THREADS=N` sizes it.
 
 use glam::Vec3;
 use hikari_bvh::rng::SplitMix64;
@@ -75,7 +76,7 @@ fn main() {
     println!(
         "build ({} threads): min {:.1} ms, median {:.1} ms over {} runs",
         if threads == 0 {
-            std::thread::available_parallelism().map_or(1, |n| n.get())
+            rayon::current_num_threads()
         } else {
             threads
         },

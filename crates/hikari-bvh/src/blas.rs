@@ -1,10 +1,10 @@
 //! Bottom-level acceleration structure: one mesh, object space.
 
 use crate::aabb::Aabb;
-use crate::build_sah::parallel::{collect_pieces, map_dynamic, ranges, split_ranges};
+use crate::build_sah::parallel::{collect_pieces, map_dynamic, ranges, split_ranges, with_threads};
 use crate::build_sah::{self, PrimRef, SahParams};
 use crate::error::BvhError;
-use crate::layout::{Hit, Ray, TriangleRecord, WideNode};
+use crate::layout::{Hit, Ray, TRIANGLE_NON_OPAQUE, TriangleRecord, WideNode};
 use crate::traverse::Stack;
 use crate::triangle::is_degenerate;
 use crate::wide;
@@ -29,8 +29,9 @@ pub struct BuildOptions {
     pub invalid: BadTriangle,
     /// Most triangles per leaf child (1..=3).
     pub max_leaf: usize,
-    /// Build threads; 0 = all available cores (at most 256 are used). The BVH is the same for
-    /// any count.
+    /// Build threads; 0 = the current rayon pool (the global one unless the caller installed
+    /// another; its size follows `RAYON_NUM_THREADS`), another count gets a pool of that many
+    /// threads for the build (at most 256). The BVH is the same for any count.
     pub threads: usize,
 }
 
@@ -42,14 +43,6 @@ impl Default for BuildOptions {
             max_leaf: 3,
             threads: 0,
         }
-    }
-}
-
-pub(crate) fn thread_count(requested: usize) -> usize {
-    if requested > 0 {
-        requested
-    } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
     }
 }
 
@@ -100,11 +93,43 @@ pub struct Blas {
 }
 
 impl Blas {
-    /// Builds a BLAS from an indexed triangle mesh. `name` appears in every error message.
+    /// Builds a BLAS from an indexed triangle mesh, every triangle opaque. `name` appears in
+    /// every error message.
     pub fn build(
         name: &str,
         positions: &[Vec3],
         indices: &[[u32; 3]],
+        options: &BuildOptions,
+    ) -> Result<Blas, BvhError> {
+        Self::build_inner(name, positions, indices, None, options)
+    }
+
+    /// [`Blas::build`] with triangles that can be cut out: `non_opaque[t]` marks triangle `t`
+    /// of `indices` (alpha-tested materials, glTF `alphaMode: MASK`). Hits on marked triangles
+    /// go through the filter of the `*_filtered` traversals (and `bvh_accept_candidate` on the
+    /// GPU); the tree itself is the same as without marks.
+    pub fn build_with_opacity(
+        name: &str,
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+        non_opaque: &[bool],
+        options: &BuildOptions,
+    ) -> Result<Blas, BvhError> {
+        if non_opaque.len() != indices.len() {
+            return Err(BvhError::OpacityCount {
+                mesh: name.into(),
+                flags: non_opaque.len(),
+                triangles: indices.len(),
+            });
+        }
+        Self::build_inner(name, positions, indices, Some(non_opaque), options)
+    }
+
+    fn build_inner(
+        name: &str,
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+        non_opaque: Option<&[bool]>,
         options: &BuildOptions,
     ) -> Result<Blas, BvhError> {
         if indices.is_empty() {
@@ -117,14 +142,28 @@ impl Blas {
                 max: build_sah::MAX_PRIMS,
             });
         }
+        // More threads than this only add start-up and join costs (and an absurd request
+        // could fail to start them all).
+        with_threads(options.threads.min(MAX_BUILD_THREADS), |threads| {
+            Self::build_on(name, positions, indices, non_opaque, options, threads)
+        })
+    }
+
+    /// The build proper, on the current rayon pool split `threads` ways (1 = the calling thread
+    /// alone).
+    fn build_on(
+        name: &str,
+        positions: &[Vec3],
+        indices: &[[u32; 3]],
+        non_opaque: Option<&[bool]>,
+        options: &BuildOptions,
+        threads: usize,
+    ) -> Result<Blas, BvhError> {
         let mut stats = BlasStats {
             input_triangles: indices.len(),
             ..Default::default()
         };
         let t_validate = std::time::Instant::now();
-        // More threads than this only add start-up and barrier costs (and an absurd request
-        // could fail to start them all).
-        let threads = thread_count(options.threads).min(MAX_BUILD_THREADS);
         let prims = prim_refs(name, positions, indices, options, threads, &mut stats)?;
         let max_leaf = options.max_leaf.clamp(1, crate::layout::MAX_LEAF_TRIANGLES);
         stats.timings.validate = t_validate.elapsed();
@@ -157,7 +196,10 @@ impl Blas {
                     v0: positions[tri[0] as usize].into(),
                     primitive: id,
                     v1: positions[tri[1] as usize].into(),
-                    _pad1: 0,
+                    flags: match non_opaque {
+                        Some(marks) if marks[id as usize] => TRIANGLE_NON_OPAQUE,
+                        _ => 0,
+                    },
                     v2: positions[tri[2] as usize].into(),
                     _pad2: 0,
                 };
@@ -203,6 +245,39 @@ impl Blas {
 
     pub fn occluded_with(&self, ray: &Ray, stack: &mut Stack) -> bool {
         crate::traverse::any_hit_blas(&self.nodes, &self.triangles, ray, stack)
+    }
+
+    /// [`Blas::intersect`] where a hit on a non-opaque triangle (see
+    /// [`Blas::build_with_opacity`]) counts only if `accept(0, primitive, u, v)` returns true.
+    pub fn intersect_filtered(
+        &self,
+        ray: &Ray,
+        accept: impl FnMut(u32, u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
+        crate::traverse::closest_hit_blas_filtered(
+            &self.nodes,
+            &self.triangles,
+            ray,
+            0,
+            &mut Stack::default(),
+            accept,
+        )
+    }
+
+    /// [`Blas::occluded`] with the filter of [`Blas::intersect_filtered`].
+    pub fn occluded_filtered(
+        &self,
+        ray: &Ray,
+        accept: impl FnMut(u32, u32, f32, f32) -> bool,
+    ) -> bool {
+        crate::traverse::any_hit_blas_filtered(
+            &self.nodes,
+            &self.triangles,
+            ray,
+            0,
+            &mut Stack::default(),
+            accept,
+        )
     }
 }
 

@@ -56,6 +56,15 @@ pub enum BvhError {
         got: usize,
     },
 
+    #[error(
+        "mesh '{mesh}': {flags} opacity flags given for {triangles} triangles (one per triangle expected)"
+    )]
+    OpacityCount {
+        mesh: String,
+        flags: usize,
+        triangles: usize,
+    },
+
     #[error("TLAS over {selected} instances: at most {max} are supported")]
     TooManyInstances { selected: usize, max: usize },
 

@@ -155,8 +155,22 @@ pub(crate) fn leaf_meta(offset: u32, count: u32) -> u8 {
     ((unary << 5) | offset) as u8
 }
 
-/// One triangle in leaf order (48 bytes, 3 x vec4): the three vertices, as given, and the index
-/// of the triangle in the source mesh.
+/// `TriangleRecord::flags` bit: hits on this triangle are candidates that a filter may reject
+/// (alpha cut-outs: glTF `alphaMode: MASK`). Clear = opaque, every hit stands. All other bits
+/// are zero.
+pub const TRIANGLE_NON_OPAQUE: u32 = 1;
+
+/// One triangle in leaf order (48 bytes, 3 x vec4): the three vertices, as given, the index of
+/// the triangle in the source mesh and its flags.
+///
+/// | bytes | field       | WGSL (`array<vec4<f32>>`, record `i` at `3 i`) |
+/// |-------|-------------|------------------------------------------------|
+/// | 0-11  | `v0`        | `[3i].xyz`                                     |
+/// | 12-15 | `primitive` | `bitcast<u32>([3i].w)`                         |
+/// | 16-27 | `v1`        | `[3i+1].xyz`                                   |
+/// | 28-31 | `flags`     | `bitcast<u32>([3i+1].w)`, bit 0 = [`TRIANGLE_NON_OPAQUE`] |
+/// | 32-43 | `v2`        | `[3i+2].xyz`                                   |
+/// | 44-47 | `_pad2`     | zero                                           |
 #[repr(C, align(16))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TriangleRecord {
@@ -164,9 +178,19 @@ pub struct TriangleRecord {
     /// Index of the triangle in the mesh's index buffer (what hits report as `primitive`).
     pub primitive: u32,
     pub v1: [f32; 3],
-    pub _pad1: u32,
+    /// [`TRIANGLE_NON_OPAQUE`] or 0 (the word was padding before, so zeroed records are
+    /// opaque).
+    pub flags: u32,
     pub v2: [f32; 3],
     pub _pad2: u32,
+}
+
+impl TriangleRecord {
+    /// True unless the triangle is marked [`TRIANGLE_NON_OPAQUE`].
+    #[inline]
+    pub fn is_opaque(&self) -> bool {
+        self.flags & TRIANGLE_NON_OPAQUE == 0
+    }
 }
 
 /// One TLAS leaf instance (64 bytes, 4 x vec4).
@@ -259,6 +283,9 @@ mod tests {
         assert_eq!(std::mem::offset_of!(WideNode, meta), 24);
         assert_eq!(std::mem::offset_of!(WideNode, lo_x), 32);
         assert_eq!(std::mem::offset_of!(WideNode, hi_z), 72);
+        assert_eq!(std::mem::offset_of!(TriangleRecord, primitive), 12);
+        assert_eq!(std::mem::offset_of!(TriangleRecord, flags), 28);
+        assert_eq!(std::mem::offset_of!(TriangleRecord, _pad2), 44);
     }
 
     #[test]

@@ -233,7 +233,8 @@ pub mod layout;
 pub mod mesh;
 pub mod reference;
 pub mod refit;
-pub mod rng;
+/// The workspace's seeded generator (SplitMix64), re-exported for tests, examples and benches.
+pub use hikari_math::sampling::rng;
 pub mod sah_cost;
 pub mod throttle;
 pub mod tlas;

@@ -58,6 +58,53 @@ pub fn any_hit_mesh(m: &Mesh, ray: &Ray) -> bool {
     })
 }
 
+/// [`closest_hit_mesh`] where a hit on triangle `p` with `non_opaque[p]` counts only if
+/// `accept(primitive, u, v)` says so: every triangle is tested, nothing is skipped by distance.
+pub fn closest_hit_mesh_filtered(
+    m: &Mesh,
+    non_opaque: &[bool],
+    ray: &Ray,
+    mut accept: impl FnMut(u32, f32, f32) -> bool,
+) -> Option<Hit> {
+    let r = PreparedRay::new(ray);
+    let mut best = Hit::NONE;
+    for (p, tri) in m.indices.iter().enumerate() {
+        let Some([a, b, c]) = usable(m, tri) else {
+            continue;
+        };
+        if let Some((t, u, v)) = intersect(&r, a, b, c, ray.t_max)
+            && t < best.t
+            && (!non_opaque[p] || accept(p as u32, u, v))
+        {
+            best = Hit {
+                t,
+                u,
+                v,
+                primitive: p as u32,
+                instance: 0,
+                _pad: [0; 3],
+            };
+        }
+    }
+    best.is_hit().then_some(best)
+}
+
+/// [`any_hit_mesh`] with the filter of [`closest_hit_mesh_filtered`].
+pub fn any_hit_mesh_filtered(
+    m: &Mesh,
+    non_opaque: &[bool],
+    ray: &Ray,
+    mut accept: impl FnMut(u32, f32, f32) -> bool,
+) -> bool {
+    let r = PreparedRay::new(ray);
+    m.indices.iter().enumerate().any(|(p, tri)| {
+        usable(m, tri).is_some_and(|[a, b, c]| {
+            intersect(&r, a, b, c, ray.t_max)
+                .is_some_and(|(_, u, v)| !non_opaque[p] || accept(p as u32, u, v))
+        })
+    })
+}
+
 fn record(inst: &Instance, index: usize) -> Option<InstanceRecord> {
     Some(InstanceRecord {
         world_to_object: world_to_object(&inst.transform)?,

@@ -7,6 +7,7 @@ use crate::error::BvhError;
 use crate::layout::{Hit, InstanceRecord, Ray, TriangleRecord, WideNode};
 use crate::traverse::{self, TraversalStacks};
 use glam::Affine3A;
+use rayon::prelude::*;
 use std::cell::RefCell;
 
 mod instance_cache;
@@ -274,7 +275,44 @@ impl Tlas {
         )
     }
 
-    /// Closest hits for a batch of rays on `threads` threads (0 = all cores), reusing traversal
+    /// [`Tlas::closest_hit`] where a hit on a non-opaque triangle counts only if
+    /// `accept(instance, primitive, u, v)` returns true (see
+    /// [`traverse::closest_hit_filtered`]).
+    pub fn closest_hit_filtered(
+        &self,
+        blases: &[Blas],
+        ray: &Ray,
+        accept: impl FnMut(u32, u32, f32, f32) -> bool,
+    ) -> Option<Hit> {
+        traverse::closest_hit_filtered(
+            &self.nodes,
+            &self.instances,
+            blases,
+            ray,
+            &mut TraversalStacks::default(),
+            accept,
+        )
+    }
+
+    /// [`Tlas::any_hit`] with the filter of [`Tlas::closest_hit_filtered`].
+    pub fn any_hit_filtered(
+        &self,
+        blases: &[Blas],
+        ray: &Ray,
+        accept: impl FnMut(u32, u32, f32, f32) -> bool,
+    ) -> bool {
+        traverse::any_hit_filtered(
+            &self.nodes,
+            &self.instances,
+            blases,
+            ray,
+            &mut TraversalStacks::default(),
+            accept,
+        )
+    }
+
+    /// Closest hits for a batch of rays on `threads` threads (0 = the current rayon pool, see
+    /// [`crate::BuildOptions::threads`]), reusing traversal
     /// stacks; what the offline bake uses when no GPU is wanted. Misses are [`Hit::NONE`].
     pub fn closest_hits(&self, blases: &[Blas], rays: &[Ray], threads: usize) -> Vec<Hit> {
         let mut out = vec![Hit::NONE; rays.len()];
@@ -305,20 +343,26 @@ fn for_each_chunk<T: Send>(
     rays: &[Ray],
     out: &mut [T],
     threads: usize,
-    f: impl Fn(&Ray, &mut T, &mut TraversalStacks) + Sync,
+    f: impl Fn(&Ray, &mut T, &mut TraversalStacks) + Sync + Send,
 ) {
-    let threads = crate::blas::thread_count(threads).max(1);
-    let chunk = rays.len().div_ceil(threads).max(1);
-    std::thread::scope(|scope| {
-        for (rays, out) in rays.chunks(chunk).zip(out.chunks_mut(chunk)) {
-            let f = &f;
-            scope.spawn(move || {
-                let mut stacks = TraversalStacks::default();
+    crate::build_sah::parallel::with_threads(threads, |threads| {
+        if threads <= 1 {
+            let mut stacks = TraversalStacks::default();
+            for (ray, o) in rays.iter().zip(out) {
+                f(ray, o, &mut stacks);
+            }
+            return;
+        }
+        // Enough rays per job that the stacks (reused within one) and the job overhead do not
+        // show, and enough jobs that a slow chunk does not hold up the rest.
+        let chunk = rays.len().div_ceil(8 * threads).clamp(1, 4096);
+        rays.par_chunks(chunk)
+            .zip(out.par_chunks_mut(chunk))
+            .for_each_init(TraversalStacks::default, |stacks, (rays, out)| {
                 for (ray, o) in rays.iter().zip(out) {
-                    f(ray, o, &mut stacks);
+                    f(ray, o, stacks);
                 }
             });
-        }
     });
 }
 

@@ -222,9 +222,19 @@ pub(crate) fn walk<F: FnMut(u32, &mut f32) -> bool>(
     }
 }
 
-/// Closest hit within one BLAS, updating `t_max` and `best`.
+/// The filter of the unfiltered traversals: with it, the opacity test of a candidate hit folds
+/// away, so scenes without cut-outs pay nothing for them.
+#[inline(always)]
+fn accept_all(_instance: u32, _primitive: u32, _u: f32, _v: f32) -> bool {
+    true
+}
+
+/// Closest hit within one BLAS, updating `t_max` and `best`. A hit on a triangle marked
+/// [`crate::layout::TRIANGLE_NON_OPAQUE`] counts only if `accept(instance, primitive, u, v)`
+/// says so; a rejected one leaves `t_max` alone, so the walk goes on past it.
 #[inline]
-pub(crate) fn closest_in_blas(
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn closest_in_blas<F: FnMut(u32, u32, f32, f32) -> bool>(
     nodes: &[WideNode],
     tris: &[TriangleRecord],
     r: &PreparedRay,
@@ -232,10 +242,13 @@ pub(crate) fn closest_in_blas(
     best: &mut Hit,
     instance: u32,
     stack: &mut Stack,
+    accept: &mut F,
 ) {
     walk(nodes, r, t_max, stack, |i, t_max| {
         let tri = &tris[i as usize];
-        if let Some((t, u, v)) = intersect_record(r, tri, *t_max) {
+        if let Some((t, u, v)) = intersect_record(r, tri, *t_max)
+            && (tri.is_opaque() || accept(instance, tri.primitive, u, v))
+        {
             *t_max = t;
             *best = Hit {
                 t,
@@ -250,21 +263,33 @@ pub(crate) fn closest_in_blas(
     });
 }
 
+/// Any accepted hit within one BLAS (see [`closest_in_blas`] for `accept`).
 #[inline]
-pub(crate) fn any_in_blas(
+pub(crate) fn any_in_blas<F: FnMut(u32, u32, f32, f32) -> bool>(
     nodes: &[WideNode],
     tris: &[TriangleRecord],
     r: &PreparedRay,
     t_max: f32,
+    instance: u32,
     stack: &mut Stack,
+    accept: &mut F,
 ) -> bool {
     let mut t = t_max;
     walk(nodes, r, &mut t, stack, |i, t_max| {
-        intersect_record(r, &tris[i as usize], *t_max).is_some()
+        let tri = &tris[i as usize];
+        match intersect_record(r, tri, *t_max) {
+            Some((_, u, v)) => tri.is_opaque() || accept(instance, tri.primitive, u, v),
+            None => false,
+        }
     })
 }
 
 /// Closest hit in one BLAS (object space); hits report `instance`.
+///
+/// Both windings count: there is no back-face culling (GI, AO and shadow rays must see both
+/// sides of a leaf or a wall), so a glTF `doubleSided: false` material matters only to the
+/// rasteriser; a caller that wants single-sided hits can compare the triangle's normal with
+/// the ray direction itself.
 pub fn closest_hit_blas(
     nodes: &[WideNode],
     tris: &[TriangleRecord],
@@ -272,22 +297,59 @@ pub fn closest_hit_blas(
     instance: u32,
     stack: &mut Stack,
 ) -> Option<Hit> {
+    closest_hit_blas_filtered(nodes, tris, ray, instance, stack, accept_all)
+}
+
+/// [`closest_hit_blas`] where hits on non-opaque triangles count only if
+/// `accept(instance, primitive, u, v)` returns true (`u`, `v` the weights of `v1` and `v2`).
+/// `accept` is called for non-opaque triangles only, possibly for candidates that a closer
+/// hit later replaces, and in no particular order.
+pub fn closest_hit_blas_filtered(
+    nodes: &[WideNode],
+    tris: &[TriangleRecord],
+    ray: &Ray,
+    instance: u32,
+    stack: &mut Stack,
+    mut accept: impl FnMut(u32, u32, f32, f32) -> bool,
+) -> Option<Hit> {
     let r = PreparedRay::new(ray);
     let mut t_max = ray.t_max;
     let mut best = Hit::NONE;
-    closest_in_blas(nodes, tris, &r, &mut t_max, &mut best, instance, stack);
+    closest_in_blas(
+        nodes,
+        tris,
+        &r,
+        &mut t_max,
+        &mut best,
+        instance,
+        stack,
+        &mut accept,
+    );
     best.is_hit().then_some(best)
 }
 
-/// True if anything in one BLAS is hit with `t_min < t < t_max`.
+/// True if anything in one BLAS is hit with `t_min < t < t_max` (both windings).
 pub fn any_hit_blas(
     nodes: &[WideNode],
     tris: &[TriangleRecord],
     ray: &Ray,
     stack: &mut Stack,
 ) -> bool {
+    any_hit_blas_filtered(nodes, tris, ray, 0, stack, accept_all)
+}
+
+/// [`any_hit_blas`] where a hit on a non-opaque triangle counts only if `accept` returns true
+/// (see [`closest_hit_blas_filtered`]); `instance` is what `accept` is told.
+pub fn any_hit_blas_filtered(
+    nodes: &[WideNode],
+    tris: &[TriangleRecord],
+    ray: &Ray,
+    instance: u32,
+    stack: &mut Stack,
+    mut accept: impl FnMut(u32, u32, f32, f32) -> bool,
+) -> bool {
     let r = PreparedRay::new(ray);
-    any_in_blas(nodes, tris, &r, ray.t_max, stack)
+    any_in_blas(nodes, tris, &r, ray.t_max, instance, stack, &mut accept)
 }
 
 /// The ray in the instance's object space. Directions are not renormalized, so `t` is shared.
@@ -324,6 +386,19 @@ pub fn closest_hit(
     ray: &Ray,
     stacks: &mut TraversalStacks,
 ) -> Option<Hit> {
+    closest_hit_filtered(tlas_nodes, instances, blases, ray, stacks, accept_all)
+}
+
+/// [`closest_hit`] with a filter for hits on non-opaque triangles, told the instance index (as
+/// hits report it) and the primitive (see [`closest_hit_blas_filtered`]).
+pub fn closest_hit_filtered(
+    tlas_nodes: &[WideNode],
+    instances: &[InstanceRecord],
+    blases: &[crate::Blas],
+    ray: &Ray,
+    stacks: &mut TraversalStacks,
+    mut accept: impl FnMut(u32, u32, f32, f32) -> bool,
+) -> Option<Hit> {
     let r = PreparedRay::new(ray);
     let mut t_max = ray.t_max;
     let mut best = Hit::NONE;
@@ -344,6 +419,7 @@ pub fn closest_hit(
             &mut best,
             inst.instance_index,
             blas,
+            &mut accept,
         );
         false
     });
@@ -358,6 +434,18 @@ pub fn any_hit(
     ray: &Ray,
     stacks: &mut TraversalStacks,
 ) -> bool {
+    any_hit_filtered(tlas_nodes, instances, blases, ray, stacks, accept_all)
+}
+
+/// [`any_hit`] with a filter for hits on non-opaque triangles (see [`closest_hit_filtered`]).
+pub fn any_hit_filtered(
+    tlas_nodes: &[WideNode],
+    instances: &[InstanceRecord],
+    blases: &[crate::Blas],
+    ray: &Ray,
+    stacks: &mut TraversalStacks,
+    mut accept: impl FnMut(u32, u32, f32, f32) -> bool,
+) -> bool {
     let r = PreparedRay::new(ray);
     let mut t_max = ray.t_max;
     let TraversalStacks { tlas, blas } = stacks;
@@ -367,7 +455,15 @@ pub fn any_hit(
             return false;
         };
         let obj = PreparedRay::new(&to_object_space(inst, ray, *t_max));
-        any_in_blas(&b.nodes, &b.triangles, &obj, *t_max, blas)
+        any_in_blas(
+            &b.nodes,
+            &b.triangles,
+            &obj,
+            *t_max,
+            inst.instance_index,
+            blas,
+            &mut accept,
+        )
     })
 }
 

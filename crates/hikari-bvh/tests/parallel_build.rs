@@ -212,3 +212,22 @@ fn parallel_validation_skips_and_keeps_triangle_order() {
         assert_eq!(*s, !bad.contains(&t), "triangle {t}");
     }
 }
+
+#[test]
+fn the_current_rayon_pool_gives_the_same_blas_whatever_its_size() {
+    // `threads: 0` builds on the pool the caller is in (the global one, or one installed).
+    let mesh = Mesh::terrain(160);
+    let one = build(&mesh, 1);
+    for n in [2, 3, 6] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .expect("pool starts");
+        let blas = pool.install(|| build(&mesh, 0));
+        assert_eq!(one.nodes, blas.nodes, "nodes differ on a pool of {n}");
+        assert_eq!(
+            one.triangles, blas.triangles,
+            "triangles differ on a pool of {n}"
+        );
+    }
+}

@@ -127,7 +127,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             hikari_bvh::TriangleRecord,
             "bvh/trace.wgsl",
-            [v0, primitive, v1, _pad1, v2, _pad2]
+            [v0, primitive, v1, flags, v2, _pad2]
         ),
         gpu_layout!(
             hikari_bvh::InstanceRecord,

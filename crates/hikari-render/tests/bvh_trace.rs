@@ -265,6 +265,46 @@ fn random_soups_match_cpu_and_brute_force() {
 }
 
 #[test]
+fn flagged_triangles_with_the_accept_all_filter_trace_like_opaque_ones() {
+    // Until the alpha lookup is wired into bvh_accept_candidate, it accepts every candidate:
+    // non-opaque triangles must then give bit-identical hits, and the flag must not disturb
+    // the records the kernel reads (vertices, primitive).
+    let Some(mut gpu) = Gpu::new() else { return };
+    let mesh = Mesh::random_soup(6, 2000, 10.0, 3.0);
+    let plain = Scene::single(mesh.clone());
+    let marks: Vec<bool> = (0..mesh.indices.len()).map(|i| i % 3 != 0).collect();
+    let mut flagged = Scene::single(mesh.clone());
+    flagged.blases = vec![
+        Blas::build_with_opacity(
+            "flagged",
+            &mesh.positions,
+            &mesh.indices,
+            &marks,
+            &BuildOptions::default(),
+        )
+        .unwrap(),
+    ];
+    flagged.tlas = Tlas::build(&flagged.instances, &[0], &flagged.blases).unwrap();
+    assert!(flagged.blases[0].triangles.iter().any(|t| !t.is_opaque()));
+    let mut rng = SplitMix64::new(61);
+    let rays = random_rays(&mut rng, 1000, 12.0);
+    for (config_name, config) in configs(&gpu.ctx) {
+        let (closest, any) = gpu.trace_with(&plain, &rays, config);
+        let (f_closest, f_any) = gpu.trace_with(&flagged, &rays, config);
+        assert!(closest == f_closest, "{config_name}: closest hits differ");
+        assert!(any == f_any, "{config_name}: any hits differ");
+        let hits = check_hits(
+            &format!("flagged, {config_name}"),
+            &flagged,
+            &rays,
+            &f_closest,
+            &f_any,
+        );
+        assert!(hits > 100, "test rays should hit something ({hits})");
+    }
+}
+
+#[test]
 fn mixed_scale_soup_matches() {
     // Tiny triangles next to long slivers: wide boxes beside small ones stress quantization.
     let Some(mut gpu) = Gpu::new() else { return };

@@ -1,55 +1,46 @@
-//! Fork-join helpers on scoped std threads, shared by the build phases (primitive boxes, binary
-//! build, collapse, triangle records). Each call starts its threads afresh (tens of microseconds
-//! for 16 threads), which a build of a million triangles does only a handful of times.
+//! Fork-join helpers on rayon, shared by the build phases (primitive boxes, binary build,
+//! collapse, triangle records). They run on the current rayon pool (the global one, sized by
+//! `RAYON_NUM_THREADS` or `rayon::ThreadPoolBuilder::build_global`, unless a caller installed
+//! another), so a build started from a rayon task shares its threads instead of starting more.
 
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use std::ops::Range;
 
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+/// Runs `f(threads)` where the build helpers see `threads` threads: 0 asks for the current
+/// rayon pool, whatever its size; a count other than the pool's gets a pool of its own for
+/// this call (1 runs on the calling thread alone). Returns what `f` returns.
+pub(crate) fn with_threads<R: Send>(requested: usize, f: impl FnOnce(usize) -> R + Send) -> R {
+    let current = rayon::current_num_threads();
+    if requested == 0 || requested == current {
+        return f(current);
+    }
+    if requested == 1 {
+        return f(1);
+    }
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(requested)
+        .build()
+    {
+        Ok(pool) => pool.install(|| f(requested)),
+        // The threads could not be started: the current pool builds the same tree.
+        Err(_) => f(current),
+    }
+}
 
-/// Calls `f` on every item on up to `threads` threads, the calling thread being one of them,
-/// and returns the results in item order. Items are taken in order from a shared counter, so
+/// Calls `f` on every item on the current rayon pool (on the calling thread alone if
+/// `threads` is 1) and returns the results in item order. Every item is a job of its own, so
 /// callers put the largest first for balance; which thread ran an item never shows in the
 /// result.
 pub(crate) fn map_dynamic<T: Send, R: Send>(
     threads: usize,
     items: Vec<T>,
-    f: impl Fn(T) -> R + Sync,
+    f: impl Fn(T) -> R + Sync + Send,
 ) -> Vec<R> {
-    let n = items.len();
-    let threads = threads.clamp(1, n.max(1));
-    if threads == 1 {
+    if threads <= 1 || items.len() <= 1 {
         return items.into_iter().map(f).collect();
     }
-    let slots: Vec<Mutex<Option<T>>> = items.into_iter().map(|t| Mutex::new(Some(t))).collect();
-    let next = AtomicUsize::new(0);
-    let work = || {
-        let mut out = Vec::new();
-        loop {
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            if i >= n {
-                return out;
-            }
-            // Every index is handed out once, so the slot is always full and never contended.
-            let item = slots[i]
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .take()
-                .expect("each work item is taken once");
-            out.push((i, f(item)));
-        }
-    };
-    let mut all: Vec<(usize, R)> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
-        let mut all = work();
-        for h in handles {
-            all.extend(h.join().expect("BVH build thread panicked"));
-        }
-        all
-    });
-    all.sort_unstable_by_key(|r| r.0);
-    all.into_iter().map(|r| r.1).collect()
+    items.into_par_iter().with_max_len(1).map(f).collect()
 }
 
 /// [`map_dynamic`] handing out the items of largest `weight` first (ties in item order), so that
@@ -58,7 +49,7 @@ pub(crate) fn map_largest_first<T: Send, R: Send>(
     threads: usize,
     items: Vec<T>,
     weight: impl Fn(&T) -> usize,
-    f: impl Fn(T) -> R + Sync,
+    f: impl Fn(T) -> R + Sync + Send,
 ) -> Vec<R> {
     let mut order: Vec<usize> = (0..items.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse(weight(&items[i])));
@@ -87,7 +78,7 @@ pub(crate) fn collect_pieces<T: Send, I: Iterator<Item = T>>(
     threads: usize,
     len: usize,
     pieces: &[Range<usize>],
-    fill: impl Fn(usize) -> I + Sync,
+    fill: impl Fn(usize) -> I + Sync + Send,
 ) -> Vec<T> {
     let mut covered = 0;
     for r in pieces {

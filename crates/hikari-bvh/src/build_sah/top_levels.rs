@@ -3,13 +3,13 @@
 //! Building the top on one thread and only then handing subtrees to threads leaves the other
 //! threads idle through the largest nodes: for a million triangles, the first six or so levels
 //! each touch every primitive. Here each level's primitives (all nodes of the level, end to
-//! end) are cut into one contiguous share per thread. A level takes three steps, separated by
-//! barriers:
+//! end) are cut into one contiguous share per thread. A level takes three steps, the first two
+//! parallel over the shares (rayon fork-join, so every step sees the previous one complete):
 //!
-//! 1. every thread bins its shares, one set of bins per share;
-//! 2. every thread merges the bins of the nodes its shares belong to, picks the same SAH split
-//!    as a single thread would (the merge is exact), and scatters its shares into the other
-//!    buffer: the left and right counts of earlier shares, read off their bins, say where its
+//! 1. every share is binned, one set of bins per piece (a share's part of one node);
+//! 2. every share merges the bins of the nodes its pieces belong to, picks the same SAH split
+//!    as a single thread would (the merge is exact), and scatters its pieces into the other
+//!    buffer: the left and right counts of earlier pieces, read off their bins, say where its
 //!    primitives go, so the result is exactly the stable partition of the whole node;
 //! 3. the calling thread appends the children and plans the next level. Nodes of at most
 //!    `threshold` primitives leave the level loop as subtrees for [`super::build`] to finish.
@@ -23,8 +23,9 @@ use super::{
 };
 use crate::aabb::Aabb;
 use glam::Vec3A;
+use rayon::prelude::*;
 use std::ops::Range;
-use std::sync::{Barrier, OnceLock, RwLock};
+use std::sync::OnceLock;
 
 /// A node left for a single thread to finish.
 #[derive(Clone, Copy)]
@@ -133,11 +134,11 @@ impl Level {
     }
 }
 
-/// The two primitive buffers, shared by all threads of a level.
+/// One of the two primitive buffers, shared by all shares of a level.
 ///
-/// Within one step of a level the threads read the source buffer and write disjoint ranges of
+/// Within one step of a level the shares read the source buffer and write disjoint ranges of
 /// the destination (the stable partition's prefix counts give every share its own output
-/// ranges); a barrier separates the steps. Plain slices cannot express "disjoint ranges decided
+/// ranges); the steps are separate parallel calls. Plain slices cannot express "disjoint ranges decided
 /// at run time by other threads", hence the raw pointer.
 #[derive(Clone, Copy)]
 struct SharedPrims {
@@ -176,25 +177,6 @@ impl SharedPrims {
     }
 }
 
-struct Shared {
-    prims: SharedPrims,
-    scratch: SharedPrims,
-    barrier: Barrier,
-    level: RwLock<Level>,
-    threads: usize,
-}
-
-impl Shared {
-    /// (source, destination) of the current level.
-    fn buffers(&self, src_in_scratch: bool) -> (SharedPrims, SharedPrims) {
-        if src_in_scratch {
-            (self.scratch, self.prims)
-        } else {
-            (self.prims, self.scratch)
-        }
-    }
-}
-
 /// What only the calling thread touches: the node array and the finished subtrees.
 struct Leader<'a> {
     nodes: &'a mut Vec<BinNode>,
@@ -202,9 +184,9 @@ struct Leader<'a> {
     threshold: usize,
 }
 
-/// Splits `root` (all of `prims`, node 0 of `nodes`) level by level on `threads` threads until
-/// every remaining node holds at most `threshold` primitives; returns those nodes. `scratch` is
-/// as long as `prims`.
+/// Splits `root` (all of `prims`, node 0 of `nodes`) level by level, in `threads` shares per
+/// level run on the current rayon pool, until every remaining node holds at most `threshold`
+/// primitives; returns those nodes. `scratch` is as long as `prims`.
 pub(super) fn split(
     prims: &mut [PrimRef],
     scratch: &mut [PrimRef],
@@ -220,75 +202,72 @@ pub(super) fn split(
             in_scratch: false,
         }];
     }
-    let shared = Shared {
-        prims: SharedPrims::new(prims),
-        scratch: SharedPrims::new(scratch),
-        barrier: Barrier::new(threads),
-        level: RwLock::new(Level::new(vec![root], false, threads)),
-        threads,
-    };
+    let prims = SharedPrims::new(prims);
+    let scratch = SharedPrims::new(scratch);
     let mut leader = Leader {
         nodes,
         subtrees: Vec::new(),
         threshold,
     };
-    std::thread::scope(|scope| {
-        for t in 1..threads {
-            let shared = &shared;
-            scope.spawn(move || worker(t, shared, None));
-        }
-        worker(0, &shared, Some(&mut leader));
-    });
+    let mut level = Level::new(vec![root], false, threads);
+    while !level.tasks.is_empty() {
+        let (src, dst) = if level.src_in_scratch {
+            (scratch, prims)
+        } else {
+            (prims, scratch)
+        };
+        for_each_share(threads, |t| bin_share(&level, t, src));
+        for_each_share(threads, |t| scatter_share(&level, t, src, dst));
+        level = next_level(&level, &mut leader, threads);
+    }
     leader.subtrees
 }
 
-fn worker(t: usize, shared: &Shared, mut leader: Option<&mut Leader>) {
-    loop {
-        // The level is planned.
-        shared.barrier.wait();
-        let level = shared.level.read().unwrap_or_else(|e| e.into_inner());
-        if level.tasks.is_empty() {
-            return;
-        }
-        let (src, dst) = shared.buffers(level.src_in_scratch);
-        let mine = level.thread_start[t]..level.thread_start[t + 1];
-        for q in mine.clone() {
-            let p = &level.pieces[q];
-            let task = &level.tasks[p.node];
-            let k = bin_scale(&task.cbounds, BINS);
-            // SAFETY: nobody writes the source buffer in this step.
-            let ps = unsafe { src.get(p.range.clone()) };
-            let _ = level.bins[q].set(Bins::accumulate(ps, task.cbounds.min, k));
-        }
-        // All pieces are binned.
-        shared.barrier.wait();
-        for q in mine {
-            let j = level.pieces[q].node;
-            match level.splits[j].get_or_init(|| level.decide(j)) {
-                Some(s) => scatter(&level, q, s, src, dst),
-                None if q == level.node_start[j] => {
-                    let task = &level.tasks[j];
-                    let r = task.begin..task.end;
-                    // SAFETY: without a split, no other thread touches this node's range in
-                    // either buffer during this step: its other pieces are skipped.
-                    let (from, to) = unsafe { (src.get_mut(r.clone()), dst.get_mut(r)) };
-                    let (mid, lb, rb, lcb, rcb) = median_split(from, &task.cbounds);
-                    to.copy_from_slice(from);
-                    let _ = level.medians[j].set(Median {
-                        mid,
-                        boxes: [lb, rb],
-                        cbounds: [lcb, rcb],
-                    });
-                }
-                None => {}
+/// `f(t)` for every share `t` of a level, each its own rayon job (one share per thread, so no
+/// finer split is worth it).
+fn for_each_share(threads: usize, f: impl Fn(usize) + Sync + Send) {
+    if threads == 1 {
+        f(0);
+    } else {
+        (0..threads).into_par_iter().with_max_len(1).for_each(f);
+    }
+}
+
+/// Step 1: bins every piece of share `t`.
+fn bin_share(level: &Level, t: usize, src: SharedPrims) {
+    for q in level.thread_start[t]..level.thread_start[t + 1] {
+        let p = &level.pieces[q];
+        let task = &level.tasks[p.node];
+        let k = bin_scale(&task.cbounds, BINS);
+        // SAFETY: nobody writes the source buffer in this step.
+        let ps = unsafe { src.get(p.range.clone()) };
+        let _ = level.bins[q].set(Bins::accumulate(ps, task.cbounds.min, k));
+    }
+}
+
+/// Step 2: decides the splits of the nodes of share `t` (whichever share gets there first) and
+/// scatters its pieces; a node without an SAH split is median-split by the share holding its
+/// first piece.
+fn scatter_share(level: &Level, t: usize, src: SharedPrims, dst: SharedPrims) {
+    for q in level.thread_start[t]..level.thread_start[t + 1] {
+        let j = level.pieces[q].node;
+        match level.splits[j].get_or_init(|| level.decide(j)) {
+            Some(s) => scatter(level, q, s, src, dst),
+            None if q == level.node_start[j] => {
+                let task = &level.tasks[j];
+                let r = task.begin..task.end;
+                // SAFETY: without a split, no other share touches this node's range in either
+                // buffer during this step: its other pieces are skipped.
+                let (from, to) = unsafe { (src.get_mut(r.clone()), dst.get_mut(r)) };
+                let (mid, lb, rb, lcb, rcb) = median_split(from, &task.cbounds);
+                to.copy_from_slice(from);
+                let _ = level.medians[j].set(Median {
+                    mid,
+                    boxes: [lb, rb],
+                    cbounds: [lcb, rcb],
+                });
             }
-        }
-        drop(level);
-        // All pieces are scattered.
-        shared.barrier.wait();
-        if let Some(leader) = leader.as_deref_mut() {
-            let mut level = shared.level.write().unwrap_or_else(|e| e.into_inner());
-            *level = next_level(&level, leader, shared.threads);
+            None => {}
         }
     }
 }

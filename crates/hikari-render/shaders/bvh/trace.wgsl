@@ -18,7 +18,7 @@ struct TriangleRecord {
     v0: vec3<f32>,
     primitive: u32,
     v1: vec3<f32>,
-    _pad1: u32,
+    flags: u32,
     v2: vec3<f32>,
     _pad2: u32,
 }

@@ -371,6 +371,21 @@ fn bvh_result() -> Hit {
     return h;
 }
 
+// TriangleRecord.flags (the w of a record's second vec4) bit: hits on the triangle are
+// candidates for bvh_accept_candidate (alpha cut-outs, glTF alphaMode MASK).
+const BVH_TRIANGLE_NON_OPAQUE: u32 = 1u;
+
+// Whether a candidate hit on a non-opaque triangle counts: `instance` is the instance index
+// as hits report it, `primitive` the triangle's index in its mesh, `u`, `v` the weights of v1
+// and v2. Called only for triangles flagged BVH_TRIANGLE_NON_OPAQUE; a rejected candidate is
+// skipped and the walk goes on (closest and any hit alike).
+// TODO(lead): wire the alpha texture lookup in here (material of the instance's primitive, UV
+// from u and v, compare with the alpha cutoff). Until then every candidate is accepted, which
+// traces flagged triangles exactly like opaque ones.
+fn bvh_accept_candidate(instance: u32, primitive: u32, u: f32, v: f32) -> bool {
+    return true;
+}
+
 // One iteration of the walk: the next node of the current group (unless primitives are
 // pending), then the primitives it hit (the next BVH_TRIANGLES_PER_STEP triangles of a BLAS
 // leaf, or entering one instance of a TLAS leaf), then a pop when the group is used up. An
@@ -423,7 +438,10 @@ fn bvh_step(stop_at_first: bool) -> bool {
                 let w1 = bvh_triangles[i + 1u];
                 let w2 = bvh_triangles[i + 2u];
                 let h = bvh_intersect_triangle(bvh_w.r, w0.xyz, w1.xyz, w2.xyz, bvh_w.t_min, bvh_w.t_max);
-                if h.hit {
+                // `||` short-circuits: an opaque triangle's hit pays one test of a word already
+                // loaded, and only flagged triangles call the filter.
+                if h.hit && ((bitcast<u32>(w1.w) & BVH_TRIANGLE_NON_OPAQUE) == 0u
+                    || bvh_accept_candidate(bvh_w.instance, bitcast<u32>(w0.w), h.u, h.v)) {
                     bvh_w.t_max = h.t;
                     bvh_w.hit_u = h.u;
                     bvh_w.hit_v = h.v;

@@ -1,58 +1,48 @@
-//! A tiny deterministic random number generator (SplitMix64, Steele, Lea and Flood 2014) and
-//! a lattice hash for noise. No global state: the same seed gives the same village.
+//! The village's random numbers (the workspace's SplitMix64, from `hikari-math`) and a
+//! lattice hash for noise. No global state: the same seed gives the same village.
 
-/// SplitMix64's output mixing function: a bijection on u64 with good avalanche.
-pub fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
+use hikari_math::sampling::rng::SplitMix64;
+pub use hikari_math::sampling::rng::mix;
 
-const GOLDEN_GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-
+/// The village's view of the workspace generator. Its integers come from the remainder of
+/// all 64 bits, which is what the village was generated with; keeping that keeps every house
+/// and tree where it was.
 #[derive(Clone, Debug)]
-pub struct Rng(u64);
+pub struct Rng(SplitMix64);
 
 impl Rng {
     /// An independent stream for one part of the village (`label`), so that changing how
     /// many numbers one part draws does not reshuffle the others.
     pub fn stream(seed: u64, label: &str) -> Rng {
-        let h = label.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-            (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
-        });
-        Rng(mix(seed ^ mix(h)))
+        Rng(SplitMix64::stream(seed, label))
     }
 
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(GOLDEN_GAMMA);
-        mix(self.0)
+        self.0.next_u64()
     }
 
     /// Uniform in [0, 1), 24 random bits.
     pub fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+        self.0.next_f32()
     }
 
     /// Uniform in [lo, hi).
     pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
+        self.0.range(lo, hi)
     }
 
     /// Uniform in [-r, r).
     pub fn signed(&mut self, r: f32) -> f32 {
-        self.range(-r, r)
+        self.0.signed(r)
     }
 
     /// Uniform integer in 0..n (n > 0; 0 gives 0).
     pub fn below(&mut self, n: usize) -> usize {
-        if n == 0 {
-            return 0;
-        }
-        (self.next_u64() % n as u64) as usize
+        self.0.below_by_remainder(n)
     }
 
     pub fn chance(&mut self, p: f32) -> bool {
-        self.unit() < p
+        self.0.chance(p)
     }
 }
 
@@ -69,7 +59,7 @@ mod tests {
     #[test]
     fn splitmix_matches_the_reference_sequence() {
         // SplitMix64 from seed 1234567 (reference values of Vigna's splitmix64.c).
-        let mut r = Rng(1234567);
+        let mut r = Rng(SplitMix64::new(1234567));
         let want = [
             6457827717110365317u64,
             3203168211198807973,
