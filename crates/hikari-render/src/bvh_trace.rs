@@ -32,7 +32,7 @@ use wgpu::util::DeviceExt;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::graph::{Buf, FrameGraph};
+use crate::graph::{BindingSet, Buf, FrameGraph};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
 
@@ -258,13 +258,26 @@ impl Kernels {
     }
 }
 
-/// The four BVH buffers of a frame, in binding order (`@binding(0..4)` of `hikari::bvh`).
+/// The four BVH buffers of a frame, in binding order of the binding set `bvh` of
+/// `hikari::bvh`.
 #[derive(Clone, Copy, Debug)]
 pub struct BvhBuffers {
     pub blas_nodes: Buf,
     pub triangles: Buf,
     pub tlas_nodes: Buf,
     pub instances: Buf,
+}
+
+impl BvhBuffers {
+    /// The binding set `bvh`, for any pass whose shader imports `hikari::bvh`.
+    pub fn binding_set(&self, g: &mut FrameGraph<'_>) -> BindingSet {
+        g.binding_set("bvh")
+            .read(self.blas_nodes)
+            .read(self.triangles)
+            .read(self.tlas_nodes)
+            .read(self.instances)
+            .finish()
+    }
 }
 
 /// One GPU buffer that is rewritten in place while the contents fit.
@@ -559,11 +572,9 @@ impl BvhTrace {
         } else {
             self.groups(g.ctx(), count, order)
         };
+        let set = bvh.binding_set(g);
         g.pass(pass)
-            .read(bvh.blas_nodes)
-            .read(bvh.triangles)
-            .read(bvh.tlas_nodes)
-            .read(bvh.instances)
+            .set(set)
             .read(rays)
             .write(hits)
             .constants(&params)

@@ -32,9 +32,9 @@ struct TraceParams {
     pad1: u32,
 }
 
-@group(0) @binding(4) var<storage, read> rays: array<Ray>;
-@group(0) @binding(5) var<storage, read_write> hits: array<Hit>;
-@group(0) @binding(6) var<uniform> params: TraceParams;
+@group(0) @binding(0) var<storage, read> rays: array<Ray>;
+@group(0) @binding(1) var<storage, read_write> hits: array<Hit>;
+@group(0) @binding(2) var<uniform> params: TraceParams;
 
 // `bvh_trace::TraceConfig` chooses these.
 #ifdef TRACE_WORKGROUP_32

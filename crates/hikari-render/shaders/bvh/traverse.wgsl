@@ -6,9 +6,9 @@
 // documented in hikari-bvh's crate docs; every record is read as whole vec4s so that each load
 // is one 128-bit transaction whatever the driver makes of a struct load.
 //
-// A pass that traces binds the four BVH buffers first, @binding(0..4) in the order below
-// (`BvhTrace::import` in hikari-render gives them in that order), and its own resources from
-// @binding(4) on. One ray per invocation: `bvh_closest_hit(ray)`, `bvh_any_hit(ray)`,
+// The four BVH buffers are the binding set `bvh`, in a group of their own
+// (`BvhBuffers::binding_set` in hikari-render makes it); a pass that traces binds it with
+// `.set(...)` beside its own resources in group 0. One ray per invocation: `bvh_closest_hit(ray)`, `bvh_any_hit(ray)`,
 // `bvh_occluded(ray)`. Kernels that trace many rays per invocation (bvh/trace.wgsl) drive the
 // walk themselves: `bvh_begin(ray)`, then `bvh_step` until it returns true, then `bvh_result()`.
 //
@@ -49,13 +49,13 @@ struct InstanceRecord {
 }
 
 // WideNode records, 5 vec4 each, all BLAS concatenated.
-@group(0) @binding(0) var<storage, read> bvh_blas_nodes: array<vec4<u32>>;
+@group(#{BVH_GROUP}) @binding(0) var<storage, read> bvh_blas_nodes: array<vec4<u32>>;
 // TriangleRecords, 3 vec4 each, all BLAS concatenated.
-@group(0) @binding(1) var<storage, read> bvh_triangles: array<vec4<f32>>;
+@group(#{BVH_GROUP}) @binding(1) var<storage, read> bvh_triangles: array<vec4<f32>>;
 // WideNode records of the TLAS; never empty (an empty scene is one node without children).
-@group(0) @binding(2) var<storage, read> bvh_tlas_nodes: array<vec4<u32>>;
+@group(#{BVH_GROUP}) @binding(2) var<storage, read> bvh_tlas_nodes: array<vec4<u32>>;
 // InstanceRecords in TLAS leaf order, 4 vec4 each.
-@group(0) @binding(3) var<storage, read> bvh_instances: array<vec4<f32>>;
+@group(#{BVH_GROUP}) @binding(3) var<storage, read> bvh_instances: array<vec4<f32>>;
 
 const BVH_MISS: u32 = 0xffffffffu;
 // One entry per tree level below the root, TLAS and BLAS together; hikari-render refuses a
