@@ -50,5 +50,23 @@ const NO_TEXTURE: u32 = 0xffffffffu;
 const INSTANCE_DOUBLE_SIDED: u32 = 1u;
 const INSTANCE_OWN_NORMAL_MATRIX: u32 = 2u;
 const INSTANCE_MOVED: u32 = 4u;
+const INSTANCE_ALPHA_TESTED: u32 = 8u;
 const EXTRA_BITANGENT_NEGATIVE: u32 = 0x10000u;
 const EXTRA_HAS_TANGENT: u32 = 0x20000u;
+
+// Texture addressing the sampler cannot do per texture (`MaterialGpu::more_textures` y):
+// 0 repeat, 1 mirrored, 2 clamp.
+fn wrap_coord(x: f32, mode: u32) -> f32 {
+    if mode == 1u {
+        let m = x - 2.0 * floor(x * 0.5);
+        return select(m, 2.0 - m, m > 1.0);
+    }
+    if mode == 2u {
+        return clamp(x, 0.0, 1.0);
+    }
+    return x;
+}
+
+fn wrap_uv(uv: vec2<f32>, bits: u32) -> vec2<f32> {
+    return vec2<f32>(wrap_coord(uv.x, bits & 3u), wrap_coord(uv.y, (bits >> 2u) & 3u));
+}
