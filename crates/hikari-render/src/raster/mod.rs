@@ -288,7 +288,10 @@ impl Rasterizer {
         }
         let depth_only = [("DEPTH_ONLY", ShaderDefValue::Bool(true))];
         let alpha = [("ALPHA_TEST", ShaderDefValue::Bool(true))];
-        let depth_alpha = [depth_only[0].clone(), alpha[0].clone()];
+        let depth_alpha = [
+            ("DEPTH_ONLY", ShaderDefValue::Bool(true)),
+            ("ALPHA_TEST", ShaderDefValue::Bool(true)),
+        ];
         // Without wgpu's runtime checks: 0.02-0.04 ms a frame at 4K (BENCHMARKS.md, session 6).
         let hot = |lib: &mut ShaderLibrary, path: &str, entry: &str, defs: &[_]| {
             // SAFETY: what the raster kernels index, they index in range: chunks below the
