@@ -4,7 +4,10 @@
 //! reads, 16 bytes a vertex), the other vertex attributes (what the resolve reads), indices with
 //! each mesh's base vertex already added, instances, materials, and the chunk table. A chunk is
 //! up to [`CHUNK_TRIANGLES`] consecutive triangles of one instance: the rasteriser runs one
-//! workgroup per chunk, and a pixel's visibility id is `chunk * CHUNK_TRIANGLES + lane`.
+//! workgroup per chunk, and a pixel's visibility id is `chunk * CHUNK_TRIANGLES + lane`. The
+//! chunks of alpha-tested instances (cut-outs) come after all the others
+//! ([`SceneGpu::first_alpha_chunk`]), so that the rasteriser draws the opaque ones without
+//! looking at alpha and the cut-outs in passes of their own.
 //! Textures go into two 2D arrays, one sRGB (base colour, emissive) and one linear (the rest).
 
 use bytemuck::{Pod, Zeroable};
@@ -64,6 +67,9 @@ pub const INSTANCE_DOUBLE_SIDED: u32 = 1;
 pub const INSTANCE_OWN_NORMAL_MATRIX: u32 = 2;
 /// `prev_model` differs from `model` (otherwise the resolve does not load it).
 pub const INSTANCE_MOVED: u32 = 4;
+/// The material is a cut-out (a positive `MaterialGpu::extra` z, its alpha cut-off): its chunks
+/// are drawn by the rasteriser's alpha-tested passes.
+pub const INSTANCE_ALPHA_TESTED: u32 = 8;
 
 /// Flags of an instance with this model and last frame's model.
 pub fn instance_flags(model: Mat4, prev_model: Mat4, double_sided: bool) -> u32 {
@@ -97,13 +103,15 @@ fn is_rotation_with_uniform_scale(m: Mat3) -> bool {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct MaterialGpu {
-    /// rgb: linear base colour; a: alpha (ignored: every surface is opaque).
+    /// rgb: linear base colour; a: alpha, coverage as `extra` z says.
     pub base_color: [f32; 4],
     /// rgb: emitted luminance in nits; a: normal map scale.
     pub emissive: [f32; 4],
     /// Perceptual roughness, metalness, anisotropy strength, anisotropy rotation (radians).
     pub params: [f32; 4],
-    /// Occlusion strength, interior mask (negative: none, use the vertex's), 0, 0.
+    /// Occlusion strength, interior mask (negative: none, use the vertex's), alpha cut-off (0:
+    /// opaque; else a fragment is drawn where base colour alpha, factor times texture A times
+    /// vertex colour A, is at least it), 0.
     pub extra: [f32; 4],
     /// Texture layers: base colour and emissive in the sRGB array, metallic-roughness and
     /// normal in the linear array; [`NO_TEXTURE`] where absent.
@@ -136,6 +144,8 @@ pub struct SceneGpu {
     pub lights: wgpu::Buffer,
     pub textures: TextureArrays,
     pub chunk_count: u32,
+    /// Chunks from this one on are alpha-tested; `chunk_count` when none is.
+    pub first_alpha_chunk: u32,
     pub light_count: u32,
     pub triangles: u64,
     /// World-space bounds of every instance, `None` for an empty scene.
@@ -153,7 +163,15 @@ pub struct SceneCpu {
     pub instances: Vec<InstanceGpu>,
     pub materials: Vec<MaterialGpu>,
     pub chunks: Vec<Chunk>,
+    /// Chunks from this one on are alpha-tested (see the module doc).
+    pub first_alpha_chunk: u32,
     pub lights: Vec<LightGpu>,
+}
+
+/// The alpha cut-off a material is drawn with: 0 (every fragment kept, as glTF's OPAQUE) or
+/// the cut-off in (0, 1]. A MASK at 0 keeps every fragment too, so it is drawn as opaque.
+pub fn alpha_cutoff(m: &hikari_scene::Material) -> f32 {
+    m.alpha_cutoff().filter(|c| *c > 0.0).unwrap_or(0.0)
 }
 
 /// A point or spot light.
@@ -254,17 +272,29 @@ impl SceneCpu {
                 });
             }
         }
+        // Opaque instances' chunks first, then the cut-outs' (see the module doc).
+        let mut alpha_chunks = Vec::new();
         for (i, inst) in scene.instances.iter().enumerate() {
             let mat = &scene.materials[inst.material];
             let normal = Mat4::from_mat3(Mat3::from_mat4(inst.transform).inverse().transpose());
+            let alpha_tested = alpha_cutoff(mat) > 0.0;
+            let mut flags = instance_flags(inst.transform, inst.transform, mat.double_sided);
+            if alpha_tested {
+                flags |= INSTANCE_ALPHA_TESTED;
+            }
             cpu.instances.push(InstanceGpu {
                 model: inst.transform.to_cols_array_2d(),
                 normal_model: normal.to_cols_array_2d(),
                 prev_model: inst.transform.to_cols_array_2d(),
                 material: inst.material as u32,
-                flags: instance_flags(inst.transform, inst.transform, mat.double_sided),
+                flags,
                 pad: [0; 2],
             });
+            let chunks = if alpha_tested {
+                &mut alpha_chunks
+            } else {
+                &mut cpu.chunks
+            };
             let triangles = scene.meshes[inst.mesh].indices.len() as u32 / 3;
             let first = mesh_first_triangle[inst.mesh];
             let mut t = 0;
@@ -277,7 +307,7 @@ impl SceneCpu {
                     .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
                         (lo.min(p), hi.max(p))
                     });
-                cpu.chunks.push(Chunk {
+                chunks.push(Chunk {
                     instance: i as u32,
                     first_triangle: first + t,
                     count,
@@ -288,6 +318,8 @@ impl SceneCpu {
                 t += count;
             }
         }
+        cpu.first_alpha_chunk = cpu.chunks.len() as u32;
+        cpu.chunks.append(&mut alpha_chunks);
         for m in &scene.materials {
             let slot = |t: &Option<hikari_scene::TextureRef>, array: &[Option<u32>]| {
                 t.map_or((NO_TEXTURE, 0), |r| {
@@ -316,7 +348,12 @@ impl SceneCpu {
                 base_color: m.base_color.extend(m.alpha).to_array(),
                 emissive: m.emissive_nits.extend(m.normal_scale).to_array(),
                 params: [m.roughness, m.metalness, aniso, rotation],
-                extra: [m.occlusion_strength, m.interior.unwrap_or(-1.0), 0.0, 0.0],
+                extra: [
+                    m.occlusion_strength,
+                    m.interior.unwrap_or(-1.0),
+                    alpha_cutoff(m),
+                    0.0,
+                ],
                 textures: [slots[0].0, slots[1].0, slots[2].0, slots[3].0],
                 more_textures: [slots[4].0, wraps, 0, 0],
             });
@@ -362,6 +399,8 @@ pub struct SceneInFrame {
     pub color_textures: Tex,
     pub data_textures: Tex,
     pub chunk_count: u32,
+    /// Chunks from this one on are alpha-tested; `chunk_count` when none is.
+    pub first_alpha_chunk: u32,
     pub light_count: u32,
     pub bounds: Option<(Vec3, Vec3)>,
 }
@@ -379,6 +418,7 @@ impl SceneGpu {
             color_textures: g.import_texture("scene.color_textures", &self.textures.color),
             data_textures: g.import_texture("scene.data_textures", &self.textures.data),
             chunk_count: self.chunk_count,
+            first_alpha_chunk: self.first_alpha_chunk,
             light_count: self.light_count,
             bounds: self.bounds,
         }
@@ -447,6 +487,7 @@ impl SceneGpu {
             lights: buffer("lights", bytemuck::cast_slice(&cpu.lights))?,
             textures,
             chunk_count: cpu.chunks.len() as u32,
+            first_alpha_chunk: cpu.first_alpha_chunk,
             light_count: cpu.lights.len() as u32,
             triangles: scene.triangle_count() as u64,
             bounds,

@@ -28,6 +28,32 @@ fn every_entry_shader_composes_and_validates() {
 }
 
 #[test]
+fn the_rasteriser_variants_compose_and_validate() {
+    // The raster kernels are also built with DEPTH_ONLY (shadow maps) and ALPHA_TEST
+    // (cut-outs), alone and together; the alpha variants bind the scene's attributes,
+    // materials, colour textures and a sampler after the rest (0 to 12, no gaps).
+    use naga_oil::compose::ShaderDefValue::Bool;
+    let caps = shader::required_capabilities();
+    let mut lib = ShaderLibrary::new(caps).expect("modules load");
+    let variants = [
+        vec![("DEPTH_ONLY", Bool(true))],
+        vec![("ALPHA_TEST", Bool(true))],
+        vec![("DEPTH_ONLY", Bool(true)), ("ALPHA_TEST", Bool(true))],
+    ];
+    for defs in &variants {
+        for path in ["raster/triangles.wgsl", "raster/tiles.wgsl"] {
+            let module = lib.module(path, defs).unwrap();
+            shader::validate(path, &module, caps).unwrap();
+            let slots = hikari_render::pipeline::reflect_bindings(path, &module).unwrap();
+            let alpha = defs.iter().any(|(k, _)| *k == "ALPHA_TEST");
+            if alpha {
+                assert_eq!(slots.len(), 13, "{path} {defs:?}");
+            }
+        }
+    }
+}
+
+#[test]
 fn every_wgsl_file_on_disk_is_embedded() {
     // Shared modules under shaders/, each technique's own beside its code under src/; keys
     // as build.rs gives them (src/techniques/x/y.wgsl is x/y.wgsl).

@@ -50,5 +50,27 @@ const NO_TEXTURE: u32 = 0xffffffffu;
 const INSTANCE_DOUBLE_SIDED: u32 = 1u;
 const INSTANCE_OWN_NORMAL_MATRIX: u32 = 2u;
 const INSTANCE_MOVED: u32 = 4u;
+const INSTANCE_ALPHA_TESTED: u32 = 8u;
 const EXTRA_BITANGENT_NEGATIVE: u32 = 0x10000u;
 const EXTRA_HAS_TANGENT: u32 = 0x20000u;
+
+// Texture addressing the sampler cannot do per texture (`MaterialGpu::more_textures` y):
+// 0 repeat, 1 mirrored, 2 clamp. The sampler repeats, so a mirrored or clamped coordinate
+// stays half a texel (`half`, of level 0) inside the edge: there both bilinear taps are the
+// edge texel, as the modes want, and not the opposite edge's. (Coarser mips still reach
+// across in a band 2^level times as wide.)
+fn wrap_coord(x: f32, mode: u32, half: f32) -> f32 {
+    if mode == 1u {
+        let m = x - 2.0 * floor(x * 0.5);
+        return clamp(select(m, 2.0 - m, m > 1.0), half, 1.0 - half);
+    }
+    if mode == 2u {
+        return clamp(x, half, 1.0 - half);
+    }
+    return x;
+}
+
+fn wrap_uv(uv: vec2<f32>, bits: u32, size: vec2<u32>) -> vec2<f32> {
+    let half = 0.5 / vec2<f32>(size);
+    return vec2<f32>(wrap_coord(uv.x, bits & 3u, half.x), wrap_coord(uv.y, (bits >> 2u) & 3u, half.y));
+}

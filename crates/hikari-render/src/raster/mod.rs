@@ -10,6 +10,14 @@
 //! triangles spanning more than 256 tiles are listed whole, with their tile rectangle, for
 //! pass 3 (`{technique}.rasterize_large`), which deals all their tiles to its workgroups in
 //! turn; a workgroup reads the records only of the triangles it draws tiles of.
+//!
+//! Alpha-tested triangles (glTF MASK cut-outs) never enter those three passes: their chunks
+//! come last in the scene's chunk table ([`crate::scene_gpu::SceneGpu::first_alpha_chunk`]),
+//! the three passes stop before them, and two more passes draw them only when the scene has
+//! some: `{technique}.rasterize_alpha` (pass 1 with the alpha test on each fragment; no large
+//! list, every larger triangle is queued tile by tile after the opaque entries) and
+//! `{technique}.rasterize_alpha_tiles` (pass 2 on those entries, with the alpha test). Both are
+//! the same WGSL built with `ALPHA_TEST`, so opaque geometry runs exactly the code it ran before.
 //! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/raster.rs).
 
 use bytemuck::{Pod, Zeroable};
@@ -17,7 +25,7 @@ use glam::Mat4;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::graph::{Buf, FrameGraph, FrameResult};
+use crate::graph::{Buf, FrameGraph, FrameResult, SamplerKind};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
@@ -50,7 +58,7 @@ pub struct RasterParams {
     /// Per view: slice of the target, origin, first pixel and end (exclusive) of the window,
     /// points packed as x | y << 16 (see [`RasterView`]).
     pub views: [[u32; 4]; MAX_VIEWS],
-    /// x: capacity of the triangle records.
+    /// x: capacity of the triangle records; y: the first chunk drawn (alpha-tested passes).
     pub limits: [u32; 4],
 }
 
@@ -145,8 +153,9 @@ pub struct QueueSizes {
 #[derive(Clone, Debug, Default)]
 pub struct RasterQueues {
     sizes: std::collections::HashMap<String, QueueSizes>,
-    /// Tile entries and large triangles the last finished frame queued, per technique.
-    last: std::collections::HashMap<String, [u32; 2]>,
+    /// Tile entries of opaque triangles, large triangles and tile entries of alpha-tested
+    /// triangles the last finished frame queued, per technique.
+    last: std::collections::HashMap<String, [u32; 3]>,
 }
 
 impl RasterQueues {
@@ -168,7 +177,7 @@ impl RasterQueues {
     pub fn workgroups(&self, technique: &str) -> [u32; 2] {
         match self.last.get(technique) {
             None => [TILE_WORKGROUPS; 2],
-            Some(&[entries, large]) => [
+            Some(&[entries, large, _]) => [
                 entries
                     .div_ceil(ENTRIES_PER_TILE_WORKGROUP)
                     .clamp(MIN_TILE_WORKGROUPS, MAX_TILE_WORKGROUPS),
@@ -178,6 +187,17 @@ impl RasterQueues {
                     TILE_WORKGROUPS
                 },
             ],
+        }
+    }
+
+    /// Workgroups of the alpha-tested tile pass of `technique`, as [`RasterQueues::workgroups`]
+    /// for its entries.
+    pub fn alpha_workgroups(&self, technique: &str) -> u32 {
+        match self.last.get(technique) {
+            None => TILE_WORKGROUPS,
+            Some(&[_, _, alpha]) => alpha
+                .div_ceil(ENTRIES_PER_TILE_WORKGROUP)
+                .clamp(MIN_TILE_WORKGROUPS, MAX_TILE_WORKGROUPS),
         }
     }
 
@@ -203,8 +223,12 @@ impl RasterQueues {
                     .get(i * 4..i * 4 + 4)
                     .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
             };
-            let (entries, large, records) = (count(0), count(1), count(2));
-            last.insert(name.clone(), [entries, large]);
+            // Every entry counts in [0]; the alpha-tested ones in [3] as well.
+            let (entries, large, records, alpha) = (count(0), count(1), count(2), count(3));
+            last.insert(
+                name.clone(),
+                [entries - alpha.min(entries), large, alpha.min(entries)],
+            );
             if large as u64 > LARGE_CAPACITY {
                 return Err(RenderError::Limit {
                     what: format!("{name}: triangles covering more than 256 tiles"),
@@ -248,6 +272,9 @@ pub struct Rasterizer {
     /// triangles, tiles, large, window clear
     visibility: [ComputePipeline; 4],
     depth: [ComputePipeline; 4],
+    /// The alpha-tested triangle and tile passes.
+    visibility_alpha: [ComputePipeline; 2],
+    depth_alpha: [ComputePipeline; 2],
 }
 
 impl Rasterizer {
@@ -260,6 +287,11 @@ impl Rasterizer {
             )));
         }
         let depth_only = [("DEPTH_ONLY", ShaderDefValue::Bool(true))];
+        let alpha = [("ALPHA_TEST", ShaderDefValue::Bool(true))];
+        let depth_alpha = [
+            ("DEPTH_ONLY", ShaderDefValue::Bool(true)),
+            ("ALPHA_TEST", ShaderDefValue::Bool(true)),
+        ];
         // Without wgpu's runtime checks: 0.02-0.04 ms a frame at 4K (BENCHMARKS.md, session 6).
         let hot = |lib: &mut ShaderLibrary, path: &str, entry: &str, defs: &[_]| {
             // SAFETY: what the raster kernels index, they index in range: chunks below the
@@ -290,6 +322,16 @@ impl Rasterizer {
                 hot(lib, "raster/tiles.wgsl", "main", &depth_only)?,
                 hot(lib, "raster/tiles.wgsl", "large", &depth_only)?,
                 ComputePipeline::new(ctx, lib, "raster/clear.wgsl", "main", &depth_only)?,
+            ],
+            // With wgpu's runtime checks: they also sample textures and index the attributes,
+            // the materials and the alpha entries, and are not the hot path.
+            visibility_alpha: [
+                ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &alpha)?,
+                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &alpha)?,
+            ],
+            depth_alpha: [
+                ComputePipeline::new(ctx, lib, "raster/triangles.wgsl", "main", &depth_alpha)?,
+                ComputePipeline::new(ctx, lib, "raster/tiles.wgsl", "main", &depth_alpha)?,
             ],
         })
     }
@@ -382,7 +424,8 @@ impl Rasterizer {
                 job.cull_back_faces as u32,
                 capacity,
                 views as u32,
-                scene.chunk_count,
+                // The alpha-tested chunks after these are drawn by their own passes below.
+                scene.first_alpha_chunk,
             ],
             views: view_params,
             limits: [record_capacity, 0, 0, 0],
@@ -411,9 +454,12 @@ impl Rasterizer {
             indices,
             instances,
             chunks,
+            attributes,
+            materials,
+            color_textures,
             ..
         } = *scene;
-        let n = scene.chunk_count.max(1);
+        let n = scene.first_alpha_chunk.max(1);
         let groups = [n.min(max), n.div_ceil(max), 1];
         let [tile_groups, large_groups] = queues.workgroups(t).map(|n| n.min(max));
         // The three passes bind the same resources; they differ in entry point and dispatch.
@@ -442,6 +488,49 @@ impl Rasterizer {
                 pass
             };
             pass.dispatch(pipeline, dispatch)?;
+        }
+        let alpha_chunks = scene.chunk_count - scene.first_alpha_chunk;
+        if alpha_chunks == 0 {
+            return Ok(());
+        }
+        let alpha_params = RasterParams {
+            config: [params.config[0], capacity, views as u32, alpha_chunks],
+            limits: [record_capacity, scene.first_alpha_chunk, 0, 0],
+            ..params
+        };
+        let [alpha_triangles, alpha_tiles] = match kind {
+            RasterTarget::Visibility => &self.visibility_alpha,
+            RasterTarget::Depth => &self.depth_alpha,
+        };
+        let alpha_tile_groups = queues.alpha_workgroups(t).min(max);
+        let stages = [
+            (
+                "rasterize_alpha",
+                [alpha_chunks.min(max), alpha_chunks.div_ceil(max), 1],
+                alpha_triangles,
+            ),
+            (
+                "rasterize_alpha_tiles",
+                [alpha_tile_groups, 1, 1],
+                alpha_tiles,
+            ),
+        ];
+        for (stage, dispatch, pipeline) in stages {
+            g.pass(&format!("{t}.{stage}"))
+                .constants(&alpha_params)
+                .write(target)
+                .write(queue)
+                .write(count)
+                .write(records)
+                .read(positions)
+                .read(indices)
+                .read(instances)
+                .read(chunks)
+                .read(attributes)
+                .read(materials)
+                .read(color_textures)
+                .sampler(SamplerKind::LinearRepeat)
+                .dispatch(pipeline, dispatch)?;
         }
         Ok(())
     }

@@ -10,6 +10,9 @@
 // so neighbours clip a shared edge to the same point.
 
 #import hikari::scene_gpu::{InstanceGpu, Chunk, CHUNK_TRIANGLES, INSTANCE_DOUBLE_SIDED}
+#ifdef ALPHA_TEST
+#import hikari::scene_gpu::{VertexAttr, MaterialGpu, NO_TEXTURE, wrap_uv}
+#endif
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
 #ifdef DEPTH_ONLY
@@ -35,6 +38,14 @@
 @group(0) @binding(6) var<storage, read> indices: array<u32>;
 @group(0) @binding(7) var<storage, read> instances: array<InstanceGpu>;
 @group(0) @binding(8) var<storage, read> chunks: array<Chunk>;
+#ifdef ALPHA_TEST
+// What the alpha test reads besides (ALPHA_TEST variants only, whose tile pass binds 0 to 12
+// too): the base colour's alpha, from the material, the vertex colours and the texture.
+@group(0) @binding(9) var<storage, read> attributes: array<VertexAttr>;
+@group(0) @binding(10) var<storage, read> materials: array<MaterialGpu>;
+@group(0) @binding(11) var color_textures: texture_2d_array<f32>;
+@group(0) @binding(12) var texture_sampler: sampler;
+#endif
 
 // The views one dispatch rasterises into (the camera, or the shadow cascades, whole or the
 // strips a scrolled cascade uncovers).
@@ -50,7 +61,8 @@ struct RasterParams {
     // mod size, sizes powers of two); z, w the first pixel and the end (exclusive) of the
     // window it draws. Points packed as x | y << 16.
     views: array<vec4<u32>, 8>,
-    // x: capacity of `records`.
+    // x: capacity of `records`; y: the first chunk (the alpha-tested passes draw the chunks
+    // from `SceneGpu::first_alpha_chunk` on; the others from 0).
     limits: vec4<u32>,
 }
 
@@ -473,5 +485,88 @@ fn texel_value(depth: f32, id: u32) -> u32 {
 #else
 fn texel_value(depth: f32, id: u32) -> u64 {
     return (u64(bitcast<u32>(depth)) << 32u) | u64(id);
+}
+#endif
+
+#ifdef ALPHA_TEST
+// The alpha test of one triangle in one view (glTF MASK: a fragment is kept where the base
+// colour alpha is at least the material's cut-off).
+//
+// Barycentrics at a pixel come from the triangle's clip-space vertices c_i, not from the
+// records (whose edges are those of the clipped polygon): a point with barycentrics b has
+// clip position sum(b_i c_i), so the pixel's homogeneous NDC n = (x, y, 1) is proportional to
+// A b, where A's columns are the c_i's x, y, w. Hence b is proportional to A^-1 n, whose rows
+// are cross products of A's columns: three dot products a pixel, then a division by their sum
+// (which makes them sum to 1 and removes A's determinant). Perspective-correct, as the
+// resolve's ray intersection, and exact for the orthographic shadow views too (w = 1).
+struct AlphaTri {
+    plane_a: vec3<f32>,
+    plane_b: vec3<f32>,
+    plane_c: vec3<f32>,
+    uv_a: vec2<f32>,
+    uv_b: vec2<f32>,
+    uv_c: vec2<f32>,
+    // Per vertex: material alpha times vertex colour alpha.
+    alpha: vec3<f32>,
+    // Base colour texture layer (NO_TEXTURE: none) and its wrap bits.
+    layer: u32,
+    wrap: u32,
+    cutoff: f32,
+}
+
+fn alpha_tri(id: u32, view: u32) -> AlphaTri {
+    var a: AlphaTri;
+    let chunk = chunks[id / CHUNK_TRIANGLES];
+    let tri = chunk.first_triangle + id % CHUNK_TRIANGLES;
+    let i = vec3<u32>(indices[tri * 3u], indices[tri * 3u + 1u], indices[tri * 3u + 2u]);
+    let m = params.view_proj[view] * instances[chunk.instance].model;
+    let c0 = (m * vec4<f32>(positions[i.x].xyz, 1.0)).xyw;
+    let c1 = (m * vec4<f32>(positions[i.y].xyz, 1.0)).xyw;
+    let c2 = (m * vec4<f32>(positions[i.z].xyz, 1.0)).xyw;
+    a.plane_a = cross(c1, c2);
+    a.plane_b = cross(c2, c0);
+    a.plane_c = cross(c0, c1);
+    let mat = materials[instances[chunk.instance].material];
+    let v0 = attributes[i.x];
+    let v1 = attributes[i.y];
+    let v2 = attributes[i.z];
+    a.uv_a = v0.uv;
+    a.uv_b = v1.uv;
+    a.uv_c = v2.uv;
+    // Vertex colour alpha: the high half of the second word (unorm16x4, RGBA).
+    a.alpha = vec3<f32>(unpack2x16unorm(v0.color.y).y, unpack2x16unorm(v1.color.y).y, unpack2x16unorm(v2.color.y).y) * mat.base_color.a;
+    a.layer = mat.textures.x;
+    a.wrap = mat.more_textures.y & 15u;
+    a.cutoff = mat.extra.z;
+    return a;
+}
+
+// Whether the fragment at pixel `px` passes the alpha test. The texture is read at mip 0:
+// the cut-out's edges are then where the full-resolution texture puts them at any distance
+// (coarser mips average alpha, and thin cut-outs would shrink or vanish with distance), at the
+// price of texture cache misses on distant cut-outs.
+fn alpha_covers(a: AlphaTri, px: vec2<i32>) -> bool {
+    let p = (vec2<f32>(px) + 0.5) * params.viewport.zw;
+    let n = vec3<f32>(p.x * 2.0 - 1.0, 1.0 - p.y * 2.0, 1.0);
+    let b = vec3<f32>(dot(a.plane_a, n), dot(a.plane_b, n), dot(a.plane_c, n));
+    let w = b / (b.x + b.y + b.z);
+    var alpha = dot(a.alpha, w);
+    if a.layer != NO_TEXTURE {
+        let uv = a.uv_a * w.x + a.uv_b * w.y + a.uv_c * w.z;
+        alpha *= textureSampleLevel(color_textures, texture_sampler, wrap_uv(uv, a.wrap, textureDimensions(color_textures)), a.layer, 0.0).a;
+    }
+    // NaN (a pixel centre on a degenerate triangle's edge) fails: no fragment.
+    return alpha >= a.cutoff;
+}
+
+// raster_block_pixel with the alpha test.
+fn raster_block_pixel_alpha(t: TriSetup, rect: PixelRect, corner: vec2<i32>, lane: u32, view: u32, id: u32, a: AlphaTri) {
+    let px = corner + vec2<i32>(vec2<u32>(lane % BLOCK, lane / BLOCK));
+    if all(px >= rect.lo) && all(px <= rect.hi) {
+        let d = tri_depth(t, vec3<f32>(vec2<f32>(px) + 0.5, 1.0));
+        if d > 0.0 && alpha_covers(a, px) {
+            write_pixel(view, px, d, id);
+        }
+    }
 }
 #endif

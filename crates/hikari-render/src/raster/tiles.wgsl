@@ -2,10 +2,20 @@
 // workgroup a tile at a time, workgroups looping over the queue. `large`: the triangles too
 // large to queue tile by tile; every workgroup takes its share of each one's tiles. Both
 // read the triangles' records set up by the triangle pass.
+// ALPHA_TEST (`main` only): the entries of the alpha-tested triangles, which the triangle pass's
+// ALPHA_TEST variant queued after every other entry (it runs after this pass's plain variant):
+// the last queue_count[3] of the queue_count[0] entries. Each entry fetches its triangle again
+// for the alpha test (`alpha_tri`).
 
 #import hikari::raster::setup::{params, queue, queue_count, load_record, raster_tile_tri, raster_block_pixel, block_corner, block_touched, tile_touched_tri, TILE_SIZE, BLOCKS_PER_SIDE, LARGE_CAPACITY}
+#ifdef ALPHA_TEST
+#import hikari::raster::setup::{alpha_tri, raster_block_pixel_alpha}
+#endif
 
 var<workgroup> entry_count: u32;
+#ifdef ALPHA_TEST
+var<workgroup> entry_first: u32;
+#endif
 // Which blocks the current entry touches. Three masks in turn: iteration i sets mask i % 3,
 // reads it after the barrier, and clears mask (i + 1) % 3, whose last readers passed the
 // previous iteration's barrier and whose next writers wait for this one's.
@@ -18,16 +28,30 @@ fn main(
     @builtin(local_invocation_index) lane: u32,
 ) {
     if lane == 0u {
+#ifdef ALPHA_TEST
+        let queued = atomicLoad(&queue_count[0]);
+        entry_first = queued - min(atomicLoad(&queue_count[3]), queued);
+        entry_count = min(queued, params.config.y);
+#else
         entry_count = min(atomicLoad(&queue_count[0]), params.config.y);
+#endif
         for (var k = 0u; k < 3u; k++) {
             atomicStore(&block_masks[k], 0u);
         }
     }
     let count = workgroupUniformLoad(&entry_count);
+#ifdef ALPHA_TEST
+    let first = workgroupUniformLoad(&entry_first);
+#else
+    let first = 0u;
+#endif
     var slot = 0u;
-    for (var e = wg.x; e < count; e += groups.x) {
+    for (var e = first + wg.x; e < count; e += groups.x) {
         let entry = queue[e];
         let r = load_record(entry.x);
+#ifdef ALPHA_TEST
+        let alpha = alpha_tri(r.id, r.view);
+#endif
         let origin = vec2<i32>(vec2<u32>(entry.y & 0xfffu, entry.y >> 12u) * TILE_SIZE);
         let next = (slot + 1u) % 3u;
         if lane == 0u {
@@ -43,7 +67,11 @@ fn main(
         while blocks != 0u {
             let b = firstTrailingBit(blocks);
             blocks &= blocks - 1u;
+#ifdef ALPHA_TEST
+            raster_block_pixel_alpha(r.tri, r.rect, block_corner(origin, b), lane, r.view, r.id, alpha);
+#else
             raster_block_pixel(r.tri, r.rect, block_corner(origin, b), lane, r.view, r.id);
+#endif
         }
     }
 }

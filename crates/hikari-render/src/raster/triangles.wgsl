@@ -2,11 +2,17 @@
 // their thread; larger ones are set up into a record and split into TILE_SIZE tiles queued
 // for `raster/tiles.wgsl` (`main`), and the largest are listed whole for its `large` entry
 // point.
+// ALPHA_TEST: the same for the chunks of cut-outs (from `limits.y` on), with the alpha test on
+// every fragment; their larger triangles all go to the tile queue (none to the large list),
+// counted apart in queue_count[3] as well, for the tile pass's ALPHA_TEST variant.
 // Dispatch: x * y workgroups cover the chunks; each draws its chunk into every view that may
 // see it.
 
 #import hikari::raster::setup::{params, chunks, chunk_corner_outside, queue, queue_count, world_tri, view_poly, WorldTri, poly_rect, view_window, poly_setup, setup_depth, write_pixel_tested, tile_touched_tri, store_record, TILE_SIZE, SMALL_TRIANGLE_PIXELS, LARGE_TRIANGLE_TILES, LARGE_CAPACITY}
 #import hikari::scene_gpu::CHUNK_TRIANGLES
+#ifdef ALPHA_TEST
+#import hikari::raster::setup::{alpha_tri, alpha_covers}
+#endif
 
 // Draws triangle `t` (visibility id `id`) into view `view`: small ones here, larger ones set
 // up into records for the tile and large passes.
@@ -22,10 +28,17 @@ fn draw_triangle(t: WorldTri, id: u32, view: u32) {
     }
     let setup = poly_setup(poly);
     if extent.x * extent.y <= SMALL_TRIANGLE_PIXELS {
+#ifdef ALPHA_TEST
+        let alpha = alpha_tri(id, view);
+#endif
         for (var y = rect.lo.y; y <= rect.hi.y; y++) {
             for (var x = rect.lo.x; x <= rect.hi.x; x++) {
                 let d = setup_depth(setup, vec2<f32>(f32(x), f32(y)) + 0.5);
+#ifdef ALPHA_TEST
+                if d > 0.0 && alpha_covers(alpha, vec2<i32>(x, y)) {
+#else
                 if d > 0.0 {
+#endif
                     write_pixel_tested(view, vec2<i32>(x, y), d, id);
                 }
             }
@@ -35,7 +48,11 @@ fn draw_triangle(t: WorldTri, id: u32, view: u32) {
     let t_lo = vec2<u32>(rect.lo) / TILE_SIZE;
     let t_hi = vec2<u32>(rect.hi) / TILE_SIZE;
     let span = t_hi - t_lo + 1u;
+#ifdef ALPHA_TEST
+    let large = false;
+#else
     let large = span.x * span.y > LARGE_TRIANGLE_TILES;
+#endif
     // A quad left by near clipping becomes two records, each rasterised on its own.
     for (var k = 0u; k < setup.tris; k++) {
         var tri = setup.first;
@@ -75,6 +92,9 @@ fn draw_triangle(t: WorldTri, id: u32, view: u32) {
         }
         store_record(record, tri, id, view, rect);
         let first = atomicAdd(&queue_count[0], touched);
+#ifdef ALPHA_TEST
+        atomicAdd(&queue_count[3], touched);
+#endif
         let capacity = params.config.y;
         var slot = first;
         for (var ty = t_lo.y; ty <= t_hi.y; ty++) {
@@ -98,10 +118,17 @@ fn main(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
+#ifdef ALPHA_TEST
+    let chunk = wg.y * groups.x + wg.x + params.limits.y;
+    if chunk - params.limits.y >= params.config.w {
+        return;
+    }
+#else
     let chunk = wg.y * groups.x + wg.x;
     if chunk >= params.config.w {
         return;
     }
+#endif
     let views = params.config.z;
     if lane < 8u {
         atomicStore(&chunk_outside[lane], 0x1fu);

@@ -5,7 +5,7 @@
 
 #import hikari::view::View
 #import hikari::octahedral::oct_encode
-#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, INSTANCE_OWN_NORMAL_MATRIX, INSTANCE_MOVED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT}
+#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, INSTANCE_OWN_NORMAL_MATRIX, INSTANCE_MOVED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT, wrap_uv}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<storage, read> visibility: array<vec2<u32>>;
@@ -62,26 +62,6 @@ fn ray_barycentrics(o: vec3<f32>, d: vec3<f32>, p0: vec3<f32>, e1: vec3<f32>, e2
     let tv = o - p0;
     let qv = cross(tv, e1);
     return vec2<f32>(dot(tv, pv), dot(d, qv)) * inv_det;
-}
-
-// Texture addressing the sampler cannot do per texture: 0 repeat, 1 mirrored, 2 clamp. The
-// sampler repeats, so a mirrored or clamped coordinate stays half a texel (`half`, of level 0)
-// inside the edge: there both bilinear taps are the edge texel, as the modes want, and not
-// the opposite edge's. (Coarser mips still reach across in a band 2^level times as wide.)
-fn wrap_coord(x: f32, mode: u32, half: f32) -> f32 {
-    if mode == 1u {
-        let m = x - 2.0 * floor(x * 0.5);
-        return clamp(select(m, 2.0 - m, m > 1.0), half, 1.0 - half);
-    }
-    if mode == 2u {
-        return clamp(x, half, 1.0 - half);
-    }
-    return x;
-}
-
-fn wrap_uv(uv: vec2<f32>, bits: u32, size: vec2<u32>) -> vec2<f32> {
-    let half = 0.5 / vec2<f32>(size);
-    return vec2<f32>(wrap_coord(uv.x, bits & 3u, half.x), wrap_coord(uv.y, (bits >> 2u) & 3u, half.y));
 }
 
 struct UvGrad {
