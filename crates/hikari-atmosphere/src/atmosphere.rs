@@ -204,9 +204,21 @@ impl Atmosphere {
             mu_s = s.dot(up);
         }
         let ctx = self.ctx();
+        let tables = &self.tables;
         let (a, b, c) = ctx.scat_uvw(r, mu, mu_s);
-        let ray = self.tables.rayleigh.sample(a, b, c);
-        let mie = self.tables.mie.sample(a, b, c);
+        let all = tables.rayleigh.sample(a, b, c);
+        let single = tables.rayleigh_single.sample(a, b, c);
+        let (single_r, mie) = ctx.single_parts(
+            &tables.transmittance,
+            &tables.rayleigh_single,
+            &tables.mie,
+            &tables.scattering_distance,
+            r,
+            mu,
+            mu_s,
+            nu,
+        );
+        let ray: [f64; 3] = std::array::from_fn(|k| all[k] - single[k] + single_r[k]);
         let (pr, pm) = (
             phase::rayleigh(nu),
             phase::cornette_shanks(nu, self.params.mie_g),

@@ -197,3 +197,33 @@ impl Shell {
         }
     }
 }
+
+impl Shell {
+    /// How far a ray from (`r`, `mu`) travels inside the Earth's shadow before it leaves it, km,
+    /// for a sun of zenith cosine `mu_s` at `nu` (cosine) from the ray: 0 when the start is lit.
+    ///
+    /// The shadow of a point sun is the half cylinder of the ground's radius behind the planet
+    /// (`y·s < 0`, distance to the sun's axis under `bottom`). A ray starting inside it leaves it
+    /// once (the region is convex) through the cylinder's side: above the ground, the plane
+    /// `y·s = 0` lies inside the planet within the cylinder.
+    pub fn shadow_length(&self, r: f64, mu: f64, mu_s: f64, nu: f64) -> f64 {
+        let r2 = self.bottom * self.bottom;
+        // The start x = r·up; its distance² to the sun's axis.
+        let c = r * r * (1.0 - mu_s * mu_s) - r2;
+        if mu_s >= 0.0 || c >= 0.0 {
+            return 0.0;
+        }
+        // |y⊥(t)|² = |x⊥|² + 2t x⊥·v⊥ + t²|v⊥|², with x⊥·v⊥ = r(mu − mu_s nu), |v⊥|² = 1 − nu².
+        let a = (1.0 - nu * nu).max(0.0);
+        let b = r * (mu - mu_s * nu);
+        if a <= 1e-12 {
+            return if b > 0.0 {
+                -c / (2.0 * b)
+            } else {
+                f64::INFINITY
+            };
+        }
+        let t = (-b + (b * b - a * c).max(0.0).sqrt()) / a;
+        t.max(0.0)
+    }
+}
