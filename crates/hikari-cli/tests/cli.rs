@@ -281,6 +281,7 @@ fn bench_frame_names_the_scene_camera_time_and_size_that_ran() {
             "camera": first_camera,
             "camera_from": "the scene's first",
             "time": "07:30",
+            "date": "2024-07-21",
             "width": 64,
             "height": 48,
         })

@@ -1,0 +1,2 @@
+pub mod lights;
+pub mod settings;
