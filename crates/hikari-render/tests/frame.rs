@@ -28,7 +28,10 @@ fn an_overflowing_offline_frame_is_drawn_again_but_counts_once() {
     tiny_queues(&mut renderer);
     for want in 0..3u64 {
         let r = renderer.render(&s, false).unwrap();
-        assert_eq!(r.result.frame, want, "each shown frame steps the index once");
+        assert_eq!(
+            r.result.frame, want,
+            "each shown frame steps the index once"
+        );
     }
     assert_eq!(renderer.runtime.frame_index(), 3);
 }
@@ -54,12 +57,18 @@ fn interactive_frames_run_ahead_and_the_queues_catch_up() {
         let r = renderer
             .render_reading(&s, |out| vec![out.gbuffer.visibility.into()])
             .unwrap();
-        assert_eq!(r.frame, want, "interactive frames are shown as drawn, never redone");
+        assert_eq!(
+            r.frame, want,
+            "interactive frames are shown as drawn, never redone"
+        );
         last = r.buffer("gbuffer.visibility").unwrap().to_vec();
         // Let the GPU finish so the late counts arrive by the next frame or the one after.
         renderer.ctx.wait_idle().unwrap();
     }
     let grown = renderer.raster_queues().sizes("gbuffer", 0);
     assert!(grown.entries > 4, "the queues never grew: {grown:?}");
-    assert!(last == reference, "after the queues grew, frames lose nothing");
+    assert!(
+        last == reference,
+        "after the queues grew, frames lose nothing"
+    );
 }

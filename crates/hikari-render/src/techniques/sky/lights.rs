@@ -79,7 +79,13 @@ pub fn attenuated(p: &AtmosphereParams, cos_zenith: f32, lux: f32) -> Vec3 {
         &p.color_space.to_rec709(),
         std::array::from_fn(|c| t[c] * white[c]),
     );
-    Vec3::from_array(out.map(|v| if v.is_finite() { v.max(0.0) as f32 } else { 0.0 }))
+    Vec3::from_array(out.map(|v| {
+        if v.is_finite() {
+            v.max(0.0) as f32
+        } else {
+            0.0
+        }
+    }))
 }
 
 impl SkyLights {
@@ -88,7 +94,10 @@ impl SkyLights {
         let when = s.date_time()?;
         let place = s.place()?;
         let atmosphere = s.weather()?.atmosphere();
-        Ok(Self::from_ephemeris(&sun_and_moon(&when, &place), &atmosphere))
+        Ok(Self::from_ephemeris(
+            &sun_and_moon(&when, &place),
+            &atmosphere,
+        ))
     }
 
     pub fn from_ephemeris(sm: &SunAndMoon, p: &AtmosphereParams) -> Self {
