@@ -32,6 +32,8 @@ fn snapshot_at(name: &str, scene: &str, camera: Option<&str>, time: Option<&str>
         ))
     });
     let mut settings = Settings::default();
+    // Snapshots of the placeholder-lit frame; the sky has tests of its own (tests/sky.rs).
+    settings.sky.enabled = false;
     // Small maps keep the CPU driver fast; the cascades still cover the view.
     settings.sun_shadows.resolution = 512;
     let s = FrameSettings {

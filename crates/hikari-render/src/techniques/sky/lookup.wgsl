@@ -59,10 +59,14 @@ fn sky_scattering_uv(r: f32, mu: f32) -> vec2<f32> {
     let bottom = sky.shell.x;
     let top = sky.shell.y;
     let h = sky.shell.z;
-    let rho = sqrt(max(r * r - bottom * bottom, 0.0));
+    // (r - bottom)(r + bottom) rather than r^2 - bottom^2: the difference of two squares of
+    // 6360 km would lose most of f32's digits near the ground.
+    let alt = r - bottom;
+    let rho2 = alt * (r + bottom);
+    let rho = sqrt(max(rho2, 0.0));
     let u_r = sky_coord(rho / h, sky.table.z);
     let r_mu = r * mu;
-    let disc = r_mu * r_mu - r * r + bottom * bottom;
+    let disc = r_mu * r_mu - rho2;
     let half_n = sky.table.x * 0.5;
     var u_mu: f32;
     if mu < 0.0 && disc >= 0.0 {
@@ -133,11 +137,12 @@ fn sky_transmittance_working(altitude_km: f32, mu: f32) -> vec3<f32> {
     let top = sky.shell.y;
     let h = sky.shell.z;
     let r = bottom + clamp(altitude_km, 1e-4, top - bottom);
-    if mu < 0.0 && r * r * (mu * mu - 1.0) + bottom * bottom >= 0.0 {
+    let rho2 = (r - bottom) * (r + bottom);
+    if mu < 0.0 && r * r * mu * mu - rho2 >= 0.0 {
         return vec3<f32>(0.0);
     }
-    let rho = sqrt(max(r * r - bottom * bottom, 0.0));
-    let d = max(-r * mu + sqrt(max(r * r * (mu * mu - 1.0) + top * top, 0.0)), 0.0);
+    let rho = sqrt(max(rho2, 0.0));
+    let d = max(-r * mu + sqrt(max(r * r * mu * mu - rho2 + h * h, 0.0)), 0.0);
     let d_min = top - r;
     let d_max = rho + h;
     var x_mu = 0.0;
