@@ -54,8 +54,8 @@ fn render(scene: &hikari_scene::Scene, s: &hikari_render::FrameSettings) -> Rend
 
 fn sh_of(v: &[[f32; 4]]) -> Sh<Vec3, 9> {
     let mut sh = Sh::<Vec3, 9>::zero();
-    for k in 0..9 {
-        sh.coeffs[k] = Vec3::new(v[k][0], v[k][1], v[k][2]);
+    for (c, x) in sh.coeffs.iter_mut().zip(v) {
+        *c = Vec3::new(x[0], x[1], x[2]);
     }
     sh
 }

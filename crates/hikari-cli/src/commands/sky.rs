@@ -50,7 +50,7 @@ const SH_NAMES: [&str; 9] = [
 ];
 
 pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
-    if !(8..=8192).contains(&a.width) || a.width % 2 != 0 {
+    if !(8..=8192).contains(&a.width) || !a.width.is_multiple_of(2) {
         anyhow::bail!("--width {} is outside the range 8 to 8192 (even)", a.width);
     }
     if a.table_quality > 2 {

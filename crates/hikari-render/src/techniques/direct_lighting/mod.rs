@@ -121,6 +121,7 @@ impl DirectLighting {
 
     /// Radiance in nits of every pixel: lit surfaces, or the sky (or the placeholder sky)
     /// where depth is 0.
+    #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,

@@ -153,14 +153,14 @@ impl<'a> SkyTwin<'a> {
             let d = fibonacci_dir(i, SH_SAMPLES);
             let l = self.background_no_disks(d).as_dvec3();
             let y = basis::eval_l2_f64(d.as_dvec3());
-            for k in 0..9 {
-                sum[k] += l * y[k];
+            for (s, yk) in sum.iter_mut().zip(y) {
+                *s += l * yk;
             }
         }
         let w = 4.0 * std::f64::consts::PI / f64::from(SH_SAMPLES);
         let mut raw = Sh::<Vec3, 9>::zero();
-        for k in 0..9 {
-            raw.coeffs[k] = (sum[k] * w).as_vec3();
+        for (c, s) in raw.coeffs.iter_mut().zip(sum) {
+            *c = (s * w).as_vec3();
         }
         let deringed = dering::dering(&raw).sh;
         (raw, deringed)
