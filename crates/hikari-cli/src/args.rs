@@ -22,13 +22,85 @@ pub struct CameraArgs {
     pub camera: Option<String>,
 }
 
-/// `--time`: the time of day.
+/// `--date`, `--time`, `--utc-offset`, `--lat`, `--lon`, `--weather`: when and where the sky
+/// is, and its weather; `--no-sun`, `--no-sky`: lights off for scenes lit by their own lamps.
+/// Each wins over the settings file's `[sky]` table (and `time`).
 #[derive(Args, Debug, Clone, Default)]
-pub struct TimeArgs {
-    /// Time of day, HH:MM: sets the sun (or moon) by a simple model until the atmosphere
-    /// issue [default: the scene's own sun].
+pub struct SkyArgs {
+    /// Local date, YYYY-MM-DD, 1900 to 2100 [default: 2024-07-21].
+    #[arg(long)]
+    pub date: Option<String>,
+    /// Local time, HH:MM or HH:MM:SS, 00:00 to 23:59:59: places the sun and the moon
+    /// [default: 12:00; scenes with their own sun keep it unless --date or --time is given].
     #[arg(long)]
     pub time: Option<String>,
+    /// Hours east of Greenwich of the local time, -14 to 14 [default: 9].
+    #[arg(long, allow_negative_numbers = true)]
+    pub utc_offset: Option<f64>,
+    /// Latitude in degrees, -90 to 90, north positive [default: 34.4, Tsushima].
+    #[arg(long, allow_negative_numbers = true)]
+    pub lat: Option<f64>,
+    /// Longitude in degrees, -180 to 180, east positive [default: 129.3].
+    #[arg(long, allow_negative_numbers = true)]
+    pub lon: Option<f64>,
+    /// Weather: clear, hazy or overcast [default: clear].
+    #[arg(long)]
+    pub weather: Option<String>,
+    /// No directional light (sun or moon).
+    #[arg(long)]
+    pub no_sun: bool,
+    /// No sky light: a black sky and no sky ambient light.
+    #[arg(long)]
+    pub no_sky: bool,
+}
+
+impl SkyArgs {
+    /// Whether a date or time was asked for (which overrides a scene's own sun).
+    pub fn sets_time(&self) -> bool {
+        self.date.is_some() || self.time.is_some()
+    }
+
+    /// Copies the given flags into `s`, checking each: the error names the flag and its
+    /// allowed range.
+    pub fn apply(&self, s: &mut hikari_render::settings::SkySettings) -> anyhow::Result<()> {
+        use anyhow::Context;
+        let check = |s: &hikari_render::settings::SkySettings, flag: &str, value: String| {
+            hikari_render::settings::TechniqueSettings::validate(s, "sky")
+                .map_err(|e| anyhow::anyhow!("{e}"))
+                .with_context(|| format!("{flag} {value}"))
+        };
+        if let Some(d) = &self.date {
+            s.date = d.clone();
+            check(s, "--date", d.clone())?;
+        }
+        if let Some(t) = &self.time {
+            s.time = t.clone();
+            check(s, "--time", t.clone())?;
+        }
+        if let Some(v) = self.utc_offset {
+            s.utc_offset_h = v;
+            check(s, "--utc-offset", v.to_string())?;
+        }
+        if let Some(v) = self.lat {
+            s.latitude_deg = v;
+            check(s, "--lat", v.to_string())?;
+        }
+        if let Some(v) = self.lon {
+            s.longitude_deg = v;
+            check(s, "--lon", v.to_string())?;
+        }
+        if let Some(w) = &self.weather {
+            s.weather = w.clone();
+            check(s, "--weather", w.clone())?;
+        }
+        if self.no_sun {
+            s.sun = false;
+        }
+        if self.no_sky {
+            s.sky = false;
+        }
+        Ok(())
+    }
 }
 
 /// `--width` and `--height`: the image size in pixels.
@@ -84,7 +156,7 @@ pub struct FrameArgs {
     #[command(flatten)]
     pub camera: CameraArgs,
     #[command(flatten)]
-    pub time: TimeArgs,
+    pub sky: SkyArgs,
     #[command(flatten)]
     pub size: SizeArgs,
     #[command(flatten)]

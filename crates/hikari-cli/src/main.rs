@@ -10,7 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{bench_frame, bench_overhead, bench_rays, constants, info, render};
+use commands::{bench_frame, bench_overhead, bench_rays, constants, info, render, sky};
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +27,9 @@ struct Cli {
 enum Command {
     /// Render a scene to a PNG (display) and a linear EXR (radiance in nits).
     Render(render::RenderArgs),
+    /// Write the sky of a date, time, place and weather as an equirectangular EXR (nits) and
+    /// print its L2 SH and the sun and moon.
+    Sky(sky::SkyCommandArgs),
     /// Benchmarks that print per-pass GPU timings.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -66,6 +69,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Sky(args) => sky::run(args),
         Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(args),
         Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),

@@ -131,8 +131,11 @@ pub struct FrameDescription {
     pub source: SceneSource,
     pub camera: String,
     pub camera_origin: CameraOrigin,
-    /// Time of day as `HH:MM`; `None` when the scene's own sun lights it.
+    /// Local time of the sun and sky (`HH:MM`, or `HH:MM:SS`); `None` when the scene's own
+    /// sun (or none) lights it.
     pub time: Option<String>,
+    /// Local date of the sun and sky, `YYYY-MM-DD`, with `time`.
+    pub date: Option<String>,
     /// Pixels.
     pub width: u32,
     pub height: u32,
@@ -142,7 +145,7 @@ impl FrameDescription {
     /// E.g. "scene village (built-in), camera `courtyard` (--camera), time 07:30, 64x64".
     pub fn line(&self) -> String {
         let time = match &self.time {
-            Some(t) => format!("time {t}"),
+            Some(t) => format!("date {}, time {t}", self.date.as_deref().unwrap_or("?")),
             None => "the scene's own sun".to_string(),
         };
         format!(
@@ -163,6 +166,7 @@ impl FrameDescription {
             "camera": self.camera,
             "camera_from": self.camera_origin.describe(),
             "time": self.time,
+            "date": self.date,
             "width": self.width,
             "height": self.height,
         })
@@ -176,10 +180,64 @@ pub struct ResolvedFrame {
     pub description: FrameDescription,
 }
 
-/// `HH:MM` of `hours` in [0, 24).
-fn format_hours(hours: f32) -> String {
-    let minutes = (hours * 60.0).round() as u32 % (24 * 60);
-    format!("{:02}:{:02}", minutes / 60, minutes % 60)
+/// Which light a scene gets, and the time it shows (`None`: the scene's own sun).
+///
+/// * A date or time given (flags, the file's `time` or `[sky]` date/time other than the
+///   defaults): the sun or moon of that instant, whatever the scene.
+/// * Else a scene that brings its own sun (a glTF directional light, or a built-in scene
+///   other than the village) keeps it; the sky follows that sun's direction.
+/// * Else a scene with no sun at all (the Cornell box) gets no sun and no sky light.
+/// * Else (the village, a glTF without lights) the sun or moon of the default instant.
+///
+/// `--no-sun` (`sky.sun = false`) always removes the directional light.
+fn is_default_sun(s: &hikari_scene::Sun) -> bool {
+    let d = hikari_scene::Sun::default();
+    s.direction == d.direction && s.illuminance_lux == d.illuminance_lux && s.color == d.color
+}
+
+fn choose_light(
+    source: &SceneSource,
+    scene: &Scene,
+    settings: &mut hikari_render::Settings,
+    args: &FrameArgs,
+    file: &crate::config::ConfigFile,
+) -> anyhow::Result<(Option<hikari_scene::Sun>, Option<String>)> {
+    let defaults = hikari_render::settings::SkySettings::default();
+    let sky = &settings.sky;
+    let time_given = args.sky.sets_time()
+        || file.time.is_some()
+        || sky.date != defaults.date
+        || sky.time != defaults.time;
+    let own_sun = match (source, &scene.sun) {
+        (_, None) => None,
+        // The loader gives a lightless glTF the default sun: that one is not the scene's own.
+        (SceneSource::Gltf(_), Some(s)) if is_default_sun(s) => None,
+        (SceneSource::Builtin(name), Some(_)) if name == "village" => None,
+        (_, Some(s)) => Some(s.clone()),
+    };
+    let when = sky.date_time()?;
+    let (h, m, sec) = when.time();
+    let now = Some(if sec == 0 {
+        format!("{h:02}:{m:02}")
+    } else {
+        format!("{h:02}:{m:02}:{sec:02}")
+    });
+    if time_given {
+        let sun = hikari_render::techniques::sky::lights::directional_light(sky)?;
+        return Ok((sun, now));
+    }
+    if scene.sun.is_none() {
+        settings.sky.sun = false;
+        settings.sky.sky = false;
+        return Ok((None, None));
+    }
+    match own_sun {
+        Some(s) => Ok((settings.sky.sun.then_some(s), None)),
+        None => {
+            let sun = hikari_render::techniques::sky::lights::directional_light(&settings.sky)?;
+            Ok((sun, now))
+        }
+    }
 }
 
 /// The scene and the frame settings: from the flags, then the config file, then defaults.
@@ -201,19 +259,16 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
         args.camera.camera.as_deref(),
         file.camera.as_deref(),
     )?;
-    let (sun, time) = match args.time.time.as_deref().or(file.time.as_deref()) {
-        Some(t) => {
-            let hours = hikari_scene::time_of_day::parse_time(t).context("--time")?;
-            (
-                Some(hikari_scene::time_of_day::sun_at(hours)),
-                Some(format_hours(hours)),
-            )
-        }
-        None => (scene.sun.clone(), None),
-    };
     let mut settings = file
         .settings_with(args.config.preset, &args.config.overrides)
         .context("settings")?;
+    if let Some(t) = &file.time {
+        settings.sky.time = t.clone();
+        hikari_render::settings::TechniqueSettings::validate(&settings.sky, "sky")
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .context("the config file's `time`")?;
+    }
+    args.sky.apply(&mut settings.sky)?;
     if let Some(ev) = args.exposure.ev100 {
         if !ev.is_finite() || !(-10.0..=30.0).contains(&ev) {
             bail!("--ev100 {ev} is outside the range -10 to 30");
@@ -221,12 +276,14 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
         settings.exposure.ev100 = Some(ev);
     }
     settings.validate().context("settings")?;
+    let (sun, time) = choose_light(&source, &scene, &mut settings, args, &file)?;
     let width = args.size.width.or(file.width).unwrap_or(DEFAULT_SIZE.0);
     let height = args.size.height.or(file.height).unwrap_or(DEFAULT_SIZE.1);
     let description = FrameDescription {
         source,
         camera: camera.name.clone(),
         camera_origin,
+        date: time.as_ref().map(|_| settings.sky.date.clone()),
         time,
         width,
         height,
@@ -261,14 +318,6 @@ mod tests {
         );
         let e = SceneSource::parse("atlantis").unwrap_err().to_string();
         assert!(e.contains("`atlantis`") && e.contains("village"), "{e}");
-    }
-
-    #[test]
-    fn hours_print_as_the_clock_time_they_were_parsed_from() {
-        for t in ["00:00", "07:05", "12:30", "23:59"] {
-            let h = hikari_scene::time_of_day::parse_time(t).unwrap();
-            assert_eq!(format_hours(h), t);
-        }
     }
 
     #[test]

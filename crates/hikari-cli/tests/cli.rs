@@ -104,10 +104,10 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     let dir = tmp("bad");
     let out = dir.join("x.png");
     let config = dir.join("bad.toml");
-    std::fs::write(&config, "[shadows]\ncascades = 9\n").unwrap();
+    std::fs::write(&config, "[sun_shadows]\ncascades = 9\n").unwrap();
     assert_clean_failure(
         &["render", "--config", config.to_str().unwrap()],
-        "`shadows.cascades` is 9; allowed: 1 to 4",
+        "`sun_shadows.cascades` is 9; allowed: 1 to 4",
     );
     assert_clean_failure(
         &["render", "--width", "0", "-o", out.to_str().unwrap()],
@@ -268,10 +268,67 @@ fn bench_frame_names_the_scene_camera_time_and_size_that_ran() {
             "camera": first_camera,
             "camera_from": "the scene's first",
             "time": "07:30",
+            "date": "2024-07-21",
             "width": 64,
             "height": 48,
         })
     );
     assert_eq!(v["frames"], 2);
     assert!(!v["passes"].as_array().unwrap().is_empty(), "{v}");
+}
+
+#[test]
+fn sky_writes_a_2_to_1_exr_and_its_json_names_sun_moon_and_sh() {
+    let dir = tmp("sky");
+    let out = dir.join("noon.exr");
+    let o = hikari(&[
+        "sky",
+        "--table-quality",
+        "0",
+        "--width",
+        "64",
+        "--time",
+        "12:30",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    // A clear summer noon at 34.4° N: the sun high in the south, near 100 klux on the ground.
+    let sun = &v["sun"];
+    assert!(sun["elevation_deg"].as_f64().unwrap() > 70.0, "{v}");
+    let lux = sun["illuminance_lux"].as_f64().unwrap();
+    assert!((80_000.0..125_000.0).contains(&lux), "{v}");
+    assert!(
+        v["moon"]["illuminated_fraction"].as_f64().unwrap() > 0.95,
+        "{v}"
+    );
+    let sh = v["sh"].as_array().unwrap();
+    assert_eq!(sh.len(), 9);
+    assert!(sh.iter().all(|c| c.as_array().unwrap().len() == 3));
+    // A blue sky: band 0 bluer than red.
+    assert!(
+        sh[0][2].as_f64().unwrap() > sh[0][0].as_f64().unwrap(),
+        "{v}"
+    );
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        &out,
+        |r, _| vec![0f32; r.width() * r.height()],
+        |_, _, (_, _, _, _): (f32, f32, f32, f32)| {},
+    )
+    .unwrap();
+    assert_eq!(img.layer_data.size.0, 64);
+    assert_eq!(img.layer_data.size.1, 32);
+
+    let bad = dir.join("bad.exr");
+    assert_clean_failure(
+        &["sky", "--lat", "95", "-o", bad.to_str().unwrap()],
+        "--lat 95",
+    );
+    assert_clean_failure(
+        &["sky", "--date", "2101-01-01", "-o", bad.to_str().unwrap()],
+        "--date 2101-01-01",
+    );
+    assert!(!bad.exists(), "nothing is written on bad input");
 }

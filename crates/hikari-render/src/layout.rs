@@ -30,7 +30,7 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sun_shadows};
+    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows};
     use crate::view;
     vec![
         gpu_layout!(
@@ -96,6 +96,32 @@ pub fn all() -> Vec<StructLayout> {
                 config,
                 cutoff
             ]
+        ),
+        gpu_layout!(
+            sky::SkyParams,
+            "direct_lighting/shade.wgsl",
+            [
+                sun,
+                moon,
+                disks,
+                shell,
+                table,
+                light_coords,
+                rec709_from_working,
+                white,
+                transmittance_size,
+                ground
+            ]
+        ),
+        gpu_layout!(
+            sky::ResampleParams,
+            "sky/resample.wgsl",
+            [table, light_coords]
+        ),
+        gpu_layout!(
+            sky::SkyAmbientParams,
+            "direct_lighting/shade.wgsl",
+            [balance]
         ),
         gpu_layout!(
             placeholder_tonemap::TonemapParams,

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
+pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
 
 /// Named quality levels, as game renderers offer them: each sets the resolutions, ray and
@@ -72,7 +73,7 @@ pub enum Range {
 }
 
 impl Range {
-    fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         match *self {
             Range::Int { lo, hi } => format!("{lo} to {hi}"),
             Range::PowerOfTwo { lo, hi } => format!("a power of two from {lo} to {hi}"),
@@ -80,7 +81,7 @@ impl Range {
         }
     }
 
-    fn admits(&self, v: &toml::Value) -> bool {
+    pub(crate) fn admits(&self, v: &toml::Value) -> bool {
         match (*self, v) {
             (Range::Int { lo, hi }, toml::Value::Integer(i)) => (lo..=hi).contains(i),
             (Range::PowerOfTwo { lo, hi }, toml::Value::Integer(i)) => {
@@ -181,6 +182,7 @@ register_settings! {
     sun_shadows: SunShadowsSettings,
     direct_lighting: DirectLightingSettings,
     exposure: ExposureSettings,
+    sky: SkySettings,
 }
 
 impl Settings {

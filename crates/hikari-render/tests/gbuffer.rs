@@ -285,7 +285,14 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
         camera,
         prev_camera: Some(prev.clone()),
         sun: scene.sun.clone(),
-        settings: Settings::default(),
+        settings: Settings {
+            // The G-buffer does not depend on the sky: skip the atmosphere's table build.
+            sky: hikari_render::settings::SkySettings {
+                enabled: false,
+                ..Default::default()
+            },
+            ..Settings::default()
+        },
     };
     let mut renderer = Renderer::new(ctx, scene).unwrap();
     let mut r = renderer

@@ -8,3 +8,4 @@ pub mod bench_rays;
 pub mod constants;
 pub mod info;
 pub mod render;
+pub mod sky;

@@ -6,4 +6,5 @@
 pub mod direct_lighting;
 pub mod gbuffer;
 pub mod placeholder_tonemap;
+pub mod sky;
 pub mod sun_shadows;

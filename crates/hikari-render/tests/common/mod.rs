@@ -77,6 +77,8 @@ pub fn small_frame_settings(
     settings.sun_shadows.resolution = 256;
     settings.sun_shadows.cascades = 2;
     settings.sun_shadows.max_distance_m = 40.0;
+    // The atmosphere has its own tests (tests/sky.rs); here the placeholders light the frame.
+    settings.sky.enabled = false;
     hikari_render::FrameSettings {
         width: w,
         height: h,

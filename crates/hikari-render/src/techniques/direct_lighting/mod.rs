@@ -11,6 +11,7 @@ use glam::Vec3;
 use hikari_scene::Sun;
 
 use super::gbuffer::GBuffer;
+use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
@@ -27,6 +28,8 @@ pub const LIGHTING_SUN: u32 = 1;
 pub const LIGHTING_PUNCTUAL: u32 = 2;
 pub const LIGHTING_EMISSIVE: u32 = 4;
 pub const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8;
+/// The sky (`hikari::sky`) where depth is 0 and its SH (`hikari::sky_ambient`) as ambient light.
+pub const LIGHTING_SKY: u32 = 16;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -94,6 +97,17 @@ impl LightingParams {
     }
 }
 
+impl LightingParams {
+    /// Lights with the atmosphere instead of the placeholders: the sky and its SH ambient
+    /// when `sky_light`, else a black sky and no ambient.
+    pub fn use_sky(&mut self, sky_light: bool) {
+        self.config[1] &= !LIGHTING_PLACEHOLDER_AMBIENT;
+        if sky_light {
+            self.config[1] |= LIGHTING_SKY;
+        }
+    }
+}
+
 pub struct DirectLighting {
     shade: ComputePipeline,
 }
@@ -105,12 +119,15 @@ impl DirectLighting {
         })
     }
 
-    /// Radiance in nits of every pixel: lit surfaces, or the placeholder sky where depth is 0.
+    /// Radiance in nits of every pixel: lit surfaces, or the sky (or the placeholder sky)
+    /// where depth is 0.
+    #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         gb: &GBuffer,
         shadows: &SunShadowMaps,
+        sky: &SkyFrame,
         scene: &SceneInFrame,
         view: &View,
         params: &LightingParams,
@@ -131,6 +148,8 @@ impl DirectLighting {
             .read(scene.lights)
             .write(radiance)
             .set(shadows.lookup)
+            .set(sky.lookup)
+            .set(sky.ambient)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(radiance)
     }

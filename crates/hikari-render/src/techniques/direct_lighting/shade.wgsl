@@ -9,6 +9,8 @@
 #import hikari::brdf::{BrdfMaterial, brdf_view, brdf_light_weights, brdf_apply_weights, brdf_fresnel_schlick, brdf_material_f0}
 #import hikari::scene_gpu::LightGpu
 #import hikari::sun_shadows::sun_visibility
+#import hikari::sky::sky_background
+#import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_specular}
 
 struct LightingParams {
     // xyz: unit vector towards the sun; w: illuminance in lux.
@@ -29,6 +31,7 @@ const LIGHTING_SUN: u32 = 1u;
 const LIGHTING_PUNCTUAL: u32 = 2u;
 const LIGHTING_EMISSIVE: u32 = 4u;
 const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8u;
+const LIGHTING_SKY: u32 = 16u;
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: LightingParams;
@@ -162,6 +165,9 @@ fn main(
     let v = select(-view_ray(view, pixel), normalize(view.position.xyz - world), d > 0.0);
     if d <= 0.0 {
         radiance = select(vec3<f32>(0.0), sky_placeholder(-v), (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u);
+        if (flags & LIGHTING_SKY) != 0u {
+            radiance = sky_background(-v);
+        }
     } else {
         let nt = textureLoad(gbuffer_normal, pixel, 0);
         let n = oct_decode(nt.xy);
@@ -204,6 +210,13 @@ fn main(
         if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
             let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);
             radiance += (diffuse + specular_placeholder(m, n, v)) * mat.w;
+        }
+        if (flags & LIGHTING_SKY) != 0u {
+            // Sky visibility 1 until the irradiance probes.
+            let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * sky_ambient_irradiance(n);
+            let r = reflect(-v, n);
+            let f = brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0));
+            radiance += (diffuse + f * sky_ambient_specular(r, m.perceptual_roughness)) * mat.w;
         }
         if (flags & LIGHTING_EMISSIVE) != 0u {
             radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;

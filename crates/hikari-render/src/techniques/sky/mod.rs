@@ -1,0 +1,434 @@
+//! The sky (issue 16): the atmosphere's tables on the GPU, resampled every frame at the sun's
+//! and moon's angles, the sky drawn where no geometry is, and the sky's deringed L2 SH as the
+//! ambient light.
+//!
+//! * Tables: hikari-atmosphere builds them on the CPU (transmittance, and Rayleigh and Mie
+//!   inscattering divided by their phases over [mu, mu_s, r]); they are uploaded once as
+//!   persistent 3D and 2D textures and rebuilt only when the atmosphere's parameters (the
+//!   weather) or the table sizes change. The CPU build is cached per parameters
+//!   ([`atmosphere_for`]), shared with the `hikari sky` command and the directional light.
+//! * `sky.resample`: the 3D tables at this frame's sun and moon zenith angles into a 2D array
+//!   [mu, r] (sun Rayleigh, sun Mie, moon Rayleigh, moon Mie), cubic along mu_s.
+//! * `sky.sh`: 4096 directions of the sky (no disks) to L2 SH, deringed.
+//! * The shared WGSL modules `hikari::sky` (binding set `sky`: `sky_inscatter`,
+//!   `sky_background`, `sky_transmittance`) and `hikari::sky_ambient` (binding set
+//!   `sky_ambient`: irradiance and specular from the SH); the deferred lighting draws the
+//!   sky with them where depth is 0 and lights surfaces with the SH.
+//!
+//! CPU twin of every pass: [`reference`].
+
+pub mod lights;
+pub mod reference;
+pub mod settings;
+
+use std::sync::{Arc, Mutex};
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use hikari_atmosphere::geometry::{Shell, coord_from_unit};
+use hikari_atmosphere::{Atmosphere, AtmosphereParams, TableSizes};
+use hikari_scene::Sun;
+
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
+use crate::shader::ShaderLibrary;
+use lights::SkyLights;
+use settings::SkySettings;
+
+/// The per-frame parameters of `hikari::sky` (see `lookup.wgsl` for each field).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct SkyParams {
+    pub sun: [f32; 4],
+    pub moon: [f32; 4],
+    pub disks: [f32; 4],
+    pub shell: [f32; 4],
+    pub table: [f32; 4],
+    pub light_coords: [f32; 4],
+    pub rec709_from_working: [[f32; 4]; 3],
+    pub white: [f32; 4],
+    pub transmittance_size: [f32; 4],
+    pub ground: [f32; 4],
+}
+
+/// What `sky.resample` needs: [`SkyParams::table`] and [`SkyParams::light_coords`].
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct ResampleParams {
+    pub table: [f32; 4],
+    pub light_coords: [f32; 4],
+}
+
+/// The per-frame parameters of `hikari::sky_ambient`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct SkyAmbientParams {
+    /// x: diffuse scale, y: specular scale.
+    pub balance: [f32; 4],
+}
+
+/// Below this sun (or moon) zenith cosine the scattering tables end (hikari-atmosphere's
+/// `MU_S_MIN`, 12° below the horizon); a light lower than that lights no sky.
+pub const MU_S_MIN: f32 = hikari_atmosphere::geometry::MU_S_MIN as f32;
+
+/// The CPU atmosphere for `params` at `sizes`, built once and kept while the same parameters are
+/// asked for (the last two builds are kept, so alternating between two weathers does not
+/// rebuild).
+pub fn atmosphere_for(params: &AtmosphereParams, sizes: TableSizes) -> Result<Arc<Atmosphere>> {
+    type Cache = Vec<(AtmosphereParams, TableSizes, Arc<Atmosphere>)>;
+    static CACHE: Mutex<Cache> = Mutex::new(Vec::new());
+    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((_, _, a)) = cache.iter().find(|(p, s, _)| p == params && *s == sizes) {
+        return Ok(a.clone());
+    }
+    let a = Arc::new(
+        Atmosphere::with_sizes(params.clone(), sizes)
+            .map_err(|e| RenderError::Graph(format!("sky: atmosphere: {e}")))?,
+    );
+    log::info!(
+        "sky: atmosphere tables built in {:.0} ms",
+        a.report.build_ms
+    );
+    cache.push((params.clone(), sizes, a.clone()));
+    if cache.len() > 2 {
+        cache.remove(0);
+    }
+    Ok(a)
+}
+
+/// What the sky of a frame is lit by: the sun and the moon from the settings' date, time and
+/// place, except that a directional light that is neither of them (a scene's own sun) takes the
+/// sun's place in the sky and the moon goes.
+pub fn frame_lights(s: &SkySettings, directional: Option<&Sun>) -> Result<SkyLights> {
+    let mut l = SkyLights::new(s).map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
+    if let Some(d) = directional {
+        let close = |v: Vec3| v.normalize().dot(d.direction.normalize()) > 0.999_999;
+        if !close(l.sun.direction) && !close(l.moon.direction) {
+            l.sun.direction = d.direction.normalize();
+            l.sun.elevation_deg = f64::from(l.sun.direction.y.clamp(-1.0, 1.0).asin().to_degrees());
+            l.moon.extraterrestrial_lux = 0.0;
+        }
+    }
+    Ok(l)
+}
+
+fn rows(m: [[f64; 3]; 3]) -> [[f32; 4]; 3] {
+    m.map(|r| [r[0] as f32, r[1] as f32, r[2] as f32, 0.0])
+}
+
+/// Extraterrestrial illuminance of a light for the sky: none once the tables no longer cover
+/// it, fading over the last degree above that.
+fn sky_lux(lux: f32, dir: Vec3) -> f32 {
+    let fade_from = (MU_S_MIN.acos() - 1f32.to_radians()).cos();
+    let f = ((dir.y - MU_S_MIN) / (fade_from - MU_S_MIN)).clamp(0.0, 1.0);
+    lux * f
+}
+
+impl SkyParams {
+    /// The parameters for `lights` over `atmosphere`, seen from `camera_altitude_km`.
+    pub fn new(
+        atmosphere: &Atmosphere,
+        lights: &SkyLights,
+        s: &SkySettings,
+        camera_altitude_km: f32,
+    ) -> Self {
+        let p = &atmosphere.params;
+        let sizes = atmosphere.tables.sizes;
+        let shell = Shell::new(p.bottom_radius_km, p.top_radius_km);
+        let [nmu, nmus, nr] = sizes.scattering;
+        let coord = |dir: Vec3| {
+            let u = coord_from_unit(shell.x_mu_s(f64::from(dir.y)), nmus);
+            (u * nmus as f64 - 0.5) as f32
+        };
+        let weather = s
+            .weather()
+            .unwrap_or_else(|_| settings::Weather::by_name("clear").expect("clear is a weather"));
+        let brightness = weather.sky_brightness;
+        let white = atmosphere.to_working(Vec3::ONE);
+        let sun_lux = sky_lux(lights.sun.extraterrestrial_lux, lights.sun.direction);
+        let moon_lux = sky_lux(lights.moon.extraterrestrial_lux, lights.moon.direction);
+        // The ground: Lambertian, lit by the direct light that reaches it and by the sky.
+        let mut ground = Vec3::ZERO;
+        for (body, lux) in [(&lights.sun, sun_lux), (&lights.moon, moon_lux)] {
+            if lux > 0.0 {
+                let zenith = body.direction.y.clamp(-1.0, 1.0).acos();
+                let direct = atmosphere.sun_illuminance_at_ground(zenith)
+                    / p.solar_illuminance_lux as f32
+                    * lux
+                    * body.direction.y.max(0.0);
+                let sky = atmosphere.sky_irradiance(0.0, zenith, Vec3::splat(lux));
+                ground += (direct + sky) * (p.ground_albedo as f32 / std::f32::consts::PI);
+            }
+        }
+        Self {
+            sun: lights.sun.direction.normalize().extend(sun_lux).to_array(),
+            moon: lights
+                .moon
+                .direction
+                .normalize()
+                .extend(moon_lux)
+                .to_array(),
+            disks: [
+                lights.sun.angular_radius,
+                lights.moon.angular_radius,
+                lights.moon_illuminated_fraction,
+                1.0,
+            ],
+            shell: [
+                p.bottom_radius_km as f32,
+                p.top_radius_km as f32,
+                shell.h as f32,
+                camera_altitude_km.max(0.0),
+            ],
+            table: [nmu as f32, nmus as f32, nr as f32, p.mie_g as f32],
+            light_coords: [
+                coord(lights.sun.direction),
+                coord(lights.moon.direction),
+                brightness,
+                0.0,
+            ],
+            rec709_from_working: rows(p.color_space.to_rec709()),
+            white: [white[0] as f32, white[1] as f32, white[2] as f32, 0.0],
+            transmittance_size: [
+                sizes.transmittance[0] as f32,
+                sizes.transmittance[1] as f32,
+                0.0,
+                0.0,
+            ],
+            ground: {
+                let w = atmosphere.to_working(ground * brightness);
+                [w[0] as f32, w[1] as f32, w[2] as f32, 0.0]
+            },
+        }
+    }
+}
+
+/// The sky of one frame, for the techniques that read it.
+#[derive(Clone, Copy, Debug)]
+pub struct SkyFrame {
+    /// Whether the atmosphere ran (else the placeholders light the frame).
+    pub enabled: bool,
+    pub params: SkyParams,
+    /// `sky.resampled`: [mu, r] x 4 layers, Rgba32Float.
+    pub resampled: Tex,
+    /// `sky.sh`: 9 raw then 9 deringed RGB coefficients (vec4 each), nits.
+    pub sh: Buf,
+    /// Binding set `sky` of `hikari::sky`.
+    pub lookup: BindingSet,
+    /// Binding set `sky_ambient` of `hikari::sky_ambient`.
+    pub ambient: BindingSet,
+    /// Illuminance of the sky alone on a horizontal plane at the ground, in lux (luminance of
+    /// the CPU model's sky irradiance), for the placeholder exposure meter: at dawn the sky
+    /// outshines the low sun.
+    pub sky_lux: f32,
+}
+
+struct Uploaded {
+    params: AtmosphereParams,
+    sizes: TableSizes,
+    atmosphere: Arc<Atmosphere>,
+    rayleigh: wgpu::Texture,
+    mie: wgpu::Texture,
+    transmittance: wgpu::Texture,
+}
+
+fn upload(ctx: &GpuContext, name: &str, t: &hikari_atmosphere::table::Table) -> wgpu::Texture {
+    let [nx, ny, nz] = t.size;
+    let texels: Vec<[f32; 4]> = t.data.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some(name),
+            size: wgpu::Extent3d {
+                width: nx as u32,
+                height: ny as u32,
+                depth_or_array_layers: nz as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: if nz > 1 {
+                wgpu::TextureDimension::D3
+            } else {
+                wgpu::TextureDimension::D2
+            },
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&texels),
+    )
+}
+
+pub struct Sky {
+    resample: ComputePipeline,
+    sh: ComputePipeline,
+    uploaded: Mutex<Option<Arc<Uploaded>>>,
+}
+
+impl Sky {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Ok(Self {
+            resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
+            sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "main", &[])?,
+            uploaded: Mutex::new(None),
+        })
+    }
+
+    /// The tables of `params` at `sizes` on the GPU, built (on the CPU) and uploaded only when
+    /// they differ from the last frame's.
+    fn tables(
+        &self,
+        ctx: &GpuContext,
+        params: &AtmosphereParams,
+        sizes: TableSizes,
+    ) -> Result<Arc<Uploaded>> {
+        let mut held = self.uploaded.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(u) = held.as_ref()
+            && u.params == *params
+            && u.sizes == sizes
+        {
+            return Ok(u.clone());
+        }
+        let atmosphere = atmosphere_for(params, sizes)?;
+        let t = &atmosphere.tables;
+        let u = Arc::new(Uploaded {
+            params: params.clone(),
+            sizes,
+            rayleigh: upload(ctx, "sky.rayleigh", &t.rayleigh),
+            mie: upload(ctx, "sky.mie", &t.mie),
+            transmittance: upload(ctx, "sky.transmittance", &t.transmittance),
+            atmosphere: atmosphere.clone(),
+        });
+        *held = Some(u.clone());
+        Ok(u)
+    }
+
+    /// Adds the sky's passes. `directional` is the frame's directional light (the sky follows
+    /// it when it is a scene's own sun); `camera_altitude_km` the camera's height above the
+    /// ground.
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        s: &SkySettings,
+        directional: Option<&Sun>,
+        camera_altitude_km: f32,
+    ) -> Result<SkyFrame> {
+        let sh = g.buffer("sky.sh", 18 * 16)?;
+        if !s.enabled {
+            return self.disabled(g, sh);
+        }
+        let weather = s
+            .weather()
+            .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
+        let u = self.tables(g.ctx(), &weather.atmosphere(), s.table_sizes())?;
+        let mut lights = frame_lights(s, directional)?;
+        if !s.sky {
+            lights.sun.extraterrestrial_lux = 0.0;
+            lights.moon.extraterrestrial_lux = 0.0;
+        }
+        let mut params = SkyParams::new(&u.atmosphere, &lights, s, camera_altitude_km);
+        let horizontal_sky_lux = if s.sky {
+            [&lights.sun, &lights.moon]
+                .iter()
+                .map(|b| (sky_lux(b.extraterrestrial_lux, b.direction), b.direction))
+                .filter(|(lux, _)| *lux > 0.0)
+                .map(|(lux, dir)| {
+                    let zenith = dir.y.clamp(-1.0, 1.0).acos();
+                    lights::luminance(u.atmosphere.sky_irradiance(0.0, zenith, Vec3::splat(lux)))
+                })
+                .sum::<f32>()
+                * weather.sky_brightness
+        } else {
+            0.0
+        };
+        if !s.sun {
+            params.disks[3] = 0.0;
+        }
+        let rayleigh = g.import_texture("sky.rayleigh", &u.rayleigh);
+        let mie = g.import_texture("sky.mie", &u.mie);
+        let transmittance = g.import_texture("sky.transmittance", &u.transmittance);
+        let [nmu, _, nr] = u.sizes.scattering;
+        let resampled = g.texture(
+            "sky.resampled",
+            TextureDesc::d2_array(nmu as u32, nr as u32, 4, wgpu::TextureFormat::Rgba32Float),
+        )?;
+        g.pass("sky.resample")
+            .constants(&ResampleParams {
+                table: params.table,
+                light_coords: params.light_coords,
+            })
+            .read(rayleigh)
+            .read(mie)
+            .write(resampled)
+            .dispatch_threads(&self.resample, [nmu as u32, nr as u32, 4])?;
+        let lookup = g
+            .binding_set("sky")
+            .constants(&params)
+            .read(resampled)
+            .read(transmittance)
+            .finish();
+        g.pass("sky.sh")
+            .write(sh)
+            .set(lookup)
+            .dispatch(&self.sh, [1, 1, 1])?;
+        let ambient = g
+            .binding_set("sky_ambient")
+            .constants(&SkyAmbientParams {
+                balance: [weather.ambient_diffuse, weather.ambient_specular, 0.0, 0.0],
+            })
+            .read(sh)
+            .finish();
+        Ok(SkyFrame {
+            enabled: true,
+            params,
+            resampled,
+            sh,
+            lookup,
+            ambient,
+            sky_lux: horizontal_sky_lux,
+        })
+    }
+
+    fn disabled<'r>(&'r self, g: &mut FrameGraph<'r>, sh: Buf) -> Result<SkyFrame> {
+        let resampled = g.texture(
+            "sky.resampled",
+            TextureDesc::d2_array(1, 1, 4, wgpu::TextureFormat::Rgba32Float),
+        )?;
+        let transmittance = g.texture(
+            "sky.transmittance",
+            TextureDesc::d2(1, 1, wgpu::TextureFormat::Rgba32Float),
+        )?;
+        g.pass("sky.clear")
+            .uses(sh, true)
+            // Never read with the sky off; wgpu zeroes them.
+            .uses(resampled, true)
+            .uses(transmittance, true)
+            .encode(move |enc, res| enc.clear_buffer(res.buffer(sh), 0, None))?;
+        let params = SkyParams::zeroed();
+        let lookup = g
+            .binding_set("sky")
+            .constants(&params)
+            .read(resampled)
+            .read(transmittance)
+            .finish();
+        let ambient = g
+            .binding_set("sky_ambient")
+            .constants(&SkyAmbientParams::zeroed())
+            .read(sh)
+            .finish();
+        Ok(SkyFrame {
+            enabled: false,
+            params,
+            resampled,
+            sh,
+            lookup,
+            ambient,
+            sky_lux: 0.0,
+        })
+    }
+}
