@@ -5,7 +5,7 @@
 //
 // Single-scattering directional albedo of the GGX lobe (height-correlated Smith):
 // .x = E (F = 1), .y = E_w (F = (1 - v.h)^5). Row j: perceptual roughness
-// BRDF_MIN_PERCEPTUAL_ROUGHNESS + (1 - BRDF_MIN_PERCEPTUAL_ROUGHNESS) j / (N - 1);
+// r_min + (1 - r_min) (j / (N - 1))^2, r_min = BRDF_MIN_PERCEPTUAL_ROUGHNESS;
 // column i: x = i / (N - 1) with n.v = x^2. Index j * N + i.
 const BRDF_TABLE_SIZE: u32 = 32u;
 
