@@ -198,7 +198,7 @@ impl AlbedoTables {
         (lerp(&self.e_avg), lerp(&self.e_schlick_avg))
     }
 
-    /// The tables as a WGSL module (`#define_import_path hikari::brdf_tables`): `f32` constants
+    /// The tables as a WGSL module (`#define_import_path hikari::brdf_tables`): `f32` arrays
     /// printed with 7 significant digits (what `f32` holds), `E` and `E_w` interleaved as
     /// `vec2` so one lookup reads both. The text depends only on the tables, so regenerating
     /// it is deterministic.
@@ -213,7 +213,11 @@ impl AlbedoTables {
         s += "// r_min + (1 - r_min) (j / (N - 1))^2, r_min = BRDF_MIN_PERCEPTUAL_ROUGHNESS;\n";
         s += "// column i: x = i / (N - 1) with n.v = x^2. Index j * N + i.\n";
         s += &format!("const BRDF_TABLE_SIZE: u32 = {N}u;\n\n");
-        s += &format!("const BRDF_ALBEDO: array<vec2<f32>, {}> = array<vec2<f32>, {}>(\n", N * N, N * N);
+        s += "// var<private>, not const: naga copies a const array into a local variable to index it\n";
+        s += "// at run time, which took lavapipe over 10 minutes to compile; a private array with a\n";
+        s += "// constant initialiser is indexed in place (about 40 s on lavapipe, once per shader:\n";
+        s += "// Mesa caches it). Never written.\n";
+        s += &format!("var<private> BRDF_ALBEDO: array<vec2<f32>, {}> = array<vec2<f32>, {}>(\n", N * N, N * N);
         for j in 0..N {
             s += &format!("    // roughness {:.4}\n", table_roughness(j));
             for chunk in (0..N).collect::<Vec<_>>().chunks(4) {
@@ -230,7 +234,7 @@ impl AlbedoTables {
         }
         s += ");\n\n";
         s += "// Cosine-weighted hemispherical averages: .x = E_avg, .y = E_w,avg; index j.\n";
-        s += &format!("const BRDF_ALBEDO_AVG: array<vec2<f32>, {N}> = array<vec2<f32>, {N}>(\n");
+        s += &format!("var<private> BRDF_ALBEDO_AVG: array<vec2<f32>, {N}> = array<vec2<f32>, {N}>(\n");
         for j in 0..N {
             s += &format!(
                 "    vec2<f32>({}, {}),\n",

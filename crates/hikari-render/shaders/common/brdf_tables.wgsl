@@ -9,7 +9,11 @@
 // column i: x = i / (N - 1) with n.v = x^2. Index j * N + i.
 const BRDF_TABLE_SIZE: u32 = 32u;
 
-const BRDF_ALBEDO: array<vec2<f32>, 1024> = array<vec2<f32>, 1024>(
+// var<private>, not const: naga copies a const array into a local variable to index it
+// at run time, which took lavapipe over 10 minutes to compile; a private array with a
+// constant initialiser is indexed in place (about 40 s on lavapipe, once per shader:
+// Mesa caches it). Never written.
+var<private> BRDF_ALBEDO: array<vec2<f32>, 1024> = array<vec2<f32>, 1024>(
     // roughness 0.0450
     vec2<f32>(9.999999e-1, 9.515291e-1), vec2<f32>(9.174764e-1, 8.803630e-1), vec2<f32>(9.155409e-1, 8.818789e-1), vec2<f32>(9.725801e-1, 9.202797e-1),
     vec2<f32>(9.912378e-1, 9.069821e-1), vec2<f32>(9.965590e-1, 8.706726e-1), vec2<f32>(9.983974e-1, 8.229805e-1), vec2<f32>(9.991501e-1, 7.677802e-1),
@@ -301,7 +305,7 @@ const BRDF_ALBEDO: array<vec2<f32>, 1024> = array<vec2<f32>, 1024>(
 );
 
 // Cosine-weighted hemispherical averages: .x = E_avg, .y = E_w,avg; index j.
-const BRDF_ALBEDO_AVG: array<vec2<f32>, 32> = array<vec2<f32>, 32>(
+var<private> BRDF_ALBEDO_AVG: array<vec2<f32>, 32> = array<vec2<f32>, 32>(
     vec2<f32>(9.999716e-1, 4.775567e-2),
     vec2<f32>(9.999695e-1, 4.775277e-2),
     vec2<f32>(9.999624e-1, 4.774299e-2),
