@@ -8,7 +8,9 @@ mod common;
 use common::Rng;
 use glam::{DVec3, Vec3};
 use hikari_math::brdf::diffuse::{albedo_scaled_lambert, lambert};
-use hikari_math::brdf::energy::{Compensation, fresnel_schlick_average, multiple_scattering_fresnel};
+use hikari_math::brdf::energy::{
+    Compensation, fresnel_schlick_average, multiple_scattering_fresnel,
+};
 use hikari_math::brdf::fresnel::{fresnel_schlick, fresnel_schlick_scalar};
 use hikari_math::brdf::ggx::{ggx_ndf, ggx_ndf_aniso};
 use hikari_math::brdf::material::{
@@ -411,7 +413,10 @@ fn multiple_scattering_colour() {
             }
             let got = multiple_scattering_fresnel(DVec3::splat(f_avg), e_avg).x;
             let want = series / (1.0 - e_avg);
-            assert!((got - want).abs() < 1e-12, "f0 {f0} E_avg {e_avg}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-12,
+                "f0 {f0} E_avg {e_avg}: {got} vs {want}"
+            );
         }
     }
     assert!((multiple_scattering_fresnel(DVec3::ONE, 0.6).x - 1.0).abs() < 1e-15);
@@ -473,8 +478,14 @@ fn check_full_furnace(spec_nodes: usize, smooth_nodes: usize, over: f64, off: f6
                 }
                 worst_over = worst_over.max(e - 1.0);
                 worst_under = worst_under.min(e - 1.0);
-                assert!(e <= 1.0 + over, "{name} r {r} {deg}°: {spec} + {ms} + {diff} = {e} > 1");
-                assert!(e >= 0.97, "{name} r {r} {deg}°: {spec} + {ms} + {diff} = {e} < 0.97");
+                assert!(
+                    e <= 1.0 + over,
+                    "{name} r {r} {deg}°: {spec} + {ms} + {diff} = {e} > 1"
+                );
+                assert!(
+                    e >= 0.97,
+                    "{name} r {r} {deg}°: {spec} + {ms} + {diff} = {e} < 0.97"
+                );
                 assert!((e - 1.0).abs() <= off, "{name} r {r} {deg}°: {e}");
             }
         }
@@ -551,13 +562,23 @@ fn compensation_lobe_albedos() {
         let c = Compensation::new(&m);
         for mu in [1.0, 0.5, 0.1] {
             let v = view(mu, 0.0);
-            let ms = integrate_hemisphere_uniform(400, |l| evaluate_lobes_f64(&m, N, T, B, v, l).multiple.y);
-            let diff = integrate_hemisphere_uniform(400, |l| evaluate_lobes_f64(&m, N, T, B, v, l).diffuse.y);
+            let ms = integrate_hemisphere_uniform(400, |l| {
+                evaluate_lobes_f64(&m, N, T, B, v, l).multiple.y
+            });
+            let diff = integrate_hemisphere_uniform(400, |l| {
+                evaluate_lobes_f64(&m, N, T, B, v, l).diffuse.y
+            });
             let (e, _) = c.single_scattering(v);
             let want_ms = c.ms_fresnel.y * (1.0 - e);
             let want_diff = m.diffuse_albedo().y * (1.0 - c.dielectric_specular_albedo(v));
-            assert!((ms - want_ms).abs() < 1e-5, "r {r} μ {mu}: ms {ms} vs {want_ms}");
-            assert!((diff - want_diff).abs() < 1e-5, "r {r} μ {mu}: diffuse {diff} vs {want_diff}");
+            assert!(
+                (ms - want_ms).abs() < 1e-5,
+                "r {r} μ {mu}: ms {ms} vs {want_ms}"
+            );
+            assert!(
+                (diff - want_diff).abs() < 1e-5,
+                "r {r} μ {mu}: diffuse {diff} vs {want_diff}"
+            );
         }
     }
 }
@@ -941,12 +962,19 @@ fn wgsl_tables_are_current() {
 // The energy-compensated model against tools/brdf_albedo_table.py --fixture
 
 fn energy_fixture() -> serde_json::Value {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/brdf_energy.json");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/brdf_energy.json"
+    );
     serde_json::from_str(&std::fs::read_to_string(path).expect("fixture present")).unwrap()
 }
 
 fn floats(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
 }
 
 /// hikari-math's tables against the independent numpy integration (a different quadrature and
@@ -968,15 +996,34 @@ fn tables_match_the_independent_reference() {
         for (i, &mu) in mus.iter().enumerate() {
             let (e, e_w) = t.lookup(mu, r);
             let tol = if mu >= 0.1 { 2e-3 } else { 5e-3 };
-            assert!((e - e_row[i]).abs() < tol, "E r {r} μ {mu}: {e} vs {}", e_row[i]);
-            assert!((e_w - ew_row[i]).abs() < tol, "E_w r {r} μ {mu}: {e_w} vs {}", ew_row[i]);
+            assert!(
+                (e - e_row[i]).abs() < tol,
+                "E r {r} μ {mu}: {e} vs {}",
+                e_row[i]
+            );
+            assert!(
+                (e_w - ew_row[i]).abs() < tol,
+                "E_w r {r} μ {mu}: {e_w} vs {}",
+                ew_row[i]
+            );
             worst = worst.max((e - e_row[i]).abs()).max((e_w - ew_row[i]).abs());
         }
         let (e_avg, e_w_avg) = t.average(r);
-        let (want, want_w) = (fx["e_avg"][j].as_f64().unwrap(), fx["e_schlick_avg"][j].as_f64().unwrap());
-        assert!((e_avg - want).abs() < 1e-3, "E_avg r {r}: {e_avg} vs {want}");
-        assert!((e_w_avg - want_w).abs() < 1e-3, "E_w,avg r {r}: {e_w_avg} vs {want_w}");
-        worst_avg = worst_avg.max((e_avg - want).abs()).max((e_w_avg - want_w).abs());
+        let (want, want_w) = (
+            fx["e_avg"][j].as_f64().unwrap(),
+            fx["e_schlick_avg"][j].as_f64().unwrap(),
+        );
+        assert!(
+            (e_avg - want).abs() < 1e-3,
+            "E_avg r {r}: {e_avg} vs {want}"
+        );
+        assert!(
+            (e_w_avg - want_w).abs() < 1e-3,
+            "E_w,avg r {r}: {e_w_avg} vs {want_w}"
+        );
+        worst_avg = worst_avg
+            .max((e_avg - want).abs())
+            .max((e_w_avg - want_w).abs());
     }
     eprintln!("tables vs numpy: worst {worst:.2e}, averages {worst_avg:.2e}");
 }

@@ -217,7 +217,11 @@ impl AlbedoTables {
         s += "// at run time, which took lavapipe over 10 minutes to compile; a private array with a\n";
         s += "// constant initialiser is indexed in place (about 40 s on lavapipe, once per shader:\n";
         s += "// Mesa caches it). Never written.\n";
-        s += &format!("var<private> BRDF_ALBEDO: array<vec2<f32>, {}> = array<vec2<f32>, {}>(\n", N * N, N * N);
+        s += &format!(
+            "var<private> BRDF_ALBEDO: array<vec2<f32>, {}> = array<vec2<f32>, {}>(\n",
+            N * N,
+            N * N
+        );
         for j in 0..N {
             s += &format!("    // roughness {:.4}\n", table_roughness(j));
             for chunk in (0..N).collect::<Vec<_>>().chunks(4) {
@@ -234,7 +238,9 @@ impl AlbedoTables {
         }
         s += ");\n\n";
         s += "// Cosine-weighted hemispherical averages: .x = E_avg, .y = E_w,avg; index j.\n";
-        s += &format!("var<private> BRDF_ALBEDO_AVG: array<vec2<f32>, {N}> = array<vec2<f32>, {N}>(\n");
+        s += &format!(
+            "var<private> BRDF_ALBEDO_AVG: array<vec2<f32>, {N}> = array<vec2<f32>, {N}>(\n"
+        );
         for j in 0..N {
             s += &format!(
                 "    vec2<f32>({}, {}),\n",

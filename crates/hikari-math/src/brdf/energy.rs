@@ -67,12 +67,13 @@ impl Compensation {
         let (ax, ay) = material.alphas();
         let roughness = isotropic_equivalent_roughness(ax, ay);
         let (e_avg, e_w_avg) = albedo_tables().average(roughness);
-        let fms = |f0: DVec3| {
-            multiple_scattering_fresnel(fresnel_schlick_average(f0), e_avg)
-        };
+        let fms = |f0: DVec3| multiple_scattering_fresnel(fresnel_schlick_average(f0), e_avg);
         let dielectric_ms_fresnel = fms(DVec3::splat(DIELECTRIC_F0)).x;
         let metal = material.metalness.clamp(0.0, 1.0) as f64;
-        let base = material.base_color.as_dvec3().clamp(DVec3::ZERO, DVec3::ONE);
+        let base = material
+            .base_color
+            .as_dvec3()
+            .clamp(DVec3::ZERO, DVec3::ONE);
         let ms_fresnel = DVec3::splat(dielectric_ms_fresnel).lerp(fms(base), metal);
         let dielectric_avg = dielectric_albedo(e_avg, e_w_avg, dielectric_ms_fresnel);
         Self {
