@@ -1154,3 +1154,143 @@ fn tolerances_catch_a_wrong_constant() {
         "a 1e-4 error in one basis constant went unnoticed"
     );
 }
+
+// ---- BRDF ----
+
+/// A random shading case for the BRDF kernel: material, frame and directions, with `n·v` and
+/// `n·l` either clearly above the surface (≥ 0.02, so f32 and f64 agree on the side) or, in one
+/// case of eight, clearly below (≤ −0.02, where both must give exactly 0).
+fn brdf_case(rng: &mut SmallRng) -> ([f32; 6], [Vec3; 5]) {
+    let r = match rng.random_range(0..4) {
+        0 => rng.random_range(0.0..0.1),
+        _ => rng.random_range(0.0..1.0),
+    };
+    let a = match rng.random_range(0..3) {
+        0 => 0.0,
+        _ => rng.random_range(-1.0..1.0),
+    };
+    let metal = match rng.random_range(0..3) {
+        0 => 0.0,
+        1 => 1.0,
+        _ => rng.random_range(0.0..1.0),
+    };
+    let mat = [
+        rng.random_range(0.0..1.0),
+        rng.random_range(0.0..1.0),
+        rng.random_range(0.0..1.0),
+        r,
+        metal,
+        a,
+    ];
+    let n = unit(rng);
+    let t = unit(rng);
+    let t = (t - n * n.dot(t)).normalize();
+    let b = n.cross(t);
+    let side = |rng: &mut SmallRng, below: bool| loop {
+        let d = unit(rng);
+        let c = d.dot(n);
+        if (below && c <= -0.02) || (!below && c >= 0.02) {
+            return d;
+        }
+    };
+    let below = rng.random_range(0..8) == 0;
+    let v_below = below && rng.random_range(0..2) == 0;
+    let v = side(rng, v_below);
+    let l = side(rng, below);
+    (mat, [n, t, b, v, l])
+}
+
+/// `hikari::brdf` against hikari-math's BRDF (f64 inside, on the same f32 inputs): the full
+/// anisotropic and isotropic evaluations, the per-light weights the deferred pass sums, and the
+/// albedo tables' lookups. Tolerances: the specular lobe's `D` divides by `|s|⁴` with
+/// `s = (h_x/α_x, h_y/α_y, h_z)`; f32 `h` (error ~6e-8 absolute) over `α` ≥ 0.002 puts up to
+/// ~1e-4 relative into `D` near the peak, and `normalize`, `length`, `sqrt` and the Vulkan
+/// division (2.5 ulp) a few ε more: 4e-4 relative, plus 1e-6 absolute (sr⁻¹) for the table
+/// terms (f32 tables, rounding 6e-8, bilinear weights in f32). The isotropic form computes `D`
+/// from `n·h` alone, whose cancellation (`1 − (n·h)²` against `α² (n·h)²`) costs up to a few
+/// per cent at the peak of the smoothest lobes (hikari_math::brdf::material), so it is held to
+/// 4e-4 only for roughness ≥ 0.2 and to 5 % below. Lookups: 1e-6 absolute.
+#[test]
+fn brdf_matches_the_cpu() {
+    use hikari_math::brdf::albedo::{albedo_tables, isotropic_equivalent_roughness};
+    use hikari_math::brdf::energy::Compensation;
+    use hikari_math::brdf::fresnel::schlick_weight;
+    use hikari_math::brdf::ggx::ggx_ndf_aniso;
+    use hikari_math::brdf::smith::visibility_aniso;
+    use hikari_math::brdf::{Material, evaluate, evaluate_isotropic};
+
+    let mut rng = SmallRng::seed_from_u64(0xB4DF_0015);
+    let n_cases = 1024;
+    let mut input = Vec::new();
+    let mut cases = Vec::new();
+    for _ in 0..n_cases {
+        let (mat, dirs) = brdf_case(&mut rng);
+        input.extend_from_slice(&mat);
+        for d in dirs {
+            input.extend_from_slice(&d.to_array());
+        }
+        cases.push((mat, dirs));
+    }
+    let Some(out) = run(Kernel::Brdf, &input) else {
+        return;
+    };
+    let mut eval_cmp = Compare::new("brdf_evaluate", 4e-4, 1e-6);
+    let mut iso_cmp = Compare::new("brdf_evaluate_isotropic", 4e-4, 1e-6);
+    let mut iso_smooth_cmp = Compare::new("brdf_evaluate_isotropic, roughness < 0.2", 5e-2, 1e-6);
+    let mut w_cmp = Compare::new("brdf_light_weights", 4e-4, 1e-6);
+    let mut table_cmp = Compare::new("brdf_albedo_lookup / average", 0.0, 1e-6);
+    let mut zero = Compare::new("below the surface: 0", 0.0, 0.0);
+    for (i, ((mat, [n, t, b, v, l]), r)) in cases.iter().zip(&out).enumerate() {
+        let m = Material {
+            base_color: Vec3::new(mat[0], mat[1], mat[2]),
+            perceptual_roughness: mat[3],
+            metalness: mat[4],
+            anisotropy: mat[5],
+        };
+        let d = |x: Vec3| x.as_dvec3();
+        let above = n.dot(*v) > 0.0 && n.dot(*l) > 0.0;
+        let want = evaluate(&m, *n, *t, *b, *v, *l);
+        let want_iso = evaluate_isotropic(&m, *n, *v, *l);
+        for k in 0..3 {
+            if !above {
+                zero.require(i, r[k] == 0.0 && r[3 + k] == 0.0, || format!("{r:?}"));
+                continue;
+            }
+            eval_cmp.check(i, r[k], want[k] as f64, want[k] as f64);
+            if mat[3] >= 0.2 {
+                iso_cmp.check(i, r[3 + k], want_iso[k] as f64, want_iso[k] as f64);
+            } else {
+                iso_smooth_cmp.check(i, r[3 + k], want_iso[k] as f64, want_iso[k] as f64);
+            }
+        }
+        // The weights, from hikari-math's pieces.
+        let to_local = |w: Vec3| DVec3::new(d(*t).dot(d(w)), d(*b).dot(d(w)), d(*n).dot(d(w)));
+        let (vl, ll) = (to_local(*v), to_local(*l));
+        if above {
+            let (ax, ay) = m.alphas();
+            let h = (vl + ll).normalize();
+            let spec = ggx_ndf_aniso(h, ax, ay) * visibility_aniso(vl, ll, ax, ay) * ll.z;
+            let c = Compensation::new(&m);
+            let (e_l, _) = c.single_scattering(ll);
+            let want_w = [
+                spec,
+                spec * schlick_weight(vl.dot(h)),
+                (1.0 - c.dielectric_specular_albedo(ll)) * ll.z,
+                (1.0 - e_l) * ll.z,
+            ];
+            for k in 0..4 {
+                w_cmp.check(i, r[6 + k], want_w[k], want_w[k]);
+            }
+        } else {
+            zero.require(i, r[6..10].iter().all(|&x| x == 0.0), || format!("{r:?}"));
+        }
+        let (ax, ay) = m.alphas();
+        let rough = isotropic_equivalent_roughness(ax, ay);
+        let (e, e_w) = albedo_tables().lookup(n.dot(*v) as f64, rough);
+        let (e_avg, e_w_avg) = albedo_tables().average(rough);
+        for (k, want) in [e, e_w, e_avg, e_w_avg].into_iter().enumerate() {
+            table_cmp.check(i, r[10 + k], want, 0.0);
+        }
+    }
+    report(&[eval_cmp, iso_cmp, iso_smooth_cmp, w_cmp, table_cmp, zero]);
+}

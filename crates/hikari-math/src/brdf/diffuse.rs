@@ -1,18 +1,18 @@
-//! Lambertian diffuse, weighted by the light that crosses the specular interface twice.
+//! Lambertian diffuse, scaled by the light the specular interface lets through.
 //!
 //! Plain Lambert `ρ / π` added to a specular lobe reflects more than it receives when `ρ` is
-//! white: the interface has already reflected `F` of the light. We weight Lambert by
-//! `(1 − F(n·l)) (1 − F(n·v))`, the Fresnel transmittance into the surface toward the light
-//! and out of it toward the viewer (the coupled diffuse term of Shirley et al. 1997,
-//! "A Practitioners' Assessment of Light Reflection Models", without its renormalisation).
-//! It is symmetric in `v` and `l`, so reciprocity holds, and it uses the macro-normal
-//! cosines, not `v·h`: weighting by `1 − F(v·h)` does not conserve energy at grazing view,
-//! where the specular lobe sees `F ≈ 1` but the half-vectors of most diffuse directions see
-//! `F ≈ F0`. The total directional albedo (specular + diffuse, white base colour) stays below
-//! 1 for every roughness, metalness and angle (checked by `tests/brdf.rs`); the price is that
-//! a little energy is lost, because light reflected back inside the interface is dropped.
+//! white: the interface has already reflected part of the light. Kelemen & Szirmay-Kalos 2001
+//! weight Lambert by `(1 − E_s(μo)) (1 − E_s(μi)) / (1 − E_s,avg)`, where `E_s` is the specular
+//! lobe's directional albedo and `E_s,avg` its cosine-weighted average: the light the interface
+//! does not reflect enters the body on the way in, and leaves it on the way out, and the
+//! normalisation makes the diffuse lobe reflect exactly `ρ (1 − E_s(μo))`. It is symmetric in
+//! `v` and `l`, so reciprocity holds.
+//!
+//! hikari weighted Lambert by the Fresnel transmittances `(1 − F(n·v)) (1 − F(n·l))` of the
+//! macro-surface before: that treats a rough surface as a mirror at grazing angles, where its
+//! specular lobe in fact reflects far less than `F(n·v) → 1`, and lost up to 60 % of the
+//! light (docs/brdf.md).
 
-use super::fresnel::fresnel_schlick;
 use glam::DVec3;
 use std::f64::consts::FRAC_1_PI;
 
@@ -21,13 +21,9 @@ pub fn lambert(albedo: DVec3) -> DVec3 {
     albedo * FRAC_1_PI
 }
 
-/// Fresnel-weighted Lambert `ρ / π · (1 − F(n·v)) (1 − F(n·l))`, sr⁻¹, with `F` Schlick's
-/// approximation for normal-incidence reflectance `f0`. 0 if either cosine is ≤ 0.
-pub fn fresnel_weighted_lambert(albedo: DVec3, f0: DVec3, n_dot_v: f64, n_dot_l: f64) -> DVec3 {
-    if n_dot_v <= 0.0 || n_dot_l <= 0.0 {
-        return DVec3::ZERO;
-    }
-    let tv = DVec3::ONE - fresnel_schlick(f0, n_dot_v);
-    let tl = DVec3::ONE - fresnel_schlick(f0, n_dot_l);
-    lambert(albedo) * tv * tl
+/// Albedo-scaled Lambert `ρ / π · (1 − e_o) (1 − e_i) / (1 − e_avg)`, sr⁻¹, for the specular
+/// lobe's directional albedos `e_o` (toward the viewer), `e_i` (toward the light) and its
+/// average `e_avg` (all in [0, 1]; `1 − e_avg` is floored at [`super::energy::MIN_LOSS`]).
+pub fn albedo_scaled_lambert(albedo: DVec3, e_o: f64, e_i: f64, e_avg: f64) -> DVec3 {
+    lambert(albedo) * ((1.0 - e_o) * (1.0 - e_i) / (1.0 - e_avg).max(super::energy::MIN_LOSS))
 }

@@ -1,31 +1,34 @@
 //! The full BRDF times the cosine: what a deferred light pass multiplies by a light's
 //! irradiance.
 
-use super::diffuse::fresnel_weighted_lambert;
+use super::energy::Compensation;
 use super::fresnel::fresnel_schlick;
 use super::ggx::{ggx_ndf, ggx_ndf_aniso};
 use super::material::Material;
 use super::smith::{visibility, visibility_aniso};
 use glam::{DVec3, Vec3};
 
-/// The two lobes of [`evaluate_f64`], each already multiplied by `n·l` (sr⁻¹).
+/// The three lobes of [`evaluate_f64`], each already multiplied by `n·l` (sr⁻¹).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lobes {
-    /// `D · V · F · (n·l)`.
+    /// Single scattering, `D · V · F · (n·l)`.
     pub specular: DVec3,
-    /// Fresnel-weighted Lambert times `n·l`.
+    /// Multiple scattering, [`Compensation::multiple_scattering`] times `n·l`.
+    pub multiple: DVec3,
+    /// Albedo-scaled Lambert, [`Compensation::diffuse`] times `n·l`.
     pub diffuse: DVec3,
 }
 
 impl Lobes {
     const ZERO: Self = Self {
         specular: DVec3::ZERO,
+        multiple: DVec3::ZERO,
         diffuse: DVec3::ZERO,
     };
 
-    /// `specular + diffuse`.
+    /// `specular + multiple + diffuse`.
     pub fn sum(&self) -> DVec3 {
-        self.specular + self.diffuse
+        self.specular + self.multiple + self.diffuse
     }
 }
 
@@ -39,7 +42,8 @@ impl Lobes {
 /// surface; a pass whose normal maps face away from the viewer must bend `n` itself.
 ///
 /// Specular: `D · V · F(v·h)` with [`ggx_ndf_aniso`], [`visibility_aniso`] (height-correlated
-/// Smith) and [`fresnel_schlick`]; diffuse: [`fresnel_weighted_lambert`]. Computed in `f64`.
+/// Smith) and [`fresnel_schlick`], plus the multiple-scattering lobe; diffuse: Lambert scaled
+/// by what the specular lobe leaves ([`Compensation`], docs/brdf.md). Computed in `f64`.
 pub fn evaluate(material: &Material, n: Vec3, t: Vec3, b: Vec3, v: Vec3, l: Vec3) -> Vec3 {
     let d = |x: Vec3| x.as_dvec3();
     evaluate_f64(material, d(n), d(t), d(b), d(v), d(l)).as_vec3()
@@ -77,15 +81,19 @@ pub fn evaluate_lobes_f64(
     let spec = ggx_ndf_aniso(h_loc, ax, ay)
         * visibility_aniso(v_loc, l_loc, ax, ay)
         * fresnel_schlick(f0, v_loc.dot(h_loc));
-    let diff = fresnel_weighted_lambert(material.diffuse_albedo(), f0, v_loc.z, l_loc.z);
+    let comp = Compensation::new(material);
+    let ms = comp.multiple_scattering(v_loc, l_loc);
+    let diff = comp.diffuse(material.diffuse_albedo(), v_loc, l_loc);
     Lobes {
         specular: spec * l_loc.z,
+        multiple: ms * l_loc.z,
         diffuse: diff * l_loc.z,
     }
 }
 
 /// [`evaluate`] without a tangent frame, for isotropic materials (`anisotropy` is ignored):
-/// uses [`ggx_ndf`] and [`visibility`] on cosines only.
+/// uses [`ggx_ndf`] and [`visibility`] on cosines only, and the material's own roughness for
+/// the compensation.
 pub fn evaluate_isotropic(material: &Material, n: Vec3, v: Vec3, l: Vec3) -> Vec3 {
     let d = |x: Vec3| x.as_dvec3();
     evaluate_isotropic_f64(material, d(n), d(v), d(l)).as_vec3()
@@ -103,6 +111,15 @@ pub fn evaluate_isotropic_f64(material: &Material, n: DVec3, v: DVec3, l: DVec3)
     let spec = ggx_ndf(n.dot(h), alpha)
         * visibility(n_dot_v, n_dot_l, alpha)
         * fresnel_schlick(f0, v.dot(h));
-    let diff = fresnel_weighted_lambert(material.diffuse_albedo(), f0, n_dot_v, n_dot_l);
-    (spec + diff) * n_dot_l
+    let comp = Compensation::new(&material.with_anisotropy(0.0));
+    // Isotropic: only the cosines matter; any azimuth will do.
+    let (wv, wl) = (polar(n_dot_v), polar(n_dot_l));
+    let ms = comp.multiple_scattering(wv, wl);
+    let diff = comp.diffuse(material.diffuse_albedo(), wv, wl);
+    (spec + ms + diff) * n_dot_l
+}
+
+/// A unit vector at cosine `mu` from the normal, in the tangent frame's `xz` plane.
+fn polar(mu: f64) -> DVec3 {
+    DVec3::new(((1.0 - mu) * (1.0 + mu)).max(0.0).sqrt(), 0.0, mu)
 }

@@ -3,7 +3,11 @@
 //! `brdf_` prefix, in `f32`).
 //!
 //! Ghost of Tsushima's shading model (Patry 2021): GGX specular NDF with optional anisotropy,
-//! Smith visibility, Schlick Fresnel, Lambertian diffuse, energy conserving.
+//! Smith visibility, Schlick Fresnel, Lambertian diffuse; energy conserving and energy
+//! preserving: the light single scattering loses comes back as a multiple-scattering lobe
+//! (Kulla & Conty 2017), and the diffuse lobe gets what the specular lobe does not reflect
+//! (Kelemen & Szirmay-Kalos 2001), so a white material reflects all it receives at every
+//! roughness and angle (docs/brdf.md).
 //!
 //! | module | what it holds |
 //! |---|---|
@@ -11,7 +15,9 @@
 //! | [`ggx`] | GGX / Trowbridge-Reitz `D(h)`, isotropic and anisotropic (Walter et al. 2007) |
 //! | [`smith`] | Smith `Λ`, `G1`, height-correlated `G2` and `V = G2 / (4 n·l n·v)` (Heitz 2014) |
 //! | [`fresnel`] | Schlick's Fresnel (Schlick 1994) |
-//! | [`diffuse`] | Lambert, and the Fresnel-weighted Lambert the full BRDF uses |
+//! | [`diffuse`] | Lambert, and the albedo-scaled Lambert the full BRDF uses |
+//! | [`albedo`] | directional albedo tables `E(μ, r)`, `E_w(μ, r)` and their averages (quadrature, and the WGSL text of `brdf_tables.wgsl`) |
+//! | [`energy`] | [`energy::Compensation`]: the multiple-scattering lobe and the diffuse weights from the tables |
 //! | (`evaluate.rs`) | [`evaluate()`]: `f(v, l) · n·l` for a material, also [`evaluate_isotropic`], the `_f64` forms and [`Lobes`] |
 //! | [`sampling`] | VNDF importance sampling of the specular lobe (Heitz 2018) |
 //!
@@ -50,9 +56,13 @@
 //! 7(4)); Burley 2012, "Physically-Based Shading at Disney"; Karis 2013, "Real Shading in
 //! Unreal Engine 4"; Schlick 1994, "An Inexpensive BRDF Model for Physically-based
 //! Rendering"; Shirley, Hu, Smits & Lafortune 1997, "A Practitioners' Assessment of Light
-//! Reflection Models"; Patry 2021, Ghost of Tsushima (SIGGRAPH Advances).
+//! Reflection Models"; Kelemen & Szirmay-Kalos 2001, "A Microfacet Based Coupled
+//! Specular-Matte BRDF Model with Importance Sampling"; Kulla & Conty 2017, "Revisiting
+//! Physically Based Shading at Imageworks" (SIGGRAPH course); Patry 2021, Ghost of Tsushima (SIGGRAPH Advances).
 
+pub mod albedo;
 pub mod diffuse;
+pub mod energy;
 mod evaluate;
 pub mod fresnel;
 pub mod ggx;

@@ -9,10 +9,14 @@
 // perceptual_roughness^2 (Burley 2012). Units: D and the BRDF in 1/sr; brdf_evaluate returns
 // BRDF * n.l, so multiplying by a light's irradiance (lux or W/m^2) gives radiance.
 //
-// Model: GGX NDF (Walter et al. 2007) with Burley 2012 anisotropy extended to [-1, 1] by sign,
-// height-correlated Smith G2 (Heitz 2014) folded into V = G2 / (4 n.l n.v), Schlick Fresnel
-// (Schlick 1994) on v.h, Lambert weighted by (1 - F(n.v)) (1 - F(n.l)) (Shirley et al. 1997)
-// so that a white material never reflects more than it receives.
+// Model (docs/brdf.md): GGX NDF (Walter et al. 2007) with Burley 2012 anisotropy extended to
+// [-1, 1] by sign, height-correlated Smith G2 (Heitz 2014) folded into V = G2 / (4 n.l n.v),
+// Schlick Fresnel (Schlick 1994) on v.h; plus the multiple-scattering lobe of Kulla & Conty
+// 2017 and Lambert scaled by what the specular lobe leaves, (1 - E_d(n.v)) (1 - E_d(n.l)) /
+// (1 - E_d,avg) (Kelemen & Szirmay-Kalos 2001), from the albedo tables of hikari::brdf_tables,
+// so that a white material reflects what it receives at every roughness and angle.
+
+#import hikari::brdf_tables::{BRDF_TABLE_SIZE, BRDF_ALBEDO, BRDF_ALBEDO_AVG}
 
 const BRDF_PI: f32 = 3.141592653589793;
 // Must match hikari_math::brdf::material::MIN_PERCEPTUAL_ROUGHNESS: keeps 1 - (n.h)^2 resolvable
@@ -155,13 +159,67 @@ fn brdf_lambert(albedo: vec3<f32>) -> vec3<f32> {
     return albedo * (1.0 / BRDF_PI);
 }
 
-fn brdf_fresnel_weighted_lambert(albedo: vec3<f32>, f0: vec3<f32>, n_dot_v: f32, n_dot_l: f32) -> vec3<f32> {
-    if n_dot_v <= 0.0 || n_dot_l <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    let tv = vec3<f32>(1.0) - brdf_fresnel_schlick(f0, n_dot_v);
-    let tl = vec3<f32>(1.0) - brdf_fresnel_schlick(f0, n_dot_l);
-    return brdf_lambert(albedo) * tv * tl;
+// Floor of 1 - E_avg in the compensation's denominators (hikari_math::brdf::energy::MIN_LOSS).
+const BRDF_MIN_LOSS: f32 = 1e-6;
+
+// Lambert scaled by the light the specular lobe (directional albedos e_o toward the viewer,
+// e_i toward the light, average e_avg) lets into and out of the body.
+fn brdf_albedo_scaled_lambert(albedo: vec3<f32>, e_o: f32, e_i: f32, e_avg: f32) -> vec3<f32> {
+    return brdf_lambert(albedo) * ((1.0 - e_o) * (1.0 - e_i) / max(1.0 - e_avg, BRDF_MIN_LOSS));
+}
+
+// F_avg = 2 int F(mu) mu dmu for Schlick's Fresnel.
+fn brdf_fresnel_schlick_average(f0: vec3<f32>) -> vec3<f32> {
+    return f0 + (vec3<f32>(1.0) - f0) * (1.0 / 21.0);
+}
+
+// Kulla & Conty 2017: colour of the multiple-scattering lobe, F_avg^2 E_avg / (1 - F_avg (1 - E_avg)).
+fn brdf_multiple_scattering_fresnel(f_avg: vec3<f32>, e_avg: f32) -> vec3<f32> {
+    return f_avg * f_avg * e_avg / (vec3<f32>(1.0) - f_avg * (1.0 - e_avg));
+}
+
+// Perceptual roughness of the isotropic lobe with the anisotropic lobe's peak, (ax ay)^(1/4):
+// where the compensation reads the tables (approximate for anisotropic lobes, docs/brdf.md).
+fn brdf_isotropic_equivalent_roughness(alphas: vec2<f32>) -> f32 {
+    return clamp(sqrt(sqrt(alphas.x * alphas.y)), BRDF_MIN_PERCEPTUAL_ROUGHNESS, 1.0);
+}
+
+// Table row of perceptual roughness r: rows sit at r_min + (1 - r_min) u^2. Returns the lower
+// row's index and the upper row's weight.
+fn brdf_table_row(perceptual_roughness: f32) -> vec2<f32> {
+    let u = sqrt(max(perceptual_roughness - BRDF_MIN_PERCEPTUAL_ROUGHNESS, 0.0) / (1.0 - BRDF_MIN_PERCEPTUAL_ROUGHNESS));
+    let p = clamp(u, 0.0, 1.0) * f32(BRDF_TABLE_SIZE - 1u);
+    let j = min(floor(p), f32(BRDF_TABLE_SIZE - 2u));
+    return vec2<f32>(j, p - j);
+}
+
+// (E, E_w) at mu = n.l on table row `row` (from brdf_table_row), bilinear in (sqrt(mu), r).
+fn brdf_albedo_lookup_row(mu: f32, row: vec2<f32>) -> vec2<f32> {
+    let p = sqrt(clamp(mu, 0.0, 1.0)) * f32(BRDF_TABLE_SIZE - 1u);
+    let i = min(floor(p), f32(BRDF_TABLE_SIZE - 2u));
+    let fx = p - i;
+    let k = u32(row.x) * BRDF_TABLE_SIZE + u32(i);
+    let lo = mix(BRDF_ALBEDO[k], BRDF_ALBEDO[k + 1u], fx);
+    let hi = mix(BRDF_ALBEDO[k + BRDF_TABLE_SIZE], BRDF_ALBEDO[k + BRDF_TABLE_SIZE + 1u], fx);
+    return mix(lo, hi, row.y);
+}
+
+// Single-scattering albedos (E with F = 1, E_w with F = (1 - v.h)^5) at mu and roughness r.
+fn brdf_albedo_lookup(mu: f32, perceptual_roughness: f32) -> vec2<f32> {
+    return brdf_albedo_lookup_row(mu, brdf_table_row(perceptual_roughness));
+}
+
+// Their cosine-weighted averages (E_avg, E_w,avg) at roughness r.
+fn brdf_albedo_average(perceptual_roughness: f32) -> vec2<f32> {
+    let row = brdf_table_row(perceptual_roughness);
+    let j = u32(row.x);
+    return mix(BRDF_ALBEDO_AVG[j], BRDF_ALBEDO_AVG[j + 1u], row.y);
+}
+
+// Directional albedo of the dielectric's specular lobe (F0 = 0.04, single + multiple
+// scattering) from (E, E_w) and the dielectric's multiple-scattering colour.
+fn brdf_dielectric_albedo(e: vec2<f32>, dielectric_ms_fresnel: f32) -> f32 {
+    return BRDF_DIELECTRIC_F0 * e.x + (1.0 - BRDF_DIELECTRIC_F0) * e.y + dielectric_ms_fresnel * (1.0 - e.x);
 }
 
 fn brdf_material_f0(m: BrdfMaterial) -> vec3<f32> {
@@ -170,6 +228,30 @@ fn brdf_material_f0(m: BrdfMaterial) -> vec3<f32> {
 
 fn brdf_material_diffuse_albedo(m: BrdfMaterial) -> vec3<f32> {
     return saturate(m.base_color) * (1.0 - saturate(m.metalness));
+}
+
+// The compensation's material terms at table roughness r (hikari_math::brdf::energy::Compensation).
+struct BrdfCompensation {
+    // brdf_table_row(r).
+    row: vec2<f32>,
+    e_avg: f32,
+    // (1 - m) F_ms(0.04) + m F_ms(base colour).
+    ms_fresnel: vec3<f32>,
+    dielectric_ms_fresnel: f32,
+    dielectric_avg: f32,
+}
+
+fn brdf_compensation(m: BrdfMaterial, perceptual_roughness: f32) -> BrdfCompensation {
+    var c: BrdfCompensation;
+    c.row = brdf_table_row(perceptual_roughness);
+    let j = u32(c.row.x);
+    let avg = mix(BRDF_ALBEDO_AVG[j], BRDF_ALBEDO_AVG[j + 1u], c.row.y);
+    c.e_avg = avg.x;
+    c.dielectric_ms_fresnel = brdf_multiple_scattering_fresnel(brdf_fresnel_schlick_average(vec3<f32>(BRDF_DIELECTRIC_F0)), avg.x).x;
+    let metal_fms = brdf_multiple_scattering_fresnel(brdf_fresnel_schlick_average(saturate(m.base_color)), avg.x);
+    c.ms_fresnel = mix(vec3<f32>(c.dielectric_ms_fresnel), metal_fms, saturate(m.metalness));
+    c.dielectric_avg = brdf_dielectric_albedo(avg, c.dielectric_ms_fresnel);
+    return c;
 }
 
 // What brdf_evaluate derives from the material and the view direction alone: computed once
@@ -182,8 +264,13 @@ struct BrdfView {
     alphas: vec2<f32>,
     // Fresnel reflectance at normal incidence.
     f_normal: vec3<f32>,
-    // Lambert times the view side's Fresnel transmission 1 - F(n.v).
+    // Albedo-scaled Lambert's view half: rho / pi (1 - E_d(n.v)) / (1 - E_d,avg).
     diffuse: vec3<f32>,
+    // Multiple-scattering lobe's view half: F_ms (1 - E(n.v)) / (pi (1 - E_avg)).
+    multiple: vec3<f32>,
+    // Table row of the compensation's roughness (brdf_table_row).
+    row: vec2<f32>,
+    dielectric_ms_fresnel: f32,
     // |v_local * (alpha_x, alpha_y, 1)|: the view's half of the height-correlated visibility.
     v_stretched: f32,
     // 1 / alpha_x, 1 / alpha_y: multiplications, not divisions, for every light's D.
@@ -200,7 +287,13 @@ fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<
     p.v_local = vec3<f32>(dot(t, v), dot(b, v), dot(n, v));
     p.alphas = brdf_anisotropic_alphas(m.perceptual_roughness, m.anisotropy);
     p.f_normal = brdf_material_f0(m);
-    p.diffuse = brdf_lambert(brdf_material_diffuse_albedo(m)) * (vec3<f32>(1.0) - brdf_fresnel_schlick(p.f_normal, p.v_local.z));
+    let c = brdf_compensation(m, brdf_isotropic_equivalent_roughness(p.alphas));
+    let e_v = brdf_albedo_lookup_row(p.v_local.z, c.row);
+    p.diffuse = brdf_lambert(brdf_material_diffuse_albedo(m))
+        * ((1.0 - brdf_dielectric_albedo(e_v, c.dielectric_ms_fresnel)) / max(1.0 - c.dielectric_avg, BRDF_MIN_LOSS));
+    p.multiple = c.ms_fresnel * ((1.0 - e_v.x) / (BRDF_PI * max(1.0 - c.e_avg, BRDF_MIN_LOSS)));
+    p.row = c.row;
+    p.dielectric_ms_fresnel = c.dielectric_ms_fresnel;
     p.v_stretched = length(p.v_local * vec3<f32>(p.alphas, 1.0));
     p.inv_alphas = 1.0 / p.alphas;
     p.spec_scale = 1.0 / (2.0 * BRDF_PI * p.alphas.x * p.alphas.y);
@@ -208,14 +301,15 @@ fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<
 }
 
 // The light-dependent factors of brdf_evaluate_view, scalars, such that
-//   brdf_evaluate_view(p, l) = f_normal * w.x + (1 - f_normal) * (w.y + diffuse * w.z):
-// w.x = D V n.l, w.y = D V n.l Schlick(v.h), w.z = (1 - Schlick(n.l)) n.l, from F = f0 +
-// (1 - f0) Schlick. A caller summing many lights sums their weighted light colours and applies
-// the material's colours once (brdf_apply_weights), rather than three colour products a light.
-fn brdf_light_weights(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
+//   brdf_evaluate_view(p, l) = f_normal w.x + (1 - f_normal) w.y + diffuse w.z + multiple w.w:
+// w.x = D V n.l, w.y = D V n.l Schlick(v.h) (from F = f0 + (1 - f0) Schlick),
+// w.z = (1 - E_d(n.l)) n.l, w.w = (1 - E(n.l)) n.l. A caller summing many lights sums their
+// weighted light colours and applies the material's colours once (brdf_apply_weights), rather
+// than four colour products a light.
+fn brdf_light_weights(p: BrdfView, l: vec3<f32>) -> vec4<f32> {
     let l_local = vec3<f32>(dot(p.t, l), dot(p.b, l), dot(p.n, l));
     if p.v_local.z <= 0.0 || l_local.z <= 0.0 {
-        return vec3<f32>(0.0);
+        return vec4<f32>(0.0);
     }
     let h_local = normalize(p.v_local + l_local);
     // D (brdf_ggx_ndf_aniso) times V (brdf_visibility_stretched) over one division: with both
@@ -224,19 +318,21 @@ fn brdf_light_weights(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
     let dd = dot(s, s);
     let vis_den = l_local.z * p.v_stretched + p.v_local.z * length(l_local * vec3<f32>(p.alphas, 1.0));
     let spec = l_local.z * p.spec_scale / (dd * dd * vis_den);
-    return vec3<f32>(spec, spec * brdf_schlick_weight(dot(p.v_local, h_local)), (1.0 - brdf_schlick_weight(l_local.z)) * l_local.z);
+    let e_l = brdf_albedo_lookup_row(l_local.z, p.row);
+    let diffuse = (1.0 - brdf_dielectric_albedo(e_l, p.dielectric_ms_fresnel)) * l_local.z;
+    return vec4<f32>(spec, spec * brdf_schlick_weight(dot(p.v_local, h_local)), diffuse, (1.0 - e_l.x) * l_local.z);
 }
 
 // Radiance from light weights summed with their colours: a = sum c w.x, b = sum c w.y,
-// c = sum c w.z (see brdf_light_weights).
-fn brdf_apply_weights(p: BrdfView, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
-    return p.f_normal * a + (vec3<f32>(1.0) - p.f_normal) * (b + p.diffuse * c);
+// c = sum c w.z, d = sum c w.w (see brdf_light_weights).
+fn brdf_apply_weights(p: BrdfView, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
+    return p.f_normal * a + (vec3<f32>(1.0) - p.f_normal) * b + p.diffuse * c + p.multiple * d;
 }
 
 // brdf_evaluate for a prepared view: BRDF * n.l, 0 when v or l is at or below the surface.
 fn brdf_evaluate_view(p: BrdfView, l: vec3<f32>) -> vec3<f32> {
     let w = brdf_light_weights(p, l);
-    return brdf_apply_weights(p, vec3<f32>(w.x), vec3<f32>(w.y), vec3<f32>(w.z));
+    return brdf_apply_weights(p, vec3<f32>(w.x), vec3<f32>(w.y), vec3<f32>(w.z), vec3<f32>(w.w));
 }
 
 // BRDF * n.l, 1/sr, per RGB channel; 0 when v or l is at or below the surface.
@@ -244,7 +340,8 @@ fn brdf_evaluate(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: v
     return brdf_evaluate_view(brdf_view(m, n, t, b, v), l);
 }
 
-// brdf_evaluate without a tangent frame; anisotropy is ignored.
+// brdf_evaluate without a tangent frame; anisotropy is ignored (the compensation reads the
+// material's own roughness).
 fn brdf_evaluate_isotropic(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     let n_dot_v = dot(n, v);
     let n_dot_l = dot(n, l);
@@ -257,6 +354,15 @@ fn brdf_evaluate_isotropic(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>, l: vec3<
     let spec = brdf_ggx_ndf(dot(n, h), alpha)
         * brdf_visibility(n_dot_v, n_dot_l, alpha)
         * brdf_fresnel_schlick(f0, dot(v, h));
-    let diff = brdf_fresnel_weighted_lambert(brdf_material_diffuse_albedo(m), f0, n_dot_v, n_dot_l);
-    return (spec + diff) * n_dot_l;
+    let c = brdf_compensation(m, clamp(m.perceptual_roughness, BRDF_MIN_PERCEPTUAL_ROUGHNESS, 1.0));
+    let e_v = brdf_albedo_lookup_row(n_dot_v, c.row);
+    let e_l = brdf_albedo_lookup_row(n_dot_l, c.row);
+    let ms = c.ms_fresnel * ((1.0 - e_v.x) * (1.0 - e_l.x) / (BRDF_PI * max(1.0 - c.e_avg, BRDF_MIN_LOSS)));
+    let diff = brdf_albedo_scaled_lambert(
+        brdf_material_diffuse_albedo(m),
+        brdf_dielectric_albedo(e_v, c.dielectric_ms_fresnel),
+        brdf_dielectric_albedo(e_l, c.dielectric_ms_fresnel),
+        c.dielectric_avg,
+    );
+    return (spec + ms + diff) * n_dot_l;
 }

@@ -1,4 +1,4 @@
-//! Verification kernels for the WGSL math twins (`hikari::sh`, `hikari::color`): no frame uses
+//! Verification kernels for the WGSL math twins (`hikari::sh`, `hikari::color`, `hikari::brdf`): no frame uses
 //! them. `tests/math_twins.rs` runs each on a few hundred random cases and compares the results
 //! with hikari-math on the CPU, so a twin that drifts from its reference fails a test instead
 //! of showing up as a lighting bug.
@@ -51,6 +51,8 @@ pub enum Kernel {
     Matrices,
     /// The Purkinje shift with the generated matrices.
     Purkinje,
+    /// The BRDF (anisotropic and isotropic forms, per-light weights) and its albedo tables.
+    Brdf,
 }
 
 impl Kernel {
@@ -66,6 +68,7 @@ impl Kernel {
             | Kernel::ShBoost => "math_check/sh.wgsl",
             Kernel::YCoCg => "math_check/ycocg.wgsl",
             Kernel::Transfer | Kernel::Matrices | Kernel::Purkinje => "math_check/color.wgsl",
+            Kernel::Brdf => "math_check/brdf.wgsl",
         }
     }
 
@@ -82,6 +85,7 @@ impl Kernel {
             Kernel::Transfer => "transfer",
             Kernel::Matrices => "matrices",
             Kernel::Purkinje => "purkinje",
+            Kernel::Brdf => "eval",
         }
     }
 
@@ -99,6 +103,7 @@ impl Kernel {
             Kernel::Transfer => 5,
             Kernel::Matrices => 3,
             Kernel::Purkinje => 3,
+            Kernel::Brdf => 21,
         }
     }
 
@@ -116,6 +121,7 @@ impl Kernel {
             Kernel::Transfer => 9,
             Kernel::Matrices => 31,
             Kernel::Purkinje => 3,
+            Kernel::Brdf => 14,
         }
     }
 }

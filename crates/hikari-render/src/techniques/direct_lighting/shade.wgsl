@@ -1,7 +1,8 @@
 // Deferred direct lighting: the sun (or moon) with its cascaded shadows, point and spot
 // lights culled per 16x16 tile, emissive surfaces, and the clearly named placeholders for sky
 // and ambient light that the atmosphere and probe issues replace. BRDF: hikari::brdf (GGX with
-// anisotropy, height-correlated Smith, Schlick Fresnel, Fresnel-weighted Lambert).
+// anisotropy, height-correlated Smith, Schlick Fresnel, multiple-scattering compensation,
+// albedo-scaled Lambert).
 // Output: radiance in nits. CPU twin: reference::direct_lighting.
 
 #import hikari::view::{View, view_ray, world_from_depth}
@@ -178,11 +179,12 @@ fn main(
         let mat = textureLoad(gbuffer_material, pixel, 0);
         let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
         let brdf = brdf_view(m, n, t, b, v);
-        // Every light's colour times its three BRDF weights, summed; the material's colours
+        // Every light's colour times its four BRDF weights, summed; the material's colours
         // are applied once after the loop.
         var sum_a = vec3<f32>(0.0);
         var sum_b = vec3<f32>(0.0);
         var sum_c = vec3<f32>(0.0);
+        var sum_d = vec3<f32>(0.0);
         if (flags & LIGHTING_SUN) != 0u && params.direction_lux.w > 0.0 {
             let l = params.direction_lux.xyz;
             let e = params.color.rgb * (params.direction_lux.w * sun_visibility(world, n));
@@ -190,6 +192,7 @@ fn main(
             sum_a += e * w.x;
             sum_b += e * w.y;
             sum_c += e * w.z;
+            sum_d += e * w.w;
         }
         for (var k = 0u; k < tile_lights_n; k++) {
             let light = lights[tile_lights[k]];
@@ -205,8 +208,9 @@ fn main(
             sum_a += e * w.x;
             sum_b += e * w.y;
             sum_c += e * w.z;
+            sum_d += e * w.w;
         }
-        radiance = brdf_apply_weights(brdf, sum_a, sum_b, sum_c);
+        radiance = brdf_apply_weights(brdf, sum_a, sum_b, sum_c, sum_d);
         if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
             let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);
             radiance += (diffuse + specular_placeholder(m, n, v)) * mat.w;
