@@ -129,6 +129,9 @@ impl GpuContext {
             max_compute_workgroup_size_z: adapter_limits.max_compute_workgroup_size_z,
             max_color_attachment_bytes_per_sample: adapter_limits
                 .max_color_attachment_bytes_per_sample,
+            // A pass's own group and one a shared binding set it imports (shadows, sky, BRDF
+            // tables, BVH...): more than WebGPU's default 4.
+            max_bind_groups: adapter_limits.max_bind_groups.min(8),
             ..wgpu::Limits::default().using_resolution(adapter_limits.clone())
         };
         let (device, queue) = adapter

@@ -3,6 +3,7 @@
 
 use hikari_scene::{Camera, Sun};
 
+use crate::brdf_tables::BrdfTables;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{FrameGraph, Tex};
@@ -83,6 +84,8 @@ pub struct Techniques {
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
     pub placeholder_tonemap: PlaceholderTonemap,
+    /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
+    pub brdf_tables: BrdfTables,
 }
 
 impl Techniques {
@@ -94,6 +97,7 @@ impl Techniques {
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
+            brdf_tables: BrdfTables::new(ctx),
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
         })
     }
@@ -165,6 +169,7 @@ pub fn record<'r>(
 
     // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
     //     sky's SH as ambient light, or the placeholders with the atmosphere off).
+    let brdf = t.brdf_tables.binding_set(g);
     let mut lighting = LightingParams::new(
         s.sun.as_ref(),
         scene.light_count,
@@ -176,7 +181,7 @@ pub fn record<'r>(
     }
     let hdr = t
         .direct_lighting
-        .record(g, &gbuffer, &shadows, &sky, scene, &view, &lighting)?;
+        .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
 
     // 12. Haze and 13. TAA: their issues add them here.
 

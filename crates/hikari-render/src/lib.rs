@@ -2,6 +2,7 @@
 //! the compute rasteriser (`raster/`), one folder per technique under `techniques/` (passes,
 //! WGSL, CPU twin, settings), and `frame.rs`, where one frame reads top to bottom.
 
+pub mod brdf_tables;
 pub mod bvh_trace;
 pub mod checks;
 pub mod context;

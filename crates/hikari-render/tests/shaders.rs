@@ -120,7 +120,7 @@ fn shared_modules_bind_in_groups_of_their_own() {
     let mut lib = ShaderLibrary::new(caps).unwrap();
     assert_eq!(
         lib.binding_sets("direct_lighting/shade.wgsl"),
-        ["sky", "sky_ambient", "sun_shadows"]
+        ["brdf_tables", "sky", "sky_ambient", "sun_shadows"]
     );
     assert!(
         lib.binding_sets("placeholder_tonemap/apply.wgsl")
@@ -133,8 +133,8 @@ fn shared_modules_bind_in_groups_of_their_own() {
         &lib.binding_sets("direct_lighting/shade.wgsl"),
     )
     .unwrap();
-    assert_eq!(groups.len(), 4);
-    let names: Vec<&str> = groups[3]
+    assert_eq!(groups.len(), 5);
+    let names: Vec<&str> = groups[4]
         .iter()
         .map(|s| shader::undecorated(&s.name))
         .collect();

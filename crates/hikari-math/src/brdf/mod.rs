@@ -16,7 +16,7 @@
 //! | [`smith`] | Smith `Λ`, `G1`, height-correlated `G2` and `V = G2 / (4 n·l n·v)` (Heitz 2014) |
 //! | [`fresnel`] | Schlick's Fresnel (Schlick 1994) |
 //! | [`diffuse`] | Lambert, and the albedo-scaled Lambert the full BRDF uses |
-//! | [`albedo`] | directional albedo tables `E(μ, r)`, `E_w(μ, r)` and their averages (quadrature, and the WGSL text of `brdf_tables.wgsl`) |
+//! | [`albedo`] | directional albedo tables `E(μ, r)`, `E_w(μ, r)` and their averages (quadrature, and the data the GPU reads, `hikari::brdf_tables`) |
 //! | [`energy`] | [`energy::Compensation`]: the multiple-scattering lobe and the diffuse weights from the tables |
 //! | (`evaluate.rs`) | [`evaluate()`]: `f(v, l) · n·l` for a material, also [`evaluate_isotropic`], the `_f64` forms and [`Lobes`] |
 //! | [`sampling`] | VNDF importance sampling of the specular lobe (Heitz 2018) |

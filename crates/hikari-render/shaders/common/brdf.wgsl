@@ -16,7 +16,7 @@
 // (1 - E_d,avg) (Kelemen & Szirmay-Kalos 2001), from the albedo tables of hikari::brdf_tables,
 // so that a white material reflects what it receives at every roughness and angle.
 
-#import hikari::brdf_tables::{BRDF_TABLE_SIZE, BRDF_ALBEDO, BRDF_ALBEDO_AVG}
+#import hikari::brdf_tables::{BRDF_TABLE_SIZE, brdf_table_albedo, brdf_table_average}
 
 const BRDF_PI: f32 = 3.141592653589793;
 // Must match hikari_math::brdf::material::MIN_PERCEPTUAL_ROUGHNESS: keeps 1 - (n.h)^2 resolvable
@@ -199,8 +199,8 @@ fn brdf_albedo_lookup_row(mu: f32, row: vec2<f32>) -> vec2<f32> {
     let i = min(floor(p), f32(BRDF_TABLE_SIZE - 2u));
     let fx = p - i;
     let k = u32(row.x) * BRDF_TABLE_SIZE + u32(i);
-    let lo = mix(BRDF_ALBEDO[k], BRDF_ALBEDO[k + 1u], fx);
-    let hi = mix(BRDF_ALBEDO[k + BRDF_TABLE_SIZE], BRDF_ALBEDO[k + BRDF_TABLE_SIZE + 1u], fx);
+    let lo = mix(brdf_table_albedo(k), brdf_table_albedo(k + 1u), fx);
+    let hi = mix(brdf_table_albedo(k + BRDF_TABLE_SIZE), brdf_table_albedo(k + BRDF_TABLE_SIZE + 1u), fx);
     return mix(lo, hi, row.y);
 }
 
@@ -213,7 +213,7 @@ fn brdf_albedo_lookup(mu: f32, perceptual_roughness: f32) -> vec2<f32> {
 fn brdf_albedo_average(perceptual_roughness: f32) -> vec2<f32> {
     let row = brdf_table_row(perceptual_roughness);
     let j = u32(row.x);
-    return mix(BRDF_ALBEDO_AVG[j], BRDF_ALBEDO_AVG[j + 1u], row.y);
+    return mix(brdf_table_average(j), brdf_table_average(j + 1u), row.y);
 }
 
 // Directional albedo of the dielectric's specular lobe (F0 = 0.04, single + multiple
@@ -245,7 +245,7 @@ fn brdf_compensation(m: BrdfMaterial, perceptual_roughness: f32) -> BrdfCompensa
     var c: BrdfCompensation;
     c.row = brdf_table_row(perceptual_roughness);
     let j = u32(c.row.x);
-    let avg = mix(BRDF_ALBEDO_AVG[j], BRDF_ALBEDO_AVG[j + 1u], c.row.y);
+    let avg = mix(brdf_table_average(j), brdf_table_average(j + 1u), c.row.y);
     c.e_avg = avg.x;
     c.dielectric_ms_fresnel = brdf_multiple_scattering_fresnel(brdf_fresnel_schlick_average(vec3<f32>(BRDF_DIELECTRIC_F0)), avg.x).x;
     let metal_fms = brdf_multiple_scattering_fresnel(brdf_fresnel_schlick_average(saturate(m.base_color)), avg.x);

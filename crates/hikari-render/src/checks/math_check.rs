@@ -130,6 +130,8 @@ impl Kernel {
 pub struct MathCheck {
     pub kernel: Kernel,
     pub pipeline: ComputePipeline,
+    /// For the kernels that evaluate `hikari::brdf`.
+    brdf_tables: crate::brdf_tables::BrdfTables,
 }
 
 impl MathCheck {
@@ -137,6 +139,7 @@ impl MathCheck {
         Ok(Self {
             kernel,
             pipeline: ComputePipeline::new(ctx, lib, kernel.shader(), kernel.entry(), &[])?,
+            brdf_tables: crate::brdf_tables::BrdfTables::new(ctx),
         })
     }
 
@@ -171,11 +174,17 @@ impl MathCheck {
         let mut g = rt.begin_frame(ctx);
         let input = g.import_buffer("math_check.input", &input_buffer);
         let output = g.buffer(&out_name, (count * k.out_stride() * 4) as u64)?;
-        g.pass(&format!("math_check.{name}"))
+        let tables =
+            (!self.pipeline.info.sets.is_empty()).then(|| self.brdf_tables.binding_set(&mut g));
+        let mut pass = g
+            .pass(&format!("math_check.{name}"))
             .constants(&params)
             .read(input)
-            .write(output)
-            .dispatch_threads(&self.pipeline, [count as u32, 1, 1])?;
+            .write(output);
+        if let Some(t) = tables {
+            pass = pass.set(t);
+        }
+        pass.dispatch_threads(&self.pipeline, [count as u32, 1, 1])?;
         g.readback(output);
         let result = g.execute()?;
         let bytes = result

@@ -15,7 +15,7 @@ use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{FrameGraph, Tex, TextureDesc};
+use crate::graph::{BindingSet, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::settings::DirectLightingSettings;
@@ -128,6 +128,7 @@ impl DirectLighting {
         gb: &GBuffer,
         shadows: &SunShadowMaps,
         sky: &SkyFrame,
+        brdf_tables: BindingSet,
         scene: &SceneInFrame,
         view: &View,
         params: &LightingParams,
@@ -150,6 +151,7 @@ impl DirectLighting {
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)
+            .set(brdf_tables)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(radiance)
     }
