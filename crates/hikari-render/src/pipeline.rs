@@ -141,12 +141,7 @@ pub fn reflect_groups(
         message,
     };
     let integer_samplers = samplers_of_integer_textures(module);
-    let has_filtering_sampler = module.global_variables.iter().any(|(h, g)| {
-        matches!(
-            module.types[g.ty].inner,
-            naga::TypeInner::Sampler { comparison: false }
-        ) && !integer_samplers.contains(&h)
-    });
+    let sampled = textures_sampled_with_filtering(module, &integer_samplers);
     let mut groups: Vec<Vec<BindingSlot>> = vec![Vec::new(); sets.len() + 1];
     for (handle, g) in module.global_variables.iter() {
         let Some(rb) = &g.binding else { continue };
@@ -172,9 +167,9 @@ pub fn reflect_groups(
                     view: view_dimension(*dim, *arrayed),
                     sample: match kind {
                         naga::ScalarKind::Float => wgpu::TextureSampleType::Float {
-                            // Shaders without a filtering sampler only load texels, which lets
-                            // them read unfilterable formats such as R32Float.
-                            filterable: has_filtering_sampler,
+                            // A texture the shader only loads texels from may be of an
+                            // unfilterable format such as R32Float.
+                            filterable: sampled.contains(&handle),
                         },
                         naga::ScalarKind::Sint => wgpu::TextureSampleType::Sint,
                         naga::ScalarKind::Uint => wgpu::TextureSampleType::Uint,
@@ -233,6 +228,41 @@ pub fn reflect_groups(
         }
     }
     Ok(groups)
+}
+
+/// Float textures a shader samples through a filtering sampler (any sampler but a comparison
+/// one or one used with integer textures).
+fn textures_sampled_with_filtering(
+    module: &naga::Module,
+    integer_samplers: &[naga::Handle<naga::GlobalVariable>],
+) -> Vec<naga::Handle<naga::GlobalVariable>> {
+    let mut out = Vec::new();
+    let functions = module
+        .functions
+        .iter()
+        .map(|(_, f)| f)
+        .chain(module.entry_points.iter().map(|e| &e.function));
+    for f in functions {
+        for (_, e) in f.expressions.iter() {
+            let naga::Expression::ImageSample { image, sampler, .. } = *e else {
+                continue;
+            };
+            if let (
+                naga::Expression::GlobalVariable(image),
+                naga::Expression::GlobalVariable(sampler),
+            ) = (&f.expressions[image], &f.expressions[sampler])
+            {
+                let filtering = matches!(
+                    module.types[module.global_variables[*sampler].ty].inner,
+                    naga::TypeInner::Sampler { comparison: false }
+                ) && !integer_samplers.contains(sampler);
+                if filtering && !out.contains(image) {
+                    out.push(*image);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Samplers a shader uses with integer textures (`textureGather` of a `texture_2d<u32>`): a

@@ -16,7 +16,7 @@
 // (1 - E_d,avg) (Kelemen & Szirmay-Kalos 2001), from the albedo tables of hikari::brdf_tables,
 // so that a white material reflects what it receives at every roughness and angle.
 
-#import hikari::brdf_tables::{BRDF_TABLE_SIZE, brdf_table_albedo, brdf_table_average}
+#import hikari::brdf_tables::{BRDF_TABLE_SIZE, brdf_table_albedo_filtered, brdf_table_average}
 
 const BRDF_PI: f32 = 3.141592653589793;
 // Must match hikari_math::brdf::material::MIN_PERCEPTUAL_ROUGHNESS: keeps 1 - (n.h)^2 resolvable
@@ -194,14 +194,12 @@ fn brdf_table_row(perceptual_roughness: f32) -> vec2<f32> {
 }
 
 // (E, E_w) at mu = n.l on table row `row` (from brdf_table_row), bilinear in (sqrt(mu), r).
+// The texture unit's bilinear filter does the interpolation (its weights may be rounded to a
+// few bits on some GPUs: an error of a few 1e-4 at most, as neighbouring entries differ by
+// under 0.1).
 fn brdf_albedo_lookup_row(mu: f32, row: vec2<f32>) -> vec2<f32> {
     let p = sqrt(clamp(mu, 0.0, 1.0)) * f32(BRDF_TABLE_SIZE - 1u);
-    let i = min(floor(p), f32(BRDF_TABLE_SIZE - 2u));
-    let fx = p - i;
-    let k = u32(row.x) * BRDF_TABLE_SIZE + u32(i);
-    let lo = mix(brdf_table_albedo(k), brdf_table_albedo(k + 1u), fx);
-    let hi = mix(brdf_table_albedo(k + BRDF_TABLE_SIZE), brdf_table_albedo(k + BRDF_TABLE_SIZE + 1u), fx);
-    return mix(lo, hi, row.y);
+    return brdf_table_albedo_filtered(p, row.x + row.y);
 }
 
 // Single-scattering albedos (E with F = 1, E_w with F = (1 - v.h)^5) at mu and roughness r.

@@ -9,7 +9,8 @@
 //!   ([`atmosphere_for`]), shared with the `hikari sky` command and the directional light.
 //! * `sky.resample`: the 3D tables at this frame's sun and moon zenith angles into a 2D array
 //!   [mu, r] (sun Rayleigh, sun Mie, moon Rayleigh, moon Mie), cubic along mu_s.
-//! * `sky.sh`: 4096 directions of the sky (no disks) to L2 SH, deringed.
+//! * `sky.sh_project`, `sky.sh`: 4096 directions of the sky (no disks) to L2 SH in 64 partial
+//!   sums, then their total, deringed.
 //! * The shared WGSL modules `hikari::sky` (binding set `sky`: `sky_inscatter`,
 //!   `sky_background`, `sky_transmittance`) and `hikari::sky_ambient` (binding set
 //!   `sky_ambient`: irradiance and specular from the SH); the deferred lighting draws the
@@ -266,7 +267,8 @@ fn upload(ctx: &GpuContext, name: &str, t: &hikari_atmosphere::table::Table) -> 
 
 pub struct Sky {
     resample: ComputePipeline,
-    sh: ComputePipeline,
+    sh_project: ComputePipeline,
+    sh_finish: ComputePipeline,
     uploaded: Mutex<Option<Arc<Uploaded>>>,
 }
 
@@ -274,7 +276,8 @@ impl Sky {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
             resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
-            sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "main", &[])?,
+            sh_project: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project", &[])?,
+            sh_finish: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "finish", &[])?,
             uploaded: Mutex::new(None),
         })
     }
@@ -372,10 +375,18 @@ impl Sky {
             .read(resampled)
             .read(transmittance)
             .finish();
-        g.pass("sky.sh")
+        // 64 workgroups of 64 directions, each summed into 9 partial coefficients.
+        let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
+        g.pass("sky.sh_project")
+            .write(partials)
             .write(sh)
             .set(lookup)
-            .dispatch(&self.sh, [1, 1, 1])?;
+            .dispatch(&self.sh_project, [64, 1, 1])?;
+        g.pass("sky.sh")
+            .write(partials)
+            .write(sh)
+            .set(lookup)
+            .dispatch(&self.sh_finish, [1, 1, 1])?;
         let ambient = g
             .binding_set("sky_ambient")
             .constants(&SkyAmbientParams {
