@@ -3,7 +3,9 @@
 mod common;
 
 use glam::{Vec2, Vec3, Vec4};
+use hikari_math::sh::Sh;
 use hikari_render::techniques::direct_lighting::{self, LightingParams};
+use hikari_render::techniques::sky::{self, reference::SkyTwin};
 use hikari_render::techniques::{gbuffer, sun_shadows};
 use hikari_render::{FrameSettings, Renderer};
 
@@ -43,15 +45,32 @@ fn settings_for(scene: &hikari_scene::Scene, w: u32, h: u32) -> FrameSettings {
     common::small_frame_settings(scene, w, h)
 }
 
-#[test]
-fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
-    let Some(ctx) = common::gpu() else { return };
-    let scene = lit_boxes();
-    let settings = settings_for(&scene, 96, 64);
+/// What a comparison of the lighting pass with its twin found.
+struct Compared {
+    /// Sky pixels compared, and those skipped on the sun's or moon's disk.
+    sky: usize,
+    disk: usize,
+    lit: usize,
+    shadowed: usize,
+    /// Surface pixels beyond tolerance, and the worst of them (1 = the tolerance).
+    bad: usize,
+    worst: f32,
+    /// Sky pixels beyond tolerance, and the worst.
+    sky_bad: usize,
+    sky_worst: f32,
+}
+
+/// Renders `settings` and compares every pixel of `direct_lighting.radiance` with the CPU twin;
+/// with the sky on, the twin is given the frame's deringed SH as read back from `sky.sh`, the
+/// weather's balance and the sky twin for the sky pixels.
+fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> Compared {
+    let ctx = common::gpu_context();
     let (w, h) = (settings.width, settings.height);
-    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let mut renderer = Renderer::new(ctx, scene).unwrap();
+    let mut frame_sky = None;
     let mut r = renderer
-        .render_reading(&settings, |o| {
+        .render_reading(settings, |o| {
+            frame_sky = Some((o.sky.enabled, o.sky.params, o.sky.sky_lux));
             let g = &o.gbuffer;
             vec![
                 g.depth.into(),
@@ -61,11 +80,14 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
                 g.emissive.into(),
                 o.shadows.texels.into(),
                 o.hdr.into(),
+                o.sky.sh.into(),
             ]
         })
         .unwrap();
+    let (sky_enabled, sky_params, sky_lux) = frame_sky.unwrap();
     let texels: Vec<f32> =
         bytemuck::cast_slice::<u8, f32>(r.buffer("sun_shadows.texels").unwrap()).to_vec();
+    let sh_buffer = bytemuck::cast_slice::<u8, [f32; 4]>(r.buffer("sky.sh").unwrap()).to_vec();
     let mut img = |n: &str| r.take_image(n).unwrap();
     let (depth, normal, albedo, material, emissive, hdr) = (
         img("gbuffer.depth"),
@@ -76,12 +98,42 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
         img("direct_lighting.radiance"),
     );
     let cpu = &renderer.scene().cpu;
-    let params = LightingParams::new(
+    let mut params = LightingParams::new(
         settings.sun.as_ref(),
         cpu.lights.len() as u32,
-        settings.metered_lux(),
+        settings.metered_lux_with_sky(sky_lux),
         &settings.settings.direct_lighting,
     );
+    assert_eq!(sky_enabled, settings.settings.sky.enabled);
+
+    // The sky's light for the twin: the GPU's deringed SH (its projection is checked against
+    // the sky twin in tests/sky.rs), the weather's balance, the sky twin for sky pixels.
+    let sky_twin_atmosphere = if sky_enabled {
+        params.use_sky(settings.settings.sky.sky);
+        let weather = settings.settings.sky.weather().unwrap();
+        Some((
+            sky::atmosphere_for(&weather.atmosphere(), settings.settings.sky.table_sizes())
+                .unwrap(),
+            weather,
+        ))
+    } else {
+        None
+    };
+    let sky_twin = sky_twin_atmosphere
+        .as_ref()
+        .map(|(a, _)| SkyTwin::new(a, sky_params));
+    let sky_light = sky_twin_atmosphere.as_ref().map(|(_, weather)| {
+        let mut sh = Sh::<Vec3, 9>::zero();
+        for (c, x) in sh.coeffs.iter_mut().zip(&sh_buffer[9..18]) {
+            *c = Vec3::new(x[0], x[1], x[2]);
+        }
+        direct_lighting::reference::SkyLight {
+            sh,
+            balance: [weather.ambient_diffuse, weather.ambient_specular],
+            background: sky_twin.as_ref(),
+        }
+    });
+
     let sun = settings.sun.clone().unwrap();
     let cascades = sun_shadows::fit_cascades(
         &settings.camera,
@@ -99,7 +151,16 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
     let inv = glam::Mat4::from_cols_array_2d(&view.inv_view_proj);
 
     let v4 = |p: [f32; 4]| Vec4::from_array(p);
-    let (mut sky, mut lit, mut shadowed, mut bad, mut worst) = (0, 0, 0, 0, 0f32);
+    let mut c = Compared {
+        sky: 0,
+        disk: 0,
+        lit: 0,
+        shadowed: 0,
+        bad: 0,
+        worst: 0.0,
+        sky_bad: 0,
+        sky_worst: 0.0,
+    };
     for y in 0..h {
         for x in 0..w {
             let d = depth.pixel(x, y)[0];
@@ -121,38 +182,120 @@ fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
             } else {
                 1.0
             };
-            if d <= 0.0 {
-                sky += 1;
-            } else if vis < 0.5 {
-                shadowed += 1;
-            } else {
-                lit += 1;
+            // The sky twin draws no disks: pixels near one are not compared.
+            if d <= 0.0
+                && sky_enabled
+                && [sky_params.sun, sky_params.moon]
+                    .iter()
+                    .any(|b| b[3] > 0.0 && dir.dot(Vec3::new(b[0], b[1], b[2])) > 0.999)
+            {
+                c.disk += 1;
+                continue;
             }
-            let want =
-                direct_lighting::reference::shade(&params, &cpu.lights, &texel, world, -dir, vis);
+            let want = direct_lighting::reference::shade_with_sky(
+                &params,
+                &cpu.lights,
+                &texel,
+                world,
+                -dir,
+                vis,
+                sky_light.as_ref(),
+            );
             let got = hdr.pixel(x, y);
             let mut px_worst = 0f32;
-            for c in 0..3 {
-                // f16 storage keeps 11 significant bits: 2^-11 relative, plus float noise in
-                // the BRDF near grazing angles.
-                let err = (got[c] - want[c]).abs() / (want[c].abs() * 4e-3 + 2e-2);
-                px_worst = px_worst.max(err);
+            for k in 0..3 {
+                let tol = if d <= 0.0 {
+                    // As tests/sky.rs: f16 output (2^-11 relative); f32 against f64 table
+                    // arithmetic.
+                    want[k].abs() * 5e-3 + want.max_element() * 1e-3 + 1e-6
+                } else {
+                    // f16 storage keeps 11 significant bits: 2^-11 relative, plus float noise
+                    // in the BRDF near grazing angles.
+                    want[k].abs() * 4e-3 + 2e-2
+                };
+                px_worst = px_worst.max((got[k] - want[k]).abs() / tol);
             }
-            if px_worst > 1.0 {
-                bad += 1;
+            if d <= 0.0 {
+                c.sky += 1;
+                c.sky_bad += (px_worst > 1.0) as usize;
+                c.sky_worst = c.sky_worst.max(px_worst);
+                continue;
             }
-            worst = worst.max(px_worst);
+            if vis < 0.5 {
+                c.shadowed += 1;
+            } else {
+                c.lit += 1;
+            }
+            c.bad += (px_worst > 1.0) as usize;
+            c.worst = c.worst.max(px_worst);
         }
     }
+    c
+}
+
+#[test]
+fn direct_lighting_matches_its_cpu_twin_on_a_real_gbuffer() {
+    let scene = lit_boxes();
+    let settings = settings_for(&scene, 96, 64);
+    let (w, h) = (settings.width, settings.height);
+    let c = render_and_compare(&scene, &settings);
     assert!(
-        sky > 100 && lit > 1000 && shadowed > 100,
-        "the view shows sky ({sky}), sunlit ({lit}) and shadowed ({shadowed}) surfaces"
+        c.sky > 100 && c.lit > 1000 && c.shadowed > 100,
+        "the view shows sky ({}), sunlit ({}) and shadowed ({}) surfaces",
+        c.sky,
+        c.lit,
+        c.shadowed
+    );
+    assert!(
+        c.sky_bad == 0,
+        "{} placeholder sky pixels beyond tolerance; worst {}",
+        c.sky_bad,
+        c.sky_worst
     );
     // A shadow edge texel compared with a receiver depth within rounding may flip one PCF tap.
     assert!(
-        bad * 500 <= (w * h) as usize,
-        "{bad} pixels beyond tolerance; worst {worst}"
+        c.bad * 500 <= (w * h) as usize,
+        "{} pixels beyond tolerance; worst {}",
+        c.bad,
+        c.worst
     );
+}
+
+/// With the atmosphere on, the sky's deringed SH lights every surface (diffuse and specular,
+/// scaled by the weather's balance) and the sky fills the background: both against the twin,
+/// fed the frame's SH as read back from `sky.sh`. Morning (sun up) and night (the moon).
+#[test]
+fn direct_lighting_with_the_sky_matches_its_cpu_twin() {
+    let scene = lit_boxes();
+    for time in ["09:00", "23:30"] {
+        let mut settings = settings_for(&scene, 96, 64);
+        settings.settings.sky.enabled = true;
+        settings.settings.sky.table_quality = 0;
+        settings.settings.sky.time = time.into();
+        settings.sun = sky::lights::directional_light(&settings.settings.sky).unwrap();
+        let (w, h) = (settings.width, settings.height);
+        let c = render_and_compare(&scene, &settings);
+        assert!(
+            c.sky > 100 && c.lit > 1000 && c.shadowed > 100,
+            "{time}: the view shows sky ({}), sunlit ({}) and shadowed ({}) surfaces",
+            c.sky,
+            c.lit,
+            c.shadowed
+        );
+        assert!(
+            c.sky_bad == 0,
+            "{time}: {} sky pixels beyond tolerance; worst {} ({} on a disk skipped)",
+            c.sky_bad,
+            c.sky_worst,
+            c.disk
+        );
+        assert!(
+            c.bad * 500 <= (w * h) as usize,
+            "{time}: {} pixels beyond tolerance; worst {}",
+            c.bad,
+            c.worst
+        );
+    }
 }
 
 #[test]

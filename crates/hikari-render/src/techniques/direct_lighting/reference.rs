@@ -3,13 +3,15 @@
 
 use glam::{Vec3, Vec4};
 use hikari_math::brdf::{self, Material};
+use hikari_math::sh::{Sh, zonal};
 
 use crate::reference::octahedral;
 use crate::scene_gpu::LightGpu;
 use crate::techniques::direct_lighting::{
-    LIGHTING_EMISSIVE, LIGHTING_PLACEHOLDER_AMBIENT, LIGHTING_PUNCTUAL, LIGHTING_SUN,
+    LIGHTING_EMISSIVE, LIGHTING_PLACEHOLDER_AMBIENT, LIGHTING_PUNCTUAL, LIGHTING_SKY, LIGHTING_SUN,
     LightingParams,
 };
+use crate::techniques::sky::reference::SkyTwin;
 
 const MAX_RADIANCE: f32 = 65000.0;
 
@@ -35,8 +37,41 @@ pub fn specular_placeholder(p: &LightingParams, m: &Material, n: Vec3, v: Vec3) 
     } else {
         Vec3::ZERO
     };
+    fresnel_at(m, n, v) * env
+}
+
+/// The atmosphere's light in one frame, as the lighting pass sees it with `LIGHTING_SKY`.
+pub struct SkyLight<'a> {
+    /// The sky's deringed L2 SH of radiance, nits (coefficients 9..18 of the `sky.sh` buffer,
+    /// hikari-math's `sh` convention).
+    pub sh: Sh<Vec3, 9>,
+    /// The weather's ambient balance: diffuse and specular scale (`SkyAmbientParams`).
+    pub balance: [f32; 2],
+    /// The sky seen where depth is 0; `None` leaves sky pixels black. The twin has no sun or
+    /// moon disk, so pixels on a disk differ from the shader's.
+    pub background: Option<&'a SkyTwin<'a>>,
+}
+
+impl SkyLight<'_> {
+    /// Irradiance from the sky's SH on a surface with unit normal `n`, lux, times the diffuse
+    /// balance (Ramamoorthi & Hanrahan's clamped-cosine convolution; negative lobes clamped).
+    pub fn irradiance(&self, n: Vec3) -> Vec3 {
+        zonal::irradiance_at(&self.sh, n).max(Vec3::ZERO) * self.balance[0]
+    }
+
+    /// Specular ambient along the mirror direction `r`: the SH's radiance there, blended with
+    /// roughness towards the cosine-weighted mean (irradiance / pi), nits, times the specular
+    /// balance.
+    pub fn specular(&self, r: Vec3, perceptual_roughness: f32) -> Vec3 {
+        let sharp = self.sh.eval(r).max(Vec3::ZERO);
+        let blurred = zonal::irradiance_at(&self.sh, r).max(Vec3::ZERO) / std::f32::consts::PI;
+        sharp.lerp(blurred, perceptual_roughness) * self.balance[1]
+    }
+}
+
+fn fresnel_at(m: &Material, n: Vec3, v: Vec3) -> Vec3 {
     let f0 = brdf::material::f0_from_metalness(m.base_color.as_dvec3(), m.metalness as f64);
-    brdf::fresnel::fresnel_schlick(f0, n.dot(v).max(0.0) as f64).as_vec3() * env
+    brdf::fresnel::fresnel_schlick(f0, n.dot(v).max(0.0) as f64).as_vec3()
 }
 
 /// Where the light's illuminance falls to the frame's cutoff, or its own range if nearer.
@@ -74,6 +109,7 @@ pub struct Texel {
 
 /// Radiance of one pixel. `world` is the surface point, `v` the unit vector to the camera
 /// (for the sky, `-v` is the view direction), `sun_visibility` the shadow lookup's result.
+/// Without the atmosphere: a frame with `LIGHTING_SKY` needs [`shade_with_sky`].
 pub fn shade(
     p: &LightingParams,
     lights: &[LightGpu],
@@ -82,13 +118,33 @@ pub fn shade(
     v: Vec3,
     sun_visibility: f32,
 ) -> Vec3 {
+    shade_with_sky(p, lights, texel, world, v, sun_visibility, None)
+}
+
+/// [`shade`] with the atmosphere's light, which `LIGHTING_SKY` adds: the sky where depth is
+/// 0 and the sky's SH as ambient (sky visibility 1, as the shader until the probes). With
+/// `sky` `None` those terms are left out.
+pub fn shade_with_sky(
+    p: &LightingParams,
+    lights: &[LightGpu],
+    texel: &Texel,
+    world: Vec3,
+    v: Vec3,
+    sun_visibility: f32,
+    sky: Option<&SkyLight>,
+) -> Vec3 {
     let flags = p.config[1];
+    let sky = sky.filter(|_| flags & LIGHTING_SKY != 0);
     if texel.depth <= 0.0 {
-        return if flags & LIGHTING_PLACEHOLDER_AMBIENT != 0 {
-            clamp(sky_placeholder(p, -v))
+        let mut l = if flags & LIGHTING_PLACEHOLDER_AMBIENT != 0 {
+            sky_placeholder(p, -v)
         } else {
             Vec3::ZERO
         };
+        if let Some(twin) = sky.and_then(|s| s.background) {
+            l = twin.background_no_disks(-v);
+        }
+        return clamp(l);
     }
     let n = octahedral::decode(texel.normal.truncate().truncate());
     let ta = octahedral::decode(glam::Vec2::new(texel.normal.z, texel.normal.w));
@@ -120,6 +176,12 @@ pub fn shade(
         let diffuse =
             m.base_color * (1.0 - m.metalness) / std::f32::consts::PI * ambient_placeholder(p, n);
         radiance += (diffuse + specular_placeholder(p, &m, n, v)) * texel.material.w;
+    }
+    if let Some(sky) = sky {
+        let diffuse = m.base_color * (1.0 - m.metalness) / std::f32::consts::PI * sky.irradiance(n);
+        let r = 2.0 * n.dot(v) * n - v;
+        let specular = fresnel_at(&m, n, v) * sky.specular(r, m.perceptual_roughness);
+        radiance += (diffuse + specular) * texel.material.w;
     }
     if flags & LIGHTING_EMISSIVE != 0 {
         radiance += texel.emissive;
