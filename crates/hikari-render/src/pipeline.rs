@@ -230,12 +230,10 @@ pub fn reflect_groups(
     Ok(groups)
 }
 
-/// Float textures a shader samples through a filtering sampler (any sampler but a comparison
-/// one or one used with integer textures).
-fn textures_sampled_with_filtering(
+/// Every (texture, sampler) pair the shader samples with, as global variables.
+fn image_samples(
     module: &naga::Module,
-    integer_samplers: &[naga::Handle<naga::GlobalVariable>],
-) -> Vec<naga::Handle<naga::GlobalVariable>> {
+) -> Vec<(naga::Handle<naga::GlobalVariable>, naga::Handle<naga::GlobalVariable>)> {
     let mut out = Vec::new();
     let functions = module
         .functions
@@ -251,18 +249,31 @@ fn textures_sampled_with_filtering(
                 naga::Expression::GlobalVariable(image),
                 naga::Expression::GlobalVariable(sampler),
             ) = (&f.expressions[image], &f.expressions[sampler])
+                && !out.contains(&(*image, *sampler))
             {
-                let filtering = matches!(
-                    module.types[module.global_variables[*sampler].ty].inner,
-                    naga::TypeInner::Sampler { comparison: false }
-                ) && !integer_samplers.contains(sampler);
-                if filtering && !out.contains(image) {
-                    out.push(*image);
-                }
+                out.push((*image, *sampler));
             }
         }
     }
     out
+}
+
+/// Float textures a shader samples through a filtering sampler (any sampler but a comparison
+/// one or one used with integer textures).
+fn textures_sampled_with_filtering(
+    module: &naga::Module,
+    integer_samplers: &[naga::Handle<naga::GlobalVariable>],
+) -> Vec<naga::Handle<naga::GlobalVariable>> {
+    image_samples(module)
+        .into_iter()
+        .filter(|(_, sampler)| {
+            matches!(
+                module.types[module.global_variables[*sampler].ty].inner,
+                naga::TypeInner::Sampler { comparison: false }
+            ) && !integer_samplers.contains(sampler)
+        })
+        .map(|(image, _)| image)
+        .collect()
 }
 
 /// Samplers a shader uses with integer textures (`textureGather` of a `texture_2d<u32>`): a
@@ -281,25 +292,9 @@ fn samplers_of_integer_textures(module: &naga::Module) -> Vec<naga::Handle<naga:
         )
     };
     let mut out = Vec::new();
-    let functions = module
-        .functions
-        .iter()
-        .map(|(_, f)| f)
-        .chain(module.entry_points.iter().map(|e| &e.function));
-    for f in functions {
-        for (_, e) in f.expressions.iter() {
-            let naga::Expression::ImageSample { image, sampler, .. } = *e else {
-                continue;
-            };
-            if let (
-                naga::Expression::GlobalVariable(image),
-                naga::Expression::GlobalVariable(sampler),
-            ) = (&f.expressions[image], &f.expressions[sampler])
-                && integer(*image)
-                && !out.contains(sampler)
-            {
-                out.push(*sampler);
-            }
+    for (image, sampler) in image_samples(module) {
+        if integer(image) && !out.contains(&sampler) {
+            out.push(sampler);
         }
     }
     out

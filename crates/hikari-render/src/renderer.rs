@@ -93,6 +93,16 @@ impl Renderer {
             .settings
             .validate()
             .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
+        let limit = self.ctx.limits.max_texture_dimension_2d;
+        for (what, v) in [("width", settings.width), ("height", settings.height)] {
+            if v == 0 || v > limit {
+                return Err(RenderError::Limit {
+                    what: format!("image {what}"),
+                    requested: v as u64,
+                    limit: limit as u64,
+                });
+            }
+        }
         let invalid =
             |what: &str, e: hikari_scene::SceneError| RenderError::Graph(format!("{what}: {e}"));
         settings
@@ -109,16 +119,6 @@ impl Renderer {
         }
         if let Some(sun) = &settings.sun {
             sun.validate().map_err(|e| invalid("sun", e))?;
-        }
-        let limit = self.ctx.limits.max_texture_dimension_2d;
-        for (what, v) in [("width", settings.width), ("height", settings.height)] {
-            if v == 0 || v > limit {
-                return Err(RenderError::Limit {
-                    what: format!("image {what}"),
-                    requested: v as u64,
-                    limit: limit as u64,
-                });
-            }
         }
         let binding_limit = self.ctx.limits.max_storage_buffer_binding_size;
         for _ in 0..MAX_QUEUE_RETRIES {

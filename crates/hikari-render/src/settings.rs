@@ -115,7 +115,7 @@ pub trait TechniqueSettings:
     fn preset(p: Preset) -> Self;
 
     /// Checks every field of [`Self::fields`]; `table` names the technique in errors.
-    fn validate(&self, table: &str) -> Result<(), SettingError> {
+    fn check_fields(&self, table: &str) -> Result<(), SettingError> {
         let value = toml::Value::try_from(self).map_err(|e| SettingError {
             field: table.into(),
             value: "?".into(),
@@ -132,6 +132,12 @@ pub trait TechniqueSettings:
             }
         }
         Ok(())
+    }
+
+    /// Checks the settings: the ranges of [`Self::fields`] (a technique with rules that a range
+    /// cannot say adds them after `check_fields`).
+    fn validate(&self, table: &str) -> Result<(), SettingError> {
+        self.check_fields(table)
     }
 }
 

@@ -57,22 +57,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn splitmix_matches_the_reference_sequence() {
-        // SplitMix64 from seed 1234567 (reference values of Vigna's splitmix64.c).
-        let mut r = Rng(SplitMix64::new(1234567));
-        let want = [
-            6457827717110365317u64,
-            3203168211198807973,
-            9817491932198370423,
-            4593380528125082431,
-            16408922859458223821,
-        ];
-        for w in want {
-            assert_eq!(r.next_u64(), w);
-        }
-    }
-
-    #[test]
     fn unit_is_in_range_and_roughly_uniform() {
         let mut r = Rng::stream(7, "test");
         let n = 100_000;

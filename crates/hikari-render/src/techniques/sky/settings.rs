@@ -228,22 +228,7 @@ impl TechniqueSettings for SkySettings {
 
     /// The ranges of [`Self::fields`], then the date, time and weather name.
     fn validate(&self, table: &str) -> Result<(), SettingError> {
-        let value = toml::Value::try_from(self).map_err(|e| SettingError {
-            field: table.into(),
-            value: "?".into(),
-            allowed: format!("a value TOML can hold ({e})"),
-        })?;
-        for f in Self::fields() {
-            if let Some(v) = value.get(f.key)
-                && !f.range.admits(v)
-            {
-                return Err(SettingError {
-                    field: format!("{table}.{}", f.key),
-                    value: v.to_string(),
-                    allowed: f.range.describe(),
-                });
-            }
-        }
+        self.check_fields(table)?;
         self.date_time()?;
         self.place()?;
         self.weather()?;

@@ -21,6 +21,19 @@ const GOLDEN_ANGLE: f32 = 2.39996322972865332;
 
 var<workgroup> terms: array<array<vec3<f32>, 9>, THREADS>;
 
+// Adds the workgroup's 64 rows of `terms` into row 0, a tree of halvings.
+fn sum_terms(lid: u32) {
+    workgroupBarrier();
+    for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
+        if lid < stride {
+            for (var k = 0u; k < 9u; k++) {
+                terms[lid][k] += terms[lid + stride][k];
+            }
+        }
+        workgroupBarrier();
+    }
+}
+
 // Direction i of the spherical Fibonacci set: equal-area bands in z, golden-angle azimuths.
 fn fibonacci_dir(i: u32) -> vec3<f32> {
     let z = 1.0 - (2.0 * f32(i) + 1.0) / f32(SAMPLES);
@@ -42,15 +55,7 @@ fn project(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg:
     terms[lid][6] = l * (SH_C3 * (3.0 * d.z * d.z - 1.0));
     terms[lid][7] = l * (SH_C2 * d.x * d.z);
     terms[lid][8] = l * (SH_C4 * (d.x * d.x - d.y * d.y));
-    workgroupBarrier();
-    for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
-        if lid < stride {
-            for (var k = 0u; k < 9u; k++) {
-                terms[lid][k] += terms[lid + stride][k];
-            }
-        }
-        workgroupBarrier();
-    }
+    sum_terms(lid);
     if lid < 9u {
         partials[wg.x * 9u + lid] = vec4<f32>(terms[0][lid], 0.0);
     }
@@ -62,15 +67,7 @@ fn finish(@builtin(local_invocation_index) lid: u32) {
     for (var k = 0u; k < 9u; k++) {
         terms[lid][k] = partials[lid * 9u + k].xyz;
     }
-    workgroupBarrier();
-    for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
-        if lid < stride {
-            for (var k = 0u; k < 9u; k++) {
-                terms[lid][k] += terms[lid + stride][k];
-            }
-        }
-        workgroupBarrier();
-    }
+    sum_terms(lid);
     if lid == 0u {
         var sh: ShL2Rgb;
         let w = 4.0 * 3.14159265358979 / f32(SAMPLES);
