@@ -27,10 +27,11 @@
 //! Alpha cut-outs: hits on triangles marked non-opaque (`hikari_bvh::TRIANGLE_NON_OPAQUE`,
 //! see `scene_bvh::blases`) count only where the material's alpha passes its cut-off, which the
 //! kernel evaluates from [`BvhAlpha`] and the scene's sRGB texture array
-//! ([`BvhTrace::upload_alpha`]). Until that is uploaded, placeholders stand in (one opaque
-//! instance record, one empty triangle, a 1 x 1 texture), which is all a BVH without marked
-//! triangles needs: tracing plain meshes takes no extra call. A TLAS that reaches marked
-//! triangles of an instance the alpha data does not cover is refused when recorded.
+//! ([`BvhTrace::upload_alpha`]). Until that is uploaded, placeholders stand in (one zeroed
+//! record of each table, a 1 x 1 texture), which is all a BVH without marked triangles needs:
+//! tracing plain meshes takes no extra call. A TLAS that reaches marked triangles of an
+//! instance the uploaded alpha data does not cover (any, before an upload) is refused when
+//! recorded. [`BvhAlpha::opaque`] with no textures makes every marked triangle opaque.
 
 use bytemuck::{Pod, Zeroable};
 use hikari_bvh::layout::{MAX_LEAF_TRIANGLES, META_INTERNAL, WIDTH};
@@ -332,7 +333,7 @@ pub struct BvhTrace {
     alpha_triangles: Upload,
     /// The scene's sRGB texture array, or a 1 x 1 placeholder.
     alpha_textures: wgpu::Texture,
-    /// Instance records uploaded in `alpha_instances`.
+    /// Instance records uploaded in `alpha_instances` (0 for the placeholder).
     alpha_instance_count: u32,
     /// One more than the largest instance index of the TLAS whose BLAS has non-opaque
     /// triangles (0: none), which the alpha instance records must cover.
@@ -388,7 +389,7 @@ impl BvhTrace {
                 bytemuck::bytes_of(&AlphaTriangle::zeroed()),
             ),
             alpha_textures: placeholder_texture(ctx),
-            alpha_instance_count: 1,
+            alpha_instance_count: 0,
             alpha_instances_needed: 0,
             blases: Vec::new(),
             blas_depth: 0,
@@ -398,14 +399,19 @@ impl BvhTrace {
 
     /// Uploads the cut-out data of the scene the BVH was built from ([`BvhAlpha::for_scene`]),
     /// with its sRGB texture array (`SceneGpu::textures.color`, layers as
-    /// `scene_textures::LayerMap` numbers them). Needed once the BVH has triangles marked
-    /// non-opaque; call again when the scene's instances or materials change.
+    /// `scene_textures::LayerMap` numbers them; `None`: a 1 x 1 white texture, for alpha data
+    /// that names no texture). Needed once the BVH has triangles marked non-opaque; call again
+    /// when the scene's instances or materials change.
     pub fn upload_alpha(
         &mut self,
         ctx: &GpuContext,
         alpha: &BvhAlpha,
-        color_textures: &wgpu::Texture,
+        color_textures: Option<&wgpu::Texture>,
     ) -> Result<()> {
+        let color_textures = match color_textures {
+            Some(t) => t.clone(),
+            None => placeholder_texture(ctx),
+        };
         if color_textures.dimension() != wgpu::TextureDimension::D2
             || !color_textures
                 .usage()
@@ -445,7 +451,7 @@ impl BvhTrace {
             tri_bytes,
         );
         self.alpha_instance_count = alpha.instances.len() as u32;
-        self.alpha_textures = color_textures.clone();
+        self.alpha_textures = color_textures;
         Ok(())
     }
 

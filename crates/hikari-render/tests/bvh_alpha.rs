@@ -183,7 +183,7 @@ fn gpu_trace(
     trace.upload_tlas(ctx, &bvh.tlas)?;
     let (textures, _) = TextureArrays::upload(ctx, scene)?;
     if let Some(alpha) = alpha {
-        trace.upload_alpha(ctx, alpha, &textures.color)?;
+        trace.upload_alpha(ctx, alpha, Some(&textures.color))?;
     }
     let ray_buffer = ctx
         .device
