@@ -111,7 +111,7 @@
 //! |---|---|
 //! | 0 | `v0: vec3<f32>` |
 //! | 12 | `primitive: u32`: triangle index in the source mesh (reported in hits) |
-//! | 16 | `v1: vec3<f32>`, then 4 bytes padding |
+//! | 16 | `v1: vec3<f32>`, then `flags: u32` (bit 0: [`layout::TRIANGLE_NON_OPAQUE`]) |
 //! | 32 | `v2: vec3<f32>`, then 4 bytes padding |
 //!
 //! ### [`InstanceRecord`] (64 bytes = 4 x vec4), the TLAS's leaf primitives, in leaf order
@@ -184,6 +184,28 @@
 //! 2013), without the double-precision fallback (WGSL has no portable f64): an edge function
 //! that rounds to exactly zero counts as inside for both triangles sharing that edge, so rays
 //! can never slip through a shared edge. There is no back-face culling.
+//!
+//! ## Cut-outs: non-opaque triangles and the any-hit filter
+//!
+//! A triangle marked [`layout::TRIANGLE_NON_OPAQUE`] ([`Blas::build_with_opacity`]; hikari-render's
+//! `scene_bvh::blases` marks every triangle of a mesh some instance draws with a glTF MASK or
+//! BLEND material) is a *candidate*: a hit on it counts only if a filter accepts it, and a
+//! rejected candidate neither shrinks `t_max` nor ends an any-hit walk, so the ray goes on
+//! through the hole. The CPU traversals take the filter as a closure (`*_filtered`:
+//! `accept(instance, primitive, u, v)`); the GPU kernel calls `bvh_accept_candidate` with the
+//! same arguments, which in hikari-render evaluates the material's alpha (factor × vertex
+//! colour A × base colour texture A, bilinear at mip 0) against its cut-off, from tables bound
+//! with the BVH (`scene_bvh::BvhAlpha`; its CPU twin is `scene_bvh::SceneAlphaFilter`).
+//!
+//! Cost. Opaque triangles pay one test of the flags word, which the triangle test loads anyway;
+//! the filter runs only for hits on marked triangles, and costs there one 16-byte instance
+//! record, one 32-byte triangle record (UVs and vertex alphas) and one bilinear texture fetch
+//! at mip 0 (cache misses on distant cut-outs: mip 0 keeps the cut-out's edges where the
+//! full-resolution texture puts them). The larger cost is in the walk: a rejected candidate
+//! leaves `t_max` where it was, so closest-hit rays keep visiting the nodes behind a cut-out,
+//! and any-hit rays (shadows, AO) cannot stop at the first candidate; dense foliage traces like
+//! several layers of geometry. Marking only the triangles whose material needs it (not whole
+//! scenes) keeps that cost to the cut-outs.
 //!
 //! ## Build
 //!

@@ -23,6 +23,15 @@
 //! range, children after their parent, meta bytes well formed, depth measured rather than
 //! trusted), every instance record must point at an uploaded BLAS, and the ray and hit buffers
 //! must hold `count` records.
+//!
+//! Alpha cut-outs: hits on triangles marked non-opaque (`hikari_bvh::TRIANGLE_NON_OPAQUE`,
+//! see `scene_bvh::blases`) count only where the material's alpha passes its cut-off, which the
+//! kernel evaluates from [`BvhAlpha`] and the scene's sRGB texture array
+//! ([`BvhTrace::upload_alpha`]). Until that is uploaded, placeholders stand in (one zeroed
+//! record of each table, a 1 x 1 texture), which is all a BVH without marked triangles needs:
+//! tracing plain meshes takes no extra call. A TLAS that reaches marked triangles of an
+//! instance the uploaded alpha data does not cover (any, before an upload) is refused when
+//! recorded. [`BvhAlpha::opaque`] with no textures makes every marked triangle opaque.
 
 use bytemuck::{Pod, Zeroable};
 use hikari_bvh::layout::{MAX_LEAF_TRIANGLES, META_INTERNAL, WIDTH};
@@ -32,8 +41,9 @@ use wgpu::util::DeviceExt;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::graph::{BindingSet, Buf, FrameGraph};
+use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex};
 use crate::pipeline::ComputePipeline;
+use crate::scene_bvh::{AlphaInstance, AlphaTriangle, BvhAlpha};
 use crate::shader::ShaderLibrary;
 
 /// Stack entries of the kernel (`BVH_STACK_SIZE` in `shaders/bvh/traverse.wgsl`).
@@ -238,7 +248,9 @@ impl Kernels {
                 // SAFETY: the kernel indexes only (a) the BVH buffers, with indices that
                 // `check_tree` and `check_instances` prove in range before any upload, walking
                 // each tree from its root exactly as the kernel does; (b) rays and hits below
-                // `params.count`, which `record` checks both buffers hold; (c) its stack, whose
+                // `params.count`, which `record` checks both buffers hold; the alpha tables
+                // (`bvh_accept_candidate`), with indices it compares with their arrayLength
+                // first, and the texture array, whose layer index sampling clamps; (c) its stack, whose
                 // depth `import` bounds by STACK_SIZE with depths measured by `check_tree`; (d)
                 // vector components 0..2 of its own making; `trace_ray_index` maps 0..count
                 // one to one onto itself. Loops end: every iteration consumes
@@ -258,14 +270,20 @@ impl Kernels {
     }
 }
 
-/// The four BVH buffers of a frame, in binding order of the binding set `bvh` of
-/// `hikari::bvh`.
+/// The BVH's resources in a frame, in binding order of the binding set `bvh` of
+/// `hikari::bvh` (a linear, repeating sampler follows them at binding 7).
 #[derive(Clone, Copy, Debug)]
 pub struct BvhBuffers {
     pub blas_nodes: Buf,
     pub triangles: Buf,
     pub tlas_nodes: Buf,
     pub instances: Buf,
+    /// [`AlphaInstance`] records (binding 4).
+    pub alpha_instances: Buf,
+    /// [`AlphaTriangle`] records (binding 5).
+    pub alpha_triangles: Buf,
+    /// The scene's sRGB texture array (binding 6), or a 1 x 1 placeholder.
+    pub alpha_textures: Tex,
 }
 
 impl BvhBuffers {
@@ -276,6 +294,10 @@ impl BvhBuffers {
             .read(self.triangles)
             .read(self.tlas_nodes)
             .read(self.instances)
+            .read(self.alpha_instances)
+            .read(self.alpha_triangles)
+            .read(self.alpha_textures)
+            .sampler(SamplerKind::LinearRepeat)
             .finish()
     }
 }
@@ -294,6 +316,8 @@ struct BlasSpan {
     triangle_offset: u32,
     nodes: u32,
     depth: u32,
+    /// Some triangle is marked non-opaque.
+    non_opaque: bool,
 }
 
 /// Pipelines plus the GPU copy of a BVH scene (all BLAS packed, and the TLAS).
@@ -305,6 +329,15 @@ pub struct BvhTrace {
     triangles: Option<Upload>,
     tlas_nodes: Option<Upload>,
     instances: Option<Upload>,
+    alpha_instances: Upload,
+    alpha_triangles: Upload,
+    /// The scene's sRGB texture array, or a 1 x 1 placeholder.
+    alpha_textures: wgpu::Texture,
+    /// Instance records uploaded in `alpha_instances` (0 for the placeholder).
+    alpha_instance_count: u32,
+    /// One more than the largest instance index of the TLAS whose BLAS has non-opaque
+    /// triangles (0: none), which the alpha instance records must cover.
+    alpha_instances_needed: u32,
     blases: Vec<BlasSpan>,
     /// Deepest BLAS, in nodes on a root-to-leaf path.
     blas_depth: u32,
@@ -345,10 +378,81 @@ impl BvhTrace {
             triangles: None,
             tlas_nodes: None,
             instances: None,
+            alpha_instances: new_upload(
+                ctx,
+                "bvh.alpha_instances",
+                bytemuck::bytes_of(&AlphaInstance::zeroed()),
+            ),
+            alpha_triangles: new_upload(
+                ctx,
+                "bvh.alpha_triangles",
+                bytemuck::bytes_of(&AlphaTriangle::zeroed()),
+            ),
+            alpha_textures: placeholder_texture(ctx),
+            alpha_instance_count: 0,
+            alpha_instances_needed: 0,
             blases: Vec::new(),
             blas_depth: 0,
             tlas_depth: 0,
         })
+    }
+
+    /// Uploads the cut-out data of the scene the BVH was built from ([`BvhAlpha::for_scene`]),
+    /// with its sRGB texture array (`SceneGpu::textures.color`, layers as
+    /// `scene_textures::LayerMap` numbers them; `None`: a 1 x 1 white texture, for alpha data
+    /// that names no texture). Needed once the BVH has triangles marked non-opaque; call again
+    /// when the scene's instances or materials change.
+    pub fn upload_alpha(
+        &mut self,
+        ctx: &GpuContext,
+        alpha: &BvhAlpha,
+        color_textures: Option<&wgpu::Texture>,
+    ) -> Result<()> {
+        let color_textures = match color_textures {
+            Some(t) => t.clone(),
+            None => placeholder_texture(ctx),
+        };
+        if color_textures.dimension() != wgpu::TextureDimension::D2
+            || !color_textures
+                .usage()
+                .contains(wgpu::TextureUsages::TEXTURE_BINDING)
+        {
+            return Err(RenderError::Pass {
+                pass: "bvh_trace".into(),
+                message: "upload_alpha needs the scene's 2D texture array (bindable for \
+                          sampling), as `SceneGpu::textures.color`"
+                    .into(),
+            });
+        }
+        let inst: &[AlphaInstance] = if alpha.instances.is_empty() {
+            &[AlphaInstance::zeroed()]
+        } else {
+            &alpha.instances
+        };
+        let tris: &[AlphaTriangle] = if alpha.triangles.is_empty() {
+            &[AlphaTriangle::zeroed()]
+        } else {
+            &alpha.triangles
+        };
+        let inst_bytes: &[u8] = bytemuck::cast_slice(inst);
+        let tri_bytes: &[u8] = bytemuck::cast_slice(tris);
+        check_size(ctx, "bvh.alpha_instances", inst_bytes.len() as u64)?;
+        check_size(ctx, "bvh.alpha_triangles", tri_bytes.len() as u64)?;
+        upload_into(
+            ctx,
+            &mut self.alpha_instances,
+            "bvh.alpha_instances",
+            inst_bytes,
+        );
+        upload_into(
+            ctx,
+            &mut self.alpha_triangles,
+            "bvh.alpha_triangles",
+            tri_bytes,
+        );
+        self.alpha_instance_count = alpha.instances.len() as u32;
+        self.alpha_textures = color_textures;
+        Ok(())
     }
 
     fn kernels(&self, order: RayOrder) -> &Kernels {
@@ -392,11 +496,15 @@ impl BvhTrace {
                 )));
             }
             let depth = check_tree(&format!("BLAS {i}"), nodes, tris as usize)?;
+            let non_opaque = packed.triangles[triangle_offset as usize..tri_end as usize]
+                .iter()
+                .any(|t| !t.is_opaque());
             spans.push(BlasSpan {
                 node_offset,
                 triangle_offset,
                 nodes: nodes.len() as u32,
                 depth,
+                non_opaque,
             });
         }
         // Zero-sized bindings are not allowed; a zeroed node has no children, so a BVH made
@@ -422,6 +530,7 @@ impl BvhTrace {
             self.tlas_nodes = None;
             self.instances = None;
             self.tlas_depth = 0;
+            self.alpha_instances_needed = 0;
         }
         self.blas_depth = spans.iter().map(|s| s.depth).max().unwrap_or(0);
         self.blases = spans;
@@ -451,6 +560,13 @@ impl BvhTrace {
         upload(ctx, &mut self.tlas_nodes, "bvh.tlas_nodes", nodes_bytes);
         upload(ctx, &mut self.instances, "bvh.instances", inst_bytes);
         self.tlas_depth = depth;
+        self.alpha_instances_needed = tlas
+            .instances
+            .iter()
+            .filter(|r| self.blases[r.blas_index as usize].non_opaque)
+            .map(|r| r.instance_index + 1)
+            .max()
+            .unwrap_or(0);
         Ok(())
     }
 
@@ -464,7 +580,9 @@ impl BvhTrace {
         ]
         .iter()
         .map(|u| u.as_ref().map_or(0, |u| u.len))
-        .sum()
+        .sum::<u64>()
+            + self.alpha_instances.len
+            + self.alpha_triangles.len
     }
 
     /// Stack entries the current scene needs: one per level below each root.
@@ -493,11 +611,23 @@ impl BvhTrace {
                 limit: STACK_SIZE as u64,
             });
         }
+        if self.alpha_instances_needed > self.alpha_instance_count {
+            return Err(RenderError::Graph(format!(
+                "bvh_trace: the TLAS reaches triangles marked non-opaque (cut-outs) of instance \
+                 {}, but the alpha data covers {} instances; upload the scene's \
+                 (BvhTrace::upload_alpha with BvhAlpha::for_scene) after its TLAS",
+                self.alpha_instances_needed - 1,
+                self.alpha_instance_count
+            )));
+        }
         Ok(BvhBuffers {
             blas_nodes: g.import_buffer("bvh.blas_nodes", &bn.buffer),
             triangles: g.import_buffer("bvh.triangles", &tr.buffer),
             tlas_nodes: g.import_buffer("bvh.tlas_nodes", &tn.buffer),
             instances: g.import_buffer("bvh.instances", &inst.buffer),
+            alpha_instances: g.import_buffer("bvh.alpha_instances", &self.alpha_instances.buffer),
+            alpha_triangles: g.import_buffer("bvh.alpha_triangles", &self.alpha_triangles.buffer),
+            alpha_textures: g.import_texture("bvh.alpha_textures", &self.alpha_textures),
         })
     }
 
@@ -701,15 +831,24 @@ fn check_size(ctx: &GpuContext, name: &str, bytes: u64) -> Result<()> {
 }
 
 fn upload(ctx: &GpuContext, slot: &mut Option<Upload>, name: &str, bytes: &[u8]) {
+    match slot {
+        Some(u) => upload_into(ctx, u, name, bytes),
+        None => *slot = Some(new_upload(ctx, name, bytes)),
+    }
+}
+
+/// Rewrites `u` in place while the bytes fit and fill at least half of it, else replaces it.
+fn upload_into(ctx: &GpuContext, u: &mut Upload, name: &str, bytes: &[u8]) {
     let len = bytes.len() as u64;
-    if let Some(u) = slot
-        && u.buffer.size() >= len
-        && u.buffer.size() <= len.saturating_mul(2)
-    {
+    if u.buffer.size() >= len && u.buffer.size() <= len.saturating_mul(2) {
         ctx.queue.write_buffer(&u.buffer, 0, bytes);
         u.len = len;
-        return;
+    } else {
+        *u = new_upload(ctx, name, bytes);
     }
+}
+
+fn new_upload(ctx: &GpuContext, name: &str, bytes: &[u8]) -> Upload {
     let buffer = ctx
         .device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -719,7 +858,34 @@ fn upload(ctx: &GpuContext, slot: &mut Option<Upload>, name: &str, bytes: &[u8])
                 | wgpu::BufferUsages::COPY_DST
                 | wgpu::BufferUsages::COPY_SRC,
         });
-    *slot = Some(Upload { buffer, len });
+    Upload {
+        buffer,
+        len: bytes.len() as u64,
+    }
+}
+
+/// The texture array bound while no scene's is uploaded: one white, opaque texel (the format
+/// of `SceneGpu::textures.color`).
+fn placeholder_texture(ctx: &GpuContext) -> wgpu::Texture {
+    ctx.device.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("bvh.alpha_textures.placeholder"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &[255; 4],
+    )
 }
 
 #[cfg(test)]

@@ -151,6 +151,16 @@ pub fn all() -> Vec<StructLayout> {
             [t, u, v, primitive, instance, _pad]
         ),
         gpu_layout!(
+            crate::scene_bvh::AlphaInstance,
+            "bvh/trace.wgsl",
+            [cutoff, alpha, texture, first_triangle]
+        ),
+        gpu_layout!(
+            crate::scene_bvh::AlphaTriangle,
+            "bvh/trace.wgsl",
+            [uv, alpha]
+        ),
+        gpu_layout!(
             hikari_bvh::TriangleRecord,
             "bvh/trace.wgsl",
             [v0, primitive, v1, flags, v2, _pad2]

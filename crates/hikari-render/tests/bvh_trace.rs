@@ -13,6 +13,7 @@ use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
 use hikari_render::GpuContext;
 use hikari_render::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode};
 use hikari_render::graph::GraphRuntime;
+use hikari_render::scene_bvh::BvhAlpha;
 use hikari_render::shader::{self, ShaderLibrary};
 use wgpu::util::DeviceExt;
 
@@ -104,6 +105,15 @@ impl Gpu {
         let ctx = &self.ctx;
         trace.upload_blases(ctx, &scene.blases).unwrap();
         trace.upload_tlas(ctx, &scene.tlas).unwrap();
+        let marked = scene
+            .blases
+            .iter()
+            .any(|b| b.triangles.iter().any(|t| !t.is_opaque()));
+        if marked {
+            // Every instance opaque: the filter accepts every candidate.
+            let alpha = BvhAlpha::opaque(scene.instances.len());
+            trace.upload_alpha(ctx, &alpha, None).unwrap();
+        }
         let ray_buffer = ctx
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -266,9 +276,10 @@ fn random_soups_match_cpu_and_brute_force() {
 
 #[test]
 fn flagged_triangles_with_the_accept_all_filter_trace_like_opaque_ones() {
-    // Until the alpha lookup is wired into bvh_accept_candidate, it accepts every candidate:
-    // non-opaque triangles must then give bit-identical hits, and the flag must not disturb
-    // the records the kernel reads (vertices, primitive).
+    // With every instance's material opaque (BvhAlpha::opaque, see `trace_on_with`),
+    // bvh_accept_candidate accepts every candidate: non-opaque triangles must then give
+    // bit-identical hits, and the flag must not disturb the records the kernel reads
+    // (vertices, primitive). tests/bvh_alpha.rs tests real cut-outs.
     let Some(mut gpu) = Gpu::new() else { return };
     let mesh = Mesh::random_soup(6, 2000, 10.0, 3.0);
     let plain = Scene::single(mesh.clone());

@@ -1,6 +1,6 @@
 // Ray tracing as a library user sees it: rays in, hits out (`hikari-render/src/passes/
-// bvh_trace.rs`, `hikari bench rays`). The BVH buffers are @binding(0..4), declared by
-// hikari::bvh.
+// bvh_trace.rs`, `hikari bench rays`). The BVH's resources are the binding set `bvh`,
+// declared by hikari::bvh (BVH buffers, then what the cut-out test reads).
 //
 // Each workgroup owns a contiguous chunk of TRACE_RAYS_PER_THREAD * TRACE_WORKGROUP rays. With
 // more than one ray per invocation, an invocation that finishes a ray starts another one of
@@ -21,6 +21,20 @@ struct TriangleRecord {
     flags: u32,
     v2: vec3<f32>,
     _pad2: u32,
+}
+
+// hikari-render's cut-out records (scene_bvh.rs), for the layout test only: hikari::bvh reads
+// them as vec4s too.
+struct AlphaInstance {
+    cutoff: f32,
+    alpha: f32,
+    texture: u32,
+    first_triangle: u32,
+}
+
+struct AlphaTriangle {
+    uv: array<vec2<f32>, 3>,
+    alpha: vec2<u32>,
 }
 
 struct TraceParams {

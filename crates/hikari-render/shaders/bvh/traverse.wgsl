@@ -6,9 +6,9 @@
 // documented in hikari-bvh's crate docs; every record is read as whole vec4s so that each load
 // is one 128-bit transaction whatever the driver makes of a struct load.
 //
-// The four BVH buffers are the binding set `bvh`, in a group of their own
-// (`BvhBuffers::binding_set` in hikari-render makes it); a pass that traces binds it with
-// `.set(...)` beside its own resources in group 0. One ray per invocation: `bvh_closest_hit(ray)`, `bvh_any_hit(ray)`,
+// The BVH buffers, and what the cut-out test reads, are the binding set `bvh`, in a group of
+// their own (`BvhBuffers::binding_set` in hikari-render makes it); a pass that traces binds it
+// with `.set(...)` beside its own resources in group 0. One ray per invocation: `bvh_closest_hit(ray)`, `bvh_any_hit(ray)`,
 // `bvh_occluded(ray)`. Kernels that trace many rays per invocation (bvh/trace.wgsl) drive the
 // walk themselves: `bvh_begin(ray)`, then `bvh_step` until it returns true, then `bvh_result()`.
 //
@@ -19,6 +19,8 @@
 // indices are as safe.
 
 #define_import_path hikari::bvh
+
+#import hikari::scene_gpu::wrap_uv
 
 // Mirrors of hikari-bvh's layout structs (registered in hikari-render's layout test;
 // TriangleRecord's mirror is in bvh/trace.wgsl, as naga_oil refuses member names that end in a
@@ -56,6 +58,15 @@ struct InstanceRecord {
 @group(#{BVH_GROUP}) @binding(2) var<storage, read> bvh_tlas_nodes: array<vec4<u32>>;
 // InstanceRecords in TLAS leaf order, 4 vec4 each.
 @group(#{BVH_GROUP}) @binding(3) var<storage, read> bvh_instances: array<vec4<f32>>;
+// Cut-outs (read by bvh_accept_candidate only, for triangles marked non-opaque; layouts in
+// hikari-render's scene_bvh.rs). AlphaInstance records, one vec4 per instance index: cut-off
+// (0: opaque material), material alpha, texture layer | wrap << 24, first AlphaTriangle.
+@group(#{BVH_GROUP}) @binding(4) var<storage, read> bvh_alpha_instances: array<vec4<u32>>;
+// AlphaTriangle records, 2 vec4 each: uv0, uv1 / uv2, vertex alphas as unorm16 (a0 | a1 << 16, a2).
+@group(#{BVH_GROUP}) @binding(5) var<storage, read> bvh_alpha_triangles: array<vec4<u32>>;
+// The scene's base colour textures (sRGB array; alpha is linear) and a linear repeating sampler.
+@group(#{BVH_GROUP}) @binding(6) var bvh_alpha_textures: texture_2d_array<f32>;
+@group(#{BVH_GROUP}) @binding(7) var bvh_alpha_sampler: sampler;
 
 const BVH_MISS: u32 = 0xffffffffu;
 // One entry per tree level below the root, TLAS and BLAS together; hikari-render refuses a
@@ -375,15 +386,46 @@ fn bvh_result() -> Hit {
 // candidates for bvh_accept_candidate (alpha cut-outs, glTF alphaMode MASK).
 const BVH_TRIANGLE_NON_OPAQUE: u32 = 1u;
 
+const BVH_ALPHA_NO_TEXTURE: u32 = 0x00ffffffu;
+
 // Whether a candidate hit on a non-opaque triangle counts: `instance` is the instance index
 // as hits report it, `primitive` the triangle's index in its mesh, `u`, `v` the weights of v1
 // and v2. Called only for triangles flagged BVH_TRIANGLE_NON_OPAQUE; a rejected candidate is
 // skipped and the walk goes on (closest and any hit alike).
-// TODO(lead): wire the alpha texture lookup in here (material of the instance's primitive, UV
-// from u and v, compare with the alpha cutoff). Until then every candidate is accepted, which
-// traces flagged triangles exactly like opaque ones.
+//
+// The rasteriser's alpha test (raster/setup.wgsl, alpha_covers) at the hit: material alpha
+// times the interpolated vertex colour alpha times the base colour texture's A, bilinear at
+// mip 0 (cut-out edges stay where the full-resolution texture puts them, at any distance),
+// against the material's cut-off. CPU twin: scene_bvh::SceneAlphaFilter. Indices past the
+// tables (a caller's mistake: BvhTrace refuses what it can see) accept the hit rather than
+// read out of bounds, as the kernel runs without runtime checks.
 fn bvh_accept_candidate(instance: u32, primitive: u32, u: f32, v: f32) -> bool {
-    return true;
+    if instance >= arrayLength(&bvh_alpha_instances) {
+        return true;
+    }
+    let rec = bvh_alpha_instances[instance];
+    let cutoff = bitcast<f32>(rec.x);
+    if !(cutoff > 0.0) {
+        return true;
+    }
+    let i = 2u * (rec.w + primitive);
+    if rec.w + primitive >= arrayLength(&bvh_alpha_triangles) / 2u {
+        return true;
+    }
+    let t0 = bvh_alpha_triangles[i];
+    let t1 = bvh_alpha_triangles[i + 1u];
+    let w = vec3<f32>(1.0 - u - v, u, v);
+    let material_alpha = bitcast<f32>(rec.y);
+    let vertex_alpha = vec3<f32>(unpack2x16unorm(t1.z), unpack2x16unorm(t1.w).x) * material_alpha;
+    var alpha = dot(vertex_alpha, w);
+    let layer = rec.z & BVH_ALPHA_NO_TEXTURE;
+    if layer != BVH_ALPHA_NO_TEXTURE {
+        let uv = bitcast<vec2<f32>>(t0.xy) * w.x + bitcast<vec2<f32>>(t0.zw) * w.y + bitcast<vec2<f32>>(t1.xy) * w.z;
+        let size = textureDimensions(bvh_alpha_textures);
+        alpha *= textureSampleLevel(bvh_alpha_textures, bvh_alpha_sampler, wrap_uv(uv, rec.z >> 24u, size), layer, 0.0).a;
+    }
+    // NaN fails: no hit.
+    return alpha >= cutoff;
 }
 
 // One iteration of the walk: the next node of the current group (unless primitives are
