@@ -30,17 +30,17 @@ pub struct ConfigFile {
     pub time: Option<String>,
     pub width: Option<u32>,
     pub height: Option<u32>,
-    /// The technique tables and `preset`, as written.
+    /// The technique tables and `preset`, as written (validated when the file was read).
     tables: toml::Table,
-    settings: Settings,
 }
 
 const HEAD_KEYS: [&str; 5] = ["scene", "camera", "time", "width", "height"];
 
 impl ConfigFile {
     /// The settings the file gives: its preset (default `high`) and its tables.
+    #[cfg(test)]
     pub fn settings(&self) -> Settings {
-        self.settings.clone()
+        self.settings_with(None, &[]).expect("validated when read")
     }
 
     /// The settings with a preset from the command line (which wins over the file's) and
@@ -72,7 +72,7 @@ pub fn parse(text: &str) -> anyhow::Result<ConfigFile> {
     let head: Head = toml::Value::Table(head)
         .try_into()
         .map_err(|e: toml::de::Error| anyhow::anyhow!("{}", e.message().trim()))?;
-    let settings = Settings::from_toml(None, tables.clone(), &[])?;
+    Settings::from_toml(None, tables.clone(), &[])?;
     Ok(ConfigFile {
         scene: head.scene,
         camera: head.camera,
@@ -80,7 +80,6 @@ pub fn parse(text: &str) -> anyhow::Result<ConfigFile> {
         width: head.width,
         height: head.height,
         tables,
-        settings,
     })
 }
 

@@ -233,7 +233,10 @@ pub fn reflect_groups(
 /// Every (texture, sampler) pair the shader samples with, as global variables.
 fn image_samples(
     module: &naga::Module,
-) -> Vec<(naga::Handle<naga::GlobalVariable>, naga::Handle<naga::GlobalVariable>)> {
+) -> Vec<(
+    naga::Handle<naga::GlobalVariable>,
+    naga::Handle<naga::GlobalVariable>,
+)> {
     let mut out = Vec::new();
     let functions = module
         .functions

@@ -400,6 +400,7 @@ const BVH_ALPHA_NO_TEXTURE: u32 = 0x00ffffffu;
 // tables (a caller's mistake: BvhTrace refuses what it can see) accept the hit rather than
 // read out of bounds, as the kernel runs without runtime checks.
 fn bvh_accept_candidate(instance: u32, primitive: u32, u: f32, v: f32) -> bool {
+#ifdef BVH_ALPHA
     if instance >= arrayLength(&bvh_alpha_instances) {
         return true;
     }
@@ -426,6 +427,10 @@ fn bvh_accept_candidate(instance: u32, primitive: u32, u: f32, v: f32) -> bool {
     }
     // NaN fails: no hit.
     return alpha >= cutoff;
+#else
+    // Kernels built without TraceConfig::alpha: the host refuses TLASes with cut-outs.
+    return true;
+#endif
 }
 
 // One iteration of the walk: the next node of the current group (unless primitives are

@@ -69,7 +69,8 @@ pub struct RaysArgs {
     /// incoherent configuration for every workload), followed by `+`-joined changes: `rpt<N>`
     /// (rays per invocation), `wg<N>` (workgroup size), `stride`, `dyn` or `refill<N>` (how
     /// the next ray is picked; refill: subgroup refill once N lanes are free), `tri<N>`
-    /// (triangles per step, 0 = all), `checked` (wgpu's runtime checks on).
+    /// (triangles per step, 0 = all), `checked` (wgpu's runtime checks on), `alpha` (the cut-out test
+    /// compiled in).
     #[arg(long, default_value = "auto", hide = true)]
     pub variants: String,
 }

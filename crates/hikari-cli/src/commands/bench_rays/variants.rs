@@ -30,6 +30,7 @@ pub(super) fn parse_variant(spec: &str) -> anyhow::Result<(TraceConfig, TraceCon
         };
         let change: Box<dyn Fn(&mut TraceConfig)> = match part {
             "checked" => Box::new(|c| c.runtime_checks = true),
+            "alpha" => Box::new(|c| c.alpha = true),
             "dyn" => Box::new(|c| c.refill = Refill::Dynamic),
             "stride" => Box::new(|c| c.refill = Refill::Stride),
             p if p.starts_with("refill") => {
@@ -71,9 +72,10 @@ pub(super) fn kernel_summary(c: &TraceConfig) -> String {
         n => n.to_string(),
     };
     format!(
-        "workgroup {}, {} rays/invocation ({refill}), {tris} triangles/step{}",
+        "workgroup {}, {} rays/invocation ({refill}), {tris} triangles/step{}{}",
         c.workgroup,
         c.rays_per_thread,
-        if c.runtime_checks { ", checked" } else { "" }
+        if c.runtime_checks { ", checked" } else { "" },
+        if c.alpha { ", cut-outs" } else { "" }
     )
 }
