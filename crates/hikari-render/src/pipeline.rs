@@ -130,7 +130,8 @@ pub fn reflect_bindings(path: &str, module: &naga::Module) -> Result<Vec<Binding
 }
 
 /// Reads every group of a module: group 0, then one group per shared binding set in `sets`.
-/// Each group's bindings must be 0..n without gaps.
+/// Group 0's bindings must be 0..n without gaps; a set's group holds those of its bindings the
+/// shader uses.
 pub fn reflect_groups(
     path: &str,
     module: &naga::Module,
@@ -218,6 +219,11 @@ pub fn reflect_groups(
     }
     for (group, slots) in groups.iter_mut().enumerate() {
         slots.sort_by_key(|s| s.binding);
+        // A binding set's group may have gaps: naga_oil leaves out the bindings of a shared
+        // module that the entry point does not reach.
+        if group > 0 {
+            continue;
+        }
         for (i, s) in slots.iter().enumerate() {
             if s.binding != i as u32 {
                 return Err(err(format!(

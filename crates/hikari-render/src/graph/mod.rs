@@ -474,15 +474,26 @@ impl<'r> FrameGraph<'r> {
                         ),
                     })?;
                 let label = format!("{} set `{}`", info.label, layout.name);
-                self.check_bindings(
-                    &name,
-                    &label,
-                    &layout.slots,
-                    &set.bindings,
-                    &set.expect_write,
-                )?;
-                touched.extend(Self::accesses(&set.bindings, &layout.slots));
-                set_bindings.push(set.bindings.clone());
+                // A set offers a resource at each binding of its module; a pipeline uses those
+                // its entry point reaches (naga_oil leaves the others out of the shader).
+                let mut bindings = Vec::with_capacity(layout.slots.len());
+                let mut expect = Vec::with_capacity(layout.slots.len());
+                for slot in &layout.slots {
+                    let i = slot.binding as usize;
+                    let b = set.bindings.get(i).ok_or_else(|| RenderError::Pass {
+                        pass: name.clone(),
+                        message: format!(
+                            "`{label}` declares @binding({i}) `{}`, but the set binds {} resources",
+                            slot.name,
+                            set.bindings.len()
+                        ),
+                    })?;
+                    bindings.push(*b);
+                    expect.push(set.expect_write[i]);
+                }
+                self.check_bindings(&name, &label, &layout.slots, &bindings, &expect)?;
+                touched.extend(Self::accesses(&bindings, &layout.slots));
+                set_bindings.push(bindings);
             }
             for s in &sets {
                 let set = &self.sets[s.0 as usize];
