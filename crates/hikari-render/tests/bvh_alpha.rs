@@ -178,7 +178,17 @@ fn gpu_trace(
     rays: &[Ray],
 ) -> hikari_render::Result<GpuHits> {
     let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
-    let mut trace = BvhTrace::new(ctx, &mut lib).unwrap();
+    gpu_trace_with(ctx, BvhTrace::new(ctx, &mut lib)?, scene, bvh, alpha, rays)
+}
+
+fn gpu_trace_with(
+    ctx: &GpuContext,
+    mut trace: BvhTrace,
+    scene: &Scene,
+    bvh: &Bvh,
+    alpha: Option<&BvhAlpha>,
+    rays: &[Ray],
+) -> hikari_render::Result<GpuHits> {
     trace.upload_blases(ctx, &bvh.blases)?;
     trace.upload_tlas(ctx, &bvh.tlas)?;
     let (textures, _) = TextureArrays::upload(ctx, scene)?;
@@ -406,4 +416,28 @@ fn a_bvh_with_cut_outs_needs_their_alpha_data() {
         .expect("alpha data for 2 of 3 instances")
         .to_string();
     assert!(e.contains("covers 2 instances"), "{e}");
+}
+
+/// Kernels built without the cut-out test (the ray benchmark's) refuse a TLAS with cut-outs
+/// rather than trace them as opaque.
+#[test]
+fn kernels_without_the_cut_out_test_refuse_cut_outs() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = builtin::cutout();
+    let bvh = bvh(&scene);
+    let rays = rays(&scene, false);
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let trace = BvhTrace::with_configs(
+        &ctx,
+        &mut lib,
+        hikari_render::bvh_trace::TraceConfig::coherent(),
+        hikari_render::bvh_trace::TraceConfig::incoherent(),
+    )
+    .unwrap();
+    let alpha = BvhAlpha::for_scene(&scene);
+    let e = gpu_trace_with(&ctx, trace, &scene, &bvh, Some(&alpha), &rays)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("TraceConfig::alpha"), "{e}");
 }

@@ -300,6 +300,12 @@ fn flagged_triangles_with_the_accept_all_filter_trace_like_opaque_ones() {
     let mut rng = SplitMix64::new(61);
     let rays = random_rays(&mut rng, 1000, 12.0);
     for (config_name, config) in configs(&gpu.ctx) {
+        // Kernels with the cut-out test compiled in (without it, a TLAS with marked
+        // triangles is refused: tests/bvh_alpha.rs).
+        let config = TraceConfig {
+            alpha: true,
+            ..config
+        };
         let (closest, any) = gpu.trace_with(&plain, &rays, config);
         let (f_closest, f_any) = gpu.trace_with(&flagged, &rays, config);
         assert!(closest == f_closest, "{config_name}: closest hits differ");

@@ -72,3 +72,54 @@ fn interactive_frames_run_ahead_and_the_queues_catch_up() {
         "after the queues grew, frames lose nothing"
     );
 }
+
+/// A NaN or infinite camera, sun or light that reaches the renderer is an error naming it,
+/// not a frame of garbage or a panic.
+#[test]
+fn non_finite_cameras_suns_and_lights_are_clear_errors() {
+    let Some(ctx) = common::gpu() else { return };
+    let scene = hikari_scene::builtin::boxes();
+    let good = common::small_frame_settings(&scene, 64, 48);
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let err = |r: Result<hikari_render::RenderedFrame, hikari_render::RenderError>| {
+        r.err().expect("refused").to_string()
+    };
+
+    let mut s = good.clone();
+    s.camera.position.x = f32::NAN;
+    let e = err(renderer.render(&s, false));
+    assert!(e.contains("camera") && e.contains("position"), "{e}");
+
+    let mut s = good.clone();
+    s.camera.vfov_deg = f32::INFINITY;
+    assert!(err(renderer.render(&s, false)).contains("vfov"));
+
+    let mut s = good.clone();
+    if let Some(sun) = s.sun.as_mut() {
+        sun.direction = glam::Vec3::new(f32::NAN, 1.0, 0.0);
+    }
+    let e = err(renderer.render(&s, false));
+    assert!(e.contains("sun") && e.contains("direction"), "{e}");
+
+    let mut s = good.clone();
+    if let Some(sun) = s.sun.as_mut() {
+        sun.illuminance_lux = f32::INFINITY;
+    }
+    assert!(err(renderer.render(&s, false)).contains("illuminance"));
+
+    // The renderer still draws a sane frame afterwards.
+    renderer.render(&good, false).unwrap();
+
+    let mut bad_light = scene.clone();
+    bad_light.lights.push(hikari_scene::Light::point_lumens(
+        "broken lamp",
+        glam::Vec3::new(0.0, f32::NAN, 0.0),
+        100.0,
+        glam::Vec3::ONE,
+    ));
+    let e = Renderer::new(common::gpu().unwrap(), &bad_light)
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("broken lamp"), "{e}");
+}
