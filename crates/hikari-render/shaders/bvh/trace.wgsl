@@ -1,5 +1,5 @@
-// Ray tracing as a library user sees it: rays in, hits out (`hikari-render/src/passes/
-// bvh_trace.rs`, `hikari bench rays`). The BVH's resources are the binding set `bvh`,
+// Ray tracing as a library user sees it: rays in, hits out (`hikari-render/src/bvh_trace.rs`,
+// `hikari bench rays`). The BVH's resources are the binding set `bvh`,
 // declared by hikari::bvh (BVH buffers, then what the cut-out test reads).
 //
 // Each workgroup owns a contiguous chunk of TRACE_RAYS_PER_THREAD * TRACE_WORKGROUP rays. With

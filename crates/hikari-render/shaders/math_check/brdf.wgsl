@@ -1,6 +1,6 @@
 // Verification kernel for the BRDF twin `hikari::brdf` (with its tables `hikari::brdf_tables`):
 // not used by any frame. One invocation per case, flat f32 records (sizes mirrored by
-// `Kernel::in_stride` / `Kernel::out_stride` in src/passes/math_check.rs), compared with
+// `Kernel::in_stride` / `Kernel::out_stride` in src/checks/math_check.rs), compared with
 // hikari-math's `brdf` module in tests/math_twins.rs.
 
 #import hikari::brdf::{

@@ -1,6 +1,6 @@
 // Verification kernels for the colour twin `hikari::color`: not used by any frame. One
 // invocation per case, flat f32 records (sizes mirrored by `Kernel::in_stride` /
-// `Kernel::out_stride` in src/passes/math_check.rs), compared with hikari-math's `color`
+// `Kernel::out_stride` in src/checks/math_check.rs), compared with hikari-math's `color`
 // module in tests/math_twins.rs.
 
 #import hikari::color::{

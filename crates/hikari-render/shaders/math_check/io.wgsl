@@ -1,7 +1,7 @@
 #define_import_path hikari::math_check_io
 
 // What every math_check verification kernel binds: one case per invocation, flat f32 records in
-// and out (see src/passes/math_check.rs), so WGSL's vec3 padding plays no part in comparisons.
+// and out (see src/checks/math_check.rs), so WGSL's vec3 padding plays no part in comparisons.
 
 struct MathCheckParams {
     count: u32,

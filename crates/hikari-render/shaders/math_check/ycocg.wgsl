@@ -1,6 +1,6 @@
 // Verification kernel for the Metro Exodus YCoCg + L1 encoding of `hikari::sh`: not used by any
 // frame. One invocation per case, flat f32 records (sizes mirrored by `Kernel::in_stride` /
-// `Kernel::out_stride` in src/passes/math_check.rs), compared with hikari-math's
+// `Kernel::out_stride` in src/checks/math_check.rs), compared with hikari-math's
 // `sh::ycocg` in tests/math_twins.rs.
 
 #import hikari::sh::{

@@ -1,7 +1,7 @@
 // G-buffer resolve: turns the visibility buffer (depth and triangle id a pixel) into the
 // G-buffer. Barycentrics come from intersecting the pixel's camera ray with the triangle, and
 // texture derivatives from the rays through the neighbouring pixel centres, so textures are
-// filtered as a rasteriser's quads would. CPU twin: `reference::gbuffer`.
+// filtered as a rasteriser's quads would. CPU twin: `gbuffer::reference`.
 
 #import hikari::view::View
 #import hikari::octahedral::oct_encode

@@ -1,6 +1,6 @@
-//! Cascaded shadow maps of the sun (or moon), rasterised in compute (`passes/raster.rs`) into
+//! Cascaded shadow maps of the sun (or moon), rasterised in compute (`raster/mod.rs`) into
 //! one u32 depth a texel, looked up with 3x3 bilinear PCF by the deferred lighting
-//! (`shaders/sun_shadows/lookup.wgsl`; CPU twin [`crate::techniques::sun_shadows::reference`]).
+//! (`techniques/sun_shadows/lookup.wgsl`; CPU twin [`crate::techniques::sun_shadows::reference`]).
 //!
 //! Stability under camera motion: each cascade is the bounding sphere of its slice of the view
 //! frustum, whose radius depends only on the slice distances and the field of view (not on the

@@ -1,4 +1,4 @@
-//! CPU twin of the sun shadow lookup (`shaders/sun_shadows/lookup.wgsl`): cascade selection
+//! CPU twin of the sun shadow lookup (`techniques/sun_shadows/lookup.wgsl`): cascade selection
 //! and 3x3 bilinear PCF over read-back shadow maps.
 
 use glam::{Mat4, Vec2, Vec3};
