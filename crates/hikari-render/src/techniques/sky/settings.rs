@@ -245,9 +245,18 @@ mod tests {
         bad(|s| s.utc_offset_h = 15.0, "sky.utc_offset_h");
         bad(|s| s.weather = "snowy".into(), "sky.weather");
         bad(|s| s.table_quality = 3, "sky.table_quality");
-        bad(|s| s.sky_brightness_scale = -0.1, "sky.sky_brightness_scale");
-        bad(|s| s.ambient_diffuse_scale = f32::NAN, "sky.ambient_diffuse_scale");
-        bad(|s| s.ambient_specular_scale = 17.0, "sky.ambient_specular_scale");
+        bad(
+            |s| s.sky_brightness_scale = -0.1,
+            "sky.sky_brightness_scale",
+        );
+        bad(
+            |s| s.ambient_diffuse_scale = f32::NAN,
+            "sky.ambient_diffuse_scale",
+        );
+        bad(
+            |s| s.ambient_specular_scale = 17.0,
+            "sky.ambient_specular_scale",
+        );
     }
 
     #[test]

@@ -65,8 +65,12 @@ pub struct TimeKey {
 /// end (12° below the horizon, `MU_S_MIN`: the sun lights no sky, the moon takes over),
 /// `twilight` in the blue hour, `golden` just after sunrise or before sunset, `day` from where
 /// the sun is high enough that the sky hardly changes any more.
-pub const KEY_ELEVATIONS_DEG: [(&str, f32); 4] =
-    [("night", -12.0), ("twilight", -4.0), ("golden", 6.0), ("day", 30.0)];
+pub const KEY_ELEVATIONS_DEG: [(&str, f32); 4] = [
+    ("night", -12.0),
+    ("twilight", -4.0),
+    ("golden", 6.0),
+    ("day", 30.0),
+];
 
 /// A weather state: what it does to the atmosphere (rebuilds the tables) and the artist knobs
 /// the talk names per time-of-day key (interpolated every frame, no rebuild).
@@ -207,7 +211,11 @@ mod tests {
     fn keys_are_ordered_and_hit_exactly_at_their_elevations() {
         for w in weathers() {
             for p in w.keys.windows(2) {
-                assert!(p[0].sun_elevation_deg < p[1].sun_elevation_deg, "{}", w.name);
+                assert!(
+                    p[0].sun_elevation_deg < p[1].sun_elevation_deg,
+                    "{}",
+                    w.name
+                );
             }
             for k in &w.keys {
                 assert_eq!(
