@@ -129,7 +129,14 @@ fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> 
         }
         direct_lighting::reference::SkyLight {
             sh,
-            balance: [weather.ambient_diffuse, weather.ambient_specular],
+            balance: {
+                // The weather's knobs at this frame's sun elevation, as the frame takes them.
+                let sky_settings = &settings.settings.sky;
+                let lights = sky::frame_lights(sky_settings, settings.sun.as_ref()).unwrap();
+                let k = sky::frame_knobs(sky_settings, &lights);
+                debug_assert_eq!(weather.name, sky_settings.weather);
+                [k.ambient_diffuse, k.ambient_specular]
+            },
             background: sky_twin.as_ref(),
         }
     });

@@ -21,6 +21,7 @@
 pub mod lights;
 pub mod reference;
 pub mod settings;
+pub mod weather;
 
 use std::sync::{Arc, Mutex};
 
@@ -39,6 +40,7 @@ use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
 use lights::SkyLights;
 use settings::SkySettings;
+use weather::ArtistKnobs;
 
 /// The per-frame parameters of `hikari::sky` (see `lookup.wgsl` for each field).
 #[repr(C)]
@@ -145,10 +147,7 @@ impl SkyParams {
             let u = coord_from_unit(shell.x_mu_s(f64::from(dir.y)), nmus);
             (u * nmus as f64 - 0.5) as f32
         };
-        let weather = s
-            .weather()
-            .unwrap_or_else(|_| settings::Weather::by_name("clear").expect("clear is a weather"));
-        let brightness = weather.sky_brightness;
+        let brightness = frame_knobs(s, lights).sky_brightness;
         let white = atmosphere.to_working(Vec3::ONE);
         let sun_lux = sky_lux(lights.sun.extraterrestrial_lux, lights.sun.direction);
         let moon_lux = sky_lux(lights.moon.extraterrestrial_lux, lights.moon.direction);
@@ -208,6 +207,16 @@ impl SkyParams {
     }
 }
 
+/// The weather's artist knobs for this frame's sun (the settings' weather; clear if it names
+/// none, as validation refuses that before a frame).
+pub fn frame_knobs(s: &SkySettings, lights: &SkyLights) -> ArtistKnobs {
+    s.knobs(lights.sun.elevation_deg).unwrap_or_else(|_| {
+        settings::Weather::by_name("clear")
+            .expect("clear is a weather")
+            .knobs_at(lights.sun.elevation_deg)
+    })
+}
+
 /// The sky of one frame, for the techniques that read it.
 #[derive(Clone, Copy, Debug)]
 pub struct SkyFrame {
@@ -226,6 +235,9 @@ pub struct SkyFrame {
     /// the CPU model's sky irradiance), for the placeholder exposure meter: at dawn the sky
     /// outshines the low sun.
     pub sky_lux: f32,
+    /// The weather's artist knobs at this frame's sun elevation (neutral with the sky off),
+    /// including the exposure hint for the exposure issue.
+    pub knobs: ArtistKnobs,
 }
 
 struct Uploaded {
@@ -325,11 +337,13 @@ impl Sky {
         if !s.enabled {
             return self.disabled(g, sh);
         }
-        let weather = s
-            .weather()
+        // The tables follow the weather alone; the time of day moves only the knobs.
+        let (atmosphere, sizes) = s
+            .table_key()
             .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
-        let u = self.tables(g.ctx(), &weather.atmosphere(), s.table_sizes())?;
+        let u = self.tables(g.ctx(), &atmosphere, sizes)?;
         let mut lights = frame_lights(s, directional)?;
+        let knobs = frame_knobs(s, &lights);
         if !s.sky {
             lights.sun.extraterrestrial_lux = 0.0;
             lights.moon.extraterrestrial_lux = 0.0;
@@ -345,7 +359,7 @@ impl Sky {
                     lights::luminance(u.atmosphere.sky_irradiance(0.0, zenith, Vec3::splat(lux)))
                 })
                 .sum::<f32>()
-                * weather.sky_brightness
+                * knobs.sky_brightness
         } else {
             0.0
         };
@@ -390,7 +404,7 @@ impl Sky {
         let ambient = g
             .binding_set("sky_ambient")
             .constants(&SkyAmbientParams {
-                balance: [weather.ambient_diffuse, weather.ambient_specular, 0.0, 0.0],
+                balance: [knobs.ambient_diffuse, knobs.ambient_specular, 0.0, 0.0],
             })
             .read(sh)
             .finish();
@@ -402,6 +416,7 @@ impl Sky {
             lookup,
             ambient,
             sky_lux: horizontal_sky_lux,
+            knobs,
         })
     }
 
@@ -440,6 +455,7 @@ impl Sky {
             lookup,
             ambient,
             sky_lux: 0.0,
+            knobs: ArtistKnobs::NEUTRAL,
         })
     }
 }

@@ -8,6 +8,8 @@ use hikari_math::astro::{DateTime, Place};
 
 use crate::settings::{Field, Preset, Range, SettingError, TechniqueSettings};
 
+pub use super::weather::{ArtistKnobs, KEY_ELEVATIONS_DEG, TimeKey, Weather};
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SkySettings {
@@ -33,6 +35,12 @@ pub struct SkySettings {
     /// Resolution of the atmosphere's tables: 0 the smallest (tests), 1 medium, 2 the
     /// atmosphere crate's defaults. The tables are built on the CPU when the weather changes.
     pub table_quality: u32,
+    /// Multiplies the weather's sky brightness at every time-of-day key, 0 to 16.
+    pub sky_brightness_scale: f32,
+    /// Multiplies the weather's ambient diffuse balance at every key, 0 to 16.
+    pub ambient_diffuse_scale: f32,
+    /// Multiplies the weather's ambient specular balance at every key, 0 to 16.
+    pub ambient_specular_scale: f32,
 }
 
 impl Default for SkySettings {
@@ -53,6 +61,9 @@ impl Default for SkySettings {
             longitude_deg: Place::TSUSHIMA.longitude_deg(),
             weather: "clear".into(),
             table_quality: 2,
+            sky_brightness_scale: 1.0,
+            ambient_diffuse_scale: 1.0,
+            ambient_specular_scale: 1.0,
         }
     }
 }
@@ -100,6 +111,24 @@ impl SkySettings {
         })
     }
 
+    /// The artist knobs of the weather with the sun `sun_elevation_deg` above the horizon
+    /// ([`Weather::knobs_at`]), times this file's scales.
+    pub fn knobs(&self, sun_elevation_deg: f64) -> Result<ArtistKnobs, SettingError> {
+        let k = self.weather()?.knobs_at(sun_elevation_deg);
+        Ok(ArtistKnobs {
+            sky_brightness: k.sky_brightness * self.sky_brightness_scale,
+            ambient_diffuse: k.ambient_diffuse * self.ambient_diffuse_scale,
+            ambient_specular: k.ambient_specular * self.ambient_specular_scale,
+            exposure_bias_ev: k.exposure_bias_ev,
+        })
+    }
+
+    /// What the sky's tables are built from and cached by: the weather's atmosphere and the
+    /// table sizes. Neither the time nor the knobs enter it.
+    pub fn table_key(&self) -> Result<(AtmosphereParams, TableSizes), SettingError> {
+        Ok((self.weather()?.atmosphere(), self.table_sizes()))
+    }
+
     /// The atmosphere's table sizes for [`SkySettings::table_quality`].
     pub fn table_sizes(&self) -> TableSizes {
         table_sizes(self.table_quality)
@@ -130,60 +159,6 @@ pub fn table_sizes(quality: u32) -> TableSizes {
     }
 }
 
-/// A weather state: what it does to the atmosphere (rebuilds the tables) and the artist knobs
-/// the talk names (applied every frame, no rebuild).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Weather {
-    pub name: &'static str,
-    /// Multiplies the Earth's aerosol (Mie) scattering and extinction at sea level.
-    pub mie_density_scale: f64,
-    /// Cornette-Shanks asymmetry of the aerosols.
-    pub mie_g: f64,
-    /// Lambertian ground albedo.
-    pub ground_albedo: f64,
-    /// Scales the sky's radiance (drawn and ambient); 1 is physical.
-    pub sky_brightness: f32,
-    /// Scales the sky's diffuse ambient light.
-    pub ambient_diffuse: f32,
-    /// Scales the sky's specular ambient light.
-    pub ambient_specular: f32,
-}
-
-impl Weather {
-    pub const NAMES: [&'static str; 3] = ["clear", "hazy", "overcast"];
-
-    /// Clear: Bruneton's aerosols. Hazy: four times the aerosols, a wider forward lobe.
-    /// Overcast: a thick aerosol layer standing in for cloud until the cloud issue, greyer
-    /// and dimmer, with a more diffuse ambient.
-    pub fn by_name(name: &str) -> Option<Self> {
-        let w = |name, mie_density_scale, mie_g, ground_albedo, sky, diffuse, specular| Weather {
-            name,
-            mie_density_scale,
-            mie_g,
-            ground_albedo,
-            sky_brightness: sky,
-            ambient_diffuse: diffuse,
-            ambient_specular: specular,
-        };
-        Some(match name {
-            "clear" => w("clear", 1.0, 0.8, 0.1, 1.0, 1.0, 1.0),
-            "hazy" => w("hazy", 4.0, 0.76, 0.15, 1.0, 1.0, 0.9),
-            "overcast" => w("overcast", 25.0, 0.7, 0.2, 0.9, 1.1, 0.6),
-            _ => return None,
-        })
-    }
-
-    /// The Earth's atmosphere under this weather (LMS Rayleigh space).
-    pub fn atmosphere(&self) -> AtmosphereParams {
-        let mut p = AtmosphereParams::default();
-        p.mie_scattering_per_km *= self.mie_density_scale;
-        p.mie_extinction_per_km *= self.mie_density_scale;
-        p.mie_g = self.mie_g;
-        p.ground_albedo = self.ground_albedo;
-        p
-    }
-}
-
 impl TechniqueSettings for SkySettings {
     fn fields() -> &'static [Field] {
         const F: &[Field] = &[
@@ -211,6 +186,18 @@ impl TechniqueSettings for SkySettings {
             Field {
                 key: "table_quality",
                 range: Range::Int { lo: 0, hi: 2 },
+            },
+            Field {
+                key: "sky_brightness_scale",
+                range: Range::Float { lo: 0.0, hi: 16.0 },
+            },
+            Field {
+                key: "ambient_diffuse_scale",
+                range: Range::Float { lo: 0.0, hi: 16.0 },
+            },
+            Field {
+                key: "ambient_specular_scale",
+                range: Range::Float { lo: 0.0, hi: 16.0 },
             },
         ];
         F
@@ -258,6 +245,18 @@ mod tests {
         bad(|s| s.utc_offset_h = 15.0, "sky.utc_offset_h");
         bad(|s| s.weather = "snowy".into(), "sky.weather");
         bad(|s| s.table_quality = 3, "sky.table_quality");
+        bad(
+            |s| s.sky_brightness_scale = -0.1,
+            "sky.sky_brightness_scale",
+        );
+        bad(
+            |s| s.ambient_diffuse_scale = f32::NAN,
+            "sky.ambient_diffuse_scale",
+        );
+        bad(
+            |s| s.ambient_specular_scale = 17.0,
+            "sky.ambient_specular_scale",
+        );
     }
 
     #[test]
@@ -267,5 +266,60 @@ mod tests {
             assert_eq!(w.name, name);
             w.atmosphere().validate().unwrap();
         }
+    }
+
+    fn at(time: &str, weather: &str) -> SkySettings {
+        SkySettings {
+            time: time.into(),
+            weather: weather.into(),
+            ..SkySettings::default()
+        }
+    }
+
+    fn sun_elevation(s: &SkySettings) -> f64 {
+        hikari_math::astro::sun_and_moon(&s.date_time().unwrap(), &s.place().unwrap())
+            .sun
+            .elevation_deg
+    }
+
+    /// Through a whole day within one weather the tables' cache key stays the same while the
+    /// knobs follow the sun; another weather changes the key.
+    #[test]
+    fn time_within_a_weather_changes_the_knobs_not_the_tables() {
+        for name in Weather::NAMES {
+            let noon = at("12:00", name);
+            let key = noon.table_key().unwrap();
+            let mut seen = Vec::new();
+            for m in (0..24 * 60).step_by(20) {
+                let s = at(&format!("{:02}:{:02}", m / 60, m % 60), name);
+                assert_eq!(s.table_key().unwrap(), key, "{name} {}", s.time);
+                seen.push(s.knobs(sun_elevation(&s)).unwrap());
+            }
+            let night = Weather::by_name(name).unwrap().keys[0].knobs;
+            let day = Weather::by_name(name).unwrap().keys[3].knobs;
+            assert!(seen.contains(&night) && seen.contains(&day), "{name}");
+            assert!(seen.iter().any(|k| *k != night && *k != day), "{name}");
+        }
+        assert_ne!(
+            at("12:00", "clear").table_key().unwrap(),
+            at("12:00", "hazy").table_key().unwrap()
+        );
+    }
+
+    #[test]
+    fn the_file_scales_multiply_the_keys() {
+        let mut s = at("23:30", "overcast");
+        let e = sun_elevation(&s);
+        let k = Weather::by_name("overcast").unwrap().knobs_at(e);
+        s.sky_brightness_scale = 2.0;
+        s.ambient_diffuse_scale = 0.5;
+        s.ambient_specular_scale = 0.0;
+        s.validate("sky").unwrap();
+        let got = s.knobs(e).unwrap();
+        assert_eq!(got.sky_brightness, 2.0 * k.sky_brightness);
+        assert_eq!(got.ambient_diffuse, 0.5 * k.ambient_diffuse);
+        assert_eq!(got.ambient_specular, 0.0);
+        assert_eq!(got.exposure_bias_ev, k.exposure_bias_ev);
+        assert_eq!(s.table_key(), at("23:30", "overcast").table_key());
     }
 }
