@@ -22,14 +22,15 @@ const GOLDEN_ANGLE: f32 = 2.39996322972865332;
 
 var<workgroup> terms: array<array<vec3<f32>, 9>, THREADS>;
 
-// Adds the workgroup's 64 rows of `terms` into row 0, a tree of halvings.
+// Adds the workgroup's 64 rows of `terms` into row 0, a tree of halvings; each level's
+// (row, coefficient) additions are spread over all threads (at most 5 each, not 9 on half).
 fn sum_terms(lid: u32) {
     workgroupBarrier();
     for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
-        if lid < stride {
-            for (var k = 0u; k < 9u; k++) {
-                terms[lid][k] += terms[lid + stride][k];
-            }
+        for (var i = lid; i < stride * 9u; i += THREADS) {
+            let g = i / 9u;
+            let k = i % 9u;
+            terms[g][k] += terms[g + stride][k];
         }
         workgroupBarrier();
     }
