@@ -7,10 +7,18 @@ mod common;
 
 use glam::Vec3;
 
-use hikari_math::sh::Sh;
+use hikari_math::sh::dering::{dering, dering_window, find_minimum};
+use hikari_math::sh::{Sh, ShL2Rgb, basis, zonal};
 use hikari_render::Renderer;
+use hikari_render::checks::math_check::{Kernel, MathCheck};
+use hikari_render::graph::GraphRuntime;
+use hikari_render::pipeline::ComputePipeline;
+use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::gbuffer;
 use hikari_render::techniques::sky::{self, SkyParams, lights, reference::SkyTwin};
+use hikari_render::wgpu::{self, util::DeviceExt};
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
 
 fn frame(time: &str, w: u32, h: u32) -> (hikari_scene::Scene, hikari_render::FrameSettings) {
     let scene = hikari_scene::builtin::by_name("boxes").unwrap();
@@ -155,4 +163,247 @@ fn a_disabled_sky_leaves_the_placeholders_and_a_zero_sh() {
     let got = render(&scene, &s);
     assert!(got.sh.iter().all(|c| *c == [0.0; 4]));
     assert_eq!(got.params, <SkyParams as bytemuck::Zeroable>::zeroed());
+}
+
+/// Random unit vector (rejection sampling in the unit ball).
+fn unit(rng: &mut SmallRng) -> Vec3 {
+    loop {
+        let v = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        let l = v.length_squared();
+        if l > 1e-3 && l <= 1.0 {
+            return v.normalize();
+        }
+    }
+}
+
+/// Skies for the deringing: random coefficients (ringing of any shape), projected delta lights
+/// on a weak ambient (the strongest ringing), smooth lobes that need no windowing, and a few
+/// with a negative mean in one channel (zeroed).
+fn dering_skies(rng: &mut SmallRng, n: usize) -> Vec<ShL2Rgb> {
+    (0..n)
+        .map(|i| {
+            let scale = 10f32.powf(rng.random_range(-2.0..2.0));
+            match i % 8 {
+                0..3 => {
+                    let amp = rng.random_range(0.05..1.2);
+                    let mut c: [Vec3; 9] = std::array::from_fn(|_| {
+                        Vec3::new(
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                        ) * amp
+                    });
+                    c[0] = Vec3::new(
+                        rng.random_range(0.2..2.0),
+                        rng.random_range(0.2..2.0),
+                        rng.random_range(0.2..2.0),
+                    );
+                    ShL2Rgb::new(c).scale(scale)
+                }
+                3..5 => {
+                    let colour = Vec3::new(
+                        rng.random_range(0.1..1.0),
+                        rng.random_range(0.1..1.0),
+                        rng.random_range(0.1..1.0),
+                    );
+                    let mut f = ShL2Rgb::delta(unit(rng), colour * scale);
+                    let ambient = rng.random_range(0.0..0.5) * f.coeffs[0];
+                    f.coeffs[0] += ambient;
+                    f
+                }
+                5 | 6 => {
+                    let b = rng.random_range(0.2..0.9);
+                    let mut f = zonal::irradiance(&ShL2Rgb::delta(unit(rng), Vec3::splat(b)));
+                    f.coeffs[0] += Vec3::splat((1.0 / basis::C0) as f32);
+                    f.scale(scale)
+                }
+                _ => {
+                    let mut f = ShL2Rgb::new(std::array::from_fn(|_| {
+                        Vec3::new(
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                        ) * scale
+                    }));
+                    f.coeffs[0] = Vec3::new(-rng.random_range(0.01..1.0), 0.5, 0.5) * scale;
+                    f
+                }
+            }
+        })
+        .collect()
+}
+
+/// Runs the sky SH pass's `finish` on 64 partial sums (vec4 each, 9 per partial) and returns
+/// its 18 coefficients (raw, then deringed).
+fn run_finish(
+    ctx: &hikari_render::GpuContext,
+    pipeline: &ComputePipeline,
+    partials: &[[f32; 4]],
+) -> Vec<[f32; 4]> {
+    let buffer = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("test.sky.sh_partials"),
+            contents: bytemuck::cast_slice(partials),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+    // The module's sky binding set, which `finish` does not read: 1-texel placeholders.
+    let texture = |name: &str, layers: u32| {
+        ctx.device.create_texture_with_data(
+            &ctx.queue,
+            &wgpu::TextureDescriptor {
+                label: Some(name),
+                size: wgpu::Extent3d {
+                    width: 1,
+                    height: 1,
+                    depth_or_array_layers: layers,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba32Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            },
+            wgpu::util::TextureDataOrder::LayerMajor,
+            &vec![0u8; 16 * layers as usize],
+        )
+    };
+    let (resampled, transmittance) = (texture("sky.resampled", 4), texture("sky.transmittance", 1));
+    let mut rt = GraphRuntime::new();
+    let mut g = rt.begin_frame(ctx);
+    let resampled = g.import_texture("sky.resampled", &resampled);
+    let transmittance = g.import_texture("sky.transmittance", &transmittance);
+    let lookup = g
+        .binding_set("sky")
+        .constants(&<SkyParams as bytemuck::Zeroable>::zeroed())
+        .read(resampled)
+        .read(transmittance)
+        .finish();
+    let p = g.import_buffer("sky.sh_partials", &buffer);
+    let sh = g.buffer("sky.sh", 18 * 16).unwrap();
+    g.pass("sky.sh")
+        .write(p)
+        .write(sh)
+        .set(lookup)
+        .dispatch(pipeline, [1, 1, 1])
+        .unwrap();
+    g.readback(sh);
+    let r = g.execute().unwrap();
+    bytemuck::pod_collect_to_vec(r.buffer("sky.sh").unwrap())
+}
+
+/// The sky pass's parallel deringing (`finish`: all strengths of the search grid at once) on
+/// ringing, smooth and negative-mean skies, against hikari_math::sh::dering of the raw
+/// coefficients the pass wrote, and against the one-thread `sh_dering_l2_rgb` it replaces.
+/// The partial sums are random shares of the sky, so the reduction is checked too.
+#[test]
+fn the_sky_pass_derings_as_hikari_math_does() {
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let pipeline = ComputePipeline::new(&ctx, &mut lib, "sky/sh.wgsl", "finish", &[]).unwrap();
+    let serial = MathCheck::new(&ctx, &mut lib, Kernel::ShDering).unwrap();
+    let mut rng = SmallRng::seed_from_u64(0x5C7_DE41);
+    let skies = dering_skies(&mut rng, 160);
+    // The pass multiplies the sum by the solid angle of a sample.
+    let w = 4.0 * std::f32::consts::PI / 4096.0;
+
+    let mut results = Vec::new();
+    let mut serial_input = Vec::new();
+    for f in &skies {
+        let shares: Vec<f32> = (0..64).map(|_| rng.random_range(0.0..1.0)).collect();
+        let total: f32 = shares.iter().sum();
+        let mut partials = vec![[0.0f32; 4]; 64 * 9];
+        for (g, s) in shares.iter().enumerate() {
+            for k in 0..9 {
+                let c = f.coeffs[k] * (s / total / w);
+                partials[g * 9 + k] = [c.x, c.y, c.z, 0.0];
+            }
+        }
+        let out = run_finish(&ctx, &pipeline, &partials);
+        let raw = ShL2Rgb::new(std::array::from_fn(|k| Vec3::from_slice(&out[k][..3])));
+        let got = ShL2Rgb::new(std::array::from_fn(|k| Vec3::from_slice(&out[9 + k][..3])));
+        // The reduction: 64 shares of each coefficient, summed in f32 in two different orders.
+        for k in 0..9 {
+            let d = (raw.coeffs[k] - f.coeffs[k]).abs().max_element();
+            let s = f.coeffs[k].abs().max_element();
+            assert!(
+                d <= s * 1e-5,
+                "coefficient {k}: sum {} of {}",
+                raw.coeffs[k],
+                f.coeffs[k]
+            );
+        }
+        for c in &raw.coeffs {
+            serial_input.extend([c.x, c.y, c.z]);
+        }
+        results.push((raw, got));
+    }
+    let serial_out = serial.run(&ctx, &serial_input).unwrap();
+    let serial_out: Vec<&[f32]> = serial_out.chunks(Kernel::ShDering.out_stride()).collect();
+
+    // The strength of the deringed result: the grid value whose window gives it.
+    let grid: Vec<f32> = (0..=8).map(|k| k as f32 / 8.0).collect();
+    let strength_of = |raw: &ShL2Rgb, got: &ShL2Rgb| -> Option<f32> {
+        grid.iter().copied().find(|&t| {
+            let want = raw.scale_bands(dering_window(t));
+            (0..9).all(|k| {
+                let d = (got.coeffs[k] - want.coeffs[k]).abs().max_element();
+                d <= raw.coeffs[k].abs().max_element() * 1e-6
+            })
+        })
+    };
+    let (mut ties, mut windowed, mut untouched, mut zeroed) = (0, 0, 0, 0);
+    for (i, (raw, got)) in results.iter().enumerate() {
+        let cpu = dering(raw);
+        if raw.coeffs[0].min_element() < 0.0 {
+            assert!(
+                got.coeffs.iter().all(|c| *c == Vec3::ZERO),
+                "sky {i}: negative mean"
+            );
+            zeroed += 1;
+            continue;
+        }
+        let Some(t) = strength_of(raw, got) else {
+            panic!("sky {i}: {got:?} is no windowing of {raw:?}");
+        };
+        // As the one-thread GPU deringing (same f32 arithmetic, so the same strength).
+        assert_eq!(
+            t, serial_out[i][0],
+            "sky {i}: strength against sh_dering_l2_rgb"
+        );
+        if t != cpu.strength {
+            // A strength between the two whose estimated minimum is within rounding of zero
+            // (1e-5 of the term scale, as in math_twins) may go either way.
+            let (lo, hi) = (t.min(cpu.strength), t.max(cpu.strength));
+            let scale = (0..3)
+                .map(|c| raw.coeffs.iter().map(|v| v[c].abs()).sum::<f32>() * 1.1)
+                .fold(0.0, f32::max);
+            let tie = grid.iter().filter(|&&s| s >= lo && s < hi).all(|&s| {
+                let w = raw.scale_bands(dering_window(s));
+                let lowest = (0..3)
+                    .map(|c| find_minimum(&w.channel(c)).1)
+                    .fold(f32::INFINITY, f32::min);
+                lowest.abs() <= 1e-5 * scale
+            });
+            assert!(tie, "sky {i}: strength {t}, hikari_math {}", cpu.strength);
+            ties += 1;
+        }
+        if t > 0.0 {
+            windowed += 1;
+        } else {
+            untouched += 1;
+        }
+    }
+    eprintln!(
+        "sky dering: {windowed} windowed, {untouched} untouched, {zeroed} zeroed, {ties} ties"
+    );
+    assert!(windowed >= skies.len() / 4 && untouched >= skies.len() / 4);
+    assert!(ties * 50 <= skies.len(), "{ties} strength mismatches");
 }

@@ -5,10 +5,11 @@
 //
 // Two passes, so that the 4096 lookups spread over the GPU instead of queueing on one
 // workgroup: `project` runs a direction a thread in 64 workgroups and sums each workgroup's
-// 64 terms in workgroup memory; `finish` adds the 64 partial sums and derings.
+// 64 terms in workgroup memory; `finish` (one workgroup of 192 threads) adds the 64 partial
+// sums and derings, testing every strength of the search grid at once (see below).
 
 #import hikari::sky::sky_background_no_disks
-#import hikari::sh::{ShL2Rgb, SH_C0, SH_C1, SH_C2, SH_C3, SH_C4, sh_dering_l2_rgb}
+#import hikari::sh::{SH_C0, SH_C1, SH_C2, SH_C3, SH_C4, sh_dering_window, sh_newton_step, sh_poly}
 
 // project: 64 workgroups x 9 partial coefficients (xyz). finish: reads them.
 @group(0) @binding(0) var<storage, read_write> partials: array<vec4<f32>, 576>;
@@ -21,14 +22,15 @@ const GOLDEN_ANGLE: f32 = 2.39996322972865332;
 
 var<workgroup> terms: array<array<vec3<f32>, 9>, THREADS>;
 
-// Adds the workgroup's 64 rows of `terms` into row 0, a tree of halvings.
+// Adds the workgroup's 64 rows of `terms` into row 0, a tree of halvings; each level's
+// (row, coefficient) additions are spread over all threads (at most 5 each, not 9 on half).
 fn sum_terms(lid: u32) {
     workgroupBarrier();
     for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
-        if lid < stride {
-            for (var k = 0u; k < 9u; k++) {
-                terms[lid][k] += terms[lid + stride][k];
-            }
+        for (var i = lid; i < stride * 9u; i += THREADS) {
+            let g = i / 9u;
+            let k = i % 9u;
+            terms[g][k] += terms[g + stride][k];
         }
         workgroupBarrier();
     }
@@ -61,23 +63,181 @@ fn project(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg:
     }
 }
 
-@compute @workgroup_size(64, 1, 1)
-fn finish(@builtin(local_invocation_index) lid: u32) {
-    // Thread g loads workgroup g's partial sums; then the same tree as `project`.
-    for (var k = 0u; k < 9u; k++) {
-        terms[lid][k] = partials[lid * 9u + k].xyz;
+// ---- finish: the 64 partial sums, then deringing with the strength grid searched in parallel ----
+//
+// hikari::sh's `sh_dering_l2_rgb` tests strength 0 and then three strengths of a binary search
+// over (0, 1] one after another, each by a minimum search of 15 starting directions x (value,
+// Newton step) per channel on one thread: ~190 Newton steps in a row. Its search only ever
+// tests strengths 0 and k/8 (k = 1..7; 1 is its answer when none passes), so `finish` tests
+// all 8 of them at once, 24 (strength, channel) minimum searches of 8 threads each, and then
+// replays the binary search's path over the 8 verdicts: the same strength as the serial search
+// even where the verdict is not monotone in the strength. Each minimum search keeps the serial
+// one's tie-breaking (the first of equal values in start order), so the result is that of
+// `sh_dering_l2_rgb`, which tests/math_twins.rs holds to hikari_math::sh::dering.
+
+const FINISH_THREADS: u32 = 192u;
+// Threads per (strength, channel) minimum search; each takes 2 of the 16 start slots
+// (slot 0: the negated band-1 direction, 1..14: the fixed directions, 15: none).
+const SEARCH_THREADS: u32 = 8u;
+// Strengths tested: 0 and k/8 for k = 1..7 (the depth-3 search's grid).
+const STRENGTHS: u32 = 8u;
+const NO_MINIMUM: vec4<f32> = vec4<f32>(0.0, 0.0, 1.0, 3.4e38);
+
+// Best (direction, value) of each thread's start slots, reduced in place per search.
+var<workgroup> candidates: array<vec4<f32>, FINISH_THREADS>;
+// Estimated minimum of each (strength, channel): index strength * 3 + channel.
+var<workgroup> minima: array<f32, 24>;
+
+// Start slot s of the minimum search (see sh_find_min_l2's list), without a local array.
+fn start_direction(s: u32, lin_dir: vec3<f32>) -> vec3<f32> {
+    let d = 0.57735026918962573;
+    if s == 0u {
+        return lin_dir;
     }
-    sum_terms(lid);
-    if lid == 0u {
-        var sh: ShL2Rgb;
-        let w = 4.0 * 3.14159265358979 / f32(SAMPLES);
-        for (var k = 0u; k < 9u; k++) {
-            sh.c[k] = terms[0][k] * w;
-            out_sh[k] = vec4<f32>(sh.c[k], 0.0);
+    if s <= 6u {
+        let axis = (s - 1u) / 2u;
+        let sign = select(1.0, -1.0, ((s - 1u) & 1u) == 1u);
+        return vec3<f32>(select(0.0, sign, axis == 0u), select(0.0, sign, axis == 1u), select(0.0, sign, axis == 2u));
+    }
+    let j = s - 7u;
+    return vec3<f32>(select(d, -d, (j & 4u) != 0u), select(d, -d, (j & 2u) != 0u), select(d, -d, (j & 1u) != 0u));
+}
+
+// Folds start slot s (its direction, then one Newton step from it) into `best` as the serial
+// search does: a value replaces the best only when strictly smaller.
+fn consider_start(c: array<f32, 9>, s: u32, lin_dir: vec3<f32>, has_lin: bool, best: vec4<f32>) -> vec4<f32> {
+    var b = best;
+    if s > 14u || (s == 0u && !has_lin) {
+        return b;
+    }
+    let v0 = start_direction(s, lin_dir);
+    let f0 = sh_poly(c, v0).f;
+    if f0 < b.w {
+        b = vec4<f32>(v0, f0);
+    }
+    let v1 = sh_newton_step(c, v0);
+    let f1 = sh_poly(c, v1).f;
+    if f1 < b.w {
+        b = vec4<f32>(v1, f1);
+    }
+    return b;
+}
+
+// Channel ch of an RGB coefficient (a select, not a dynamically indexed vector).
+fn channel_of(v: vec3<f32>, ch: u32) -> f32 {
+    return select(select(v.z, v.y, ch == 1u), v.x, ch == 0u);
+}
+
+// The depth-3 binary search of sh_dering_strength_rgb replayed over the verdicts of the grid,
+// in eighths: 0 when strength 0 passes, else 1..8.
+fn search_eighths() -> u32 {
+    if strength_passes(0u) {
+        return 0u;
+    }
+    var lo = 0u;
+    var hi = 8u;
+    for (var i = 0u; i < 3u; i++) {
+        let mid = (lo + hi) / 2u;
+        if strength_passes(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
         }
-        let d = sh_dering_l2_rgb(sh);
-        for (var k = 0u; k < 9u; k++) {
-            out_sh[9u + k] = vec4<f32>(d.c[k], 0.0);
+    }
+    return hi;
+}
+
+// As sh_rgb_non_negative: no channel's estimated minimum is below zero.
+fn strength_passes(k: u32) -> bool {
+    return !(minima[k * 3u] < 0.0 || minima[k * 3u + 1u] < 0.0 || minima[k * 3u + 2u] < 0.0);
+}
+
+@compute @workgroup_size(192, 1, 1)
+fn finish(@builtin(local_invocation_index) lid: u32) {
+    // The same tree of halvings as `project` (and as the one-thread-per-partial version before
+    // it, so the sums are bit for bit the same), spread over (partial, coefficient) pairs; the
+    // first level adds while loading.
+    for (var i = lid; i < 32u * 9u; i += FINISH_THREADS) {
+        let g = i / 9u;
+        let k = i % 9u;
+        terms[g][k] = partials[i].xyz + partials[i + 32u * 9u].xyz;
+    }
+    workgroupBarrier();
+    for (var stride = 16u; stride > 0u; stride >>= 1u) {
+        for (var i = lid; i < stride * 9u; i += FINISH_THREADS) {
+            let g = i / 9u;
+            let k = i % 9u;
+            terms[g][k] += terms[g + stride][k];
         }
+        workgroupBarrier();
+    }
+
+    let w = 4.0 * 3.14159265358979 / f32(SAMPLES);
+    let raw0 = terms[0][0] * w;
+    let raw1 = terms[0][1] * w;
+    let raw2 = terms[0][2] * w;
+    let raw3 = terms[0][3] * w;
+    let raw4 = terms[0][4] * w;
+    let raw5 = terms[0][5] * w;
+    let raw6 = terms[0][6] * w;
+    let raw7 = terms[0][7] * w;
+    let raw8 = terms[0][8] * w;
+
+    // This thread's share of the minimum search of (strength, channel).
+    let search = lid / SEARCH_THREADS;
+    let j = lid % SEARCH_THREADS;
+    let strength = search / 3u;
+    let ch = search % 3u;
+    let f = sh_dering_window(f32(strength) / 8.0);
+    let c = array<f32, 9>(
+        channel_of(raw0, ch) * f.x,
+        channel_of(raw1, ch) * f.y,
+        channel_of(raw2, ch) * f.y,
+        channel_of(raw3, ch) * f.y,
+        channel_of(raw4, ch) * f.z,
+        channel_of(raw5, ch) * f.z,
+        channel_of(raw6, ch) * f.z,
+        channel_of(raw7, ch) * f.z,
+        channel_of(raw8, ch) * f.z,
+    );
+    let lin = -vec3<f32>(c[3], c[1], c[2]);
+    let ll = length(lin);
+    let has_lin = ll > 0.0;
+    let lin_dir = select(vec3<f32>(0.0, 0.0, 1.0), lin / ll, has_lin);
+    var best = consider_start(c, 2u * j, lin_dir, has_lin, NO_MINIMUM);
+    best = consider_start(c, 2u * j + 1u, lin_dir, has_lin, best);
+    candidates[lid] = best;
+    workgroupBarrier();
+    // Neighbours first, so the left side always holds the earlier slots: keeping it on equal
+    // values keeps the serial search's first-found tie-breaking.
+    for (var span = 1u; span < SEARCH_THREADS; span <<= 1u) {
+        if (j & (2u * span - 1u)) == 0u {
+            let right = candidates[lid + span];
+            if right.w < candidates[lid].w {
+                candidates[lid] = right;
+            }
+        }
+        workgroupBarrier();
+    }
+    if j == 0u {
+        // The serial search's refinement: one more Newton step from the best.
+        var b = candidates[lid];
+        let r = sh_newton_step(c, b.xyz);
+        let fr = sh_poly(c, r).f;
+        if fr < b.w {
+            b = vec4<f32>(r, fr);
+        }
+        minima[search] = b.w;
+    }
+    workgroupBarrier();
+
+    if lid < 9u {
+        let raw = terms[0][lid] * w;
+        out_sh[lid] = vec4<f32>(raw, 0.0);
+        // A negative mean cannot be windowed to non-negative: zero, as sh_dering_l2_rgb.
+        let fw = sh_dering_window(f32(search_eighths()) / 8.0);
+        let band = select(select(fw.z, fw.y, lid < 4u), fw.x, lid == 0u);
+        let deringed = select(raw * band, vec3<f32>(0.0), any(raw0 < vec3<f32>(0.0)));
+        out_sh[9u + lid] = vec4<f32>(deringed, 0.0);
     }
 }
