@@ -163,10 +163,11 @@ fn render(shot: &Shot) -> Vec<u8> {
     let camera = shot.camera.map_or(scene.cameras[0].clone(), |c| {
         scene.camera(c).unwrap().clone()
     });
+    // A time: the sun or moon of that time on the sky settings' default date and place.
     let sun = shot.time.map_or(scene.sun.clone(), |t| {
-        Some(hikari_scene::time_of_day::sun_at(
-            hikari_scene::time_of_day::parse_time(t).unwrap(),
-        ))
+        let mut sky = shot.settings.sky.clone();
+        sky.time = t.into();
+        hikari_render::techniques::sky::lights::directional_light(&sky).unwrap()
     });
     let s = FrameSettings {
         width: SIZE.0,

@@ -8,11 +8,11 @@
 //! lux, point and spot lights ([`Light`]) in candela (with constructors from lumens), emissive
 //! surfaces ([`Material::emissive_nits`]) in nits (cd/m²).
 //!
-//! # Animation and time of day
+//! # Animation
 //!
 //! A mesh may carry a [`Deformation`] (vertex animation in object space: plants swaying,
-//! wheels spinning), evaluated deterministically by [`Mesh::deformed`]. [`time_of_day`] turns
-//! "HH:MM" into a sun (or moon) with a simple documented model.
+//! wheels spinning), evaluated deterministically by [`Mesh::deformed`]. The sun and moon of a
+//! date, time and place come from `hikari_math::astro` through hikari-render's sky settings.
 //!
 //! # Built-in scenes ([`builtin`])
 //!
@@ -93,7 +93,6 @@ pub mod deformation;
 pub mod gltf;
 pub mod model;
 pub mod shapes;
-pub mod time_of_day;
 pub mod validation;
 pub mod village;
 

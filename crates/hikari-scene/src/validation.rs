@@ -1,7 +1,7 @@
 //! Checks of the numbers a renderer takes from a camera, the sun and punctual lights, so that
 //! no NaN, infinity or degenerate frame reaches the GPU. [`crate::Scene::validate`] runs them
 //! for everything in a scene; renderers run them again on cameras and lights they are handed
-//! directly (a camera moved by a user, a sun from [`crate::time_of_day`]). Each error names the
+//! directly (a camera moved by a user, a sun computed for a time of day). Each error names the
 //! object and the field.
 
 use glam::Vec3;

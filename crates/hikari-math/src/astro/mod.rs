@@ -23,7 +23,7 @@
 //! # Axes
 //!
 //! [`SunPosition::direction`] and [`MoonPosition::direction`] point from the place towards
-//! the body in hikari's world axes (as `hikari-scene`'s `time_of_day`): Y up, +Z north,
+//! the body in hikari's world axes (as hikari-scene's scenes): Y up, +Z north,
 //! −X east, +X west. For azimuth A (clockwise from north) and elevation e the direction is
 //! `(−sin A cos e, sin e, cos A cos e)`.
 //!

@@ -22,12 +22,12 @@
 //! - Paper lanterns on posts along the street and the temple path ([`lanterns`]), emissive at
 //!   [`materials::LANTERN_NITS`], with point lights in every other street lantern.
 //! - Cameras ([`cameras::NAMES`]): `exterior_wide`, `courtyard`, `house_interior`,
-//!   `temple_interior`, `night_street`, `pond`, `bell`. The sun is [`Sun::default`]; use
-//!   [`crate::time_of_day::sun_at`] for other times (e.g. 21:00 for `night_street`).
+//!   `temple_interior`, `night_street`, `pond`, `bell`. The sun is [`Sun::default`]; a renderer places the
+//!   sun or moon for other times (hikari-render's sky settings, e.g. 21:00 for `night_street`).
 //!
 //! # Conventions
 //!
-//! Metres, Y up, north along +z (as in [`crate::time_of_day`], where +x is west). The street
+//! Metres, Y up, north along +z, +x west (as `hikari_math::astro` gives directions). The street
 //! runs along x at z = 0; the temple courtyard is north of its +x end, the pond south of it.
 //!
 //! Interior mask: 1 on everything inside a building (floors, ceilings, furniture, the
