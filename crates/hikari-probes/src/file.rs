@@ -43,9 +43,12 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let name = path.file_name().ok_or_else(|| {
         std::io::Error::new(std::io::ErrorKind::InvalidInput, "path names no file")
     })?;
+    // Unique per process and call, so concurrent writers never share a temporary file.
+    static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let call = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let mut temp_name = std::ffi::OsString::from(".");
     temp_name.push(name);
-    temp_name.push(format!(".tmp{}", std::process::id()));
+    temp_name.push(format!(".tmp{}-{call}", std::process::id()));
     let temp = dir.join(temp_name);
     let result = (|| {
         let mut file = std::fs::File::create(&temp)?;

@@ -83,6 +83,25 @@ fn round_trip_through_a_file_is_exact() {
 }
 
 #[test]
+fn rewriting_replaces_the_old_file_and_failures_name_it() {
+    let dir = tempdir();
+    let path = dir.join("scene.hkprobe");
+    let first = random_bake(11, 1);
+    let second = random_bake(12, 2);
+    hikari_probes::write_bake(&path, &first).unwrap();
+    hikari_probes::write_bake(&path, &second).unwrap();
+    assert_eq!(
+        hikari_probes::read_bake(&path, &second.scene).unwrap(),
+        second
+    );
+
+    let nowhere = dir.join("no-such-dir").join("scene.hkprobe");
+    let err = hikari_probes::write_bake(&nowhere, &first).unwrap_err();
+    assert!(matches!(err.problem, Problem::Io(_)));
+    assert!(err.to_string().contains("no-such-dir"), "{err}");
+}
+
+#[test]
 fn an_empty_bake_round_trips() {
     let bake = Bake::new(SceneKey::from_u64(1), BakeSettings::with_rays(1));
     let bytes = hikari_probes::encode(&bake).unwrap();
