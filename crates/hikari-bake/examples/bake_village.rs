@@ -46,6 +46,39 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         s.sky_rays_per_second()
     );
 
+    // Visible sky fraction (c0 / 2√π) per layer: the 1.5 m layer should see the least sky.
+    let full = 2.0 * std::f32::consts::PI.sqrt();
+    for layer in 0..hikari_bake::LAYERS {
+        let per_tile = bake.options.probes_per_tile as usize;
+        let per_tile = per_tile * per_tile;
+        let fractions: Vec<f32> = bake
+            .tiles
+            .iter()
+            .flat_map(|t| &t.probes[layer * per_tile..(layer + 1) * per_tile])
+            .filter(|p| p.placement != Placement::Dropped)
+            .map(|p| p.sky_visibility[0] / full)
+            .collect();
+        let mean = fractions.iter().sum::<f32>() / fractions.len().max(1) as f32;
+        let min = fractions.iter().copied().fold(f32::INFINITY, f32::min);
+        println!(
+            "layer {} m: visible sky fraction mean {mean:.3}, min {min:.3}",
+            bake.options.heights[layer]
+        );
+    }
+
+    // Probes that see (almost) no sky yet passed the inside test: sealed rooms, or solids
+    // whose faces point inwards.
+    let sealed: Vec<_> = bake
+        .tiles
+        .iter()
+        .flat_map(|t| &t.probes)
+        .filter(|p| p.placement != Placement::Dropped && p.sky_visibility[0] < 0.01 * full)
+        .collect();
+    println!("kept probes seeing < 1 % of the sky: {}", sealed.len());
+    for p in sealed.iter().take(5) {
+        println!("  at {:.2} ({:?})", p.position, p.placement);
+    }
+
     // Error left by `rays`: every 97th kept probe, against 16x the rays.
     let tracer = SceneRays::build(&scene)?;
     let reference = SphereRays::fibonacci(rays * 16);

@@ -20,8 +20,9 @@
 //!
 //! Probes stand `spacing` metres apart (12.5 m) along x and z from the scene bounds' minimum
 //! corner, in three layers `heights` above the ground (1.5 m, 10 m, 30 m), grouped in tiles of
-//! `probes_per_tile` x `probes_per_tile` x 3 (16 x 16 x 3, a 200 m square). Enough tiles that
-//! the probes reach past the bounds' maximum corner. Probe `(ix, iz, layer)` of a tile is
+//! `probes_per_tile` x `probes_per_tile` x 3 (16 x 16 x 3, a 200 m square). Along each axis,
+//! the fewest tiles whose probes span the scene's bounds less one spacing, centred on the
+//! bounds (the outermost probes are at most half a spacing inside the bounds). Probe `(ix, iz, layer)` of a tile is
 //! `probes[layer * n * n + iz * n + ix]`. The ground is the lowest upward-facing surface under
 //! the column ([`placement::ground_height`]).
 //!
@@ -252,10 +253,17 @@ pub fn bake_grid_sky_visibility(
     };
     let n = options.probes_per_tile as usize;
     let tile_size = options.spacing * n as f32;
-    // Enough tiles that the last probe reaches the far side of the bounds.
-    let tiles_along = |extent: f32| (((extent + options.spacing) / tile_size).ceil() as u32).max(1);
-    let (tiles_x, tiles_z) = (tiles_along(hi.x - lo.x), tiles_along(hi.z - lo.z));
-    let origin = Vec2::new(lo.x, lo.z);
+    // Enough tiles that the probes span the bounds less one spacing, centred on them: at most
+    // half a spacing at each side is left to the lookup's clamping, and a scene a hair wider
+    // than whole tiles (the village's 400.2 m) does not get a row of tiles over nothing.
+    let tiles_along = |extent: f32| {
+        let tiles = (((extent - options.spacing) / tile_size).ceil() as u32).max(1);
+        let span = tiles as f32 * tile_size - options.spacing;
+        (tiles, -0.5 * (span - extent))
+    };
+    let ((tiles_x, margin_x), (tiles_z, margin_z)) =
+        (tiles_along(hi.x - lo.x), tiles_along(hi.z - lo.z));
+    let origin = Vec2::new(lo.x + margin_x, lo.z + margin_z);
     let tile_count = (tiles_x * tiles_z) as usize;
     let columns_per_tile = n * n;
 

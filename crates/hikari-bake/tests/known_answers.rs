@@ -151,11 +151,16 @@ fn inside_a_closed_box_sees_nothing() {
 
 #[test]
 fn grid_follows_the_ground_and_lifts_or_drops_probes_inside_solids() {
-    // Ground at y = 2 over 300 m; a low solid block (top at 4.7 m: the 1.5 m probe at 3.5 m is
-    // inside it, lifted 1.5 m) and a tall one (top at 40 m: the 1.5 m and 10 m probes are
-    // inside beyond the largest lift and dropped; the 30 m probe is inside too and dropped).
-    let low = shapes::cuboid(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 4.7, 1.0));
-    let tall = shapes::cuboid(Vec3::new(99.0, 0.0, 99.0), Vec3::new(101.0, 40.0, 101.0));
+    // Ground at y = 2 over 300 m: 300 m less one spacing needs 2 tiles along each axis, whose
+    // probes span 2 * 200 - 12.5 = 387.5 m, centred: the first column is at -193.75 and every
+    // column at 6.25 + 12.5 k. A low solid block on the column (6.25, 6.25) (top at 4.7 m: the
+    // 1.5 m probe at 3.5 m is inside it, lifted 1.5 m) and a tall one on (106.25, 106.25) (top
+    // at 40 m: all three probes are inside beyond the largest lift, dropped).
+    let low = shapes::cuboid(Vec3::new(5.25, 0.0, 5.25), Vec3::new(7.25, 4.7, 7.25));
+    let tall = shapes::cuboid(
+        Vec3::new(105.25, 0.0, 105.25),
+        Vec3::new(107.25, 40.0, 107.25),
+    );
     let scene = scene_of(vec![ground(150.0, 2.0), low, tall]);
     let options = GridBakeOptions {
         rays_per_probe: 256,
@@ -164,7 +169,6 @@ fn grid_follows_the_ground_and_lifts_or_drops_probes_inside_solids() {
     let mut reports = Vec::new();
     let bake = bake_grid_sky_visibility(&scene, &options, |d, t| reports.push((d, t)))
         .expect("bake succeeds");
-    // 300 m plus one spacing over 200 m tiles: 2 x 2 tiles of 16 x 16 x 3.
     assert_eq!((bake.tiles_x, bake.tiles_z), (2, 2));
     assert_eq!(bake.stats.probes, 4 * 16 * 16 * 3);
     assert_eq!(
@@ -182,31 +186,30 @@ fn grid_follows_the_ground_and_lifts_or_drops_probes_inside_solids() {
         let tile = &bake.tiles[(iz / 16) * bake.tiles_x as usize + ix / 16];
         tile.probes[layer * 256 + (iz % 16) * 16 + ix % 16]
     };
-    assert_eq!(bake.origin.x, -150.0);
+    assert_eq!(bake.origin.x, -193.75);
+    assert_eq!(bake.origin.y, -193.75);
     // Columns on the open ground: the ground is 2 m, probes at 3.5, 12 and 32 m.
     for (layer, h) in [1.5f32, 10.0, 30.0].into_iter().enumerate() {
-        let p = probe_at(-150.0 + 12.5 * 5.0, -150.0 + 12.5 * 3.0, layer);
+        let p = probe_at(-93.75, -43.75, layer);
         assert_eq!(p.placement, Placement::Planned);
         assert!((p.position.y - (2.0 + h)).abs() < 1e-4, "{p:?}");
     }
-    // (0, 0) is a column (-150 + 12 * 12.5): inside the low block.
-    let lifted = probe_at(0.0, 0.0, 0);
+    let lifted = probe_at(6.25, 6.25, 0);
     assert_eq!(lifted.placement, Placement::Lifted(1.5), "{lifted:?}");
     assert!((lifted.position.y - 5.0).abs() < 1e-4, "{lifted:?}");
     assert!(lifted.sky_visibility[0] > 0.0);
-    assert_eq!(probe_at(0.0, 0.0, 1).placement, Placement::Planned);
-    // (100, 100) is a column: inside the tall block for the two lower layers.
-    for layer in 0..2 {
-        let p = probe_at(100.0, 100.0, layer);
+    assert_eq!(probe_at(6.25, 6.25, 1).placement, Placement::Planned);
+    for layer in 0..3 {
+        let p = probe_at(106.25, 106.25, layer);
         assert_eq!(p.placement, Placement::Dropped, "layer {layer}: {p:?}");
         assert_eq!(p.sky_visibility, [0.0; 9]);
     }
-    assert_eq!(probe_at(100.0, 100.0, 2).placement, Placement::Dropped);
     assert_eq!(bake.stats.dropped, 3);
     assert_eq!(bake.stats.lifted, 1);
     assert_eq!(bake.stats.sky_rays, 256 * (bake.stats.probes as u64 - 3));
-    // Every kept probe on open ground near the middle sees about the upper hemisphere.
-    let mid = probe_at(-150.0 + 12.5 * 4.0, -150.0 + 12.5 * 4.0, 0);
+    // A probe on open ground 100 m from the plane's edges sees about the upper hemisphere (the
+    // edge hides 1.5 m / 100 m of the horizon; the blocks subtend little).
+    let mid = probe_at(-43.75, -43.75, 0);
     assert!((mid.sky_visibility[0] - PI.sqrt()).abs() < 0.2, "{mid:?}");
 }
 
