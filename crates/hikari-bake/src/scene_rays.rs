@@ -20,6 +20,8 @@ pub struct SurfaceHit {
     pub normal: Vec3,
     /// The ray arrived from behind the front face.
     pub back_face: bool,
+    /// Index of the scene instance hit.
+    pub instance: usize,
 }
 
 pub struct SceneRays {
@@ -140,6 +142,7 @@ impl SceneRays {
             t: hit.t,
             normal,
             back_face: normal.dot(dir) > 0.0,
+            instance: inst,
         })
     }
 

@@ -262,3 +262,47 @@ fn bad_geometry_is_an_error_not_a_panic() {
         .expect_err("NaN vertex");
     assert!(err.to_string().contains("ground"), "{err}");
 }
+
+#[test]
+fn inside_test_knows_solids_from_rooms_under_any_transform() {
+    use hikari_bake::placement::inside_geometry;
+    let solid = shapes::cuboid(Vec3::splat(-1.0), Vec3::splat(1.0));
+    // The same box wound inwards: a room.
+    let mut room = solid.clone();
+    room.name = "room".into();
+    for t in room.indices.chunks_exact_mut(3) {
+        t.swap(1, 2);
+    }
+    let rays = SphereRays::fibonacci(64);
+    let mut stacks = TraversalStacks::default();
+    // glTF: a mirroring transform (negative determinant) flips the winding back, so a mirrored
+    // solid is still a solid.
+    for (name, transform) in [
+        ("identity", Mat4::IDENTITY),
+        ("mirrored", Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))),
+        (
+            "rotated and scaled",
+            Mat4::from_rotation_y(0.7) * Mat4::from_scale(Vec3::splat(3.0)),
+        ),
+    ] {
+        for (mesh, inside) in [(&solid, true), (&room, false)] {
+            let mut scene = scene_of(vec![mesh.clone()]);
+            scene.instances[0].transform = transform;
+            let tracer = SceneRays::build(&scene).expect("builds");
+            assert_eq!(
+                inside_geometry(&tracer, &rays, Vec3::new(0.1, 0.2, -0.3), 0.5, &mut stacks),
+                inside,
+                "{} under {name}",
+                mesh.name
+            );
+            // Outside either box nothing is inside.
+            assert!(!inside_geometry(
+                &tracer,
+                &rays,
+                Vec3::new(0.0, 9.0, 0.0),
+                0.5,
+                &mut stacks
+            ));
+        }
+    }
+}
