@@ -1,0 +1,17 @@
+//! What can go wrong in a bake: bad options, or a scene the BVH cannot be built from.
+
+use thiserror::Error;
+
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum BakeError {
+    #[error("bake option `{option}` is {value}: {why}")]
+    BadOption {
+        option: &'static str,
+        value: String,
+        why: &'static str,
+    },
+    #[error("the scene cannot be baked: {0}")]
+    Scene(String),
+    #[error("building the scene's BVH failed: {0}")]
+    Bvh(#[from] hikari_bvh::BvhError),
+}
