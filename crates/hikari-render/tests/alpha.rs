@@ -14,94 +14,18 @@
 
 mod common;
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use common::cutout::{self, CHECKER, RAMP, Traced};
+
+use glam::{Mat4, Vec3, Vec4};
 use hikari_render::techniques::gbuffer::reference::pixel_ray;
 use hikari_render::techniques::sun_shadows;
 use hikari_render::{FrameSettings, Renderer};
-use hikari_scene::builtin::{self, CUTOUT_CHECKER_CELLS, CUTOUT_RAMP_CUTOFF, CUTOUT_TEXTURE_SIZE};
+use hikari_scene::builtin;
 use hikari_scene::{AlphaMode, Scene};
 
-/// Instances of the `cutout` scene (see `builtin::cutout`).
-const GROUND: u32 = 0;
-const CHECKER: u32 = 1;
-const RAMP: u32 = 2;
-/// Half the side of the ground square, metres.
-const GROUND_HALF: f32 = 6.0;
-/// UV distance from a cut-out edge within which GPU and reference may disagree.
-const CUT_BAND: f32 = 0.25 / CUTOUT_TEXTURE_SIZE as f32;
-/// Distance from a quad's or the ground's outline, metres, within which they may disagree.
-const OUTLINE_BAND: f32 = 1e-3;
-
-/// What a ray sees first, with the alpha test, and whether the answer is within the
-/// tolerance band (see the module doc) of going another way.
-#[derive(Clone, Copy, Debug)]
-struct Traced {
-    hit: Option<(u32, f32)>,
-    ambiguous: bool,
-}
-
-/// Where the quads stand: centre x and instance; each spans x ± 1, y from 0.25 to 2.25 at
-/// z = 0, with u = 0 at its left end (-x) and v = 0 at its top.
-const QUADS: [(f32, u32); 2] = [(-1.25, CHECKER), (1.25, RAMP)];
-
-fn covered(instance: u32, uv: Vec2) -> bool {
-    if instance == CHECKER {
-        builtin::cutout_checker_covered(uv)
-    } else {
-        builtin::cutout_ramp_alpha(uv.x) >= CUTOUT_RAMP_CUTOFF
-    }
-}
-
-fn near_cut(instance: u32, uv: Vec2) -> bool {
-    let cells = CUTOUT_CHECKER_CELLS as f32;
-    let to_integer = |x: f32| (x - x.round()).abs();
-    if instance == CHECKER {
-        to_integer(uv.x * cells) < CUT_BAND * cells || to_integer(uv.y * cells) < CUT_BAND * cells
-    } else {
-        (uv.x - 0.25).abs() < CUT_BAND
-    }
-}
-
-/// The first surface along `o + t d` for t in (t_min, t_max), with the alpha test (or
-/// without, `alpha_test` false: the quads whole).
+/// The analytic reference seen by the rasteriser, which culls the ground's back.
 fn trace(o: Vec3, d: Vec3, t_min: f32, t_max: f32, alpha_test: bool) -> Traced {
-    let mut out = Traced {
-        hit: None,
-        ambiguous: false,
-    };
-    // The ground faces +Y and is single-sided.
-    if d.y < 0.0 {
-        let t = -o.y / d.y;
-        let p = o + d * t;
-        let edge = GROUND_HALF - p.x.abs().max(p.z.abs());
-        if t > t_min && t < t_max && edge.abs() < OUTLINE_BAND {
-            out.ambiguous = true;
-        }
-        if t > t_min && t < t_max && edge > 0.0 {
-            out.hit = Some((GROUND, t));
-        }
-    }
-    if d.z != 0.0 {
-        let t = -o.z / d.z;
-        let nearer = out.hit.is_none_or(|(_, h)| t < h);
-        if t > t_min && t < t_max && nearer {
-            let p = o + d * t;
-            for (x, instance) in QUADS {
-                // 2 m quads: UV is metres / 2.
-                let uv = Vec2::new(p.x - (x - 1.0), 2.25 - p.y) / 2.0;
-                let inside = uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all();
-                let outline = uv.min(Vec2::ONE - uv).min_element().abs() * 2.0;
-                let near_outline = outline < OUTLINE_BAND;
-                if near_outline || (inside && alpha_test && near_cut(instance, uv)) {
-                    out.ambiguous = true;
-                }
-                if inside && (!alpha_test || covered(instance, uv)) {
-                    out.hit = Some((instance, t));
-                }
-            }
-        }
-    }
-    out
+    cutout::trace(o, d, t_min, t_max, alpha_test, false)
 }
 
 /// How the GPU's answers compare with the reference's.

@@ -17,7 +17,9 @@
 
 mod common;
 
-use glam::{Vec2, Vec3};
+use common::cutout::{self, QUADS};
+
+use glam::Vec3;
 use hikari_bvh::reference::{random_dir, same_hit};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Ray, Tlas};
@@ -28,40 +30,8 @@ use hikari_render::scene_bvh::{self, BvhAlpha, SceneAlphaFilter};
 use hikari_render::scene_textures::TextureArrays;
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_scene::Scene;
-use hikari_scene::builtin::{self, CUTOUT_CHECKER_CELLS, CUTOUT_RAMP_CUTOFF, CUTOUT_TEXTURE_SIZE};
+use hikari_scene::builtin::{self, CUTOUT_RAMP_CUTOFF};
 use wgpu::util::DeviceExt;
-
-/// Instances of the `cutout` scene (see `builtin::cutout`).
-const GROUND: u32 = 0;
-const CHECKER: u32 = 1;
-const RAMP: u32 = 2;
-/// Half the side of the ground square, metres.
-const GROUND_HALF: f32 = 6.0;
-/// UV distance from a cut-out edge within which the answers may differ.
-const CUT_BAND: f32 = 0.25 / CUTOUT_TEXTURE_SIZE as f32;
-/// Distance from a quad's or the ground's outline, metres, within which they may differ.
-const OUTLINE_BAND: f32 = 1e-3;
-/// Where the quads stand: centre x and instance; each spans x ± 1, y from 0.25 to 2.25 at
-/// z = 0, with u = 0 at its left end (-x) and v = 0 at its top.
-const QUADS: [(f32, u32); 2] = [(-1.25, CHECKER), (1.25, RAMP)];
-
-fn covered(instance: u32, uv: Vec2) -> bool {
-    if instance == CHECKER {
-        builtin::cutout_checker_covered(uv)
-    } else {
-        builtin::cutout_ramp_alpha(uv.x) >= CUTOUT_RAMP_CUTOFF
-    }
-}
-
-fn near_cut(instance: u32, uv: Vec2) -> bool {
-    let cells = CUTOUT_CHECKER_CELLS as f32;
-    let to_integer = |x: f32| (x - x.round()).abs();
-    if instance == CHECKER {
-        to_integer(uv.x * cells) < CUT_BAND * cells || to_integer(uv.y * cells) < CUT_BAND * cells
-    } else {
-        (uv.x - 0.25).abs() < CUT_BAND
-    }
-}
 
 /// The analytic answer for one ray: the first surface it meets in (t_min, t_max) with the
 /// cut-outs, whether that answer is within the tolerance band of another, and whether the ray
@@ -75,49 +45,19 @@ struct Analytic {
 
 /// Traces the scene analytically. The BVH culls no faces, so the ground counts from below too.
 fn analytic(ray: &Ray) -> Analytic {
-    let (o, d) = (Vec3::from(ray.origin), Vec3::from(ray.dir));
-    let in_range = |t: f32| t > ray.t_min && t < ray.t_max;
-    let mut out = Analytic {
-        hit: None,
-        ambiguous: false,
-        through_hole: false,
-    };
-    let mut nearest = f32::INFINITY;
-    if d.y != 0.0 {
-        let t = -o.y / d.y;
-        let p = o + d * t;
-        let edge = GROUND_HALF - p.x.abs().max(p.z.abs());
-        if in_range(t) && edge.abs() < OUTLINE_BAND {
-            out.ambiguous = true;
-        }
-        if in_range(t) && edge > 0.0 {
-            out.hit = Some(GROUND);
-            nearest = t;
-        }
+    let t = cutout::trace(
+        Vec3::from(ray.origin),
+        Vec3::from(ray.dir),
+        ray.t_min,
+        ray.t_max,
+        true,
+        true,
+    );
+    Analytic {
+        hit: t.hit.map(|(i, _)| i),
+        ambiguous: t.ambiguous,
+        through_hole: t.through_hole,
     }
-    if d.z != 0.0 {
-        let t = -o.z / d.z;
-        if in_range(t) && t < nearest {
-            let p = o + d * t;
-            for (x, instance) in QUADS {
-                // 2 m quads: UV is metres / 2.
-                let uv = Vec2::new(p.x - (x - 1.0), 2.25 - p.y) / 2.0;
-                let inside = uv.cmpge(Vec2::ZERO).all() && uv.cmple(Vec2::ONE).all();
-                let outline = uv.min(Vec2::ONE - uv).min_element().abs() * 2.0;
-                if outline < OUTLINE_BAND || (inside && near_cut(instance, uv)) {
-                    out.ambiguous = true;
-                }
-                if inside {
-                    if covered(instance, uv) {
-                        out.hit = Some(instance);
-                    } else {
-                        out.through_hole = true;
-                    }
-                }
-            }
-        }
-    }
-    out
 }
 
 /// Rays that cross the quads from the front and from behind (`t_max` infinite, or `short`:

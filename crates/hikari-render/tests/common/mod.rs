@@ -4,6 +4,8 @@
 
 #![allow(dead_code)]
 
+pub mod cutout;
+
 use hikari_render::{ContextOptions, GpuContext};
 
 /// The GPU context for a test; panics (failing the test) when there is no adapter.
