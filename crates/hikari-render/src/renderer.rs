@@ -26,7 +26,6 @@ pub struct Renderer {
     techniques: Techniques,
     scene: SceneGpu,
     state: FrameState,
-    interactive: bool,
 }
 
 impl Renderer {
@@ -38,7 +37,6 @@ impl Renderer {
             techniques,
             scene: scene_gpu,
             state: FrameState::default(),
-            interactive: false,
             ctx,
         })
     }
@@ -76,7 +74,6 @@ impl Renderer {
     /// from the counts of a frame or two before, with headroom, and a frame that overflowed
     /// is shown as it is (missing a few triangles for a frame) while the queues grow.
     pub fn set_interactive(&mut self, interactive: bool) {
-        self.interactive = interactive;
         self.runtime.set_wait_for_readbacks(!interactive);
     }
 
@@ -143,7 +140,8 @@ impl Renderer {
                 // Cascades drawn into an overflowing queue lack triangles: draw them all again.
                 self.state.shadow_cache = Default::default();
             }
-            if !overflowed || self.interactive {
+            // Interactive frames (the runtime does not wait for their counts) are shown as drawn.
+            if !overflowed || !self.runtime.waits_for_readbacks() {
                 self.runtime.commit_frame();
                 return Ok(result);
             }

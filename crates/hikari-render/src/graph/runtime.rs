@@ -147,6 +147,10 @@ impl GraphRuntime {
         self.wait_for_readbacks = wait;
     }
 
+    pub fn waits_for_readbacks(&self) -> bool {
+        self.wait_for_readbacks
+    }
+
     /// How the GPU is timed (per pass by default, when the device supports timestamps).
     pub fn set_timestamps(&mut self, mode: TimestampMode) {
         self.timestamps = mode;
