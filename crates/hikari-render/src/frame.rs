@@ -16,6 +16,7 @@ use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
+use crate::techniques::taa::{self, Taa};
 use crate::view::View;
 
 /// What a frame depends on besides the scene.
@@ -74,6 +75,9 @@ impl FrameSettings {
 pub struct FrameState {
     pub shadow_cache: sun_shadows::ShadowCache,
     pub raster_queues: RasterQueues,
+    /// Where the last frame's camera was, to tell a cut (a new camera that claims it did not
+    /// move) from a still frame: temporal techniques drop their history on a cut.
+    pub last_camera: Option<[f32; 6]>,
 }
 
 /// Every technique's pipelines, built once.
@@ -83,6 +87,7 @@ pub struct Techniques {
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
+    pub taa: Taa,
     pub placeholder_tonemap: PlaceholderTonemap,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
@@ -98,6 +103,7 @@ impl Techniques {
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
+            taa: Taa::new(ctx, &mut lib)?,
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
         })
     }
@@ -109,8 +115,10 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
-    /// Linear radiance in nits (Rgba16Float), for the EXR.
+    /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA.
     pub hdr: Tex,
+    /// The lit image before TAA.
+    pub lit: Tex,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
     pub ldr: Tex,
 }
@@ -127,12 +135,23 @@ pub fn record<'r>(
 
     // 1. Update: camera and sun. The sun (or moon) comes from the sky settings' date, time and
     //    place (`sky::lights`, resolved by the caller into `s.sun`) or is the scene's own.
+    //    With TAA on, the camera moves by a sub-pixel jitter each frame.
+    let taa_on = s.settings.taa.enabled;
+    let jitter = if taa_on {
+        taa::reference::jitter(g.frame_index(), s.settings.taa.jitter_samples)
+    } else {
+        [0.0; 2]
+    };
     let view = View::with_previous(
         &s.camera,
         s.prev_camera.as_ref().unwrap_or(&s.camera),
         s.width,
         s.height,
-    );
+    )
+    .jittered(jitter);
+    let pose = camera_pose(&s.camera);
+    let camera_cut = s.prev_camera.is_none() && state.last_camera.is_some_and(|p| p != pose);
+    state.last_camera = Some(pose);
     let to_sun = s.sun.as_ref().map_or(glam::Vec3::ZERO, |sun| sun.direction);
     let scene = &scene.import(g);
 
@@ -183,7 +202,17 @@ pub fn record<'r>(
         .direct_lighting
         .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
 
-    // 12. Haze and 13. TAA: their issues add them here.
+    // 12. Haze: its issue adds it here.
+
+    // 13. TAA.
+    let lit = hdr;
+    let hdr = if taa_on {
+        t.taa
+            .record(g, lit, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
+            .output
+    } else {
+        lit
+    };
 
     // 14. Exposure and tonemap (placeholder).
     let ldr = t.placeholder_tonemap.record(
@@ -198,6 +227,13 @@ pub fn record<'r>(
         shadows,
         sky,
         hdr,
+        lit,
         ldr,
     })
+}
+
+/// The camera's position and forward direction, which together tell a cut.
+fn camera_pose(c: &Camera) -> [f32; 6] {
+    let f = c.forward();
+    [c.position.x, c.position.y, c.position.z, f.x, f.y, f.z]
 }

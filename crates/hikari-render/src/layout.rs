@@ -30,7 +30,7 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows};
+    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows, taa};
     use crate::view;
     vec![
         gpu_layout!(
@@ -42,7 +42,8 @@ pub fn all() -> Vec<StructLayout> {
                 position,
                 viewport,
                 prev_view_proj,
-                forward_near
+                forward_near,
+                jitter
             ]
         ),
         gpu_layout!(
@@ -127,6 +128,11 @@ pub fn all() -> Vec<StructLayout> {
             placeholder_tonemap::TonemapParams,
             "placeholder_tonemap/apply.wgsl",
             [exposure]
+        ),
+        gpu_layout!(
+            taa::TaaParams,
+            "taa/resolve.wgsl",
+            [history_valid, clip, max_history, _pad]
         ),
         gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),
         gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),

@@ -16,6 +16,9 @@ pub struct View {
     pub prev_view_proj: [[f32; 4]; 4],
     /// xyz: unit forward; w: near plane distance in metres.
     pub forward_near: [f32; 4],
+    /// xy: this frame's sub-pixel jitter in pixels (x right, y down), already in `view_proj`;
+    /// zw: unused. `prev_view_proj` has none, so motion vectors are free of it.
+    pub jitter: [f32; 4],
 }
 
 impl View {
@@ -41,7 +44,24 @@ impl View {
                 1.0 / height as f32,
             )
             .to_array(),
+            jitter: [0.0; 4],
         }
+    }
+
+    /// This view with its image shifted by `jitter` pixels (x right, y down): a surface at
+    /// pixel position `q` without jitter is drawn at `q + jitter`.
+    pub fn jittered(mut self, jitter: [f32; 2]) -> Self {
+        let [w, h] = [self.viewport[0], self.viewport[1]];
+        let shift = Mat4::from_translation(glam::Vec3::new(
+            2.0 * jitter[0] / w,
+            -2.0 * jitter[1] / h,
+            0.0,
+        ));
+        let vp = shift * self.view_proj();
+        self.view_proj = vp.to_cols_array_2d();
+        self.inv_view_proj = vp.inverse().to_cols_array_2d();
+        self.jitter = [jitter[0], jitter[1], 0.0, 0.0];
+        self
     }
 
     pub fn view_proj(&self) -> Mat4 {

@@ -295,6 +295,9 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
         },
     };
     let mut renderer = Renderer::new(ctx, scene).unwrap();
+    // The second frame, whose TAA jitter moves the image by a sub-pixel offset and which the
+    // motion vectors must leave out.
+    renderer.render(&s, false).unwrap();
     let mut r = renderer
         .render_reading(&s, |o| {
             let g = &o.gbuffer;
@@ -319,7 +322,10 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
         img("gbuffer.emissive"),
         img("gbuffer.instance"),
     );
-    let view = hikari_render::view::View::with_previous(&s.camera, &prev, w, h);
+    let jitter =
+        hikari_render::techniques::taa::reference::jitter(1, s.settings.taa.jitter_samples);
+    assert!(jitter != [0.0; 2]);
+    let view = hikari_render::view::View::with_previous(&s.camera, &prev, w, h).jittered(jitter);
     let cpu = &renderer.scene().cpu;
     // The twin leaves normal maps out: it resolves everything else from the scene without
     // them, and `mapped_frame` gives the normal and anisotropy direction.

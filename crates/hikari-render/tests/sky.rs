@@ -48,7 +48,7 @@ fn render(scene: &hikari_scene::Scene, s: &hikari_render::FrameSettings) -> Rend
     let mut r = renderer
         .render_reading(s, |o| {
             params = Some(o.sky.params);
-            vec![o.gbuffer.depth.into(), o.hdr.into(), o.sky.sh.into()]
+            vec![o.gbuffer.depth.into(), o.lit.into(), o.sky.sh.into()]
         })
         .unwrap();
     let sh = bytemuck::cast_slice::<u8, [f32; 4]>(r.buffer("sky.sh").unwrap()).to_vec();

@@ -25,6 +25,11 @@ pub struct RenderArgs {
     /// Do not write the EXR.
     #[arg(long)]
     pub no_exr: bool,
+    /// Frames of the same view to render; the last is written. Default: one jitter cycle of
+    /// TAA (`taa.jitter_samples`, 8), after which the history is the exact mean of every
+    /// sub-pixel position; 1 with TAA off.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub frames: Option<u32>,
     /// Print a per-pass GPU timing table.
     #[arg(long)]
     pub timings: bool,
@@ -53,6 +58,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         TimestampMode::Frame
     });
+    let frames = args.frames.unwrap_or(if settings.settings.taa.enabled {
+        settings.settings.taa.jitter_samples
+    } else {
+        1
+    });
+    for _ in 1..frames {
+        renderer.render(&settings, false)?;
+    }
     let frame = renderer.render(&settings, true)?;
 
     let png = &args.output;

@@ -92,3 +92,30 @@ impl Sobol {
         self.sample_u32(index, dim) as f64 / 4_294_967_296.0
     }
 }
+
+/// The `i`-th point of the Halton sequence in `base` (the radical inverse of `i`), in [0, 1).
+pub fn halton(mut i: u32, base: u32) -> f32 {
+    let inv = 1.0 / base as f64;
+    let (mut f, mut r) = (1.0f64, 0.0f64);
+    while i > 0 {
+        f *= inv;
+        r += f * (i % base) as f64;
+        i /= base;
+    }
+    r as f32
+}
+
+#[cfg(test)]
+mod halton_tests {
+    use super::halton;
+
+    #[test]
+    fn halton_is_the_radical_inverse() {
+        // By definition: the digits of i in the base, mirrored about the radix point.
+        assert_eq!(halton(0, 2), 0.0);
+        assert_eq!(halton(1, 2), 0.5);
+        assert_eq!(halton(6, 2), 0.375); // 110 -> 0.011
+        assert!((halton(1, 3) - 1.0 / 3.0).abs() < 1e-7);
+        assert!((halton(5, 3) - 7.0 / 9.0).abs() < 1e-7); // 12 -> 0.21
+    }
+}

@@ -13,6 +13,9 @@ struct View {
     prev_view_proj: mat4x4<f32>,
     // xyz: unit forward; w: near plane distance in metres.
     forward_near: vec4<f32>,
+    // xy: this frame's sub-pixel jitter in pixels (x right, y down), already in view_proj
+    // (prev_view_proj has none); zw unused.
+    jitter: vec4<f32>,
 }
 
 // World position of the pixel centre `pixel` at reverse-Z depth `depth`.

@@ -222,7 +222,9 @@ pub fn resolve(
         occlusion: (1.0 + material.occlusion_strength as f64 * (occ_tex - 1.0)).clamp(0.0, 1.0)
             as f32,
         emissive: emissive.as_vec3(),
-        motion: (prev - centre).as_vec2(),
+        // Now is the pixel centre less the jitter: `prev_view_proj` has none.
+        motion: (prev - centre + DVec2::new(view.jitter[0] as f64, view.jitter[1] as f64))
+            .as_vec2(),
         view_depth: (p - eye).dot(fwd) as f32,
         instance: chunk.instance,
     })

@@ -113,7 +113,7 @@ fn write_sky(px: vec2<u32>) {
     textureStore(out_normal, px, vec4<f32>(0.0));
     textureStore(out_albedo, px, vec4<f32>(0.0));
     textureStore(out_material, px, vec4<f32>(0.0));
-    textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre), 0.0, 0.0));
+    textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre + view.jitter.xy), 0.0, 0.0));
     textureStore(out_emissive, px, vec4<f32>(0.0));
     textureStore(out_instance, px, vec4<u32>(NO_INSTANCE));
 }
@@ -231,7 +231,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let vertex_interior = f32(a0.extra & 0xffffu) * w.x + f32(a1.extra & 0xffffu) * w.y + f32(a2.extra & 0xffffu) * w.z;
     let interior = select(vertex_interior / 65535.0, mat.extra.y, mat.extra.y >= 0.0);
 
-    // Motion: where this surface point was last frame, minus where it is now, in pixels.
+    // Motion: where this surface point was last frame, minus where it is now, in pixels. Now is
+    // the pixel centre less this frame's jitter: `prev_view_proj` is unjittered.
     let q = q0 * w.x + q1 * w.y + q2 * w.z;
     let world = p0 + e1 * b.x + e2 * b.y;
     var prev_world = vec4<f32>(world, 1.0);
@@ -245,7 +246,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(out_normal, px, vec4<f32>(oct_encode(n), oct_encode(aniso_dir)));
     textureStore(out_albedo, px, vec4<f32>(clamp(base, vec3<f32>(0.0), vec3<f32>(1.0)), clamp(interior, 0.0, 1.0)));
     textureStore(out_material, px, vec4<f32>(roughness, metalness, clamp(mat.params.z, 0.0, 1.0), clamp(occlusion, 0.0, 1.0)));
-    textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre), finite_half2(vec2<f32>(view_depth, 0.0))));
+    textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre + view.jitter.xy), finite_half2(vec2<f32>(view_depth, 0.0))));
     textureStore(out_emissive, px, vec4<f32>(clamp(emissive, vec3<f32>(0.0), vec3<f32>(MAX_HALF)), 0.0));
     textureStore(out_instance, px, vec4<u32>(chunk.instance, 0u, 0u, 0u));
 }
