@@ -12,7 +12,9 @@ use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
+use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
+use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
@@ -83,6 +85,8 @@ pub struct Techniques {
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
+    pub exposure: Exposure,
+    pub local_tonemap: LocalTonemap,
     pub placeholder_tonemap: PlaceholderTonemap,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
@@ -98,6 +102,8 @@ impl Techniques {
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
+            exposure: Exposure::new(ctx, &mut lib)?,
+            local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
         })
     }
@@ -111,6 +117,10 @@ pub struct FrameOutputs {
     pub sky: SkyFrame,
     /// Linear radiance in nits (Rgba16Float), for the EXR.
     pub hdr: Tex,
+    /// Lux arriving at each surface pixel, -1 on the sky (R32Float).
+    pub illuminance: Tex,
+    pub exposure: ExposureFrame,
+    pub local_tonemap: LocalTonemapFrame,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
     pub ldr: Tex,
 }
@@ -179,13 +189,44 @@ pub fn record<'r>(
     if sky.enabled {
         lighting.use_sky(s.settings.sky.sky);
     }
-    let hdr = t
+    let lit = t
         .direct_lighting
         .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
+    let hdr = lit.radiance;
 
     // 12. Haze and 13. TAA: their issues add them here.
 
-    // 14. Exposure and tonemap (placeholder).
+    // 14. Exposure, metered on the illuminance; the local tonemap's gain; the tonemap
+    //     (placeholder, with its own exposure until the tonemap issue reads `exposure.value`).
+    let exposure = t.exposure.record(
+        g,
+        hdr,
+        lit.illuminance,
+        size,
+        &ExposureParams::new(
+            &s.settings.exposure,
+            sky.knobs.exposure_bias_ev,
+            s.ev100_with_sky(sky.sky_lux),
+        ),
+    )?;
+    let sun_elevation_deg = s.sun.as_ref().map_or(f32::NAN, |sun| {
+        sun.direction
+            .normalize_or_zero()
+            .y
+            .clamp(-1.0, 1.0)
+            .asin()
+            .to_degrees()
+    });
+    let local_tonemap = t.local_tonemap.record(
+        g,
+        hdr,
+        exposure.value,
+        size,
+        &s.settings.local_tonemap,
+        s.settings
+            .local_tonemap
+            .look_for(&s.settings.sky.weather, sun_elevation_deg),
+    )?;
     let ldr = t.placeholder_tonemap.record(
         g,
         hdr,
@@ -198,6 +239,9 @@ pub fn record<'r>(
         shadows,
         sky,
         hdr,
+        illuminance: lit.illuminance,
+        exposure,
+        local_tonemap,
         ldr,
     })
 }
