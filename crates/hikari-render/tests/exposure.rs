@@ -229,19 +229,34 @@ fn black_and_white_albedo_get_the_same_exposure() {
         let settings = common::small_frame_settings(&scene, 96, 64);
         let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
         let mut r = renderer
-            .render_reading(&settings, |o| vec![o.exposure.value.into(), o.hdr.into()])
+            .render_reading(&settings, |o| {
+                vec![o.exposure.value.into(), o.hdr.into(), o.illuminance.into()]
+            })
             .unwrap();
         let hdr = r.take_image("direct_lighting.radiance").unwrap();
+        let lux = r.take_image("direct_lighting.illuminance").unwrap();
         let mean_log2_luminance = hdr
             .rgba
             .iter()
             .map(|c| reference::luminance([c[0], c[1], c[2]]).max(1e-6).log2())
             .sum::<f32>()
             / hdr.rgba.len() as f32;
-        (value(&r), mean_log2_luminance)
+        (value(&r), mean_log2_luminance, lux.rgba)
     };
-    let (white, white_l) = render(0.9);
-    let (black, black_l) = render(0.03);
+    let (white, white_l, white_lux) = render(0.9);
+    let (black, black_l, black_lux) = render(0.03);
+    // The meter's input itself does not see albedo: the same lux at every pixel (to f32
+    // rounding), the sky (-1) in the same places.
+    let surface = white_lux.iter().filter(|p| p[0] >= 0.0).count();
+    assert!(surface > white_lux.len() / 2, "{surface} surface pixels");
+    for (w, b) in white_lux.iter().zip(&black_lux) {
+        assert!(
+            (w[0] - b[0]).abs() <= 1e-5 * w[0].abs().max(1.0),
+            "{} vs {} lux",
+            w[0],
+            b[0]
+        );
+    }
     assert!(
         white_l - black_l > 2.0,
         "the albedo changes the image: {white_l} vs {black_l}"
