@@ -12,7 +12,9 @@ use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
+use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
+use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
@@ -88,6 +90,8 @@ pub struct Techniques {
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
     pub taa: Taa,
+    pub exposure: Exposure,
+    pub local_tonemap: LocalTonemap,
     pub placeholder_tonemap: PlaceholderTonemap,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
@@ -104,6 +108,8 @@ impl Techniques {
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
             taa: Taa::new(ctx, &mut lib)?,
+            exposure: Exposure::new(ctx, &mut lib)?,
+            local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
         })
     }
@@ -119,6 +125,10 @@ pub struct FrameOutputs {
     pub hdr: Tex,
     /// The lit image before TAA.
     pub lit: Tex,
+    /// Lux arriving at each surface pixel, -1 on the sky (R32Float).
+    pub illuminance: Tex,
+    pub exposure: ExposureFrame,
+    pub local_tonemap: LocalTonemapFrame,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
     pub ldr: Tex,
 }
@@ -198,14 +208,14 @@ pub fn record<'r>(
     if sky.enabled {
         lighting.use_sky(s.settings.sky.sky);
     }
-    let hdr = t
+    let lit_frame = t
         .direct_lighting
         .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
 
     // 12. Haze: its issue adds it here.
 
     // 13. TAA.
-    let lit = hdr;
+    let lit = lit_frame.radiance;
     let hdr = if taa_on {
         t.taa
             .record(g, lit, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
@@ -214,7 +224,37 @@ pub fn record<'r>(
         lit
     };
 
-    // 14. Exposure and tonemap (placeholder).
+    // 14. Exposure, metered on the illuminance; the local tonemap's gain; the tonemap
+    //     (placeholder, with its own exposure until the tonemap issue reads `exposure.value`).
+    let exposure = t.exposure.record(
+        g,
+        hdr,
+        lit_frame.illuminance,
+        size,
+        &ExposureParams::new(
+            &s.settings.exposure,
+            sky.knobs.exposure_bias_ev,
+            s.ev100_with_sky(sky.sky_lux),
+        ),
+    )?;
+    let sun_elevation_deg = s.sun.as_ref().map_or(f32::NAN, |sun| {
+        sun.direction
+            .normalize_or_zero()
+            .y
+            .clamp(-1.0, 1.0)
+            .asin()
+            .to_degrees()
+    });
+    let local_tonemap = t.local_tonemap.record(
+        g,
+        hdr,
+        exposure.value,
+        size,
+        &s.settings.local_tonemap,
+        s.settings
+            .local_tonemap
+            .look_for(&s.settings.sky.weather, sun_elevation_deg),
+    )?;
     let ldr = t.placeholder_tonemap.record(
         g,
         hdr,
@@ -228,6 +268,9 @@ pub fn record<'r>(
         sky,
         hdr,
         lit,
+        illuminance: lit_frame.illuminance,
+        exposure,
+        local_tonemap,
         ldr,
     })
 }

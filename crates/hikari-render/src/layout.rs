@@ -30,7 +30,9 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows, taa};
+    use crate::techniques::{
+        direct_lighting, exposure, local_tonemap, placeholder_tonemap, sky, sun_shadows, taa,
+    };
     use crate::view;
     vec![
         gpu_layout!(
@@ -133,6 +135,21 @@ pub fn all() -> Vec<StructLayout> {
             taa::TaaParams,
             "taa/resolve.wgsl",
             [history_valid, clip, max_history, _pad]
+        ),
+        gpu_layout!(
+            exposure::ExposureParams,
+            "exposure/adapt.wgsl",
+            [histogram, meter, rule, adapt, config]
+        ),
+        gpu_layout!(
+            local_tonemap::LocalTonemapParams,
+            "local_tonemap/apply.wgsl",
+            [grid, tone, blend]
+        ),
+        gpu_layout!(
+            local_tonemap::BlurParams,
+            "local_tonemap/blur_grid.wgsl",
+            [sigma, config]
         ),
         gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),
         gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),

@@ -12,7 +12,8 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
-pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
+pub use crate::techniques::exposure::settings::ExposureSettings;
+pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
 pub use crate::techniques::taa::settings::TaaSettings;
@@ -189,6 +190,7 @@ register_settings! {
     sun_shadows: SunShadowsSettings,
     direct_lighting: DirectLightingSettings,
     exposure: ExposureSettings,
+    local_tonemap: LocalTonemapSettings,
     sky: SkySettings,
     taa: TaaSettings,
 }

@@ -4,7 +4,9 @@
 //! `tests/sun_shadows.rs`.
 
 pub mod direct_lighting;
+pub mod exposure;
 pub mod gbuffer;
+pub mod local_tonemap;
 pub mod placeholder_tonemap;
 pub mod sky;
 pub mod sun_shadows;

@@ -108,6 +108,16 @@ impl LightingParams {
     }
 }
 
+/// What the lighting pass writes.
+#[derive(Clone, Copy, Debug)]
+pub struct LitFrame {
+    /// `direct_lighting.radiance`: nits, Rgba16Float.
+    pub radiance: Tex,
+    /// `direct_lighting.illuminance`: lux arriving at each surface pixel from the sun, lights
+    /// and ambient light (not its own emission), -1 on the sky; R32Float. The exposure meters it.
+    pub illuminance: Tex,
+}
+
 pub struct DirectLighting {
     shade: ComputePipeline,
 }
@@ -120,7 +130,7 @@ impl DirectLighting {
     }
 
     /// Radiance in nits of every pixel: lit surfaces, or the sky (or the placeholder sky)
-    /// where depth is 0.
+    /// where depth is 0, and the illuminance at every surface pixel.
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
@@ -132,11 +142,15 @@ impl DirectLighting {
         scene: &SceneInFrame,
         view: &View,
         params: &LightingParams,
-    ) -> Result<Tex> {
+    ) -> Result<LitFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
             "direct_lighting.radiance",
             TextureDesc::d2(w, h, RADIANCE_FORMAT),
+        )?;
+        let illuminance = g.texture(
+            "direct_lighting.illuminance",
+            TextureDesc::d2(w, h, wgpu::TextureFormat::R32Float),
         )?;
         g.pass("direct_lighting.shade")
             .constants(view)
@@ -148,11 +162,15 @@ impl DirectLighting {
             .read(gb.emissive)
             .read(scene.lights)
             .write(radiance)
+            .write(illuminance)
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)
             .set(brdf_tables)
             .dispatch_threads(&self.shade, [w, h, 1])?;
-        Ok(radiance)
+        Ok(LitFrame {
+            radiance,
+            illuminance,
+        })
     }
 }

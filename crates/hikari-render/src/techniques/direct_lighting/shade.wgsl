@@ -43,6 +43,9 @@ const LIGHTING_SKY: u32 = 16u;
 @group(0) @binding(6) var gbuffer_emissive: texture_2d<f32>;
 @group(0) @binding(7) var<storage, read> lights: array<LightGpu>;
 @group(0) @binding(8) var out_radiance: texture_storage_2d<rgba16float, write>;
+// Illuminance in lux arriving at the surface (sun, lights, ambient; not its own emission), the
+// exposure's meter; -1 on the sky.
+@group(0) @binding(9) var out_illuminance: texture_storage_2d<r32float, write>;
 
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
@@ -55,6 +58,9 @@ const MAX_TILE_LIGHTS: u32 = 256u;
 var<workgroup> bounds_lo: array<vec3<f32>, 256>;
 var<workgroup> bounds_hi: array<vec3<f32>, 256>;
 var<workgroup> tile_count: atomic<u32>;
+// Rec.709 luminance weights, for the illuminance the exposure meters.
+const EXPOSURE_LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
+
 var<workgroup> tile_lights: array<u32, MAX_TILE_LIGHTS>;
 // 1 / range^2 of each listed light, found once a tile rather than once a pixel.
 var<workgroup> tile_inv_range2: array<f32, MAX_TILE_LIGHTS>;
@@ -161,6 +167,7 @@ fn main(
         return;
     }
     var radiance: vec3<f32>;
+    var illuminance = -1.0;
     let flags = params.config.y;
     // Towards the camera: from the surface point where there is one (no second unprojection).
     let v = select(-view_ray(view, pixel), normalize(view.position.xyz - world), d > 0.0);
@@ -185,6 +192,7 @@ fn main(
         var sum_b = vec3<f32>(0.0);
         var sum_c = vec3<f32>(0.0);
         var sum_d = vec3<f32>(0.0);
+        illuminance = 0.0;
         if (flags & LIGHTING_SUN) != 0u && params.direction_lux.w > 0.0 {
             let l = params.direction_lux.xyz;
             let e = params.color.rgb * (params.direction_lux.w * sun_visibility(world, n));
@@ -193,6 +201,7 @@ fn main(
             sum_b += e * w.y;
             sum_c += e * w.z;
             sum_d += e * w.w;
+            illuminance += dot(e, EXPOSURE_LUMA) * max(dot(n, l), 0.0);
         }
         for (var k = 0u; k < tile_lights_n; k++) {
             let light = lights[tile_lights[k]];
@@ -209,11 +218,13 @@ fn main(
             sum_b += e * w.y;
             sum_c += e * w.z;
             sum_d += e * w.w;
+            illuminance += dot(e, EXPOSURE_LUMA) * max(dot(n, l), 0.0);
         }
         radiance = brdf_apply_weights(brdf, sum_a, sum_b, sum_c, sum_d);
         if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
             let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);
             radiance += (diffuse + specular_placeholder(m, n, v)) * mat.w;
+            illuminance += dot(ambient_placeholder(n), EXPOSURE_LUMA) * mat.w;
         }
         if (flags & LIGHTING_SKY) != 0u {
             // Sky visibility 1 until the irradiance probes.
@@ -221,6 +232,7 @@ fn main(
             let r = reflect(-v, n);
             let f = brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0));
             radiance += (diffuse + f * sky_ambient_specular(r, m.perceptual_roughness)) * mat.w;
+            illuminance += dot(sky_ambient_irradiance(n), EXPOSURE_LUMA) * mat.w;
         }
         if (flags & LIGHTING_EMISSIVE) != 0u {
             radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;
@@ -229,4 +241,5 @@ fn main(
     // NaN fails every comparison, so this also turns NaN into 0.
     radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
     textureStore(out_radiance, pixel, vec4<f32>(radiance, 1.0));
+    textureStore(out_illuminance, pixel, vec4<f32>(select(0.0, illuminance, illuminance >= -1.0), 0.0, 0.0, 0.0));
 }
