@@ -30,9 +30,14 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows};
+    use crate::techniques::{direct_lighting, gi_denoiser, placeholder_tonemap, sky, sun_shadows};
     use crate::view;
     vec![
+        gpu_layout!(
+            gi_denoiser::GiDenoiserParams,
+            "gi_denoiser/spatial.wgsl",
+            [radius, rotation, scales, flags, disk]
+        ),
         gpu_layout!(
             view::View,
             "gbuffer/resolve.wgsl",
