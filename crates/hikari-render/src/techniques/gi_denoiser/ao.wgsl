@@ -73,7 +73,7 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
 
 // Weighted mean AO of the samples around `centre_px` (pixel units) against the surface `s`,
 // starting from the centre sum `acc` and weight `acc_w`.
-fn filter(centre_px: vec2<f32>, s: Surface, variance_scale: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
+fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
     var acc = acc_in;
     var acc_w = acc_w_in;
     let radius_m = params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale;
@@ -142,7 +142,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         && dot(a.surface.normal, b.surface.normal) >= EDGE_NORMAL_COS;
     if shared_ok {
         // One set of samples about the pair's midpoint, against a's tangent plane.
-        let acc = filter(
+        let acc = filter_ao(
             vec2<f32>(f32(pa.x) + 1.0, f32(pa.y) + 0.5),
             a.surface,
             max(a.variance_scale, b.variance_scale),
@@ -156,13 +156,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var out_a = a.ao;
     if a.surface.valid {
-        out_a = combine(a, filter(vec2<f32>(pa) + 0.5, a.surface, a.variance_scale, centre_weight(a) * a.ao, centre_weight(a), size));
+        out_a = combine(a, filter_ao(vec2<f32>(pa) + 0.5, a.surface, a.variance_scale, centre_weight(a) * a.ao, centre_weight(a), size));
     }
     textureStore(out_ao, pa, vec4<f32>(out_a, 0.0, 0.0, 1.0));
     if has_b {
         var out_b = b.ao;
         if b.surface.valid {
-            out_b = combine(b, filter(vec2<f32>(pb) + 0.5, b.surface, b.variance_scale, centre_weight(b) * b.ao, centre_weight(b), size));
+            out_b = combine(b, filter_ao(vec2<f32>(pb) + 0.5, b.surface, b.variance_scale, centre_weight(b) * b.ao, centre_weight(b), size));
         }
         textureStore(out_ao, pb, vec4<f32>(out_b, 0.0, 0.0, 1.0));
     }

@@ -85,7 +85,7 @@ fn combine_weight(history_length: f32, params: GiDenoiserParams) -> f32 {
 // that both sides of a curved surface count): linear falloff or a step.
 fn geometry_weight(centre: Surface, p: vec3<f32>, params: GiDenoiserParams) -> f32 {
     let d = abs(dot(centre.normal, p - centre.position));
-    let tolerance = params.radius.w * centre.view_z;
+    let tolerance = max(params.radius.w * centre.view_z, 1e-6);
     if params.flags.z != 0u {
         return select(0.0, 1.0, d < tolerance);
     }

@@ -126,8 +126,20 @@ impl GiDenoiser {
         let mut y = input.gi_y;
         let mut cocg = input.gi_cocg;
         let passes = [
-            (settings.pass1, p1, "gi_denoiser.pass1", "pass1_y", "pass1_cocg"),
-            (settings.pass2, p2, "gi_denoiser.pass2", "pass2_y", "pass2_cocg"),
+            (
+                settings.pass1,
+                p1,
+                "gi_denoiser.pass1",
+                "pass1_y",
+                "pass1_cocg",
+            ),
+            (
+                settings.pass2,
+                p2,
+                "gi_denoiser.pass2",
+                "pass2_y",
+                "pass2_cocg",
+            ),
         ];
         for (enabled, p, label, y_name, cocg_name) in passes {
             if !enabled {

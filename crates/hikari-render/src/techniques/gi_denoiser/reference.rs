@@ -95,7 +95,7 @@ pub fn combine_weight(history_length: f32, p: &GiDenoiserParams) -> f32 {
 /// Weight by the distance to the centre's tangent plane.
 pub fn geometry_weight(centre: &Surface, p: Vec3, params: &GiDenoiserParams) -> f32 {
     let d = centre.normal.dot(p - centre.position).abs();
-    let tolerance = params.radius[3] * centre.view_z;
+    let tolerance = (params.radius[3] * centre.view_z).max(1e-6);
     if params.flags[2] != 0 {
         return if d < tolerance { 1.0 } else { 0.0 };
     }
@@ -338,7 +338,9 @@ pub fn ao_pass(
             let a = load_ao_pixel(params, view, geo, ao, history_length, pa);
             let b = has_b.then(|| load_ao_pixel(params, view, geo, ao, history_length, pb));
             let ia = (y * w + x) as usize;
-            if let (Some(b), Some(sa), Some(sb)) = (&b, &a.surface, b.as_ref().and_then(|b| b.surface)) {
+            if let (Some(b), Some(sa), Some(sb)) =
+                (&b, &a.surface, b.as_ref().and_then(|b| b.surface))
+            {
                 if geometry_weight(sa, sb.position, params) > 0.0
                     && sa.normal.dot(sb.normal) >= EDGE_NORMAL_COS
                 {

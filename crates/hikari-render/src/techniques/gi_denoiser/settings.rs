@@ -106,15 +106,12 @@ impl TechniqueSettings for GiDenoiserSettings {
             },
             Field {
                 key: "plane_tolerance",
-                range: Range::Float {
-                    lo: 0.0001,
-                    hi: 100.0,
-                },
+                range: Range::Float { lo: 0.0, hi: 100.0 },
             },
             Field {
                 key: "variance_reference",
                 range: Range::Float {
-                    lo: 0.001,
+                    lo: 0.0625,
                     hi: 100.0,
                 },
             },
