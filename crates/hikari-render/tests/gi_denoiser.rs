@@ -57,19 +57,23 @@ struct Scene {
 }
 
 fn cast(camera: &Camera, planes: &[Plane]) -> Scene {
-    let view = View::new(camera, SIZE, SIZE);
+    cast_sized(camera, planes, [SIZE, SIZE])
+}
+
+fn cast_sized(camera: &Camera, planes: &[Plane], [w, h]: [u32; 2]) -> Scene {
+    let view = View::new(camera, w, h);
     let vp = view.view_proj();
-    let n = (SIZE * SIZE) as usize;
+    let n = (w * h) as usize;
     let mut geo = GeometryImage {
-        width: SIZE,
-        height: SIZE,
+        width: w,
+        height: h,
         depth: vec![0.0; n],
         normal_oct: vec![Vec2::ZERO; n],
     };
     let mut hit = vec![None; n];
     let mut normals = vec![Vec3::Z; n];
     for i in 0..n {
-        let pixel = UVec2::new(i as u32 % SIZE, i as u32 / SIZE);
+        let pixel = UVec2::new(i as u32 % w, i as u32 / w);
         // The ray through the pixel centre, as `view_ray` in hikari::view.
         let near = reference::world_from_depth(&view, pixel, 1.0);
         let dir = (near - camera.position).normalize();
@@ -157,7 +161,11 @@ fn corner_scene() -> Scene {
 /// Floor, a wall that stops at 2 m (sky above), and a box face standing in front of it:
 /// planes, a step edge, corners and sky in one image.
 fn mixed_scene() -> Scene {
-    cast(
+    mixed_scene_sized([SIZE, SIZE])
+}
+
+fn mixed_scene_sized(size: [u32; 2]) -> Scene {
+    cast_sized(
         &camera(Vec3::new(0.0, 1.5, 4.0), Vec3::new(0.0, 0.6, 0.0)),
         &[
             Plane::infinite(Vec3::Y, Vec3::ZERO),
@@ -174,6 +182,7 @@ fn mixed_scene() -> Scene {
                 Vec3::new(2.0, 1.2, 0.6),
             ),
         ],
+        size,
     )
 }
 
@@ -280,7 +289,8 @@ fn run_gpu(
 ) -> GpuOut {
     use wgpu::TextureFormat as F;
     let ctx = &gpu.ctx;
-    let tex = |format, data: &[u8]| common::texture_with_data(ctx, format, SIZE, SIZE, data);
+    let (w, h) = (scene.geo.width, scene.geo.height);
+    let tex = |format, data: &[u8]| common::texture_with_data(ctx, format, w, h, data);
     let depth = tex(F::R32Float, bytemuck::cast_slice(&scene.geo.depth));
     let normal = tex(
         F::Rgba16Float,
@@ -302,7 +312,7 @@ fn run_gpu(
     );
     let history = tex(F::R16Float, &halves(signal.history.iter().copied()));
     let ao = tex(F::R16Float, &halves(signal.ao.iter().copied()));
-    let hit = tex(F::R16Float, &halves(vec![0.0; (SIZE * SIZE) as usize]));
+    let hit = tex(F::R16Float, &halves(vec![0.0; (w * h) as usize]));
 
     let mut rt = GraphRuntime::new();
     let mut dumps = Vec::new();
@@ -332,14 +342,7 @@ fn run_gpu(
             hit_distance: g.import_texture("test.hit_distance", &hit),
         };
         gpu.denoiser
-            .record(
-                &mut g,
-                settings,
-                &scene.view,
-                geometry,
-                &input,
-                [SIZE, SIZE],
-            )
+            .record(&mut g, settings, &scene.view, geometry, &input, [w, h])
             .unwrap();
         let r = g.execute().unwrap();
         let img = |name: &str| r.image(name).cloned();
@@ -722,5 +725,82 @@ fn constant_input_comes_out_unchanged() {
         for a in ao.as_ref().unwrap() {
             assert!((a - a0).abs() <= tol(a0), "{who} AO: {a} from {a0}");
         }
+    }
+}
+
+/// GPU time of each pass at 2560x1440 (the size), the median of 20 frames after 5 of
+/// warm-up; run by hand on a real GPU: `cargo test --test gi_denoiser -- --ignored timing`.
+#[test]
+#[ignore = "a measurement, not a check: run by hand on the GPU it is for"]
+fn timing_at_2560x1440() {
+    use hikari_render::graph::TimestampMode;
+    use wgpu::TextureFormat as F;
+    let gpu = gpu();
+    let (w, h) = (2560u32, 1440u32);
+    let scene = mixed_scene_sized([w, h]);
+    let signal = noisy_signal(&scene, 11, |rng| rng.random_range(1..=32) as f32);
+    let ctx = &gpu.ctx;
+    let tex = |format, data: &[u8]| common::texture_with_data(ctx, format, w, h, data);
+    let depth = tex(F::R32Float, bytemuck::cast_slice(&scene.geo.depth));
+    let normal = tex(
+        F::Rgba16Float,
+        &halves(
+            scene
+                .geo
+                .normal_oct
+                .iter()
+                .flat_map(|o| [o.x, o.y, 0.0, 0.0]),
+        ),
+    );
+    let gi_y = tex(
+        F::Rgba16Float,
+        &halves(signal.gi.y.iter().flat_map(|v| v.to_array())),
+    );
+    let gi_cocg = tex(
+        F::Rg16Float,
+        &halves(signal.gi.cocg.iter().flat_map(|v| v.to_array())),
+    );
+    let history = tex(F::R16Float, &halves(signal.history.iter().copied()));
+    let ao = tex(F::R16Float, &halves(signal.ao.iter().copied()));
+    let hit = tex(F::R16Float, &halves(vec![0.0; (w * h) as usize]));
+    let mut rt = GraphRuntime::new();
+    rt.set_timestamps(TimestampMode::Pass);
+    let settings = GiDenoiserSettings::default();
+    let mut times: std::collections::BTreeMap<String, Vec<f64>> = Default::default();
+    for frame in 0..25 {
+        let mut g = rt.begin_frame(ctx);
+        let geometry = GiDenoiserGeometry {
+            depth: g.import_texture("test.depth", &depth),
+            normal: g.import_texture("test.normal", &normal),
+        };
+        let input = GiDenoiserInput {
+            gi_y: g.import_texture("test.gi_y", &gi_y),
+            gi_cocg: g.import_texture("test.gi_cocg", &gi_cocg),
+            history_length: g.import_texture("test.history_length", &history),
+            ao: g.import_texture("test.ao", &ao),
+            hit_distance: g.import_texture("test.hit_distance", &hit),
+        };
+        let out = gpu
+            .denoiser
+            .record(&mut g, &settings, &scene.view, geometry, &input, [w, h])
+            .unwrap();
+        g.readback(out.ao);
+        let r = g.execute().unwrap();
+        if frame >= 5 {
+            for t in &r.timings {
+                if let Some(ms) = t.gpu_ms {
+                    times.entry(t.name.clone()).or_default().push(ms);
+                }
+            }
+        }
+    }
+    eprintln!("{}", ctx.describe());
+    for (name, mut v) in times {
+        v.sort_by(f64::total_cmp);
+        eprintln!(
+            "{name}: median {:.3} ms, min {:.3} ms",
+            v[v.len() / 2],
+            v[0]
+        );
     }
 }

@@ -149,7 +149,7 @@ impl GiDenoiserParams {
     /// Poisson point `i`, rotated by this frame's angle.
     pub fn disk_point(&self, i: u32) -> Vec2 {
         let e = self.disk[i as usize / 2];
-        let p = if i % 2 == 0 {
+        let p = if i.is_multiple_of(2) {
             Vec2::new(e[0], e[1])
         } else {
             Vec2::new(e[2], e[3])

@@ -1,6 +1,9 @@
 //! CPU twin of the GI and AO denoisers (`spatial.wgsl`, `ao.wgsl`), the same arithmetic in
 //! f32 over small images, for the tests.
 
+// `!(x > 0.0)` is kept where the shader has it: it is also true for NaN, which must be rejected.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 
 use super::params::GiDenoiserParams;
@@ -260,6 +263,7 @@ fn load_ao_pixel(
 }
 
 /// Weighted AO sum and weight of the samples about `centre_px` against `s`, added to `acc`.
+#[allow(clippy::too_many_arguments)]
 fn filter_ao(
     params: &GiDenoiserParams,
     view: &View,
@@ -340,24 +344,22 @@ pub fn ao_pass(
             let ia = (y * w + x) as usize;
             if let (Some(b), Some(sa), Some(sb)) =
                 (&b, &a.surface, b.as_ref().and_then(|b| b.surface))
+                && geometry_weight(sa, sb.position, params) > 0.0
+                && sa.normal.dot(sb.normal) >= EDGE_NORMAL_COS
             {
-                if geometry_weight(sa, sb.position, params) > 0.0
-                    && sa.normal.dot(sb.normal) >= EDGE_NORMAL_COS
-                {
-                    let acc = filter_ao(
-                        params,
-                        view,
-                        geo,
-                        ao,
-                        Vec2::new(x as f32 + 1.0, y as f32 + 0.5),
-                        sa,
-                        a.variance_scale.max(b.variance_scale),
-                        centre_acc(&a) + centre_acc(b),
-                    );
-                    out[ia] = combine_ao(&a, acc);
-                    out[ia + 1] = combine_ao(b, acc);
-                    continue;
-                }
+                let acc = filter_ao(
+                    params,
+                    view,
+                    geo,
+                    ao,
+                    Vec2::new(x as f32 + 1.0, y as f32 + 0.5),
+                    sa,
+                    a.variance_scale.max(b.variance_scale),
+                    centre_acc(&a) + centre_acc(b),
+                );
+                out[ia] = combine_ao(&a, acc);
+                out[ia + 1] = combine_ao(b, acc);
+                continue;
             }
             for (p, pixel, idx) in [(Some(&a), pa, ia), (b.as_ref(), pb, ia + 1)] {
                 let Some(p) = p else { continue };
