@@ -45,7 +45,7 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     p.ao_ok = is_finite_f(raw);
     p.ao = select(1.0, raw, p.ao_ok);
     let raw_history = textureLoad(history_tex, pixel, 0).x;
-    p.keep = combine_weight(select(1.0, raw_history, is_finite_f(raw_history)), params);
+    p.keep = combine_weight(select(1.0, raw_history, is_finite_f(raw_history)), params.scales);
     var sum = 0.0;
     var sum_sq = 0.0;
     var count = 0.0;
@@ -66,7 +66,7 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     p.variance_scale = radius_scale_variance(
         sum / max(count, 1.0),
         sum_sq / max(count, 1.0),
-        params
+        params.scales
     );
     return p;
 }
@@ -77,13 +77,13 @@ fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, acc_in: f32,
     var acc = acc_in;
     var acc_w = acc_w_in;
     let radius_m = params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale;
-    let radius = radius_pixels(radius_m, s.view_z, params);
+    let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
     let count = min(
         max(u32(ceil(f32(params.flags.x) * variance_scale)), min(MIN_SAMPLES, params.flags.x)),
         params.flags.x
     );
     for (var i = 0u; i < count; i++) {
-        let q = vec2<i32>(floor(centre_px + disk_point(i, params) * radius));
+        let q = vec2<i32>(floor(centre_px + disk_point(i, params.disk[i / 2u], params.rotation) * radius));
         if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
             continue;
         }
@@ -91,7 +91,7 @@ fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, acc_in: f32,
         if !(depth > 0.0) || !is_finite_f(depth) {
             continue;
         }
-        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params);
+        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params.radius, params.flags);
         if !(w > 0.0) {
             continue;
         }
@@ -138,7 +138,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 
     let shared_ok = has_b && a.surface.valid && b.surface.valid
-        && geometry_weight(a.surface, b.surface.position, params) > 0.0
+        && geometry_weight(a.surface, b.surface.position, params.radius, params.flags) > 0.0
         && dot(a.surface.normal, b.surface.normal) >= EDGE_NORMAL_COS;
     if shared_ok {
         // One set of samples about the pair's midpoint, against a's tangent plane.

@@ -73,9 +73,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let history = select(1.0, raw_history, is_finite_f(raw_history));
 
     let scale = radius_scale_z(s.view_z, params.rotation.w)
-        * radius_scale_variance(mean, mean_sq, params)
+        * radius_scale_variance(mean, mean_sq, params.scales)
         * max(ao, params.scales.y);
-    let radius = radius_pixels(params.radius.x * scale, s.view_z, params);
+    let radius = radius_pixels(params.radius.x * scale, s.view_z, params.radius, params.rotation);
     // Small radius, bigger step: fewer taps where the kernel covers fewer pixels.
     let step = min(max(u32(min(params.radius.z / max(radius, 1e-3), 64.0)), 1u), params.flags.w);
 
@@ -84,7 +84,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var acc_w = select(0.0, 1.0, centre_ok);
     let centre_px = vec2<f32>(pixel) + 0.5;
     for (var i = 0u; i < params.flags.x; i += step) {
-        let q = vec2<i32>(floor(centre_px + disk_point(i, params) * radius));
+        let q = vec2<i32>(floor(centre_px + disk_point(i, params.disk[i / 2u], params.rotation) * radius));
         if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
             continue;
         }
@@ -92,7 +92,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if !(depth > 0.0) || !is_finite_f(depth) {
             continue;
         }
-        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params);
+        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params.radius, params.flags);
         if !(w > 0.0) {
             continue;
         }
@@ -119,7 +119,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var out_sh = centre_y;
     var out_c = centre_c;
     if acc_w > 0.0 {
-        let k = select(0.0, combine_weight(history, params), centre_ok);
+        let k = select(0.0, combine_weight(history, params.scales), centre_ok);
         out_sh = mix(acc_y / acc_w, centre_y, k);
         out_c = mix(acc_c / acc_w, centre_c, k);
     }
