@@ -131,7 +131,9 @@ fn flat_scene() -> Scene {
     )
 }
 
-/// Two camera-facing planes 2 m apart in depth: the near one fills the left half.
+/// Two camera-facing planes 2 m apart in depth: the near one fills the left half, up to
+/// x = 5 cm, which puts the edge between columns 32 and 33, inside one of the AO denoiser's
+/// pixel pairs.
 fn edge_scene() -> Scene {
     cast(
         &camera(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO),
@@ -140,7 +142,7 @@ fn edge_scene() -> Scene {
                 Vec3::Z,
                 Vec3::ZERO,
                 Vec3::new(-100.0, -100.0, -1.0),
-                Vec3::new(0.0, 100.0, 1.0),
+                Vec3::new(0.05, 100.0, 1.0),
             ),
             Plane::infinite(Vec3::Z, Vec3::new(0.0, 0.0, -2.0)),
         ],
@@ -565,7 +567,8 @@ fn worst_bleed(input: &GiImage, output: &GiImage, bright: f32) -> f32 {
         .fold(0.0, f32::max)
 }
 
-/// Noise-free GI of luminance `bright` on plane 0 and `dark` elsewhere.
+/// Noise-free GI of luminance `bright` on plane 0 and `dark` elsewhere; AO 1 on plane 0 and
+/// 0.2 elsewhere.
 fn two_tone(scene: &Scene, bright: f32, dark: f32) -> Signal {
     Signal::from_fn(scene.hit.len(), |i| {
         let y = if scene.hit[i] == Some(0) {
@@ -573,7 +576,8 @@ fn two_tone(scene: &Scene, bright: f32, dark: f32) -> Signal {
         } else {
             dark
         };
-        (constant_sh(y), 1.0, 1.0)
+        let ao = if scene.hit[i] == Some(0) { 1.0 } else { 0.2 };
+        (constant_sh(y), 1.0, ao)
     })
 }
 
@@ -581,15 +585,30 @@ fn two_tone(scene: &Scene, bright: f32, dark: f32) -> Signal {
 fn step_edge_does_not_bleed_across_depths() {
     let gpu = gpu();
     let scene = edge_scene();
+    let edge_row = &scene.hit[(32 * SIZE) as usize..][..SIZE as usize];
+    assert!(
+        edge_row[32] == Some(0) && edge_row[33] == Some(1),
+        "the edge lies inside the pair (32, 33)"
+    );
     let signal = two_tone(&scene, 1.0, 0.05);
     let bright = signal.gi.y.iter().map(|v| v.x).fold(0.0, f32::max);
     let settings = GiDenoiserSettings::default();
     let out = run_gpu(&gpu, &settings, &scene, &signal, 1);
     let cpu = run_cpu(&scene, &signal, &out);
-    for (who, p1, p2) in [
-        ("GPU", &out.pass1, &out.pass2),
-        ("CPU", &cpu.pass1, &cpu.pass2),
+    let ao_bleed = |ao: &[f32]| {
+        ao.iter()
+            .zip(&signal.ao)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f32::max)
+    };
+    for (who, p1, p2, ao) in [
+        ("GPU", &out.pass1, &out.pass2, &out.ao),
+        ("CPU", &cpu.pass1, &cpu.pass2, &cpu.ao),
     ] {
+        // AO 1 against 0.2: two pixels of a pair across the edge must not share samples.
+        let b = ao_bleed(ao.as_ref().unwrap());
+        eprintln!("{who} AO: edge bleed {b}");
+        assert!(b <= 0.002, "{who}: the AO bled {b} across the edge");
         // Only f16 rounding may move a texel: the planes lie 2 m apart and the geometry weight
         // reaches 0 at 1 % of the view depth (5 cm).
         for (pass, img) in [("pass 1", p1), ("pass 2", p2)] {
@@ -610,6 +629,9 @@ fn step_edge_does_not_bleed_across_depths() {
         b > 0.05,
         "control: without the geometry weight the edge bled only {b}"
     );
+    let b = ao_bleed(out.ao.as_ref().unwrap());
+    eprintln!("control AO bleed {b}");
+    assert!(b > 0.05, "control: the AO bled only {b}");
 }
 
 #[test]
