@@ -158,3 +158,35 @@ impl GiDenoiserParams {
         Vec2::new(c * p.x - s * p.y, s * p.x + c * p.y)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disks_hold_every_point_inside_the_unit_disk_and_apart() {
+        for count in [GI_DISK_POINTS, MAX_DISK_POINTS] {
+            let pts = poisson_points(count, 7).unwrap();
+            assert_eq!(pts.len(), count);
+            assert!(pts.iter().all(|p| p.length() <= 1.0));
+            // Dart throwing at this density keeps points at least ~0.5 / sqrt(n) apart.
+            let closest = pts
+                .iter()
+                .enumerate()
+                .flat_map(|(i, a)| pts[i + 1..].iter().map(move |b| a.distance(*b)))
+                .fold(f32::MAX, f32::min);
+            assert!(closest >= 0.5 / (count as f32).sqrt(), "{count}: {closest}");
+        }
+    }
+
+    #[test]
+    fn the_rotation_is_a_unit_rotation_that_changes_every_frame() {
+        let angles: Vec<Vec2> = (0..64).map(rotation).collect();
+        for (i, r) in angles.iter().enumerate() {
+            assert!((r.length() - 1.0).abs() < 1e-6);
+            if i > 0 {
+                assert!(r.distance(angles[i - 1]) > 0.1, "frame {i}");
+            }
+        }
+    }
+}
