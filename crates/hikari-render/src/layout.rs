@@ -31,10 +31,16 @@ pub fn all() -> Vec<StructLayout> {
     use crate::raster;
     use crate::scene_gpu;
     use crate::techniques::{
-        direct_lighting, exposure, local_tonemap, placeholder_tonemap, sky, sun_shadows, taa,
+        direct_lighting, exposure, gi_denoiser, local_tonemap, placeholder_tonemap, sky,
+        sun_shadows, taa,
     };
     use crate::view;
     vec![
+        gpu_layout!(
+            gi_denoiser::GiDenoiserParams,
+            "gi_denoiser/spatial.wgsl",
+            [radius, rotation, scales, flags, disk]
+        ),
         gpu_layout!(
             view::View,
             "gbuffer/resolve.wgsl",

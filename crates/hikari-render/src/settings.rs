@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::exposure::settings::ExposureSettings;
+pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
 pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
@@ -193,6 +194,7 @@ register_settings! {
     local_tonemap: LocalTonemapSettings,
     sky: SkySettings,
     taa: TaaSettings,
+    gi_denoiser: GiDenoiserSettings,
 }
 
 impl Settings {

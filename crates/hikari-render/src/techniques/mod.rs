@@ -6,6 +6,7 @@
 pub mod direct_lighting;
 pub mod exposure;
 pub mod gbuffer;
+pub mod gi_denoiser;
 pub mod local_tonemap;
 pub mod placeholder_tonemap;
 pub mod sky;

@@ -1,0 +1,169 @@
+// The RTAO denoiser (Metro Exodus, GDC 2019): adaptive sampling, up to 64 Poisson-disk samples
+// rotated once a frame, the count scaled by the AO's 3x3 variance; two horizontally adjacent
+// pixels a thread, which share one set of samples when no edge lies between them (same
+// tangent plane within the tolerance, normals within EDGE_NORMAL_COS). Weights: geometry
+// (distance to the tangent plane) times the normal's dot product. Output:
+// lerp(denoised, input, 0.5 * accumulation speed). CPU twin: gi_denoiser/reference.rs `ao_pass`.
+
+#import hikari::view::{View, world_from_depth}
+#import hikari::octahedral::oct_decode
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point}
+
+@group(0) @binding(0) var<uniform> params: GiDenoiserParams;
+@group(0) @binding(1) var<uniform> view: View;
+@group(0) @binding(2) var depth_tex: texture_2d<f32>;
+@group(0) @binding(3) var normal_tex: texture_2d<f32>;
+@group(0) @binding(4) var ao_tex: texture_2d<f32>;
+@group(0) @binding(5) var history_tex: texture_2d<f32>;
+@group(0) @binding(6) var out_ao: texture_storage_2d<r16float, write>;
+
+// Two pixels whose normals differ by more than about 25 degrees do not share samples.
+const EDGE_NORMAL_COS: f32 = 0.9;
+// The fewest samples a pixel takes, however flat its AO.
+const MIN_SAMPLES: u32 = 8u;
+
+struct AoPixel {
+    surface: Surface,
+    // Input AO, 1 (open) where the input was not finite.
+    ao: f32,
+    ao_ok: bool,
+    // 0.5 * accumulation speed.
+    keep: f32,
+    // F(variance) of the AO over 3x3.
+    variance_scale: f32,
+}
+
+fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
+    var p: AoPixel;
+    p.surface = make_surface(
+        view,
+        pixel,
+        textureLoad(depth_tex, pixel, 0).x,
+        textureLoad(normal_tex, pixel, 0).xy
+    );
+    let raw = textureLoad(ao_tex, pixel, 0).x;
+    p.ao_ok = is_finite_f(raw);
+    p.ao = select(1.0, raw, p.ao_ok);
+    let raw_history = textureLoad(history_tex, pixel, 0).x;
+    p.keep = combine_weight(select(1.0, raw_history, is_finite_f(raw_history)), params.scales);
+    var sum = 0.0;
+    var sum_sq = 0.0;
+    var count = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
+            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+                continue;
+            }
+            let v = textureLoad(ao_tex, q, 0).x;
+            if is_finite_f(v) {
+                sum += v;
+                sum_sq += v * v;
+                count += 1.0;
+            }
+        }
+    }
+    p.variance_scale = radius_scale_variance(
+        sum / max(count, 1.0),
+        sum_sq / max(count, 1.0),
+        params.scales
+    );
+    return p;
+}
+
+// Weighted mean AO of the samples around `centre_px` (pixel units) against the surface `s`,
+// starting from the centre sum `acc` and weight `acc_w`.
+fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
+    var acc = acc_in;
+    var acc_w = acc_w_in;
+    let radius_m = params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale;
+    let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
+    let count = min(
+        max(u32(ceil(f32(params.flags.x) * variance_scale)), min(MIN_SAMPLES, params.flags.x)),
+        params.flags.x
+    );
+    for (var i = 0u; i < count; i++) {
+        let q = vec2<i32>(floor(centre_px + disk_point(i, params.disk[i / 2u], params.rotation) * radius));
+        if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+            continue;
+        }
+        let depth = textureLoad(depth_tex, q, 0).x;
+        if !(depth > 0.0) || !is_finite_f(depth) {
+            continue;
+        }
+        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params.radius, params.flags);
+        if !(w > 0.0) {
+            continue;
+        }
+        let oct = textureLoad(normal_tex, q, 0).xy;
+        if !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
+            continue;
+        }
+        w *= max(dot(s.normal, oct_decode(oct)), 0.0);
+        let v = textureLoad(ao_tex, q, 0).x;
+        if !(w > 0.0) || !is_finite_f(v) {
+            continue;
+        }
+        acc += w * v;
+        acc_w += w;
+    }
+    return vec2<f32>(acc, acc_w);
+}
+
+fn combine(p: AoPixel, acc: vec2<f32>) -> f32 {
+    if !(acc.y > 0.0) {
+        return p.ao;
+    }
+    let k = select(0.0, p.keep, p.ao_ok);
+    return clamp(mix(acc.x / acc.y, p.ao, k), 0.0, 1.0);
+}
+
+fn centre_weight(p: AoPixel) -> f32 {
+    return select(0.0, 1.0, p.ao_ok);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(out_ao);
+    let pa = vec2<u32>(id.x * 2u, id.y);
+    if any(pa >= size) {
+        return;
+    }
+    let pb = pa + vec2<u32>(1u, 0u);
+    let has_b = pb.x < size.x;
+    let a = load_pixel(pa, size);
+    var b: AoPixel;
+    if has_b {
+        b = load_pixel(pb, size);
+    }
+
+    let shared_ok = has_b && a.surface.valid && b.surface.valid
+        && geometry_weight(a.surface, b.surface.position, params.radius, params.flags) > 0.0
+        && dot(a.surface.normal, b.surface.normal) >= EDGE_NORMAL_COS;
+    if shared_ok {
+        // One set of samples about the pair's midpoint, against a's tangent plane.
+        let acc = filter_ao(
+            vec2<f32>(f32(pa.x) + 1.0, f32(pa.y) + 0.5),
+            a.surface,
+            max(a.variance_scale, b.variance_scale),
+            centre_weight(a) * a.ao + centre_weight(b) * b.ao,
+            centre_weight(a) + centre_weight(b),
+            size
+        );
+        textureStore(out_ao, pa, vec4<f32>(combine(a, acc), 0.0, 0.0, 1.0));
+        textureStore(out_ao, pb, vec4<f32>(combine(b, acc), 0.0, 0.0, 1.0));
+        return;
+    }
+    var out_a = a.ao;
+    if a.surface.valid {
+        out_a = combine(a, filter_ao(vec2<f32>(pa) + 0.5, a.surface, a.variance_scale, centre_weight(a) * a.ao, centre_weight(a), size));
+    }
+    textureStore(out_ao, pa, vec4<f32>(out_a, 0.0, 0.0, 1.0));
+    if has_b {
+        var out_b = b.ao;
+        if b.surface.valid {
+            out_b = combine(b, filter_ao(vec2<f32>(pb) + 0.5, b.surface, b.variance_scale, centre_weight(b) * b.ao, centre_weight(b), size));
+        }
+        textureStore(out_ao, pb, vec4<f32>(out_b, 0.0, 0.0, 1.0));
+    }
+}

@@ -1,0 +1,107 @@
+#define_import_path hikari::gi_denoiser_common
+
+// What the GI passes and the AO denoiser share: their constants, the NaN test, the surface a
+// pixel holds, the radius scale and the geometry weight. CPU twin: gi_denoiser/reference.rs.
+
+#import hikari::view::{View, world_from_depth}
+#import hikari::octahedral::oct_decode
+
+struct GiDenoiserParams {
+    // x: base radius in metres; y, z: smallest and largest radius in pixels; w: distance to the
+    // tangent plane at which the geometry weight reaches 0, as a fraction of view depth.
+    radius: vec4<f32>,
+    // x, y: cos and sin of this frame's disk rotation; z: metres one pixel spans per metre of
+    // view depth; w: view depth in metres at which F(viewZ) = 1/2.
+    rotation: vec4<f32>,
+    // x: coefficient of variation at which F(variance) reaches 1; y: floor of F(variance) and
+    // F(AO); z: largest accumulation speed; w: unused.
+    scales: vec4<f32>,
+    // x: samples at most; y: 1 = normal weight; z: 1 = step geometry falloff; w: largest step.
+    flags: vec4<u32>,
+    // Poisson-disk points in the unit disk, two an entry (xy, zw).
+    disk: array<vec4<f32>, 32>,
+}
+
+struct Surface {
+    valid: bool,
+    position: vec3<f32>,
+    normal: vec3<f32>,
+    // Metres along the camera's forward axis.
+    view_z: f32,
+}
+
+// Bit test instead of `x != x`: compilers may fold the latter away under fast-math rules.
+fn is_finite_f(x: f32) -> bool {
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+fn is_finite4(v: vec4<f32>) -> bool {
+    return all((bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u)) != vec4<u32>(0x7f800000u));
+}
+
+// The helpers take the fields of GiDenoiserParams they need, not the struct: a copy of the
+// struct with its disk array could be spilled to local memory where the disk is indexed.
+
+// The surface at `pixel` from the G-buffer's reverse-Z depth and octahedral normal; invalid
+// for the sky (depth 0) and for any non-finite G-buffer texel.
+fn make_surface(view: View, pixel: vec2<u32>, depth: f32, oct: vec2<f32>) -> Surface {
+    var s: Surface;
+    s.valid = depth > 0.0 && is_finite_f(depth) && is_finite4(vec4<f32>(oct, 0.0, 0.0));
+    if !s.valid {
+        return s;
+    }
+    s.position = world_from_depth(view, pixel, depth);
+    s.normal = oct_decode(oct);
+    s.view_z = dot(s.position - view.position.xyz, view.forward_near.xyz);
+    s.valid = s.view_z > 0.0 && is_finite4(vec4<f32>(s.position, s.view_z));
+    return s;
+}
+
+// F(viewZ) = z / (z + z_half): near the camera a metre spans many pixels, so the world
+// radius shrinks there; far away it tends to the base radius.
+fn radius_scale_z(view_z: f32, z_half: f32) -> f32 {
+    return view_z / (view_z + z_half);
+}
+
+// F(variance): the 3x3 coefficient of variation over its reference, floored, at most 1.
+// `mean` and `mean_sq` are E[x] and E[x^2] over the 3x3 neighbourhood.
+// `scales` is GiDenoiserParams::scales.
+fn radius_scale_variance(mean: f32, mean_sq: f32, scales: vec4<f32>) -> f32 {
+    let sigma = sqrt(max(mean_sq - mean * mean, 0.0));
+    let cv = sigma / (abs(mean) + 1e-4);
+    return min(max(cv / scales.x, scales.y), 1.0);
+}
+
+// Blur radius in pixels of a world radius `radius_m` at view depth `view_z`; `radius` and
+// `rotation` are those of GiDenoiserParams.
+fn radius_pixels(radius_m: f32, view_z: f32, radius: vec4<f32>, rotation: vec4<f32>) -> f32 {
+    let px = radius_m / (view_z * rotation.z);
+    return min(max(px, radius.y), radius.z);
+}
+
+// The talk's combiner weight: 0.5 * accumulation speed, with the speed 1 - 1 / history
+// length (0 for a fresh pixel, rising as its history grows), capped.
+fn combine_weight(history_length: f32, scales: vec4<f32>) -> f32 {
+    let speed = 1.0 - 1.0 / max(history_length, 1.0);
+    return 0.5 * min(max(speed, 0.0), scales.z);
+}
+
+// Weight of a sample at `p` by its distance to the centre's tangent plane (absolute value, so
+// that both sides of a curved surface count): linear falloff or a step.
+fn geometry_weight(centre: Surface, p: vec3<f32>, radius: vec4<f32>, flags: vec4<u32>) -> f32 {
+    let d = abs(dot(centre.normal, p - centre.position));
+    let tolerance = max(radius.w * centre.view_z, 1e-6);
+    if flags.z != 0u {
+        return select(0.0, 1.0, d < tolerance);
+    }
+    return max(1.0 - d / tolerance, 0.0);
+}
+
+// Poisson point `i` of the packed disk entry `e` (= disk[i / 2]), rotated by this frame's
+// angle (one rotation for every pixel); `rotation` is GiDenoiserParams::rotation.
+fn disk_point(i: u32, e: vec4<f32>, rotation: vec4<f32>) -> vec2<f32> {
+    let p = select(e.zw, e.xy, (i & 1u) == 0u);
+    let c = rotation.x;
+    let s = rotation.y;
+    return vec2<f32>(c * p.x - s * p.y, s * p.x + c * p.y);
+}

@@ -1,0 +1,128 @@
+// One spatial pass of the two-pass GI denoiser (Metro Exodus, GDC 2019, "denoiser block"):
+// variance of the input over 3x3 -> radius scale F(viewZ) * F(variance) * F(AO) -> adaptive
+// step -> every Nth of up to 32 Poisson-disk samples, rotated once a frame; weights: geometry
+// (distance to the tangent plane), and in the second pass the normal (a plain dot product).
+// Y SH and CoCg share the weights. Output: lerp(denoised, input, 0.5 * accumulation speed).
+// A non-finite input texel is dropped where it is read, so it never reaches the output.
+// CPU twin: gi_denoiser/reference.rs `spatial_pass`.
+
+#import hikari::view::{View, world_from_depth}
+#import hikari::octahedral::oct_decode
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point}
+
+@group(0) @binding(0) var<uniform> params: GiDenoiserParams;
+@group(0) @binding(1) var<uniform> view: View;
+@group(0) @binding(2) var depth_tex: texture_2d<f32>;
+@group(0) @binding(3) var normal_tex: texture_2d<f32>;
+@group(0) @binding(4) var in_y: texture_2d<f32>;
+@group(0) @binding(5) var in_cocg: texture_2d<f32>;
+@group(0) @binding(6) var history_tex: texture_2d<f32>;
+@group(0) @binding(7) var ao_tex: texture_2d<f32>;
+@group(0) @binding(8) var out_y: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(9) var out_cocg: texture_storage_2d<rg16float, write>;
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(out_y);
+    if any(id.xy >= size) {
+        return;
+    }
+    let pixel = id.xy;
+    let raw_y = textureLoad(in_y, pixel, 0);
+    let raw_c = textureLoad(in_cocg, pixel, 0).xy;
+    let centre_ok = is_finite4(raw_y) && is_finite4(vec4<f32>(raw_c, 0.0, 0.0));
+    let centre_y = select(vec4<f32>(0.0), raw_y, centre_ok);
+    let centre_c = select(vec2<f32>(0.0), raw_c, centre_ok);
+
+    let s = make_surface(
+        view,
+        pixel,
+        textureLoad(depth_tex, pixel, 0).x,
+        textureLoad(normal_tex, pixel, 0).xy
+    );
+    if !s.valid {
+        textureStore(out_y, pixel, centre_y);
+        textureStore(out_cocg, pixel, vec4<f32>(centre_c, 0.0, 0.0));
+        return;
+    }
+
+    // Variance of the luminance (the SH's c0) over 3x3, finite texels only.
+    var sum = 0.0;
+    var sum_sq = 0.0;
+    var count = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
+            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+                continue;
+            }
+            let v = textureLoad(in_y, q, 0).x;
+            if is_finite_f(v) {
+                sum += v;
+                sum_sq += v * v;
+                count += 1.0;
+            }
+        }
+    }
+    let mean = sum / max(count, 1.0);
+    let mean_sq = sum_sq / max(count, 1.0);
+
+    let raw_ao = textureLoad(ao_tex, pixel, 0).x;
+    let ao = select(1.0, clamp(raw_ao, 0.0, 1.0), is_finite_f(raw_ao));
+    let raw_history = textureLoad(history_tex, pixel, 0).x;
+    let history = select(1.0, raw_history, is_finite_f(raw_history));
+
+    let scale = radius_scale_z(s.view_z, params.rotation.w)
+        * radius_scale_variance(mean, mean_sq, params.scales)
+        * max(ao, params.scales.y);
+    let radius = radius_pixels(params.radius.x * scale, s.view_z, params.radius, params.rotation);
+    // Small radius, bigger step: fewer taps where the kernel covers fewer pixels.
+    let step = min(max(u32(min(params.radius.z / max(radius, 1e-3), 64.0)), 1u), params.flags.w);
+
+    var acc_y = centre_y;
+    var acc_c = centre_c;
+    var acc_w = select(0.0, 1.0, centre_ok);
+    let centre_px = vec2<f32>(pixel) + 0.5;
+    for (var i = 0u; i < params.flags.x; i += step) {
+        let q = vec2<i32>(floor(centre_px + disk_point(i, params.disk[i / 2u], params.rotation) * radius));
+        if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+            continue;
+        }
+        let depth = textureLoad(depth_tex, q, 0).x;
+        if !(depth > 0.0) || !is_finite_f(depth) {
+            continue;
+        }
+        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params.radius, params.flags);
+        if !(w > 0.0) {
+            continue;
+        }
+        if params.flags.y != 0u {
+            let oct = textureLoad(normal_tex, q, 0).xy;
+            if !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
+                continue;
+            }
+            w *= max(dot(s.normal, oct_decode(oct)), 0.0);
+            if !(w > 0.0) {
+                continue;
+            }
+        }
+        // The heavy data, only for samples that count.
+        let y = textureLoad(in_y, q, 0);
+        let c = textureLoad(in_cocg, q, 0).xy;
+        if !is_finite4(y) || !is_finite4(vec4<f32>(c, 0.0, 0.0)) {
+            continue;
+        }
+        acc_y += w * y;
+        acc_c += w * c;
+        acc_w += w;
+    }
+    var out_sh = centre_y;
+    var out_c = centre_c;
+    if acc_w > 0.0 {
+        let k = select(0.0, combine_weight(history, params.scales), centre_ok);
+        out_sh = mix(acc_y / acc_w, centre_y, k);
+        out_c = mix(acc_c / acc_w, centre_c, k);
+    }
+    textureStore(out_y, pixel, out_sh);
+    textureStore(out_cocg, pixel, vec4<f32>(out_c, 0.0, 0.0));
+}
