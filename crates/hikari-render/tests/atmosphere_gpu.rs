@@ -9,9 +9,12 @@
 //! the CPU computes in f64, so:
 //! * transmittance: 2e-3 everywhere (an optical depth of up to ~40 summed over 500 f32 steps
 //!   carries ~1e-3 of it into exp);
-//! * every other table, 99 % of texels within 2e-3 and all within 1e-2: f32 ray geometry over a
-//!   6360 km planet moves sample points by metres, and the errors of the transmittance and of
-//!   each order's inputs add up through the iteration;
+//! * every other table, 99 % of texels within 5e-3 and all within 2e-2: f32 ray geometry over a
+//!   6360 km planet moves sample points by metres, a grazing sun's light passes an optical depth
+//!   of 5 to 40 (so 1e-4 of it is up to 4e-3 of the light), GPUs other than lavapipe fuse
+//!   multiply-adds and approximate exp, pow, sin and cos, and the errors of each order's inputs
+//!   add up through the iteration. Measured: at most 2.7e-3 on lavapipe; on an H100 see
+//!   docs/atmosphere.md;
 //! * the scattering distances (km): the same bounds on each of the two channels.
 //!
 //! The passes' f32 tests of "is this sample's sun below the horizon" use the texel's exact
@@ -26,6 +29,12 @@ use hikari_atmosphere::table::Table;
 use hikari_atmosphere::{Atmosphere, AtmosphereParams, ColorSpace, TableSizes};
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::sky::gpu_build::{TableBuilder, print_build_timings};
+
+/// Allowed relative luminance error of the transmittance table, every texel.
+const TRANSMITTANCE: f64 = 2e-3;
+/// Allowed relative luminance error of every other table: 99 % of texels, and every texel.
+const P99: f64 = 5e-3;
+const MAX: f64 = 2e-2;
 
 fn small() -> TableSizes {
     TableSizes {
@@ -68,6 +77,7 @@ fn errors(cpu: &Table, gpu: &Table, value: impl Fn([f64; 3]) -> f64) -> Errors {
     }
 }
 
+/// Prints the table's errors; returns what failed, if anything.
 fn check(
     name: &str,
     cpu: &Table,
@@ -75,7 +85,7 @@ fn check(
     value: impl Fn([f64; 3]) -> f64,
     p99: f64,
     max: f64,
-) {
+) -> Option<String> {
     let e = errors(cpu, gpu, &value);
     let [nx, ny, _] = cpu.size;
     let w = e.worst;
@@ -89,18 +99,21 @@ fn check(
         gpu.data[w],
         e.p99
     );
-    assert!(
-        e.p99 <= p99 && e.max <= max,
-        "{name}: relative error p99 {:.3e} (allowed {p99:.0e}), max {:.3e} (allowed {max:.0e}) \
-         at texel {w}: cpu {:?} gpu {:?}",
-        e.p99,
-        e.max,
-        cpu.data[w],
-        gpu.data[w]
-    );
+    (e.p99 > p99 || e.max > max).then(|| {
+        format!(
+            "{name}: relative error p99 {:.3e} (allowed {p99:.0e}), max {:.3e} (allowed \
+             {max:.0e}) at texel {w}: cpu {:?} gpu {:?}",
+            e.p99, e.max, cpu.data[w], gpu.data[w]
+        )
+    })
 }
 
-fn compare(params: AtmosphereParams, builder: &TableBuilder, ctx: &hikari_render::GpuContext) {
+/// Every table of one atmosphere; returns the failures.
+fn compare(
+    params: AtmosphereParams,
+    builder: &TableBuilder,
+    ctx: &hikari_render::GpuContext,
+) -> Vec<String> {
     let cpu = Atmosphere::with_sizes(params.clone(), small()).unwrap();
     let (gpu, report, timings) = builder.build_and_read(ctx, &params, small()).unwrap();
     print_build_timings(&timings);
@@ -118,14 +131,15 @@ fn compare(params: AtmosphereParams, builder: &TableBuilder, ctx: &hikari_render
     let wy: [f64; 3] = std::array::from_fn(|c| (0..3).map(|k| y[k] * to709[k][c]).sum());
     let lum = move |v: [f64; 3]| wy[0] * v[0] + wy[1] * v[1] + wy[2] * v[2];
     let (c, g) = (&cpu.tables, &gpu);
-    check(
+    let mut failed = Vec::new();
+    failed.extend(check(
         "transmittance",
         &c.transmittance,
         &g.transmittance,
         lum,
-        2e-3,
-        2e-3,
-    );
+        TRANSMITTANCE,
+        TRANSMITTANCE,
+    ));
     for (name, a, b) in [
         ("rayleigh_single", &c.rayleigh_single, &g.rayleigh_single),
         ("mie", &c.mie, &g.mie),
@@ -142,18 +156,19 @@ fn compare(params: AtmosphereParams, builder: &TableBuilder, ctx: &hikari_render
             &g.ground_irradiance,
         ),
     ] {
-        check(name, a, b, lum, 2e-3, 1e-2);
+        failed.extend(check(name, a, b, lum, P99, MAX));
     }
     for k in 0..2 {
-        check(
+        failed.extend(check(
             ["distance rayleigh", "distance mie"][k],
             &c.scattering_distance,
             &g.scattering_distance,
             move |v| v[k],
-            2e-3,
-            1e-2,
-        );
+            P99,
+            MAX,
+        ));
     }
+    failed
 }
 
 #[test]
@@ -170,6 +185,7 @@ fn gpu_tables_match_the_cpu_model() {
         ground_albedo: 0.3,
         ..AtmosphereParams::default()
     };
+    let mut failed = Vec::new();
     for params in [
         AtmosphereParams::default(),
         AtmosphereParams::earth(ColorSpace::Rec709),
@@ -179,8 +195,9 @@ fn gpu_tables_match_the_cpu_model() {
             "--- {:?}, mie {}",
             params.color_space, params.mie_scattering_per_km
         );
-        compare(params, &builder, &ctx);
+        failed.extend(compare(params, &builder, &ctx));
     }
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
 }
 
 /// The GPU build's time per table at the default (full) sizes, printed as `bench` prints

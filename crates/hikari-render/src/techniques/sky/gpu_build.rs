@@ -65,6 +65,8 @@ pub struct WorkLayout {
     pub ground_irradiance: u32,
     /// 1 + 32 texels: total luminance, stop flag, orders done; then each order's contribution.
     pub control: u32,
+    /// One luminance partial sum per 64 scattering texels (x).
+    pub partials: u32,
     /// Texels in all.
     pub len: u32,
 }
@@ -99,6 +101,7 @@ impl WorkLayout {
             ground_orders: take(g * max_orders),
             ground_irradiance: take(g),
             control: take(33),
+            partials: take(s.div_ceil(64)),
             len: 0,
         };
         Self { len: at, ..l }
@@ -165,7 +168,7 @@ impl TableBuildParams {
                 l.irradiance_rayleigh,
                 l.irradiance_mie,
             ],
-            offsets3: [l.ground_orders, l.ground_irradiance, l.control, 0],
+            offsets3: [l.ground_orders, l.ground_irradiance, l.control, l.partials],
         }
     }
 }

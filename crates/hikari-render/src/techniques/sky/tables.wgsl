@@ -43,7 +43,8 @@ struct BuildParams {
     offsets1: vec4<u32>,
     // Sum of J Rayleigh, sum of J Mie, irradiance Rayleigh, irradiance Mie.
     offsets2: vec4<u32>,
-    // Ground irradiance of each order (one slot per order, from order 1), their sum, control.
+    // Ground irradiance of each order (one slot per order, from order 1), their sum, control,
+    // the luminance partials (one per workgroup of 64 scattering texels).
     offsets3: vec4<u32>,
 }
 
@@ -459,19 +460,44 @@ fn integrate_single(t: Texel) -> Ray {
     return out;
 }
 
+const SUM_THREADS: u32 = 256u;
+var<workgroup> partial: array<f32, SUM_THREADS>;
+
+// Sums `value` over the 64 threads of a texel pass's workgroup into the workgroup's slot of
+// the luminance partials (`offsets3.w`), which `luminance` adds up: the order's luminance
+// costs one small reduction per workgroup instead of a second sweep over the table.
+fn store_partial(lid: u32, group: u32, value: f32) {
+    partial[lid] = value;
+    workgroupBarrier();
+    for (var stride = 32u; stride > 0u; stride >>= 1u) {
+        if lid < stride {
+            partial[lid] += partial[lid + stride];
+        }
+        workgroupBarrier();
+    }
+    if lid == 0u {
+        work[p.offsets3.w + group] = vec4<f32>(partial[0], 0.0, 0.0, 0.0);
+    }
+}
+
 @compute @workgroup_size(64, 1, 1)
-fn single(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn single(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg: vec3<u32>) {
     let n = p.sizes_scattering;
     let i = gid.x;
-    if i >= n.x * n.y * n.z {
-        return;
+    var lum = 0.0;
+    if i < n.x * n.y * n.z {
+        let t = scat_texel(i);
+        let s = integrate_single(t);
+        work[p.offsets0.y + i] = vec4<f32>(s.a, 0.0);
+        work[p.offsets0.z + i] = vec4<f32>(s.b, 0.0);
+        let dr = select(0.0, s.db.x / s.a.y, s.a.y > 0.0);
+        let dm = select(0.0, s.db.y / s.b.y, s.b.y > 0.0);
+        work[p.offsets0.w + i] = vec4<f32>(dr, dm, 0.0, 0.0);
+        // The CPU's luminance_sum: single scattering times its phases at the texel's angle.
+        let nu = t.mu * t.mu_s;
+        lum = dot(p.luminance.xyz, s.a) * rayleigh_phase(nu) + dot(p.luminance.xyz, s.b) * mie_phase(nu);
     }
-    let s = integrate_single(scat_texel(i));
-    work[p.offsets0.y + i] = vec4<f32>(s.a, 0.0);
-    work[p.offsets0.z + i] = vec4<f32>(s.b, 0.0);
-    let dr = select(0.0, s.db.x / s.a.y, s.a.y > 0.0);
-    let dm = select(0.0, s.db.y / s.b.y, s.b.y > 0.0);
-    work[p.offsets0.w + i] = vec4<f32>(dr, dm, 0.0, 0.0);
+    store_partial(lid, wg.x, lum);
 }
 
 // Sky irradiance on a horizontal plane from the previous order's radiance (order 1: single
@@ -509,26 +535,16 @@ fn ground(@builtin(global_invocation_id) gid: vec3<u32>) {
     work[p.offsets3.x + (order - 1u) * n.x * n.y + i] = vec4<f32>(e, 0.0);
 }
 
-const SUM_THREADS: u32 = 256u;
-var<workgroup> partial: array<f32, SUM_THREADS>;
-
-// The order's summed luminance over every scattering texel (single scattering times its
-// phases at the texel's own angle, as the CPU's `luminance_sum`), and the stopping rule.
+// The order's summed luminance over every scattering texel (the partials its `single` or
+// `multiple` pass left, one per workgroup of 64 texels), and the stopping rule.
 @compute @workgroup_size(256, 1, 1)
 fn luminance(@builtin(local_invocation_index) lid: u32) {
     let n = p.sizes_scattering;
-    let count = n.x * n.y * n.z;
+    let groups = (n.x * n.y * n.z + 63u) / 64u;
     let order = p.sphere_order.z;
     var sum = 0.0;
-    for (var i = lid; i < count; i += SUM_THREADS) {
-        if order == 1u {
-            let t = scat_texel(i);
-            let nu = t.mu * t.mu_s;
-            sum += dot(p.luminance.xyz, work[p.offsets0.y + i].xyz) * rayleigh_phase(nu);
-            sum += dot(p.luminance.xyz, work[p.offsets0.z + i].xyz) * mie_phase(nu);
-        } else {
-            sum += dot(p.luminance.xyz, work[p.offsets1.x + i].xyz);
-        }
+    for (var i = lid; i < groups; i += SUM_THREADS) {
+        sum += work[p.offsets3.w + i].x;
     }
     partial[lid] = sum;
     workgroupBarrier();
@@ -613,12 +629,19 @@ fn density(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // Multiple scattering of `order`: the density integrated along each texel's ray.
 @compute @workgroup_size(64, 1, 1)
-fn multiple(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn multiple(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg: vec3<u32>) {
     let n = p.sizes_scattering;
     let i = gid.x;
-    if i >= n.x * n.y * n.z || stopped() {
-        return;
+    var lum = 0.0;
+    if i < n.x * n.y * n.z && !stopped() {
+        lum = dot(p.luminance.xyz, multiple_texel(i));
     }
+    store_partial(lid, wg.x, lum);
+}
+
+// Order n's multiple scattering of texel i, written to the delta table and added to the sum.
+fn multiple_texel(i: u32) -> vec3<f32> {
+    let n = p.sizes_scattering;
     let t = scat_texel(i);
     let steps = n.w;
     let d_end = distance_to_boundary(t.r, t.mu, t.hits);
@@ -641,6 +664,7 @@ fn multiple(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     work[p.offsets1.x + i] = vec4<f32>(a, 0.0);
     work[p.offsets1.y + i] += vec4<f32>(a, 0.0);
+    return a;
 }
 
 // The talk's irradiance tables: direct sun plus the summed density divided by each phase.
