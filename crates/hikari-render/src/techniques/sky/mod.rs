@@ -12,8 +12,8 @@
 //!   meter) read a small CPU build ([`SCALAR_TABLE_QUALITY`]).
 //! * `sky.resample`: the 3D tables at this frame's sun and moon zenith angles into a 2D array
 //!   [mu, r] (sun Rayleigh, sun Mie, moon Rayleigh, moon Mie), cubic along mu_s.
-//! * `sky.sh_project`, `sky.sh`: 4096 directions of the sky (no disks) to L2 SH in 64 partial
-//!   sums, then their total, deringed.
+//! * `sky.sh`: 4096 directions of the sky (no disks) to L2 SH, deringed, in one dispatch (16
+//!   workgroups project; the last to finish sums and derings: `sh.wgsl`).
 //! * The shared WGSL modules `hikari::sky` (binding set `sky`: `sky_inscatter`,
 //!   `sky_background`, `sky_transmittance`) and `hikari::sky_ambient` (binding set
 //!   `sky_ambient`: irradiance and specular from the SH); the deferred lighting draws the
@@ -315,8 +315,7 @@ fn upload(ctx: &GpuContext, name: &str, t: &hikari_atmosphere::table::Table) -> 
 
 pub struct Sky {
     resample: ComputePipeline,
-    sh_project: ComputePipeline,
-    sh_finish: ComputePipeline,
+    sh: ComputePipeline,
     uploaded: Mutex<Option<Arc<Uploaded>>>,
     builder: TableBuilder,
     /// What the persistent GPU tables hold now.
@@ -327,8 +326,7 @@ impl Sky {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
             resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
-            sh_project: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project", &[])?,
-            sh_finish: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "finish", &[])?,
+            sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project_dering", &[])?,
             uploaded: Mutex::new(None),
             builder: TableBuilder::new(ctx, lib)?,
             gpu_built: Mutex::new(None),
@@ -480,18 +478,15 @@ impl Sky {
             .read(resampled)
             .read(transmittance)
             .finish();
-        // 64 workgroups of 64 directions, each summed into 9 partial coefficients.
+        // 16 workgroups' partial sums, and their count, which the last workgroup resets.
         let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
-        g.pass("sky.sh_project")
-            .write(partials)
-            .write(sh)
-            .set(lookup)
-            .dispatch(&self.sh_project, [64, 1, 1])?;
+        let (done, _) = g.persistent_buffer("sky.sh_done", 4)?;
         g.pass("sky.sh")
             .write(partials)
             .write(sh)
+            .write(done)
             .set(lookup)
-            .dispatch(&self.sh_finish, [1, 1, 1])?;
+            .dispatch(&self.sh, [16, 1, 1])?;
         let ambient = g
             .binding_set("sky_ambient")
             .constants(&SkyAmbientParams {
