@@ -184,7 +184,10 @@ fn project_dering(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_
     }
     // The last workgroup to finish sums every group's partials and derings: one dispatch, the
     // lookups still spread over 16 workgroups. The partials are stored before the count
-    // (storage barrier), and the count's atomic orders the groups.
+    // (storage barrier), and the count's atomic orders the groups. WGSL has no device-scope
+    // release/acquire, so this is the usual practice (as single-pass downsamplers do it) rather
+    // than a guarantee of the memory model: checked on lavapipe and the H200
+    // (tests/sky.rs: the SH against the twin, and frame after frame).
     storageBarrier();
     if lid == 0u {
         last_group = select(0u, 1u, atomicAdd(&sh_done, 1u) == GROUPS - 1u);
