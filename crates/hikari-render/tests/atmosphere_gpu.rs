@@ -231,3 +231,36 @@ fn gpu_build_time_per_table_at_full_size() {
         start.elapsed().as_secs_f64() * 1e3
     );
 }
+
+/// The tables are built on the first frame and again only when the weather changes (or the
+/// setting moves them to the CPU and back); the time of day alone never rebuilds them.
+#[test]
+fn the_tables_are_rebuilt_only_when_the_weather_changes() {
+    let scene = hikari_scene::builtin::by_name("boxes").unwrap();
+    let mut s = common::small_frame_settings(&scene, 32, 32);
+    s.settings.sky.enabled = true;
+    s.settings.sky.table_quality = 0;
+    let ctx = common::gpu().unwrap();
+    let mut renderer = hikari_render::Renderer::new(ctx, &scene).unwrap();
+    let mut built = |s: &hikari_render::FrameSettings| {
+        let r = renderer.render_reading(s, |_| Vec::new()).unwrap();
+        r.timings.iter().any(|t| t.name.starts_with("sky.tables."))
+    };
+    let mut steps = Vec::new();
+    steps.push(("first frame", built(&s), true));
+    steps.push(("same frame", built(&s), false));
+    s.settings.sky.time = "17:30".into();
+    steps.push(("another time", built(&s), false));
+    s.settings.sky.weather = "hazy".into();
+    steps.push(("hazy", built(&s), true));
+    steps.push(("hazy again", built(&s), false));
+    s.settings.sky.tables_on_gpu = false;
+    steps.push(("tables on the CPU", built(&s), false));
+    s.settings.sky.tables_on_gpu = true;
+    steps.push(("back on the GPU", built(&s), false));
+    s.settings.sky.weather = "clear".into();
+    steps.push(("clear", built(&s), true));
+    for (what, got, want) in steps {
+        assert_eq!(got, want, "{what}: sky.tables.* passes recorded: {got}");
+    }
+}
