@@ -6,6 +6,10 @@
 //! phase functions restore the angle to the sun at run time. All quantities are per unit
 //! extraterrestrial solar illuminance (so the tables read in sr⁻¹ and are scaled by the sun's
 //! illuminance in lux when looked up).
+//!
+//! hikari-render builds the same tables on the GPU (`techniques/sky/tables.wgsl`, which mirrors
+//! this file function by function in f32) and tests them against this build; a change here
+//! needs the same change there.
 
 use std::f64::consts::PI;
 

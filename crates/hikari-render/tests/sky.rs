@@ -286,9 +286,12 @@ fn run_finish(
         .finish();
     let p = g.import_buffer("sky.sh_partials", &buffer);
     let sh = g.buffer("sky.sh", 18 * 16).unwrap();
+    // The module's workgroup count of `project_dering`, which `finish` does not use.
+    let done = g.buffer("sky.sh_done", 4).unwrap();
     g.pass("sky.sh")
         .write(p)
         .write(sh)
+        .write(done)
         .set(lookup)
         .dispatch(pipeline, [1, 1, 1])
         .unwrap();
@@ -406,4 +409,73 @@ fn the_sky_pass_derings_as_hikari_math_does() {
     );
     assert!(windowed >= skies.len() / 4 && untouched >= skies.len() / 4);
     assert!(ties * 50 <= skies.len(), "{ties} strength mismatches");
+}
+
+/// `sky.sh` is one dispatch whose last workgroup derings, found by a count that it resets for
+/// the next frame: a count left over would leave no workgroup last and the SH unwritten, so
+/// morning, afternoon, morning again in one renderer must give two different SH and then the
+/// first one again.
+#[test]
+fn the_sky_sh_follows_the_sky_on_every_frame() {
+    let (scene, morning) = frame("09:00", 32, 32);
+    let (_, afternoon) = frame("15:00", 32, 32);
+    let ctx = common::gpu().unwrap();
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let mut shs = Vec::new();
+    for s in [&morning, &afternoon, &morning] {
+        let r = renderer
+            .render_reading(s, |o| vec![o.sky.sh.into()])
+            .unwrap();
+        shs.push(bytemuck::cast_slice::<u8, [f32; 4]>(r.buffer("sky.sh").unwrap()).to_vec());
+    }
+    assert!(shs[0][0][1] > 0.0, "no sky in the SH: {:?}", shs[0]);
+    assert_ne!(shs[0], shs[1], "the afternoon's SH is the morning's");
+    assert_eq!(shs[0], shs[2]);
+}
+
+/// The sky's per-frame passes and the table build's first frame, GPU timestamps, as `bench`
+/// prints them: `cargo test -p hikari-render --test sky -- --ignored --nocapture` on the
+/// machine to measure (full-size tables, a 256x128 frame: the SH pass does not depend on it).
+#[test]
+#[ignore = "timing: run by hand on real hardware"]
+fn sky_pass_timings() {
+    let (scene, mut s) = frame("09:00", 256, 128);
+    s.settings.sky.table_quality = 2;
+    let ctx = common::gpu().unwrap();
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let mut per_pass: std::collections::BTreeMap<String, Vec<f64>> = Default::default();
+    for frame in 0..40 {
+        let r = renderer.render_reading(&s, |_| Vec::new()).unwrap();
+        let tables: f64 = r
+            .timings
+            .iter()
+            .filter(|t| t.name.starts_with("sky.tables."))
+            .filter_map(|t| t.gpu_ms)
+            .sum();
+        if frame == 0 {
+            println!("frame 0: sky.tables.* {tables:.4} ms GPU");
+        } else {
+            assert_eq!(tables, 0.0, "the tables were rebuilt on frame {frame}");
+        }
+        assert_eq!(
+            r.timings.iter().filter(|t| t.name == "sky.sh").count(),
+            1,
+            "frame {frame}"
+        );
+        for t in r.timings.iter().filter(|t| t.name.starts_with("sky.")) {
+            if frame >= 10 {
+                per_pass.entry(t.name.clone()).or_default().extend(t.gpu_ms);
+            }
+        }
+    }
+    println!(
+        "{:<24} {:>10} {:>10}",
+        "pass (frames 10..40)", "median ms", "min ms"
+    );
+    for (name, mut v) in per_pass {
+        v.sort_by(f64::total_cmp);
+        if let (Some(min), Some(med)) = (v.first(), v.get(v.len() / 2)) {
+            println!("{name:<24} {med:>10.4} {min:>10.4}");
+        }
+    }
 }

@@ -2,15 +2,18 @@
 //! and moon's angles, the sky drawn where no geometry is, and the sky's deringed L2 SH as the
 //! ambient light.
 //!
-//! * Tables: hikari-atmosphere builds them on the CPU (transmittance, and Rayleigh and Mie
-//!   inscattering divided by their phases over [mu, mu_s, r]); they are uploaded once as
-//!   persistent 3D and 2D textures and rebuilt only when the atmosphere's parameters (the
-//!   weather) or the table sizes change. The CPU build is cached per parameters
-//!   ([`atmosphere_for`]), shared with the `hikari sky` command and the directional light.
+//! * Tables (transmittance, and Rayleigh and Mie inscattering divided by their phases over
+//!   [mu, mu_s, r]): built by the GPU passes `sky.tables.*` ([`gpu_build`]) into persistent
+//!   3D and 2D textures, or with `sky.tables_on_gpu = false` built on the CPU by
+//!   hikari-atmosphere (the passes' twin) and uploaded; either way rebuilt only when the
+//!   atmosphere's parameters (the weather) or the table sizes change. The CPU build is cached
+//!   per parameters ([`atmosphere_for`]), shared with the `hikari sky` command; with the GPU
+//!   build, the few CPU-side lookups (the ground's radiance, the sky's lux for the exposure
+//!   meter) read a small CPU build ([`SCALAR_TABLE_QUALITY`]).
 //! * `sky.resample`: the 3D tables at this frame's sun and moon zenith angles into a 2D array
 //!   [mu, r] (sun Rayleigh, sun Mie, moon Rayleigh, moon Mie), cubic along mu_s.
-//! * `sky.sh_project`, `sky.sh`: 4096 directions of the sky (no disks) to L2 SH in 64 partial
-//!   sums, then their total, deringed.
+//! * `sky.sh`: 4096 directions of the sky (no disks) to L2 SH, deringed, in one dispatch (16
+//!   workgroups project; the last to finish sums and derings: `sh.wgsl`).
 //! * The shared WGSL modules `hikari::sky` (binding set `sky`: `sky_inscatter`,
 //!   `sky_background`, `sky_transmittance`) and `hikari::sky_ambient` (binding set
 //!   `sky_ambient`: irradiance and specular from the SH); the deferred lighting draws the
@@ -18,6 +21,7 @@
 //!
 //! CPU twin of every pass: [`reference`].
 
+pub mod gpu_build;
 pub mod lights;
 pub mod reference;
 pub mod settings;
@@ -38,6 +42,7 @@ use crate::error::{RenderError, Result};
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
+use gpu_build::{TableBuilder, TableTargets, WorkLayout};
 use lights::SkyLights;
 use settings::SkySettings;
 use weather::ArtistKnobs;
@@ -77,6 +82,11 @@ pub struct SkyAmbientParams {
 /// Below this sun (or moon) zenith cosine the scattering tables end (hikari-atmosphere's
 /// `MU_S_MIN`, 12° below the horizon); a light lower than that lights no sky.
 pub const MU_S_MIN: f32 = hikari_atmosphere::geometry::MU_S_MIN as f32;
+
+/// With the tables built on the GPU, the CPU-side lookups of a frame (the ground's radiance in
+/// [`SkyParams`], the sky's horizontal lux) read a CPU build at this `table_quality`: a few
+/// tens of ms once per weather instead of the full build, and within a few per cent of it.
+pub const SCALAR_TABLE_QUALITY: u32 = 0;
 
 /// The CPU atmosphere for `params` at `sizes`, built once and kept while the same parameters are
 /// asked for (the last two builds are kept, so alternating between two weathers does not
@@ -139,8 +149,25 @@ impl SkyParams {
         s: &SkySettings,
         camera_altitude_km: f32,
     ) -> Self {
+        Self::with_sizes(
+            atmosphere,
+            atmosphere.tables.sizes,
+            lights,
+            s,
+            camera_altitude_km,
+        )
+    }
+
+    /// The same for GPU tables at `sizes`, with `atmosphere` (same parameters, any sizes)
+    /// giving the CPU-side lookups.
+    pub fn with_sizes(
+        atmosphere: &Atmosphere,
+        sizes: TableSizes,
+        lights: &SkyLights,
+        s: &SkySettings,
+        camera_altitude_km: f32,
+    ) -> Self {
         let p = &atmosphere.params;
-        let sizes = atmosphere.tables.sizes;
         let shell = Shell::new(p.bottom_radius_km, p.top_radius_km);
         let [nmu, nmus, nr] = sizes.scattering;
         let coord = |dir: Vec3| {
@@ -249,6 +276,15 @@ struct Uploaded {
     transmittance: wgpu::Texture,
 }
 
+/// The sky's three tables in this frame's graph, and the CPU atmosphere for its CPU-side
+/// lookups.
+struct FrameTables {
+    atmosphere: Arc<Atmosphere>,
+    rayleigh: Tex,
+    mie: Tex,
+    transmittance: Tex,
+}
+
 fn upload(ctx: &GpuContext, name: &str, t: &hikari_atmosphere::table::Table) -> wgpu::Texture {
     let [nx, ny, nz] = t.size;
     let texels: Vec<[f32; 4]> = t.data.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
@@ -279,18 +315,72 @@ fn upload(ctx: &GpuContext, name: &str, t: &hikari_atmosphere::table::Table) -> 
 
 pub struct Sky {
     resample: ComputePipeline,
-    sh_project: ComputePipeline,
-    sh_finish: ComputePipeline,
+    sh: ComputePipeline,
     uploaded: Mutex<Option<Arc<Uploaded>>>,
+    builder: TableBuilder,
+    /// What the persistent GPU tables hold now.
+    gpu_built: Mutex<Option<(AtmosphereParams, TableSizes)>>,
 }
 
 impl Sky {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
             resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
-            sh_project: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project", &[])?,
-            sh_finish: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "finish", &[])?,
+            sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project_dering", &[])?,
             uploaded: Mutex::new(None),
+            builder: TableBuilder::new(ctx, lib)?,
+            gpu_built: Mutex::new(None),
+        })
+    }
+
+    /// The GPU table builder (for tests and timing: [`TableBuilder::build_and_read`]).
+    pub fn table_builder(&self) -> &TableBuilder {
+        &self.builder
+    }
+
+    /// This frame's tables: persistent textures the `sky.tables.*` passes fill when the
+    /// parameters changed (or the textures are new), else CPU-built uploads.
+    fn frame_tables<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        s: &SkySettings,
+        params: &AtmosphereParams,
+        sizes: TableSizes,
+    ) -> Result<FrameTables> {
+        if !s.tables_on_gpu {
+            let u = self.tables(g.ctx(), params, sizes)?;
+            return Ok(FrameTables {
+                atmosphere: u.atmosphere.clone(),
+                rayleigh: g.import_texture("sky.rayleigh", &u.rayleigh),
+                mie: g.import_texture("sky.mie", &u.mie),
+                transmittance: g.import_texture("sky.transmittance", &u.transmittance),
+            });
+        }
+        let (d3, d2) = gpu_build::table_descs(&sizes);
+        let layout = WorkLayout::new(&sizes, params.max_scattering_orders);
+        let (rayleigh, fresh_r) = g.persistent_texture("sky.rayleigh", d3)?;
+        let (mie, fresh_m) = g.persistent_texture("sky.mie", d3)?;
+        let (transmittance, fresh_t) = g.persistent_texture("sky.transmittance", d2)?;
+        let (work, fresh_w) = g.persistent_buffer("sky.tables.work", layout.bytes())?;
+        let mut built = self.gpu_built.lock().unwrap_or_else(|e| e.into_inner());
+        let current = built
+            .as_ref()
+            .is_some_and(|(p, z)| p == params && *z == sizes);
+        if !current || fresh_r || fresh_m || fresh_t || fresh_w {
+            let to = TableTargets {
+                rayleigh,
+                mie,
+                transmittance,
+                work,
+            };
+            self.builder.record(g, params, &sizes, to)?;
+            *built = Some((params.clone(), sizes));
+        }
+        Ok(FrameTables {
+            atmosphere: atmosphere_for(params, settings::table_sizes(SCALAR_TABLE_QUALITY))?,
+            rayleigh,
+            mie,
+            transmittance,
         })
     }
 
@@ -341,14 +431,15 @@ impl Sky {
         let (atmosphere, sizes) = s
             .table_key()
             .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
-        let u = self.tables(g.ctx(), &atmosphere, sizes)?;
+        let u = self.frame_tables(g, s, &atmosphere, sizes)?;
         let mut lights = frame_lights(s, directional)?;
         let knobs = frame_knobs(s, &lights);
         if !s.sky {
             lights.sun.extraterrestrial_lux = 0.0;
             lights.moon.extraterrestrial_lux = 0.0;
         }
-        let mut params = SkyParams::new(&u.atmosphere, &lights, s, camera_altitude_km);
+        let mut params =
+            SkyParams::with_sizes(&u.atmosphere, sizes, &lights, s, camera_altitude_km);
         let horizontal_sky_lux = if s.sky {
             [&lights.sun, &lights.moon]
                 .iter()
@@ -366,10 +457,8 @@ impl Sky {
         if !s.sun {
             params.disks[3] = 0.0;
         }
-        let rayleigh = g.import_texture("sky.rayleigh", &u.rayleigh);
-        let mie = g.import_texture("sky.mie", &u.mie);
-        let transmittance = g.import_texture("sky.transmittance", &u.transmittance);
-        let [nmu, _, nr] = u.sizes.scattering;
+        let (rayleigh, mie, transmittance) = (u.rayleigh, u.mie, u.transmittance);
+        let [nmu, _, nr] = sizes.scattering;
         let resampled = g.texture(
             "sky.resampled",
             TextureDesc::d2_array(nmu as u32, nr as u32, 4, wgpu::TextureFormat::Rgba32Float),
@@ -389,18 +478,15 @@ impl Sky {
             .read(resampled)
             .read(transmittance)
             .finish();
-        // 64 workgroups of 64 directions, each summed into 9 partial coefficients.
+        // 16 workgroups' partial sums, and their count, which the last workgroup resets.
         let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
-        g.pass("sky.sh_project")
-            .write(partials)
-            .write(sh)
-            .set(lookup)
-            .dispatch(&self.sh_project, [64, 1, 1])?;
+        let (done, _) = g.persistent_buffer("sky.sh_done", 4)?;
         g.pass("sky.sh")
             .write(partials)
             .write(sh)
+            .write(done)
             .set(lookup)
-            .dispatch(&self.sh_finish, [1, 1, 1])?;
+            .dispatch(&self.sh, [16, 1, 1])?;
         let ambient = g
             .binding_set("sky_ambient")
             .constants(&SkyAmbientParams {

@@ -35,6 +35,10 @@ pub struct SkySettings {
     /// Resolution of the atmosphere's tables: 0 the smallest (tests), 1 medium, 2 the
     /// atmosphere crate's defaults. The tables are built on the CPU when the weather changes.
     pub table_quality: u32,
+    /// Build the tables with the GPU passes `sky.tables.*` (true) or on the CPU with
+    /// hikari-atmosphere and upload them (false: the twin, as a fallback). Either way they are
+    /// rebuilt only when the weather or the table quality changes.
+    pub tables_on_gpu: bool,
     /// Multiplies the weather's sky brightness at every time-of-day key, 0 to 16.
     pub sky_brightness_scale: f32,
     /// Multiplies the weather's ambient diffuse balance at every key, 0 to 16.
@@ -61,6 +65,7 @@ impl Default for SkySettings {
             longitude_deg: Place::TSUSHIMA.longitude_deg(),
             weather: "clear".into(),
             table_quality: 2,
+            tables_on_gpu: true,
             sky_brightness_scale: 1.0,
             ambient_diffuse_scale: 1.0,
             ambient_specular_scale: 1.0,

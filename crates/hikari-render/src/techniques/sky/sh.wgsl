@@ -3,18 +3,25 @@
 // then derings it as Ghost of Tsushima does (Sloan 2017's window; hikari::sh's Newton step and
 // depth-3 binary search). CPU twin: reference::sky_sh.
 //
-// Two passes, so that the 4096 lookups spread over the GPU instead of queueing on one
-// workgroup: `project` runs a direction a thread in 64 workgroups and sums each workgroup's
-// 64 terms in workgroup memory; `finish` (one workgroup of 192 threads) adds the 64 partial
-// sums and derings, testing every strength of the search grid at once (see below).
+// One pass, `project_dering` (the frame's `sky.sh`): 16 workgroups of 256 threads project a
+// direction a thread and sum their terms in workgroup memory into partial sums; the last
+// workgroup to finish (an atomic count) adds the 16 partials and derings, testing every
+// strength of the search grid at once (see below). It replaced two dispatches (the projection,
+// then one workgroup adding and deringing): on the H200 those measured 7.9 + 8.0 us, while a
+// single workgroup doing everything measured 22 us (its serial lookups, 4 or 16 a thread,
+// cost more than the second launch). `finish` is the deringing alone from 64 given partial
+// sums; tests/sky.rs feeds it chosen skies.
 
 #import hikari::sky::sky_background_no_disks
 #import hikari::sh::{SH_C0, SH_C1, SH_C2, SH_C3, SH_C4, sh_dering_window, sh_newton_step, sh_poly}
 
-// project: 64 workgroups x 9 partial coefficients (xyz). finish: reads them.
+// 9 coefficients (xyz) per partial sum: project_dering writes 16, finish reads 64.
 @group(0) @binding(0) var<storage, read_write> partials: array<vec4<f32>, 576>;
 // finish: 9 raw coefficients, then 9 deringed ones.
 @group(0) @binding(1) var<storage, read_write> out_sh: array<vec4<f32>, 18>;
+// project_dering: how many of its workgroups have stored their partial sums (persistent, 0
+// between frames). finish: unused.
+@group(0) @binding(2) var<storage, read_write> sh_done: atomic<u32>;
 
 const SAMPLES: u32 = 4096u;
 const THREADS: u32 = 64u;
@@ -22,45 +29,12 @@ const GOLDEN_ANGLE: f32 = 2.39996322972865332;
 
 var<workgroup> terms: array<array<vec3<f32>, 9>, THREADS>;
 
-// Adds the workgroup's 64 rows of `terms` into row 0, a tree of halvings; each level's
-// (row, coefficient) additions are spread over all threads (at most 5 each, not 9 on half).
-fn sum_terms(lid: u32) {
-    workgroupBarrier();
-    for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
-        for (var i = lid; i < stride * 9u; i += THREADS) {
-            let g = i / 9u;
-            let k = i % 9u;
-            terms[g][k] += terms[g + stride][k];
-        }
-        workgroupBarrier();
-    }
-}
-
 // Direction i of the spherical Fibonacci set: equal-area bands in z, golden-angle azimuths.
 fn fibonacci_dir(i: u32) -> vec3<f32> {
     let z = 1.0 - (2.0 * f32(i) + 1.0) / f32(SAMPLES);
     let r = sqrt(max(1.0 - z * z, 0.0));
     let phi = GOLDEN_ANGLE * f32(i);
     return vec3<f32>(r * cos(phi), z, r * sin(phi));
-}
-
-@compute @workgroup_size(64, 1, 1)
-fn project(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg: vec3<u32>) {
-    let d = fibonacci_dir(wg.x * THREADS + lid);
-    let l = sky_background_no_disks(d);
-    terms[lid][0] = l * SH_C0;
-    terms[lid][1] = l * (SH_C1 * d.y);
-    terms[lid][2] = l * (SH_C1 * d.z);
-    terms[lid][3] = l * (SH_C1 * d.x);
-    terms[lid][4] = l * (SH_C2 * d.x * d.y);
-    terms[lid][5] = l * (SH_C2 * d.y * d.z);
-    terms[lid][6] = l * (SH_C3 * (3.0 * d.z * d.z - 1.0));
-    terms[lid][7] = l * (SH_C2 * d.x * d.z);
-    terms[lid][8] = l * (SH_C4 * (d.x * d.x - d.y * d.y));
-    sum_terms(lid);
-    if lid < 9u {
-        partials[wg.x * 9u + lid] = vec4<f32>(terms[0][lid], 0.0);
-    }
 }
 
 // ---- finish: the 64 partial sums, then deringing with the strength grid searched in parallel ----
@@ -152,6 +126,95 @@ fn strength_passes(k: u32) -> bool {
     return !(minima[k * 3u] < 0.0 || minima[k * 3u + 1u] < 0.0 || minima[k * 3u + 2u] < 0.0);
 }
 
+// The 9 coefficients of direction d's radiance l, before the quadrature weight.
+fn project_terms(d: vec3<f32>, l: vec3<f32>) -> array<vec3<f32>, 9> {
+    return array<vec3<f32>, 9>(
+        l * SH_C0,
+        l * (SH_C1 * d.y),
+        l * (SH_C1 * d.z),
+        l * (SH_C1 * d.x),
+        l * (SH_C2 * d.x * d.y),
+        l * (SH_C2 * d.y * d.z),
+        l * (SH_C3 * (3.0 * d.z * d.z - 1.0)),
+        l * (SH_C2 * d.x * d.z),
+        l * (SH_C4 * (d.x * d.x - d.y * d.y)),
+    );
+}
+
+// project_dering: 16 workgroups of 256 threads, a direction a thread.
+const GROUP_THREADS: u32 = 256u;
+const GROUPS: u32 = SAMPLES / GROUP_THREADS;
+
+var<workgroup> last_group: u32;
+
+@compute @workgroup_size(256, 1, 1)
+fn project_dering(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg: vec3<u32>) {
+    let d = fibonacci_dir(wg.x * GROUP_THREADS + lid);
+    let t = project_terms(d, sky_background_no_disks(d));
+    // The 256 rows into the 64 of `terms`, 64 at a time, then a tree of halvings.
+    for (var q = 0u; q < GROUP_THREADS / THREADS; q++) {
+        if lid / THREADS == q {
+            let row = lid % THREADS;
+            if q == 0u {
+                terms[row] = t;
+            } else {
+                terms[row][0] += t[0];
+                terms[row][1] += t[1];
+                terms[row][2] += t[2];
+                terms[row][3] += t[3];
+                terms[row][4] += t[4];
+                terms[row][5] += t[5];
+                terms[row][6] += t[6];
+                terms[row][7] += t[7];
+                terms[row][8] += t[8];
+            }
+        }
+        workgroupBarrier();
+    }
+    for (var stride = THREADS / 2u; stride > 0u; stride >>= 1u) {
+        for (var i = lid; i < stride * 9u; i += GROUP_THREADS) {
+            let g = i / 9u;
+            let k = i % 9u;
+            terms[g][k] += terms[g + stride][k];
+        }
+        workgroupBarrier();
+    }
+    if lid < 9u {
+        partials[wg.x * 9u + lid] = vec4<f32>(terms[0][lid], 0.0);
+    }
+    // The last workgroup to finish sums every group's partials and derings: one dispatch, the
+    // lookups still spread over 16 workgroups. The partials are stored before the count
+    // (storage barrier), and the count's atomic orders the groups. WGSL has no device-scope
+    // release/acquire, so this is the usual practice (as single-pass downsamplers do it) rather
+    // than a guarantee of the memory model: checked on lavapipe and the H200
+    // (tests/sky.rs: the SH against the twin, and frame after frame).
+    storageBarrier();
+    if lid == 0u {
+        last_group = select(0u, 1u, atomicAdd(&sh_done, 1u) == GROUPS - 1u);
+    }
+    if workgroupUniformLoad(&last_group) == 0u {
+        return;
+    }
+    storageBarrier();
+    for (var i = lid; i < GROUPS * 9u; i += GROUP_THREADS) {
+        terms[i / 9u][i % 9u] = partials[i].xyz;
+    }
+    workgroupBarrier();
+    for (var stride = GROUPS / 2u; stride > 0u; stride >>= 1u) {
+        for (var i = lid; i < stride * 9u; i += GROUP_THREADS) {
+            let g = i / 9u;
+            let k = i % 9u;
+            terms[g][k] += terms[g + stride][k];
+        }
+        workgroupBarrier();
+    }
+    dering_and_store(lid);
+    if lid == 0u {
+        // Ready for the next frame (the buffer is persistent and starts at zero).
+        atomicStore(&sh_done, 0u);
+    }
+}
+
 @compute @workgroup_size(192, 1, 1)
 fn finish(@builtin(local_invocation_index) lid: u32) {
     // The same tree of halvings as `project` (and as the one-thread-per-partial version before
@@ -171,7 +234,13 @@ fn finish(@builtin(local_invocation_index) lid: u32) {
         }
         workgroupBarrier();
     }
+    dering_and_store(lid);
+}
 
+// Derings the sum in terms[0] and writes out_sh. Needs a workgroup of at least 192 threads
+// (FINISH_THREADS: 24 minimum searches of 8 threads); threads past those only keep the barriers.
+fn dering_and_store(lid: u32) {
+    let searching = lid < FINISH_THREADS;
     let w = 4.0 * 3.14159265358979 / f32(SAMPLES);
     let raw0 = terms[0][0] * w;
     let raw1 = terms[0][1] * w;
@@ -184,7 +253,7 @@ fn finish(@builtin(local_invocation_index) lid: u32) {
     let raw8 = terms[0][8] * w;
 
     // This thread's share of the minimum search of (strength, channel).
-    let search = lid / SEARCH_THREADS;
+    let search = min(lid, FINISH_THREADS - 1u) / SEARCH_THREADS;
     let j = lid % SEARCH_THREADS;
     let strength = search / 3u;
     let ch = search % 3u;
@@ -204,14 +273,16 @@ fn finish(@builtin(local_invocation_index) lid: u32) {
     let ll = length(lin);
     let has_lin = ll > 0.0;
     let lin_dir = select(vec3<f32>(0.0, 0.0, 1.0), lin / ll, has_lin);
-    var best = consider_start(c, 2u * j, lin_dir, has_lin, NO_MINIMUM);
-    best = consider_start(c, 2u * j + 1u, lin_dir, has_lin, best);
-    candidates[lid] = best;
+    if searching {
+        var best = consider_start(c, 2u * j, lin_dir, has_lin, NO_MINIMUM);
+        best = consider_start(c, 2u * j + 1u, lin_dir, has_lin, best);
+        candidates[lid] = best;
+    }
     workgroupBarrier();
     // Neighbours first, so the left side always holds the earlier slots: keeping it on equal
     // values keeps the serial search's first-found tie-breaking.
     for (var span = 1u; span < SEARCH_THREADS; span <<= 1u) {
-        if (j & (2u * span - 1u)) == 0u {
+        if searching && (j & (2u * span - 1u)) == 0u {
             let right = candidates[lid + span];
             if right.w < candidates[lid].w {
                 candidates[lid] = right;
@@ -219,7 +290,7 @@ fn finish(@builtin(local_invocation_index) lid: u32) {
         }
         workgroupBarrier();
     }
-    if j == 0u {
+    if searching && j == 0u {
         // The serial search's refinement: one more Newton step from the best.
         var b = candidates[lid];
         let r = sh_newton_step(c, b.xyz);
