@@ -138,6 +138,26 @@ pub fn all() -> Vec<StructLayout> {
             [exposure]
         ),
         gpu_layout!(
+            sky::gpu_build::TableBuildParams,
+            "sky/tables.wgsl",
+            [
+                shell,
+                rayleigh,
+                ozone,
+                mie,
+                misc,
+                luminance,
+                sizes_2d,
+                sizes_scattering,
+                sizes_density,
+                sphere_order,
+                offsets0,
+                offsets1,
+                offsets2,
+                offsets3
+            ]
+        ),
+        gpu_layout!(
             taa::TaaParams,
             "taa/resolve.wgsl",
             [history_valid, clip, max_history, _pad]

@@ -16,7 +16,7 @@
 // stop once an order adds under 1 % of the luminance so far) by setting a flag in `work` that
 // makes the later orders' passes return at once.
 
-struct BuildParams {
+struct TableBuildParams {
     // Ground radius, top radius, horizon distance sqrt(top^2 - ground^2) (km), MU_S_MIN.
     shell: vec4<f32>,
     // Rayleigh scattering at sea level per working channel (km^-1); w: its scale height (km).
@@ -48,7 +48,7 @@ struct BuildParams {
     offsets3: vec4<u32>,
 }
 
-@group(0) @binding(0) var<uniform> p: BuildParams;
+@group(0) @binding(0) var<uniform> p: TableBuildParams;
 @group(0) @binding(1) var<storage, read_write> work: array<vec4<f32>>;
 @group(0) @binding(2) var out_rayleigh: texture_storage_3d<rgba32float, write>;
 @group(0) @binding(3) var out_mie: texture_storage_3d<rgba32float, write>;
