@@ -87,6 +87,7 @@
 pub mod error;
 mod file;
 pub mod format;
+pub mod locate;
 pub mod model;
 mod validate;
 
