@@ -41,9 +41,10 @@ pub struct Tetrahedralization {
 
 struct Tet {
     v: [u32; 4],
-    /// Circumcentre and squared radius in f64, for a fast conservative reject.
+    /// Circumcentre and radius in f64, and a bound on their rounding error, for a fast
+    /// conservative reject; an infinite radius leaves every decision to the exact test.
     centre: [f64; 3],
-    radius2: f64,
+    radius: f64,
 }
 
 fn coord(p: [f64; 3]) -> Coord3D<f64> {
@@ -54,6 +55,9 @@ fn coord(p: [f64; 3]) -> Coord3D<f64> {
     }
 }
 
+/// Circumcentre and radius grown by a generous bound on the rounding of the centre (the
+/// condition of the 3x3 solve: `|b|²|c||d| + ...` over the determinant, times 1e-10, far above
+/// f64's 1e-16), so that a point rejected by it is outside the true sphere.
 fn circumsphere(p: [[f64; 3]; 4]) -> ([f64; 3], f64) {
     let a = p[0];
     let sub = |q: [f64; 3]| [q[0] - a[0], q[1] - a[1], q[2] - a[2]];
@@ -74,11 +78,14 @@ fn circumsphere(p: [[f64; 3]; 4]) -> ([f64; 3], f64) {
         (bb * cd[1] + cc * db[1] + dd * bc[1]) / det,
         (bb * cd[2] + cc * db[2] + dd * bc[2]) / det,
     ];
-    if !o.iter().all(|x| x.is_finite()) {
+    let err =
+        1e-10 * (bb * (cc * dd).sqrt() + cc * (dd * bb).sqrt() + dd * (bb * cc).sqrt()) / det.abs();
+    let r = dot(o, o).sqrt() + 2.0 * err;
+    if !(o.iter().all(|x| x.is_finite()) && r.is_finite()) {
         // A (near-)flat tetrahedron: never reject it cheaply, let the exact test decide.
         return ([0.0; 3], f64::INFINITY);
     }
-    ([o[0] + a[0], o[1] + a[1], o[2] + a[2]], dot(o, o))
+    ([o[0] + a[0], o[1] + a[1], o[2] + a[2]], r)
 }
 
 /// Delaunay tetrahedralisation of `points`. Degenerate input (duplicates, four or more
@@ -124,15 +131,23 @@ pub fn tetrahedralize(points: &[[f64; 3]]) -> Result<Tetrahedralization, Delauna
             centre[2] + far * s[2],
         ]);
     }
+    let s = n as u32;
     let make = |v: [u32; 4], verts: &[[f64; 3]]| {
-        let (centre, radius2) = circumsphere(v.map(|i| verts[i as usize]));
-        Tet { v, centre, radius2 }
+        if v.iter().any(|&i| i >= s) {
+            // Vertices a million extents out: the f64 sphere is too coarse to reject with.
+            return Tet {
+                v,
+                centre: [0.0; 3],
+                radius: f64::INFINITY,
+            };
+        }
+        let (centre, radius) = circumsphere(v.map(|i| verts[i as usize]));
+        Tet { v, centre, radius }
     };
     let positive = |v: [u32; 4], verts: &[[f64; 3]]| {
         let [a, b, c, d] = v.map(|i| coord(verts[i as usize]));
         orient3d(a, b, c, d) > 0.0
     };
-    let s = n as u32;
     let mut first = [s, s + 1, s + 2, s + 3];
     if !positive(first, &verts) {
         first.swap(0, 1);
@@ -141,6 +156,7 @@ pub fn tetrahedralize(points: &[[f64; 3]]) -> Result<Tetrahedralization, Delauna
 
     let mut cavity: Vec<[u32; 4]> = Vec::new();
     let mut faces: HashMap<[u32; 3], (u32, [u32; 4], usize)> = HashMap::new();
+    let mut boundary: Vec<([u32; 3], [u32; 4], usize)> = Vec::new();
     for (index, p) in points.iter().enumerate() {
         let pc = coord(*p);
         cavity.clear();
@@ -148,7 +164,7 @@ pub fn tetrahedralize(points: &[[f64; 3]]) -> Result<Tetrahedralization, Delauna
         while k < tets.len() {
             let t = &tets[k];
             let d2 = (0..3).map(|i| (p[i] - t.centre[i]).powi(2)).sum::<f64>();
-            let maybe = !(d2 > t.radius2 * (1.0 + 1e-9) + 1e-12);
+            let maybe = !(d2.sqrt() > t.radius);
             let inside = maybe && {
                 let [a, b, c, d] = t.v.map(|i| coord(verts[i as usize]));
                 insphere(a, b, c, d, pc) > 0.0
@@ -181,10 +197,16 @@ pub fn tetrahedralize(points: &[[f64; 3]]) -> Result<Tetrahedralization, Delauna
                     .or_insert((1, *v, skip));
             }
         }
-        for &(count, v, skip) in faces.values() {
-            if count != 1 {
-                continue;
-            }
+        // In face order, not the hash map's (seeded per map), so that a bake is reproducible.
+        boundary.clear();
+        boundary.extend(
+            faces
+                .iter()
+                .filter(|(_, e)| e.0 == 1)
+                .map(|(k, e)| (*k, e.1, e.2)),
+        );
+        boundary.sort_unstable_by_key(|b| b.0);
+        for &(_, v, skip) in &boundary {
             // The cavity is star-shaped from p, so p stands on the same side of this face as
             // the vertex it replaces and the orientation is kept.
             let mut nv = v;
