@@ -164,7 +164,8 @@ pub fn tetrahedralize(points: &[[f64; 3]]) -> Result<Tetrahedralization, Delauna
         while k < tets.len() {
             let t = &tets[k];
             let d2 = (0..3).map(|i| (p[i] - t.centre[i]).powi(2)).sum::<f64>();
-            let maybe = !(d2.sqrt() > t.radius);
+            // NaN distances (never expected) fall through to the exact test.
+            let maybe = d2.sqrt() <= t.radius || d2.is_nan();
             let inside = maybe && {
                 let [a, b, c, d] = t.v.map(|i| coord(verts[i as usize]));
                 insphere(a, b, c, d, pc) > 0.0

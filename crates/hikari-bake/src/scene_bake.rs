@@ -35,7 +35,7 @@ use crate::{GridBakeOptions, GridLayout, LAYERS, place_probe, placement};
 
 /// Secondary rays per probe-ray hit, by default (see [`crate::transport`]); the error this
 /// leaves is measured by `examples/bake_village.rs`.
-pub const DEFAULT_BOUNCE_RAYS: u32 = 4;
+pub const DEFAULT_BOUNCE_RAYS: u32 = 2;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneBakeOptions {

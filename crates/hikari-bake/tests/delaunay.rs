@@ -96,11 +96,11 @@ fn empty_circumspheres_positive_volumes_mutual_adjacency() {
             }
         }
         for (i, nb) in t.adjacency.iter().enumerate() {
-            for k in 0..4 {
-                if nb[k] == HULL {
+            for (k, &across) in nb.iter().enumerate() {
+                if across == HULL {
                     continue;
                 }
-                let other = t.tets[nb[k] as usize];
+                let other = t.tets[across as usize];
                 let face: Vec<u32> = (0..4).filter(|&j| j != k).map(|j| t.tets[i][j]).collect();
                 assert!(face.iter().all(|v| other.contains(v)), "tet {i} face {k}");
                 assert!(!other.contains(&t.tets[i][k]));
@@ -142,8 +142,8 @@ fn tetrahedra_fill_the_hull_and_every_point_inside_is_located() {
         let v = mesh.tets[tet as usize];
         let mut back = [0.0f64; 3];
         for k in 0..4 {
-            for c in 0..3 {
-                back[c] += f64::from(weights[k]) * f64::from(mesh.positions[v[k] as usize][c]);
+            for (b, x) in back.iter_mut().zip(mesh.positions[v[k] as usize]) {
+                *b += f64::from(weights[k]) * f64::from(x);
             }
         }
         for c in 0..3 {
