@@ -35,7 +35,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         t0.elapsed().as_secs_f64()
     );
     let start = Instant::now();
+    let rays_traced = std::cell::Cell::new(0u64);
     let bake = bake_scene(&scene, &options, &|p| {
+        rays_traced.set(p.rays_traced);
         let eta = p
             .eta()
             .map_or("?".into(), |e| format!("{:.1} s", e.as_secs_f64()));
@@ -85,7 +87,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             m.tets.len()
         );
     }
-    println!("bake: {seconds:.2} s");
+    let probes = (grid_probes + mesh_probes).max(1) as u64;
+    println!(
+        "bake: {seconds:.2} s; {} rays traced, {} a probe on average (placement included), {:.3e} rays/s",
+        rays_traced.get(),
+        rays_traced.get() / probes,
+        rays_traced.get() as f64 / seconds
+    );
     if args.next().as_deref() == Some("--bake-only") {
         return Ok(());
     }

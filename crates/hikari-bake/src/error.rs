@@ -28,4 +28,7 @@ pub enum BakeError {
     },
     #[error("the bake was cancelled")]
     Cancelled,
+    /// Reading or writing the bake file or its checkpoint (the message names the file).
+    #[error("{0}")]
+    File(String),
 }

@@ -54,7 +54,8 @@ use rayon::prelude::*;
 
 pub use error::BakeError;
 pub use scene_bake::{
-    BakeProgress, DEFAULT_BOUNCE_RAYS, SceneBakeOptions, bake_scene, bake_scene_resume,
+    BakeProgress, BakedFile, DEFAULT_BOUNCE_RAYS, SceneBakeOptions, bake_scene, bake_scene_resume,
+    bake_to_file,
 };
 pub use scene_rays::SceneRays;
 pub use sky_visibility::SphereRays;

@@ -16,6 +16,8 @@
 //! transport, a mesh probe is left out of the mesh.
 
 use std::ops::ControlFlow;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
@@ -84,6 +86,8 @@ pub struct BakeProgress {
     pub elapsed: Duration,
     /// Probes done in this run (not resumed), for the rate.
     pub probes_this_run: usize,
+    /// Rays traced in this run so far: probe rays, bounce rays, ground and inside tests.
+    pub rays_traced: u64,
 }
 
 impl BakeProgress {
@@ -159,11 +163,13 @@ struct Tracer<'a> {
     sphere: &'a SphereRays,
     inside: &'a SphereRays,
     options: &'a SceneBakeOptions,
+    /// Rays traced so far, by all threads.
+    traced: AtomicU64,
 }
 
 impl Tracer<'_> {
     fn transport(&self, at: Vec3, seed: u64, stacks: &mut TraversalStacks) -> ProbeTransport {
-        probe_transport(
+        let t = probe_transport(
             self.rays,
             self.albedo,
             self.sphere,
@@ -172,7 +178,13 @@ impl Tracer<'_> {
             seed,
             self.options.enclosure_radius,
             stacks,
-        )
+        );
+        self.traced.fetch_add(t.rays, Ordering::Relaxed);
+        t
+    }
+
+    fn count(&self, rays: u64) {
+        self.traced.fetch_add(rays, Ordering::Relaxed);
     }
 
     fn probe(&self, t: &ProbeTransport) -> (ProbeSh, bool) {
@@ -189,6 +201,7 @@ impl Tracer<'_> {
     /// the spacing; `None` to drop it.
     fn free_position(&self, at: Vec3, spacing: f32, stacks: &mut TraversalStacks) -> Option<Vec3> {
         let inside = |p: Vec3, stacks: &mut TraversalStacks| {
+            self.count(self.inside.len() as u64);
             placement::inside_geometry(
                 self.rays,
                 self.inside,
@@ -246,6 +259,7 @@ pub fn bake_scene_resume(
         sphere: &sphere,
         inside: &inside,
         options,
+        traced: AtomicU64::new(0),
     };
     let grid = &options.grid;
     let n = grid.probes_per_tile as usize;
@@ -272,6 +286,7 @@ pub fn bake_scene_resume(
             sections_total,
             elapsed: start.elapsed(),
             probes_this_run: this_run,
+            rays_traced: tracer.traced.load(Ordering::Relaxed),
         })
     };
     report(0, 0, 0);
@@ -294,7 +309,10 @@ pub fn bake_scene_resume(
                 .into_par_iter()
                 .map_init(TraversalStacks::default, |stacks, c| {
                     let xz = column_xz(c);
-                    placement::ground_height(&rays, xz.x, xz.y, top, lo.y, stacks).0
+                    let (y, traced) =
+                        placement::ground_height(&rays, xz.x, xz.y, top, lo.y, stacks);
+                    tracer.count(traced);
+                    y
                 })
                 .collect();
             let mut probes = Vec::with_capacity(probes_per_tile);
@@ -307,7 +325,9 @@ pub fn bake_scene_resume(
                         let (layer, c) = (k / (n * n), k % (n * n));
                         let xz = column_xz(c);
                         let planned = Vec3::new(xz.x, ground[c] + grid.heights[layer], xz.y);
-                        match place_probe(&rays, &inside, planned, grid, stacks).0 {
+                        let (placed, traced) = place_probe(&rays, &inside, planned, grid, stacks);
+                        tracer.count(traced);
+                        match placed {
                             Some((at, _)) => {
                                 let seed = ((t as u64) << 32) | k as u64;
                                 tracer.probe(&tracer.transport(at, seed, stacks))
@@ -408,4 +428,58 @@ pub fn bake_scene_resume(
         .map_err(|p| BakeError::Scene(format!("the bake failed its own checks: {p}")))?;
     bake.complete = true;
     Ok(bake)
+}
+
+/// A bake written to its file.
+#[derive(Debug)]
+pub struct BakedFile {
+    pub bake: Bake,
+    /// Tiles and meshes taken from a checkpoint instead of baked.
+    pub resumed_sections: usize,
+    /// Why a checkpoint that existed was not used (other scene, settings or version, or
+    /// corrupt), for a warning.
+    pub discarded_checkpoint: Option<hikari_probes::BakeFileError>,
+}
+
+/// Bakes `scene` into `path`: resumes from `<path>.partial` when that holds a checkpoint of
+/// the same scene key and settings, saves a checkpoint after a finished tile or mesh when
+/// `checkpoint_interval` has passed since the last one, and when `cancel` is set (checked
+/// after every tile or mesh; the bake then stops with [`BakeError::Cancelled`] and the next
+/// call resumes it); at the end writes `path` atomically and removes the checkpoint.
+pub fn bake_to_file(
+    scene: &Scene,
+    options: &SceneBakeOptions,
+    path: &Path,
+    progress: &dyn Fn(BakeProgress),
+    cancel: &AtomicBool,
+    checkpoint_interval: Duration,
+) -> Result<BakedFile, BakeError> {
+    let resumed = hikari_probes::resume(path, options.scene_key, bake_settings(options));
+    let resumed_sections = resumed.bake.tiles.len() + resumed.bake.meshes.len();
+    let mut last_save = Instant::now();
+    let mut save_error = None;
+    let result = bake_scene_resume(scene, options, resumed.bake, progress, &mut |bake| {
+        let stop = cancel.load(Ordering::Relaxed);
+        if stop || last_save.elapsed() >= checkpoint_interval {
+            if let Err(e) = hikari_probes::save_checkpoint(path, bake) {
+                save_error = Some(e.to_string());
+                return ControlFlow::Break(());
+            }
+            last_save = Instant::now();
+        }
+        if stop {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    });
+    if let Some(e) = save_error {
+        return Err(BakeError::File(e));
+    }
+    let bake = hikari_probes::finish(path, result?).map_err(|e| BakeError::File(e.to_string()))?;
+    Ok(BakedFile {
+        bake,
+        resumed_sections,
+        discarded_checkpoint: resumed.discarded,
+    })
 }

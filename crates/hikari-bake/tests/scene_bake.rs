@@ -253,3 +253,57 @@ fn gltf_extras_mark_probe_volumes() {
     assert!(e.contains("missing.gltf"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn bake_to_file_checkpoints_on_cancel_and_resumes() {
+    use hikari_bake::bake_to_file;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::time::Duration;
+    let dir = std::env::temp_dir().join(format!("hikari-bake-file-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("room.hikprobe");
+    let scene = room_scene();
+    let options = small_options(vec![room_volume()]);
+    let cancel = AtomicBool::new(false);
+    // Cancel as soon as the first probes are done: the bake stops after its first section.
+    let e = bake_to_file(
+        &scene,
+        &options,
+        &path,
+        &|p| {
+            if p.probes_done > 0 {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        },
+        &cancel,
+        Duration::from_secs(3600),
+    )
+    .unwrap_err();
+    assert!(matches!(e, BakeError::Cancelled));
+    assert!(!path.exists());
+    let partial = hikari_probes::partial_path(&path);
+    assert!(partial.exists());
+    let rays = RefCell::new(0u64);
+    let done = bake_to_file(
+        &scene,
+        &options,
+        &path,
+        &|p| *rays.borrow_mut() = p.rays_traced,
+        &AtomicBool::new(false),
+        Duration::ZERO,
+    )
+    .expect("resumes");
+    assert_eq!(done.resumed_sections, 1);
+    assert!(done.discarded_checkpoint.is_none());
+    assert!(!partial.exists());
+    // Only the mesh was traced in the second run: its probes' rays and inside tests.
+    let mesh = &done.bake.meshes[0];
+    assert!(*rays.borrow() >= mesh.probes.len() as u64 * 64);
+    let read = hikari_probes::read_bake(&path, &options.scene_key).expect("reads");
+    let full = bake_scene(&scene, &options, &|_| {}).expect("bakes");
+    assert!(
+        read == full,
+        "the resumed file differs from an uninterrupted bake"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
