@@ -87,6 +87,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             m.tets.len()
         );
     }
+    // Exterior probes that see (almost) no sky: buried under terrain or sealed in a solid
+    // the inside test let pass.
+    let full = 2.0 * std::f32::consts::PI.sqrt();
+    let sealed: Vec<[f32; 3]> = bake
+        .meshes
+        .iter()
+        .flat_map(|m| m.positions.iter().zip(&m.probes).zip(&m.interior))
+        .filter(|((_, p), i)| !**i && p.sky_visibility[0] < 0.01 * full)
+        .map(|((x, _), _)| *x)
+        .collect();
+    println!(
+        "exterior mesh probes seeing < 1 % of the sky: {} {:?}",
+        sealed.len(),
+        &sealed[..sealed.len().min(5)]
+    );
     let probes = (grid_probes + mesh_probes).max(1) as u64;
     println!(
         "bake: {seconds:.2} s; {} rays traced, {} a probe on average (placement included), {:.3e} rays/s",

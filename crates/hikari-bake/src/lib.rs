@@ -1,7 +1,11 @@
 //! # hikari-bake: offline probe bake on the CPU
 //!
-//! Issue 17's grid of irradiance probes and their sky visibility, traced with hikari-bvh's CPU
-//! traversal on all cores (rayon's global pool; `RAYON_NUM_THREADS` sets its size).
+//! Issue 17's irradiance probes, traced with hikari-bvh's CPU traversal on all cores (rayon's
+//! global pool; `RAYON_NUM_THREADS` sets its size). [`bake_scene`] (and [`bake_scene_resume`],
+//! [`bake_to_file`]) bakes the grid and the tetrahedral meshes of [`volumes`] into a
+//! `hikari_probes::Bake`: sky visibility, bounced sky visibility ([`transport`]) and interior
+//! flags ([`scene_bake`]); docs/irradiance-probes-bake.md describes it all. Below, the grid and
+//! [`bake_grid_sky_visibility`], the first, grid-only entry point (kept).
 //!
 //! ```
 //! use hikari_bake::{GridBakeOptions, bake_grid_sky_visibility};
