@@ -14,4 +14,21 @@ pub enum BakeError {
     Scene(String),
     #[error("building the scene's BVH failed: {0}")]
     Bvh(#[from] hikari_bvh::BvhError),
+    #[error("probe volume `{name}`: {why}")]
+    BadVolume { name: String, why: &'static str },
+    #[error("{}: {what}", path.display())]
+    Gltf {
+        path: std::path::PathBuf,
+        what: String,
+    },
+    #[error("tetrahedralising probe volume `{volume}`: {source}")]
+    Tetrahedralize {
+        volume: String,
+        source: crate::delaunay::DelaunayError,
+    },
+    #[error("the bake was cancelled")]
+    Cancelled,
+    /// Reading or writing the bake file or its checkpoint (the message names the file).
+    #[error("{0}")]
+    File(String),
 }

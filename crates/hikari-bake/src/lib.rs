@@ -1,7 +1,11 @@
 //! # hikari-bake: offline probe bake on the CPU
 //!
-//! Issue 17's grid of irradiance probes and their sky visibility, traced with hikari-bvh's CPU
-//! traversal on all cores (rayon's global pool; `RAYON_NUM_THREADS` sets its size).
+//! Issue 17's irradiance probes, traced with hikari-bvh's CPU traversal on all cores (rayon's
+//! global pool; `RAYON_NUM_THREADS` sets its size). [`bake_scene`] (and [`bake_scene_resume`],
+//! [`bake_to_file`]) bakes the grid and the tetrahedral meshes of [`volumes`] into a
+//! `hikari_probes::Bake`: sky visibility, bounced sky visibility ([`transport`]) and interior
+//! flags ([`scene_bake`]); docs/irradiance-probes-bake.md describes it all. Below, the grid and
+//! [`bake_grid_sky_visibility`], the first, grid-only entry point (kept).
 //!
 //! ```
 //! use hikari_bake::{GridBakeOptions, bake_grid_sky_visibility};
@@ -35,10 +39,15 @@
 //!
 //! See [`sky_visibility`]: `rays_per_probe` Fibonacci-sphere directions, weight `4π / n` each.
 
+pub mod delaunay;
 pub mod error;
 pub mod placement;
+pub mod scene_bake;
 pub mod scene_rays;
 pub mod sky_visibility;
+pub mod surfaces;
+pub mod transport;
+pub mod volumes;
 
 use std::time::Instant;
 
@@ -48,8 +57,13 @@ use hikari_scene::Scene;
 use rayon::prelude::*;
 
 pub use error::BakeError;
+pub use scene_bake::{
+    BakeProgress, BakedFile, DEFAULT_BOUNCE_RAYS, SceneBakeOptions, bake_scene, bake_scene_resume,
+    bake_to_file,
+};
 pub use scene_rays::SceneRays;
 pub use sky_visibility::SphereRays;
+pub use volumes::ProbeVolume;
 
 /// Layers of a grid tile (1.5 m, 10 m, 30 m above the ground by default).
 pub const LAYERS: usize = 3;
@@ -164,7 +178,66 @@ pub struct GridBake {
     pub stats: BakeStats,
 }
 
-fn check(options: &GridBakeOptions) -> Result<(), BakeError> {
+/// Where the grid's tiles lie over a scene's bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridLayout {
+    /// x, z of probe (0, 0) of tile (0, 0), metres.
+    pub origin: Vec2,
+    pub tiles_x: u32,
+    pub tiles_z: u32,
+}
+
+impl GridLayout {
+    /// Enough tiles that the probes span the bounds less one spacing, centred on them: at most
+    /// half a spacing at each side is left to the lookup's clamping, and a scene a hair wider
+    /// than whole tiles (the village's 400.2 m) does not get a row of tiles over nothing.
+    pub fn plan(lo: Vec3, hi: Vec3, options: &GridBakeOptions) -> Self {
+        let tile_size = options.spacing * options.probes_per_tile as f32;
+        let tiles_along = |extent: f32| {
+            let tiles = (((extent - options.spacing) / tile_size).ceil() as u32).max(1);
+            let span = tiles as f32 * tile_size - options.spacing;
+            (tiles, -0.5 * (span - extent))
+        };
+        let ((tiles_x, margin_x), (tiles_z, margin_z)) =
+            (tiles_along(hi.x - lo.x), tiles_along(hi.z - lo.z));
+        Self {
+            origin: Vec2::new(lo.x + margin_x, lo.z + margin_z),
+            tiles_x,
+            tiles_z,
+        }
+    }
+}
+
+/// Lifts a probe planned at `planned` out of geometry: the first of `planned + k * lift_step`
+/// (k = 0, 1, ... up to `max_lift`) outside geometry, with its lift in metres; `None` when all
+/// are inside (the probe is dropped). Also returns the inside-test rays traced.
+pub fn place_probe(
+    rays: &SceneRays,
+    inside_rays: &SphereRays,
+    planned: Vec3,
+    options: &GridBakeOptions,
+    stacks: &mut TraversalStacks,
+) -> (Option<(Vec3, f32)>, u64) {
+    let lifts = (options.max_lift / options.lift_step).floor() as u32;
+    let mut traced = 0u64;
+    for step in 0..=lifts {
+        let lift = step as f32 * options.lift_step;
+        let at = planned + Vec3::Y * lift;
+        traced += inside_rays.len() as u64;
+        if !placement::inside_geometry(
+            rays,
+            inside_rays,
+            at,
+            options.inside_back_face_fraction,
+            stacks,
+        ) {
+            return (Some((at, lift)), traced);
+        }
+    }
+    (None, traced)
+}
+
+pub(crate) fn check(options: &GridBakeOptions) -> Result<(), BakeError> {
     let bad = |option, value: String, why| Err(BakeError::BadOption { option, value, why });
     let positive = |v: f32| v.is_finite() && v > 0.0;
     if !positive(options.spacing) {
@@ -253,17 +326,8 @@ pub fn bake_grid_sky_visibility(
     };
     let n = options.probes_per_tile as usize;
     let tile_size = options.spacing * n as f32;
-    // Enough tiles that the probes span the bounds less one spacing, centred on them: at most
-    // half a spacing at each side is left to the lookup's clamping, and a scene a hair wider
-    // than whole tiles (the village's 400.2 m) does not get a row of tiles over nothing.
-    let tiles_along = |extent: f32| {
-        let tiles = (((extent - options.spacing) / tile_size).ceil() as u32).max(1);
-        let span = tiles as f32 * tile_size - options.spacing;
-        (tiles, -0.5 * (span - extent))
-    };
-    let ((tiles_x, margin_x), (tiles_z, margin_z)) =
-        (tiles_along(hi.x - lo.x), tiles_along(hi.z - lo.z));
-    let origin = Vec2::new(lo.x + margin_x, lo.z + margin_z);
+    let layout = GridLayout::plan(lo, hi, options);
+    let (origin, tiles_x, tiles_z) = (layout.origin, layout.tiles_x, layout.tiles_z);
     let tile_count = (tiles_x * tiles_z) as usize;
     let columns_per_tile = n * n;
 
@@ -292,7 +356,6 @@ pub fn bake_grid_sky_visibility(
     let inside_rays = SphereRays::fibonacci(options.inside_test_rays);
     let probes_per_tile = columns_per_tile * LAYERS;
     let total = tile_count * probes_per_tile;
-    let lifts = (options.max_lift / options.lift_step).floor() as u32;
     let mut probes = Vec::with_capacity(total);
     let mut probe_rays = (0u64, 0u64);
     progress(0, total);
@@ -307,24 +370,8 @@ pub fn bake_grid_sky_visibility(
                 let c = tile * columns_per_tile + col;
                 let xz = column_xz(c);
                 let planned = Vec3::new(xz.x, ground[c].0 + options.heights[layer], xz.y);
-                let mut placement_rays = 0u64;
-                let mut placed = None;
-                for step in 0..=lifts {
-                    let lift = step as f32 * options.lift_step;
-                    let at = planned + Vec3::Y * lift;
-                    placement_rays += inside_rays.len() as u64;
-                    let inside = placement::inside_geometry(
-                        &rays,
-                        &inside_rays,
-                        at,
-                        options.inside_back_face_fraction,
-                        stacks,
-                    );
-                    if !inside {
-                        placed = Some((at, lift));
-                        break;
-                    }
-                }
+                let (placed, placement_rays) =
+                    place_probe(&rays, &inside_rays, planned, options, stacks);
                 match placed {
                     Some((at, lift)) => {
                         let sh = sky_visibility::sky_visibility(&rays, &sphere, at, stacks);

@@ -22,6 +22,10 @@ pub struct SurfaceHit {
     pub back_face: bool,
     /// Index of the scene instance hit.
     pub instance: usize,
+    /// Triangle of the instance's mesh hit.
+    pub primitive: usize,
+    /// Barycentric weights of the triangle's second and third vertices at the hit.
+    pub uv: [f32; 2],
 }
 
 pub struct SceneRays {
@@ -143,7 +147,23 @@ impl SceneRays {
             normal,
             back_face: normal.dot(dir) > 0.0,
             instance: inst,
+            primitive: hit.primitive as usize,
+            uv: [hit.u, hit.v],
         })
+    }
+
+    /// World position of `hit` on its triangle (from the barycentrics, not `origin + t dir`,
+    /// which loses the surface on long rays) and the largest coordinate magnitude of the
+    /// triangle's world vertices, metres: the scale of the traversal's rounding near it.
+    pub fn hit_point(&self, hit: &SurfaceHit) -> Option<(Vec3, f32)> {
+        let xf = self.transforms.get(hit.instance)?;
+        let mesh = *self.instance_mesh.get(hit.instance)?;
+        let [a, b, c] = *self.triangles.get(mesh)?.get(hit.primitive)?;
+        let p = self.positions.get(mesh)?;
+        let [a, b, c] = [a, b, c].map(|i| xf.transform_point3(p[i as usize]));
+        let [u, v] = hit.uv;
+        let scale = a.abs().max(b.abs()).max(c.abs()).max_element();
+        Some((a + (b - a) * u + (c - a) * v, scale))
     }
 
     fn face_normal(&self, instance: usize, primitive: usize) -> Option<Vec3> {

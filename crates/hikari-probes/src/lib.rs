@@ -6,7 +6,8 @@
 //! 30 m above the terrain) and tetrahedral meshes (free probe positions, tetrahedra and their
 //! adjacency). Every probe carries its sky visibility (mono L2 SH) and bounced sky visibility
 //! (RGB L2 SH), both in the order l=0; l=1 m=-1,0,1; l=2 m=-2..2 of the real orthonormal
-//! basis, and an interior flag. See [`model`].
+//! basis, and an interior flag. See [`model`]. [`locate`] finds the tetrahedron holding a
+//! point by walking the adjacency (with barycentric weights), for tools and CPU twins.
 //!
 //! # File format, version 1
 //!
@@ -87,6 +88,7 @@
 pub mod error;
 mod file;
 pub mod format;
+pub mod locate;
 pub mod model;
 mod validate;
 

@@ -141,7 +141,10 @@ pub struct TetMesh {
     pub probes: Vec<ProbeSh>,
     /// One per position: true for probes inside buildings.
     pub interior: Vec<bool>,
-    /// Four distinct probe indices per tetrahedron.
+    /// Four distinct probe indices per tetrahedron. hikari-bake writes them with positive
+    /// volume, `(b - a) · ((c - a) × (d - a)) > 0`, as the Delaunay tetrahedralisation of the
+    /// probes (so the mesh is convex and a walk that leaves through a hull face has left it);
+    /// the reader does not check either.
     pub tets: Vec<[u32; 4]>,
     /// Per tetrahedron, the neighbour across the face opposite vertex k in entry k, or
     /// [`HULL`]. Neighbours are mutual.
