@@ -11,6 +11,7 @@ use crate::raster::{RasterQueues, Rasterizer};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
+use crate::techniques::area_lights::{AreaLightParams, AreaLightScene, AreaLights};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
@@ -83,6 +84,7 @@ pub struct Techniques {
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
+    pub area_lights: AreaLights,
     pub placeholder_tonemap: PlaceholderTonemap,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
@@ -97,6 +99,7 @@ impl Techniques {
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
+            area_lights: AreaLights::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
         })
@@ -109,6 +112,8 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
+    /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`).
+    pub area_lights: Tex,
     /// Linear radiance in nits (Rgba16Float), for the EXR.
     pub hdr: Tex,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
@@ -119,6 +124,7 @@ pub fn record<'r>(
     g: &mut FrameGraph<'r>,
     t: &'r Techniques,
     scene: &'r SceneGpu,
+    area: &'r AreaLightScene,
     s: &FrameSettings,
     state: &mut FrameState,
 ) -> Result<FrameOutputs> {
@@ -179,9 +185,32 @@ pub fn record<'r>(
     if sky.enabled {
         lighting.use_sky(s.settings.sky.sky);
     }
-    let hdr = t
-        .direct_lighting
-        .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
+    // Area lights, and point and spot lights with ray-traced shadows (issue 18), added by the
+    // deferred lighting, which then leaves the point and spot lights to them.
+    let area_params = AreaLightParams::new(
+        &s.settings.area_lights,
+        area.light_count(),
+        scene.light_count,
+        s.metered_lux_with_sky(sky.sky_lux),
+        g.frame_index(),
+    );
+    if area_params.shades_punctual() {
+        lighting.skip_punctual();
+    }
+    let area_lights = t
+        .area_lights
+        .record(g, area, &gbuffer, brdf, scene, &view, &area_params)?;
+    let hdr = t.direct_lighting.record(
+        g,
+        &gbuffer,
+        &shadows,
+        &sky,
+        brdf,
+        scene,
+        &view,
+        &lighting,
+        area_lights,
+    )?;
 
     // 12. Haze and 13. TAA: their issues add them here.
 
@@ -197,6 +226,7 @@ pub fn record<'r>(
         gbuffer,
         shadows,
         sky,
+        area_lights,
         hdr,
         ldr,
     })

@@ -11,6 +11,7 @@
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+pub use crate::techniques::area_lights::settings::AreaLightsSettings;
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
 pub use crate::techniques::sky::settings::SkySettings;
@@ -189,6 +190,7 @@ register_settings! {
     direct_lighting: DirectLightingSettings,
     exposure: ExposureSettings,
     sky: SkySettings,
+    area_lights: AreaLightsSettings,
 }
 
 impl Settings {

@@ -98,6 +98,11 @@ impl LightingParams {
 }
 
 impl LightingParams {
+    /// Leaves the point and spot lights out (another pass shades them, with shadows).
+    pub fn skip_punctual(&mut self) {
+        self.config[1] &= !LIGHTING_PUNCTUAL;
+    }
+
     /// Lights with the atmosphere instead of the placeholders: the sky and its SH ambient
     /// when `sky_light`, else a black sky and no ambient.
     pub fn use_sky(&mut self, sky_light: bool) {
@@ -120,7 +125,9 @@ impl DirectLighting {
     }
 
     /// Radiance in nits of every pixel: lit surfaces, or the sky (or the placeholder sky)
-    /// where depth is 0.
+    /// where depth is 0. `area_lights` (`area_lights.radiance`, nits) is added on surfaces;
+    /// when that pass shades the point and spot lights, clear `LIGHTING_PUNCTUAL` in `params`
+    /// ([`LightingParams::skip_punctual`]).
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
@@ -132,6 +139,7 @@ impl DirectLighting {
         scene: &SceneInFrame,
         view: &View,
         params: &LightingParams,
+        area_lights: Tex,
     ) -> Result<Tex> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
@@ -148,6 +156,7 @@ impl DirectLighting {
             .read(gb.emissive)
             .read(scene.lights)
             .write(radiance)
+            .read(area_lights)
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)

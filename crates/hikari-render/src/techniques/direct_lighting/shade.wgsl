@@ -43,6 +43,8 @@ const LIGHTING_SKY: u32 = 16u;
 @group(0) @binding(6) var gbuffer_emissive: texture_2d<f32>;
 @group(0) @binding(7) var<storage, read> lights: array<LightGpu>;
 @group(0) @binding(8) var out_radiance: texture_storage_2d<rgba16float, write>;
+// Radiance of the area lights and shadowed point and spot lights (area_lights.shade), nits.
+@group(0) @binding(9) var area_light_radiance: texture_2d<f32>;
 
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
@@ -225,6 +227,7 @@ fn main(
         if (flags & LIGHTING_EMISSIVE) != 0u {
             radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;
         }
+        radiance += textureLoad(area_light_radiance, pixel, 0).rgb;
     }
     // NaN fails every comparison, so this also turns NaN into 0.
     radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
