@@ -495,3 +495,66 @@ fn cornell_box_direct_light_matches_mitsuba() {
     assert!((back - 1.0).abs() < 0.02, "back wall ratio {back}");
     assert!((floor - 1.0).abs() < 0.15, "floor ratio {floor}");
 }
+
+/// Which emissive instances become area lights: the size rule, the material flag both ways,
+/// and a point light inside an emissive shell (a lamp's paper) keeping it out, and out of the
+/// shadow rays' BVH.
+#[test]
+fn emissive_meshes_become_area_lights_by_the_rule_and_the_flag() {
+    let quad = |scene: &mut Scene, material: Material, at: Vec3| {
+        scene.materials.push(material);
+        scene.meshes.push(shapes::plane(0.5));
+        scene.instances.push(Instance {
+            mesh: scene.meshes.len() - 1,
+            material: scene.materials.len() - 1,
+            transform: Mat4::from_translation(at),
+        });
+    };
+    let glow = Material::emissive("glow", Vec3::splat(1000.0));
+    let mut scene = Scene::default();
+    quad(
+        &mut scene,
+        Material::diffuse("plain", Vec3::ONE),
+        Vec3::ZERO,
+    );
+    quad(&mut scene, glow.clone(), Vec3::X * 2.0);
+    quad(
+        &mut scene,
+        Material {
+            area_light: Some(false),
+            ..glow.clone()
+        },
+        Vec3::X * 4.0,
+    );
+    // A point light in the plane of this one: inside its (flat) bounds.
+    quad(&mut scene, glow.clone(), Vec3::X * 6.0);
+    quad(
+        &mut scene,
+        Material {
+            area_light: Some(true),
+            ..glow.clone()
+        },
+        Vec3::X * 8.0,
+    );
+    scene.lights.push(hikari_scene::Light::point(
+        "inside",
+        Vec3::X * 6.0,
+        10.0,
+        Vec3::ONE,
+    ));
+    scene.lights.push(hikari_scene::Light::point(
+        "inside the forced one",
+        Vec3::X * 8.0,
+        10.0,
+        Vec3::ONE,
+    ));
+    let lights = PolygonLights::for_scene(&scene);
+    let centres: Vec<f32> = lights.lights.iter().map(|l| l.centroid_radius[0]).collect();
+    assert_eq!(centres, [2.0, 8.0], "skipped: {:?}", lights.skipped);
+    assert_eq!(lights.skipped.len(), 2, "{:?}", lights.skipped);
+    // Flux: pi x luminance x area.
+    let flux = std::f32::consts::PI * 1000.0 * 0.25;
+    assert!((lights.lights[0].radiance_flux[3] - flux).abs() < 1e-3 * flux);
+    // Shadow casters: every instance but the shells around a light (instances 3 and 4).
+    assert_eq!(area_lights::shadow_casters(&scene), [0, 1, 2]);
+}

@@ -113,7 +113,7 @@ impl PolygonLights {
                 .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
                 .collect();
             let area: f32 = areas.iter().sum();
-            if !(area > 0.0) || !area.is_finite() {
+            if area.is_nan() || area <= 0.0 || !area.is_finite() {
                 out.skipped.push((i, "zero area"));
                 continue;
             }

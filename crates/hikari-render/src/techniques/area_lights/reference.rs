@@ -26,8 +26,8 @@ fn luminance(c: Vec3) -> f32 {
 pub fn sample_2d(pixel: [u32; 2], i: u32, rotation: [f32; 4]) -> Vec2 {
     let fract = |x: f32| x - x.floor();
     let (x, y) = (pixel[0] as f32, pixel[1] as f32);
-    let ign = fract(52.982_918_9 * fract(0.067_110_56 * x + 0.005_837_15 * y));
-    let ign2 = fract(52.982_918_9 * fract(0.067_110_56 * (x + 5.0) + 0.005_837_15 * (y + 7.0)));
+    let ign = fract(52.982_92 * fract(0.067_110_56 * x + 0.005_837_15 * y));
+    let ign2 = fract(52.982_92 * fract(0.067_110_56 * (x + 5.0) + 0.005_837_15 * (y + 7.0)));
     let r2 = Vec2::new(fract(i as f32 * 0.754_877_7), fract(i as f32 * 0.569_840_3));
     let s = r2 + Vec2::new(ign, ign2) + Vec2::new(rotation[0], rotation[1]);
     Vec2::new(fract(s.x), fract(s.y))
@@ -128,6 +128,7 @@ impl Frame {
 
 /// Radiance of one pixel (nits): `texel` the G-buffer's, `world` its surface point, `eye` the
 /// camera position. Zero where the G-buffer is empty or the pass is off.
+#[allow(clippy::too_many_arguments)]
 pub fn shade(
     p: &AreaLightParams,
     lights: &PolygonLights,
@@ -307,7 +308,7 @@ pub fn area_visibility(
         let (p0, p1, p2) = (v3(tri.p0_cdf), v3(tri.p1), v3(tri.p2));
         let q = p0 * (1.0 - su) + p1 * (su * (1.0 - u.y)) + p2 * (su * u.y);
         let dist = (q - origin).length();
-        if !(dist > 1e-6) {
+        if dist.is_nan() || dist <= 1e-6 {
             continue;
         }
         let dir = (q - origin) / dist;
@@ -349,7 +350,7 @@ fn shade_area_light(
         n.as_dvec3(),
     );
     let e = fv.dot(n.as_dvec3()) as f32;
-    if !(e > 0.0) {
+    if e.is_nan() || e <= 0.0 {
         return Vec3::ZERO;
     }
     let vis = if p.counts[0] > 0 {
