@@ -217,7 +217,7 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
                 material: v4(f.material.pixel(x, y)),
                 emissive: Vec3::ZERO,
             };
-            want.push(reference::shade(
+            want.push(reference::shade_with_lux(
                 &f.params,
                 lights,
                 &renderer.scene().cpu.lights,
@@ -229,15 +229,17 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
             ));
         }
     }
-    let mean = want.iter().map(|c| c.element_sum() / 3.0).sum::<f32>() / want.len() as f32;
+    let mean = want.iter().map(|c| c.0.element_sum() / 3.0).sum::<f32>() / want.len() as f32;
+    let mean_lux = want.iter().map(|c| c.1).sum::<f32>() / want.len() as f32;
     assert!(mean > 1.0, "the box is lit: mean {mean} nits");
     let (mut bad, mut lit, mut worst) = (0, 0, 0f32);
     for y in 0..64 {
         for x in 0..64 {
-            let w = want[(y * 64 + x) as usize];
+            let (w, w_lux) = want[(y * 64 + x) as usize];
             let g = f.radiance.pixel(x, y);
             lit += (w.max_element() > 0.0) as usize;
-            let mut px = 0f32;
+            // The alpha: lux the light brings, for the exposure meter.
+            let mut px = (g[3] - w_lux).abs() / (0.02 * w_lux + 0.01 * mean_lux);
             for k in 0..3 {
                 let tol = 0.02 * w[k].abs() + 0.01 * mean;
                 px = px.max((g[k] - w[k]).abs() / tol);

@@ -206,7 +206,9 @@ impl AreaLights {
     }
 
     /// `area_lights.radiance`: the area lights' light, and the point and spot lights' when
-    /// `params` says so, in nits; zero where the pass is off.
+    /// `params` says so, in nits (rgb), and the illuminance in lux they bring to the surface,
+    /// shadowed (a: what the deferred lighting's illuminance for the exposure meter lacks);
+    /// zero where the pass is off and on the sky.
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,

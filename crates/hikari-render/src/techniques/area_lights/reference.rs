@@ -139,9 +139,25 @@ pub fn shade(
     world: Vec3,
     eye: Vec3,
 ) -> Vec3 {
+    shade_with_lux(p, lights, punctual, scene, pixel, texel, world, eye).0
+}
+
+/// [`shade`] and the illuminance in lux the lights bring to the surface, shadowed (the
+/// texture's alpha, for the exposure meter).
+#[allow(clippy::too_many_arguments)]
+pub fn shade_with_lux(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> (Vec3, f32) {
     let flags = p.config[1];
     if texel.depth <= 0.0 || flags == 0 {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, 0.0);
     }
     let n = octahedral::decode(texel.normal.truncate().truncate());
     let ta = octahedral::decode(Vec2::new(texel.normal.z, texel.normal.w));
@@ -160,6 +176,7 @@ pub fn shade(
     };
     let origin = world + n * (1e-3 + 1e-3 * (eye - world).length());
     let mut out = Vec3::ZERO;
+    let mut lux = 0.0;
     if flags & AREA_POLYGONS != 0 {
         let keep = p.counts[1].min(MAX_LIGHTS_PER_PIXEL) as usize;
         let mut scored: Vec<(f32, usize)> = Vec::new();
@@ -187,7 +204,10 @@ pub fn shade(
         // Largest first; ties keep the lower index, as the shader's insertion does.
         scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         for (slot, &(_, i)) in scored.iter().take(keep).enumerate() {
-            out += shade_area_light(p, lights, i, slot as u32, scene, pixel, world, origin, &f);
+            let (radiance, e) =
+                shade_area_light(p, lights, i, slot as u32, scene, pixel, world, origin, &f);
+            out += radiance;
+            lux += e;
         }
     }
     if flags & AREA_PUNCTUAL != 0 {
@@ -218,9 +238,11 @@ pub fn shade(
             }
             let (s, d) = f.lobes(l);
             out += (s + d) * e * n.dot(l).max(0.0);
+            lux += luminance(e) * n.dot(l).max(0.0);
         }
     }
-    clamp(out)
+    let lux = if lux >= 0.0 { lux.min(65000.0) } else { 0.0 };
+    (clamp(out), lux)
 }
 
 /// The deferred lighting's point and spot attenuation (`direct_lighting::reference`), with
@@ -339,7 +361,7 @@ fn shade_area_light(
     world: Vec3,
     origin: Vec3,
     f: &Frame,
-) -> Vec3 {
+) -> (Vec3, f32) {
     let light = &lights.lights[i];
     let double_sided = light.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
     let n = f.n;
@@ -351,7 +373,7 @@ fn shade_area_light(
     );
     let e = fv.dot(n.as_dvec3()) as f32;
     if e.is_nan() || e <= 0.0 {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, 0.0);
     }
     let vis = if p.counts[0] > 0 {
         area_visibility(p, lights, i, slot, scene, pixel, origin, n)
@@ -393,5 +415,5 @@ fn shade_area_light(
     let widened = (alpha + 0.5 * size).min(1.0);
     let norm = (alpha / widened).powi(2);
     let (specular, _) = f.lobes(l_s);
-    (specular * norm + diffuse) * radiance
+    ((specular * norm + diffuse) * radiance, luminance(radiance))
 }

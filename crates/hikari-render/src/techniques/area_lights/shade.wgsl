@@ -7,7 +7,8 @@
 // points sampled by area on the light, each weighted by its unshadowed integrand. Point and spot
 // lights: as the deferred lighting shades them, the brightest few per pixel times the fraction
 // of shadow rays to a disc of the light's radius that reach it. Rays: hikari::bvh.
-// Output: radiance in nits. CPU twin: area_lights::reference.
+// Output: radiance in nits (rgb) and the illuminance in lux these lights bring to the surface,
+// shadowed (a), for the exposure meter. CPU twin: area_lights::reference.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
@@ -149,6 +150,8 @@ struct Sums {
 }
 
 var<private> sums: Sums;
+// Illuminance (lux) arriving from the lights shaded so far.
+var<private> lux: f32;
 
 fn add_light(w: vec4<f32>, e: vec3<f32>) {
     sums.a += e * w.x;
@@ -234,6 +237,7 @@ fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origi
         vis = area_visibility(i, slot, pixel, origin, n);
     }
     let radiance = light.radiance_flux.rgb * (e * vis);
+    lux += luminance(radiance);
     // Diffuse lobes from the direction of the vector irradiance.
     let l_d = normalize(f);
     let w_d = brdf_light_weights(brdf, l_d) / max(dot(n, l_d), 1e-4);
@@ -314,6 +318,7 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
     // depth buffer's reconstruction error stays well under.
     let origin = world + n * (1e-3 + 1e-3 * length(to_eye));
     sums = Sums(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    lux = 0.0;
     let flags = params.config.y;
 
     if (flags & AREA_POLYGONS) != 0u {
@@ -401,6 +406,7 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
                     break;
                 }
             }
+            lux += luminance(e) * max(dot(n, l), 0.0);
             add_light(brdf_light_weights(brdf, l), e);
         }
     }
@@ -415,11 +421,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     var radiance = vec3<f32>(0.0);
+    lux = 0.0;
     let d = textureLoad(depth, pixel, 0).r;
     if d > 0.0 && params.config.y != 0u {
         radiance = shade(pixel, d);
     }
     // NaN fails every comparison, so this also turns NaN into 0.
-    radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
-    textureStore(out_radiance, pixel, vec4<f32>(radiance, 1.0));
+    let out = vec4<f32>(radiance, lux);
+    textureStore(out_radiance, pixel, select(vec4<f32>(0.0), min(out, vec4<f32>(MAX_RADIANCE)), out >= vec4<f32>(0.0)));
 }
