@@ -35,7 +35,7 @@ impl Renderer {
     pub fn new(ctx: GpuContext, scene: &Scene) -> Result<Self> {
         let techniques = Techniques::new(&ctx)?;
         let scene_gpu = SceneGpu::upload(&ctx, scene)?;
-        let area_lights = AreaLightScene::new(&ctx, scene)?;
+        let area_lights = AreaLightScene::new(&ctx, scene, &scene_gpu.textures.color)?;
         Ok(Self {
             area_lights,
             runtime: GraphRuntime::new(),

@@ -24,7 +24,6 @@ use crate::graph::{BindingSet, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_bvh::{self, BvhAlpha};
 use crate::scene_gpu::SceneInFrame;
-use crate::scene_textures::TextureArrays;
 use crate::shader::{self, ShaderLibrary};
 use crate::view::View;
 
@@ -143,7 +142,9 @@ pub fn shadow_casters(scene: &Scene) -> Vec<u32> {
 }
 
 impl AreaLightScene {
-    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
+    /// `color_textures`: the scene's sRGB texture array as uploaded (`SceneGpu::textures.color`),
+    /// which the shadow rays' cut-out test samples.
+    pub fn new(ctx: &GpuContext, scene: &Scene, color_textures: &wgpu::Texture) -> Result<Self> {
         let invalid = |e: hikari_bvh::BvhError| RenderError::Graph(format!("area lights: {e}"));
         let blases = scene_bvh::blases(scene, &BuildOptions::default()).map_err(invalid)?;
         let instances = scene_bvh::instances(scene);
@@ -159,8 +160,7 @@ impl AreaLightScene {
         )?;
         bvh.upload_blases(ctx, &blases)?;
         bvh.upload_tlas(ctx, &tlas)?;
-        let (textures, _) = TextureArrays::upload(ctx, scene)?;
-        bvh.upload_alpha(ctx, &BvhAlpha::for_scene(scene), Some(&textures.color))?;
+        bvh.upload_alpha(ctx, &BvhAlpha::for_scene(scene), Some(color_textures))?;
         let lights = PolygonLights::for_scene(scene);
         use wgpu::util::DeviceExt;
         let buffer = |name: &str, bytes: &[u8]| {
