@@ -11,6 +11,7 @@ use crate::raster::{RasterQueues, Rasterizer};
 use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
+use crate::techniques::area_lights::{AreaLightParams, AreaLightScene, AreaLights};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
@@ -89,6 +90,7 @@ pub struct Techniques {
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
+    pub area_lights: AreaLights,
     pub taa: Taa,
     pub exposure: Exposure,
     pub local_tonemap: LocalTonemap,
@@ -106,6 +108,7 @@ impl Techniques {
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
+            area_lights: AreaLights::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
             taa: Taa::new(ctx, &mut lib)?,
             exposure: Exposure::new(ctx, &mut lib)?,
@@ -121,6 +124,8 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
+    /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`).
+    pub area_lights: Tex,
     /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA.
     pub hdr: Tex,
     /// The lit image before TAA.
@@ -137,6 +142,7 @@ pub fn record<'r>(
     g: &mut FrameGraph<'r>,
     t: &'r Techniques,
     scene: &'r SceneGpu,
+    area: &'r AreaLightScene,
     s: &FrameSettings,
     state: &mut FrameState,
 ) -> Result<FrameOutputs> {
@@ -208,9 +214,37 @@ pub fn record<'r>(
     if sky.enabled {
         lighting.use_sky(s.settings.sky.sky);
     }
-    let lit_frame = t
-        .direct_lighting
-        .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
+    // Area lights, and point and spot lights with ray-traced shadows (issue 18), added by the
+    // deferred lighting, which then leaves the point and spot lights to them.
+    //    `direct_lighting.punctual` switches point and spot lights off in both passes.
+    let area_params = AreaLightParams::new(
+        &s.settings.area_lights,
+        area.light_count(),
+        if s.settings.direct_lighting.punctual {
+            scene.light_count
+        } else {
+            0
+        },
+        s.metered_lux_with_sky(sky.sky_lux),
+        g.frame_index(),
+    );
+    if area_params.shades_punctual() {
+        lighting.skip_punctual();
+    }
+    let area_lights = t
+        .area_lights
+        .record(g, area, &gbuffer, brdf, scene, &view, &area_params)?;
+    let lit_frame = t.direct_lighting.record(
+        g,
+        &gbuffer,
+        &shadows,
+        &sky,
+        brdf,
+        scene,
+        &view,
+        &lighting,
+        area_lights,
+    )?;
 
     // 12. Haze: its issue adds it here.
 
@@ -266,6 +300,7 @@ pub fn record<'r>(
         gbuffer,
         shadows,
         sky,
+        area_lights,
         hdr,
         lit,
         illuminance: lit_frame.illuminance,

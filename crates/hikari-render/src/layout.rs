@@ -225,5 +225,20 @@ pub fn all() -> Vec<StructLayout> {
                 blas_index
             ]
         ),
+        gpu_layout!(
+            crate::techniques::area_lights::AreaLightParams,
+            "area_lights/shade.wgsl",
+            [config, counts, values, rotation]
+        ),
+        gpu_layout!(
+            crate::techniques::area_lights::AreaLightGpu,
+            "area_lights/shade.wgsl",
+            [centroid_radius, normal_area, radiance_flux, range]
+        ),
+        gpu_layout!(
+            crate::techniques::area_lights::AreaTriangleGpu,
+            "area_lights/shade.wgsl",
+            [p0_cdf, p1, p2]
+        ),
     ]
 }

@@ -8,6 +8,7 @@ use crate::frame::{self, FrameOutputs, FrameSettings, FrameState, Techniques};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
 use crate::raster::RasterQueues;
 use crate::scene_gpu::SceneGpu;
+use crate::techniques::area_lights::AreaLightScene;
 
 /// A rendered frame: timings, and the images if they were asked for.
 pub struct RenderedFrame {
@@ -25,6 +26,8 @@ pub struct Renderer {
     pub runtime: GraphRuntime,
     techniques: Techniques,
     scene: SceneGpu,
+    /// The scene's area lights and the BVH of its shadow rays.
+    area_lights: AreaLightScene,
     state: FrameState,
 }
 
@@ -32,7 +35,9 @@ impl Renderer {
     pub fn new(ctx: GpuContext, scene: &Scene) -> Result<Self> {
         let techniques = Techniques::new(&ctx)?;
         let scene_gpu = SceneGpu::upload(&ctx, scene)?;
+        let area_lights = AreaLightScene::new(&ctx, scene, &scene_gpu.textures.color)?;
         Ok(Self {
+            area_lights,
             runtime: GraphRuntime::new(),
             techniques,
             scene: scene_gpu,
@@ -43,6 +48,11 @@ impl Renderer {
 
     pub fn scene(&self) -> &SceneGpu {
         &self.scene
+    }
+
+    /// The scene's area lights and shadow-ray BVH.
+    pub fn area_lights(&self) -> &AreaLightScene {
+        &self.area_lights
     }
 
     /// The rasteriser's queue sizes, which grow by themselves; for tests and tuning.
@@ -124,6 +134,7 @@ impl Renderer {
                 &mut g,
                 &self.techniques,
                 &self.scene,
+                &self.area_lights,
                 settings,
                 &mut self.state,
             )?;

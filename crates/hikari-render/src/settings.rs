@@ -11,6 +11,7 @@
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+pub use crate::techniques::area_lights::settings::AreaLightsSettings;
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::exposure::settings::ExposureSettings;
 pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
@@ -195,6 +196,7 @@ register_settings! {
     sky: SkySettings,
     taa: TaaSettings,
     gi_denoiser: GiDenoiserSettings,
+    area_lights: AreaLightsSettings,
 }
 
 impl Settings {

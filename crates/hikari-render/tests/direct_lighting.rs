@@ -42,7 +42,11 @@ fn lit_boxes() -> hikari_scene::Scene {
 }
 
 fn settings_for(scene: &hikari_scene::Scene, w: u32, h: u32) -> FrameSettings {
-    common::small_frame_settings(scene, w, h)
+    let mut s = common::small_frame_settings(scene, w, h);
+    // The twin is of this pass alone: the area lights (tests/area_lights.rs) off, so the point
+    // and spot lights stay here, unshadowed.
+    s.settings.area_lights.enabled = false;
+    s
 }
 
 /// What a comparison of the lighting pass with its twin found.

@@ -741,6 +741,8 @@ impl<'o> Loader<'o> {
                     .as_ref()
                     .map_or(1.0, |o| o.strength())
                     .clamp(0.0, 1.0),
+                area_light: area_light_flag(m.extras())
+                    .map_err(|e| format!("material `{name}`: {e}"))?,
                 name,
                 ..Default::default()
             };
@@ -1066,6 +1068,23 @@ impl<'o> Loader<'o> {
             ));
         }
         Ok(())
+    }
+}
+
+/// The material `extras` flag `{"hikari": {"area_light": true|false}}` ([`Material::area_light`]);
+/// `None` when absent. Other extras are ignored; a flag that is not a boolean is an error.
+fn area_light_flag(extras: &gltf::json::Extras) -> Res<Option<bool>> {
+    let Some(raw) = extras else {
+        return Ok(None);
+    };
+    let value: gltf::json::Value = gltf::json::deserialize::from_str(raw.get())
+        .map_err(|e| format!("extras are not JSON: {e}"))?;
+    match value.get("hikari").and_then(|h| h.get("area_light")) {
+        None => Ok(None),
+        Some(gltf::json::Value::Bool(b)) => Ok(Some(*b)),
+        Some(other) => Err(format!(
+            "extras hikari.area_light must be true or false, not {other}"
+        )),
     }
 }
 

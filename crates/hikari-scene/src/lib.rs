@@ -73,7 +73,9 @@
 //! extension other than the two above listed in `extensionsUsed`. An extension in
 //! `extensionsRequired` that is not supported is an error. Also ignored silently: `zfar` and
 //! `aspectRatio` of cameras (the renderer uses an infinite far plane and the image's aspect
-//! ratio), texture filters (the renderer chooses its own), `extras`.
+//! ratio), texture filters (the renderer chooses its own), `extras` (but a material's
+//! `{"hikari": {"area_light": true}}` or `false`, read into [`Material::area_light`]; any other
+//! value of that key is an error).
 //!
 //! A file without cameras gets one named `auto` framing the bounds of the whole scene
 //! ([`Camera::framing`]); a file without any light gets [`Sun::default`] (100 000 lux).

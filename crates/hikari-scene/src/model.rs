@@ -192,6 +192,10 @@ pub struct Material {
     pub anisotropy: Option<Anisotropy>,
     /// Interior mask in [0, 1] for meshes without a per-vertex one.
     pub interior: Option<f32>,
+    /// Whether instances of this emissive material are polygonal area lights (`Some(true)`),
+    /// never are (`Some(false)`), or follow the renderer's size and power rule (`None`);
+    /// glTF material `extras` `{"hikari": {"area_light": true}}`. docs/area-lights.md.
+    pub area_light: Option<bool>,
 }
 
 impl Default for Material {
@@ -214,6 +218,7 @@ impl Default for Material {
             occlusion_strength: 1.0,
             anisotropy: None,
             interior: None,
+            area_light: None,
         }
     }
 }

@@ -1080,3 +1080,33 @@ fn alpha_modes_load() {
     );
     assert!(!loaded.warnings.iter().any(|w| w.contains("mask")));
 }
+
+/// A material's `extras` `{"hikari": {"area_light": ...}}` sets `Material::area_light`; other
+/// extras are ignored; a flag that is not a boolean is an error naming the material.
+#[test]
+fn area_light_extras_load() {
+    let c = case("area_light_extras", &[], |d, _| {
+        d["materials"] = json!([
+            {"name": "plain"},
+            {"name": "on", "extras": {"hikari": {"area_light": true}, "other": 1}},
+            {"name": "off", "extras": {"hikari": {"area_light": false}}},
+            {"name": "unrelated", "extras": {"tool": "blender"}}
+        ]);
+    });
+    let loaded = load(&c.write()).unwrap();
+    let flags: Vec<_> = loaded
+        .scene
+        .materials
+        .iter()
+        .map(|m| m.area_light)
+        .collect();
+    assert_eq!(flags, [None, Some(true), Some(false), None]);
+    let bad = case("area_light_extras_bad", &[], |d, _| {
+        d["materials"] = json!([{"name": "lamp", "extras": {"hikari": {"area_light": "yes"}}}]);
+    });
+    let e = load(&bad.write()).unwrap_err().to_string();
+    assert!(
+        e.contains("material `lamp`") && e.contains("area_light"),
+        "{e}"
+    );
+}

@@ -3,6 +3,7 @@
 //! passes `sun_shadows.*`, names its dumps `sun_shadows.*`, and is tested in
 //! `tests/sun_shadows.rs`.
 
+pub mod area_lights;
 pub mod direct_lighting;
 pub mod exposure;
 pub mod gbuffer;

@@ -98,6 +98,11 @@ impl LightingParams {
 }
 
 impl LightingParams {
+    /// Leaves the point and spot lights out (another pass shades them, with shadows).
+    pub fn skip_punctual(&mut self) {
+        self.config[1] &= !LIGHTING_PUNCTUAL;
+    }
+
     /// Lights with the atmosphere instead of the placeholders: the sky and its SH ambient
     /// when `sky_light`, else a black sky and no ambient.
     pub fn use_sky(&mut self, sky_light: bool) {
@@ -130,7 +135,10 @@ impl DirectLighting {
     }
 
     /// Radiance in nits of every pixel: lit surfaces, or the sky (or the placeholder sky)
-    /// where depth is 0, and the illuminance at every surface pixel.
+    /// where depth is 0, and the illuminance at every surface pixel. `area_lights`
+    /// (`area_lights.radiance`: nits, alpha its lux) is added on surfaces; when that pass shades
+    /// the point and spot lights, clear `LIGHTING_PUNCTUAL` in `params`
+    /// ([`LightingParams::skip_punctual`]).
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
@@ -142,6 +150,7 @@ impl DirectLighting {
         scene: &SceneInFrame,
         view: &View,
         params: &LightingParams,
+        area_lights: Tex,
     ) -> Result<LitFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
@@ -163,6 +172,7 @@ impl DirectLighting {
             .read(scene.lights)
             .write(radiance)
             .write(illuminance)
+            .read(area_lights)
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)

@@ -46,6 +46,9 @@ const LIGHTING_SKY: u32 = 16u;
 // Illuminance in lux arriving at the surface (sun, lights, ambient; not its own emission), the
 // exposure's meter; -1 on the sky.
 @group(0) @binding(9) var out_illuminance: texture_storage_2d<r32float, write>;
+// Radiance of the area lights and shadowed point and spot lights (area_lights.shade), nits;
+// alpha: the lux they bring to the surface.
+@group(0) @binding(10) var area_light_radiance: texture_2d<f32>;
 
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
@@ -237,6 +240,9 @@ fn main(
         if (flags & LIGHTING_EMISSIVE) != 0u {
             radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;
         }
+        let area = textureLoad(area_light_radiance, pixel, 0);
+        radiance += area.rgb;
+        illuminance += area.a;
     }
     // NaN fails every comparison, so this also turns NaN into 0.
     radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));

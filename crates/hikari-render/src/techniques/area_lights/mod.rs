@@ -1,0 +1,247 @@
+//! Polygonal area lights with ray-traced soft shadows, and the ray-traced shadows of point
+//! and spot lights (docs/area-lights.md). One pass, `area_lights.shade`, writes
+//! `area_lights.radiance` (nits) before the deferred lighting, which adds it. CPU twin:
+//! [`reference`].
+
+pub mod lights;
+pub mod reference;
+pub mod settings;
+
+use bytemuck::{Pod, Zeroable};
+use hikari_bvh::{BuildOptions, Tlas};
+use hikari_scene::Scene;
+use naga_oil::compose::ShaderDefValue;
+
+pub use lights::{AreaLightGpu, AreaTriangleGpu, PolygonLights};
+pub use settings::AreaLightsSettings;
+
+use super::direct_lighting::{LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, RADIANCE_FORMAT};
+use super::gbuffer::GBuffer;
+use crate::bvh_trace::{BvhTrace, TraceConfig};
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::graph::{BindingSet, FrameGraph, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
+use crate::scene_bvh::{self, BvhAlpha};
+use crate::scene_gpu::SceneInFrame;
+use crate::shader::{self, ShaderLibrary};
+use crate::view::View;
+
+/// [`AreaLightParams::config`] `.y` bit: shade the polygonal lights.
+pub const AREA_POLYGONS: u32 = 1;
+/// [`AreaLightParams::config`] `.y` bit: shade point and spot lights, with shadows.
+pub const AREA_PUNCTUAL: u32 = 2;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct AreaLightParams {
+    /// Area lights, `AREA_*` flags, frame index, point and spot lights.
+    pub config: [u32; 4],
+    /// Shadow rays per area light, area lights per pixel, shadowed point and spot lights per
+    /// pixel, shadow rays per point or spot light.
+    pub counts: [u32; 4],
+    /// Minimum flux (lm), point and spot radius (m), point and spot cut-off (lux), 0.
+    pub values: [f32; 4],
+    /// xy: the frame's random rotation of the sample pattern, in [0, 1).
+    pub rotation: [f32; 4],
+}
+
+impl AreaLightParams {
+    /// `metered_lux`: the frame's metered illuminance, which sets the point and spot lights'
+    /// cut-off exactly as the deferred lighting's ([`super::direct_lighting::LightingParams`]).
+    pub fn new(
+        s: &AreaLightsSettings,
+        area_lights: u32,
+        punctual_lights: u32,
+        metered_lux: f32,
+        frame: u64,
+    ) -> Self {
+        let mut flags = 0;
+        if s.enabled && area_lights > 0 {
+            flags |= AREA_POLYGONS;
+        }
+        if s.enabled && s.punctual_shadows && punctual_lights > 0 {
+            flags |= AREA_PUNCTUAL;
+        }
+        Self {
+            config: [area_lights, flags, frame as u32, punctual_lights],
+            counts: [
+                s.shadow_rays,
+                s.lights_per_pixel,
+                s.shadowed_punctual_per_pixel,
+                s.punctual_shadow_rays,
+            ],
+            values: [
+                s.min_flux_lm,
+                s.punctual_radius_m,
+                (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX),
+                0.0,
+            ],
+            rotation: frame_rotation(frame),
+        }
+    }
+
+    /// Whether this pass shades the point and spot lights (the deferred lighting must then
+    /// leave them out).
+    pub fn shades_punctual(&self) -> bool {
+        self.config[1] & AREA_PUNCTUAL != 0
+    }
+}
+
+/// One random rotation of the sample pattern per frame, shared by all pixels (a hash of the
+/// frame index; frame 0 is not rotated, so single renders are repeatable).
+pub fn frame_rotation(frame: u64) -> [f32; 4] {
+    if frame == 0 {
+        return [0.0; 4];
+    }
+    let mut rng = hikari_math::sampling::rng::SplitMix64::stream(frame, "area_lights");
+    [rng.next_f32(), rng.next_f32(), 0.0, 0.0]
+}
+
+/// What the pass needs of a scene, built once when it is loaded: its area lights and a BVH
+/// of its instances at their rest pose for the shadow rays. Instances that are the glowing
+/// shell of a point or spot light are left out of the BVH: they stand for that light's own
+/// light passing through them (the village's lanterns).
+pub struct AreaLightScene {
+    pub lights: PolygonLights,
+    bvh: BvhTrace,
+    light_buffer: wgpu::Buffer,
+    triangle_buffer: wgpu::Buffer,
+}
+
+/// The instances of `scene` that cast shadows: all but emissive shells around a point or spot
+/// light (an emissive instance whose bounds hold a light's position).
+pub fn shadow_casters(scene: &Scene) -> Vec<u32> {
+    (0..scene.instances.len() as u32)
+        .filter(|&i| {
+            let inst = &scene.instances[i as usize];
+            if scene.materials[inst.material].emissive_nits.max_element() <= 0.0 {
+                return true;
+            }
+            let Some((lo, hi)) = scene.meshes[inst.mesh].bounds() else {
+                return true;
+            };
+            let m = inst.transform;
+            let corners = (0..8).map(|k| {
+                m.transform_point3(glam::Vec3::new(
+                    if k & 1 == 0 { lo.x } else { hi.x },
+                    if k & 2 == 0 { lo.y } else { hi.y },
+                    if k & 4 == 0 { lo.z } else { hi.z },
+                ))
+            });
+            let (wlo, whi) = corners.fold(
+                (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+                |(a, b), p| (a.min(p), b.max(p)),
+            );
+            !scene
+                .lights
+                .iter()
+                .any(|l| l.position.cmpge(wlo).all() && l.position.cmple(whi).all())
+        })
+        .collect()
+}
+
+impl AreaLightScene {
+    /// `color_textures`: the scene's sRGB texture array as uploaded (`SceneGpu::textures.color`),
+    /// which the shadow rays' cut-out test samples.
+    pub fn new(ctx: &GpuContext, scene: &Scene, color_textures: &wgpu::Texture) -> Result<Self> {
+        let invalid = |e: hikari_bvh::BvhError| RenderError::Graph(format!("area lights: {e}"));
+        let blases = scene_bvh::blases(scene, &BuildOptions::default()).map_err(invalid)?;
+        let instances = scene_bvh::instances(scene);
+        let tlas = Tlas::build(&instances, &shadow_casters(scene), &blases).map_err(invalid)?;
+        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
+        let mut bvh = BvhTrace::with_config(
+            ctx,
+            &mut lib,
+            TraceConfig {
+                alpha: true,
+                ..TraceConfig::coherent()
+            },
+        )?;
+        bvh.upload_blases(ctx, &blases)?;
+        bvh.upload_tlas(ctx, &tlas)?;
+        bvh.upload_alpha(ctx, &BvhAlpha::for_scene(scene), Some(color_textures))?;
+        let lights = PolygonLights::for_scene(scene);
+        use wgpu::util::DeviceExt;
+        let buffer = |name: &str, bytes: &[u8]| {
+            let padded = [0u8; 64];
+            ctx.device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(name),
+                    contents: if bytes.is_empty() { &padded } else { bytes },
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                })
+        };
+        Ok(Self {
+            light_buffer: buffer("area_lights.lights", bytemuck::cast_slice(&lights.lights)),
+            triangle_buffer: buffer(
+                "area_lights.triangles",
+                bytemuck::cast_slice(&lights.triangles),
+            ),
+            lights,
+            bvh,
+        })
+    }
+
+    pub fn light_count(&self) -> u32 {
+        self.lights.lights.len() as u32
+    }
+}
+
+pub struct AreaLights {
+    shade: ComputePipeline,
+}
+
+impl AreaLights {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Ok(Self {
+            shade: ComputePipeline::new(
+                ctx,
+                lib,
+                "area_lights/shade.wgsl",
+                "main",
+                &[("BVH_ALPHA", ShaderDefValue::Bool(true))],
+            )?,
+        })
+    }
+
+    /// `area_lights.radiance`: the area lights' light, and the point and spot lights' when
+    /// `params` says so, in nits (rgb), and the illuminance in lux they bring to the surface,
+    /// shadowed (a: what the deferred lighting's illuminance for the exposure meter lacks);
+    /// zero where the pass is off and on the sky.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        area: &'r AreaLightScene,
+        gb: &GBuffer,
+        brdf_tables: BindingSet,
+        scene: &SceneInFrame,
+        view: &View,
+        params: &AreaLightParams,
+    ) -> Result<Tex> {
+        let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
+        let radiance = g.texture(
+            "area_lights.radiance",
+            TextureDesc::d2(w, h, RADIANCE_FORMAT),
+        )?;
+        let bvh = area.bvh.import(g)?.binding_set(g);
+        let lights = g.import_buffer("area_lights.lights", &area.light_buffer);
+        let triangles = g.import_buffer("area_lights.triangles", &area.triangle_buffer);
+        g.pass("area_lights.shade")
+            .constants(view)
+            .constants(params)
+            .read(gb.depth)
+            .read(gb.normal)
+            .read(gb.albedo)
+            .read(gb.material)
+            .read(lights)
+            .read(triangles)
+            .read(scene.lights)
+            .write(radiance)
+            .set(brdf_tables)
+            .set(bvh)
+            .dispatch_threads(&self.shade, [w, h, 1])?;
+        Ok(radiance)
+    }
+}

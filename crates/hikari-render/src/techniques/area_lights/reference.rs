@@ -1,0 +1,419 @@
+//! CPU twin of `area_lights.shade`: the polygon integration in f64, the BRDF from
+//! hikari-math (f64), shadow rays through hikari-bvh's CPU traversal of the same BVH, with
+//! the shader's sample pattern.
+
+use glam::{DVec3, Vec2, Vec3};
+use hikari_bvh::{Blas, Ray, Tlas};
+use hikari_math::brdf::{self, Material};
+
+use super::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, AreaTriangleGpu, PolygonLights};
+use super::settings::MAX_LIGHTS_PER_PIXEL;
+use super::{AREA_POLYGONS, AREA_PUNCTUAL, AreaLightParams};
+use crate::reference::octahedral;
+use crate::scene_gpu::LightGpu;
+use crate::techniques::direct_lighting::reference::{Texel, clamp};
+
+fn v3(a: [f32; 4]) -> Vec3 {
+    Vec3::new(a[0], a[1], a[2])
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The shader's sample `i` of `pixel` under the frame rotation `rotation` (R2 sequence, shifted
+/// by interleaved gradient noise and the rotation), in f32 as the shader computes it.
+pub fn sample_2d(pixel: [u32; 2], i: u32, rotation: [f32; 4]) -> Vec2 {
+    let fract = |x: f32| x - x.floor();
+    let (x, y) = (pixel[0] as f32, pixel[1] as f32);
+    let ign = fract(52.982_92 * fract(0.067_110_56 * x + 0.005_837_15 * y));
+    let ign2 = fract(52.982_92 * fract(0.067_110_56 * (x + 5.0) + 0.005_837_15 * (y + 7.0)));
+    let r2 = Vec2::new(fract(i as f32 * 0.754_877_7), fract(i as f32 * 0.569_840_3));
+    let s = r2 + Vec2::new(ign, ign2) + Vec2::new(rotation[0], rotation[1]);
+    Vec2::new(fract(s.x), fract(s.y))
+}
+
+/// Lambert's vector irradiance per unit radiance (sr) of the polygon `q` (vertices relative to
+/// the receiving point, wound so that its front faces the point), clipped to the hemisphere
+/// around `n`: the irradiance on a surface of normal `n` is `L n·F` (Lambert 1760; Arvo 1995).
+pub fn polygon_vector_irradiance(q: &[DVec3], n: DVec3) -> DVec3 {
+    let mut clipped = Vec::with_capacity(q.len() + 1);
+    for i in 0..q.len() {
+        let (a, b) = (q[i], q[(i + 1) % q.len()]);
+        let (da, db) = (a.dot(n), b.dot(n));
+        if da >= 0.0 {
+            clipped.push(a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            clipped.push(a + (b - a) * (da / (da - db)));
+        }
+    }
+    if clipped.len() < 3 {
+        return DVec3::ZERO;
+    }
+    let mut f = DVec3::ZERO;
+    for i in 0..clipped.len() {
+        let a = clipped[i].normalize();
+        let b = clipped[(i + 1) % clipped.len()].normalize();
+        let c = b.cross(a);
+        let s = c.length();
+        let theta = s.atan2(a.dot(b));
+        f += 0.5 * if s < 1e-12 { c } else { c * (theta / s) };
+    }
+    f
+}
+
+/// Vector irradiance per unit radiance of a light's triangles at `world` (see
+/// [`polygon_vector_irradiance`]): back faces skipped, or turned round when double-sided.
+pub fn light_vector_irradiance(
+    tris: &[AreaTriangleGpu],
+    double_sided: bool,
+    world: DVec3,
+    n: DVec3,
+) -> DVec3 {
+    let mut f = DVec3::ZERO;
+    for t in tris {
+        let q0 = v3(t.p0_cdf).as_dvec3() - world;
+        let mut q1 = v3(t.p1).as_dvec3() - world;
+        let mut q2 = v3(t.p2).as_dvec3() - world;
+        if -q0.dot((q1 - q0).cross(q2 - q0)) <= 0.0 {
+            if !double_sided {
+                continue;
+            }
+            std::mem::swap(&mut q1, &mut q2);
+        }
+        f += polygon_vector_irradiance(&[q0, q1, q2], n);
+    }
+    f
+}
+
+/// The scene as the twin traces it: the BVH of `AreaLightScene` (BLAS per mesh, a TLAS over
+/// [`super::shadow_casters`]) and the cut-out test.
+pub struct TwinScene<'a> {
+    pub blases: &'a [Blas],
+    pub tlas: &'a Tlas,
+    pub accept: &'a dyn Fn(u32, u32, f32, f32) -> bool,
+}
+
+impl TwinScene<'_> {
+    fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
+        let ray = Ray::new(origin, dir, 0.0, t_max);
+        self.tlas
+            .any_hit_filtered(self.blases, &ray, |i, p, u, v| (self.accept)(i, p, u, v))
+    }
+}
+
+struct Frame {
+    n: Vec3,
+    t: Vec3,
+    b: Vec3,
+    v: Vec3,
+    m: Material,
+}
+
+impl Frame {
+    /// (specular, diffuse + multiple scattering) of `hikari_math::brdf` towards `l`, each
+    /// divided by n·l: the BRDF, sr⁻¹.
+    fn lobes(&self, l: Vec3) -> (Vec3, Vec3) {
+        let d = |x: Vec3| x.as_dvec3();
+        let lobes =
+            brdf::evaluate_lobes_f64(&self.m, d(self.n), d(self.t), d(self.b), d(self.v), d(l));
+        let cos = (self.n.dot(l) as f64).max(1e-4);
+        (
+            (lobes.specular / cos).as_vec3(),
+            ((lobes.diffuse + lobes.multiple) / cos).as_vec3(),
+        )
+    }
+}
+
+/// Radiance of one pixel (nits): `texel` the G-buffer's, `world` its surface point, `eye` the
+/// camera position. Zero where the G-buffer is empty or the pass is off.
+#[allow(clippy::too_many_arguments)]
+pub fn shade(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> Vec3 {
+    shade_with_lux(p, lights, punctual, scene, pixel, texel, world, eye).0
+}
+
+/// [`shade`] and the illuminance in lux the lights bring to the surface, shadowed (the
+/// texture's alpha, for the exposure meter).
+#[allow(clippy::too_many_arguments)]
+pub fn shade_with_lux(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> (Vec3, f32) {
+    let flags = p.config[1];
+    if texel.depth <= 0.0 || flags == 0 {
+        return (Vec3::ZERO, 0.0);
+    }
+    let n = octahedral::decode(texel.normal.truncate().truncate());
+    let ta = octahedral::decode(Vec2::new(texel.normal.z, texel.normal.w));
+    let t = (ta - n * n.dot(ta)).normalize();
+    let f = Frame {
+        n,
+        t,
+        b: n.cross(t),
+        v: (eye - world).normalize(),
+        m: Material {
+            base_color: texel.albedo.truncate(),
+            perceptual_roughness: texel.material.x,
+            metalness: texel.material.y,
+            anisotropy: texel.material.z,
+        },
+    };
+    let origin = world + n * (1e-3 + 1e-3 * (eye - world).length());
+    let mut out = Vec3::ZERO;
+    let mut lux = 0.0;
+    if flags & AREA_POLYGONS != 0 {
+        let keep = p.counts[1].min(MAX_LIGHTS_PER_PIXEL) as usize;
+        let mut scored: Vec<(f32, usize)> = Vec::new();
+        for (i, l) in lights.lights.iter().enumerate().take(p.config[0] as usize) {
+            if l.radiance_flux[3] < p.values[0] && l.range[2] & AREA_LIGHT_FORCED == 0 {
+                continue;
+            }
+            let to_c = v3(l.centroid_radius) - world;
+            let r = l.centroid_radius[3];
+            if to_c.dot(n) < -r {
+                continue;
+            }
+            let nl = v3(l.normal_area);
+            if l.range[2] & AREA_LIGHT_DOUBLE_SIDED == 0
+                && nl.length() > 0.99
+                && (-to_c).dot(nl) < -r
+            {
+                continue;
+            }
+            let s = l.radiance_flux[3] / to_c.length_squared().max(r * r);
+            if s > 0.0 {
+                scored.push((s, i));
+            }
+        }
+        // Largest first; ties keep the lower index, as the shader's insertion does.
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        for (slot, &(_, i)) in scored.iter().take(keep).enumerate() {
+            let (radiance, e) =
+                shade_area_light(p, lights, i, slot as u32, scene, pixel, world, origin, &f);
+            out += radiance;
+            lux += e;
+        }
+    }
+    if flags & AREA_PUNCTUAL != 0 {
+        let keep = p.counts[2].min(MAX_LIGHTS_PER_PIXEL) as usize;
+        let illuminance = |light: &LightGpu| {
+            let to_light = v3(light.position_range) - world;
+            let d2 = to_light.length_squared();
+            let l = to_light / d2.max(1e-8).sqrt();
+            (l, v3(light.intensity) * attenuation(p, light, l, d2))
+        };
+        let mut scored: Vec<(f32, usize)> = Vec::new();
+        for (i, light) in punctual.iter().enumerate().take(p.config[3] as usize) {
+            let (l, e) = illuminance(light);
+            let s = luminance(e) * n.dot(l).max(0.0);
+            if s > 0.0 {
+                scored.push((s, i));
+            }
+        }
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        scored.truncate(keep);
+        for (i, light) in punctual.iter().enumerate().take(p.config[3] as usize) {
+            let (l, mut e) = illuminance(light);
+            if luminance(e) <= 0.0 {
+                continue;
+            }
+            if let Some(slot) = scored.iter().position(|s| s.1 == i) {
+                e *= punctual_visibility(p, light, slot as u32, scene, pixel, origin);
+            }
+            let (s, d) = f.lobes(l);
+            out += (s + d) * e * n.dot(l).max(0.0);
+            lux += luminance(e) * n.dot(l).max(0.0);
+        }
+    }
+    let lux = if lux >= 0.0 { lux.min(65000.0) } else { 0.0 };
+    (clamp(out), lux)
+}
+
+/// The deferred lighting's point and spot attenuation (`direct_lighting::reference`), with
+/// this pass's cut-off.
+fn attenuation(p: &AreaLightParams, light: &LightGpu, l: Vec3, d2: f32) -> f32 {
+    let peak = v3(light.intensity).max_element();
+    let range = light.position_range[3]
+        .min((peak / p.values[2]).sqrt())
+        .max(1e-3);
+    let x = d2 / (range * range);
+    let window = (1.0 - x * x).clamp(0.0, 1.0);
+    let mut a = window * window / d2.max(1e-4);
+    if light.direction_kind[3] > 0.5 {
+        let s =
+            ((-l).dot(v3(light.direction_kind)) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
+        a *= s * s;
+    }
+    a
+}
+
+fn orthonormal(n: Vec3) -> Vec3 {
+    let a = if n.x.abs() > 0.9 { Vec3::Y } else { Vec3::X };
+    n.cross(a).normalize()
+}
+
+fn punctual_visibility(
+    p: &AreaLightParams,
+    light: &LightGpu,
+    slot: u32,
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    origin: Vec3,
+) -> f32 {
+    let rays = p.counts[3];
+    if rays == 0 {
+        return 1.0;
+    }
+    let pos = v3(light.position_range);
+    let axis = (pos - origin).normalize();
+    let t = orthonormal(axis);
+    let b = axis.cross(t);
+    let mut passed = 0;
+    for s in 0..rays {
+        let u = sample_2d(pixel, 64 + slot * rays + s, p.rotation);
+        let rho = p.values[1] * u.x.sqrt();
+        let phi = 2.0 * std::f32::consts::PI * u.y;
+        let q = pos + rho * (phi.cos() * t + phi.sin() * b);
+        let dist = (q - origin).length();
+        if !scene.occluded(origin, (q - origin) / dist.max(1e-6), dist * (1.0 - 1e-3)) {
+            passed += 1;
+        }
+    }
+    passed as f32 / rays as f32
+}
+
+/// The ratio estimator of the light's visibility (see the shader).
+#[allow(clippy::too_many_arguments)]
+pub fn area_visibility(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    i: usize,
+    slot: u32,
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    origin: Vec3,
+    n: Vec3,
+) -> f32 {
+    let light = &lights.lights[i];
+    let tris = lights.triangles_of(i);
+    let double_sided = light.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
+    let rays = p.counts[0];
+    let (mut num, mut den) = (0.0f32, 0.0f32);
+    for s in 0..rays {
+        let u = sample_2d(pixel, slot * rays + s, p.rotation);
+        let mut j = 0;
+        let mut lo = 0.0;
+        while u.x > tris[j].p0_cdf[3] && j + 1 < tris.len() {
+            lo = tris[j].p0_cdf[3];
+            j += 1;
+        }
+        let tri = &tris[j];
+        let hi = tri.p0_cdf[3];
+        let ux = ((u.x - lo) / (hi - lo).max(1e-12)).clamp(0.0, 1.0);
+        let su = ux.sqrt();
+        let (p0, p1, p2) = (v3(tri.p0_cdf), v3(tri.p1), v3(tri.p2));
+        let q = p0 * (1.0 - su) + p1 * (su * (1.0 - u.y)) + p2 * (su * u.y);
+        let dist = (q - origin).length();
+        if dist.is_nan() || dist <= 1e-6 {
+            continue;
+        }
+        let dir = (q - origin) / dist;
+        let ng = (p1 - p0).cross(p2 - p0).normalize();
+        let mut cos_l = -dir.dot(ng);
+        if double_sided {
+            cos_l = cos_l.abs();
+        }
+        let w = dir.dot(n).max(0.0) * cos_l.max(0.0) / (dist * dist);
+        if w > 0.0 {
+            if !scene.occluded(origin, dir, dist * (1.0 - 1e-3)) {
+                num += w;
+            }
+            den += w;
+        }
+    }
+    if den > 0.0 { num / den } else { 1.0 }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn shade_area_light(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    i: usize,
+    slot: u32,
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    world: Vec3,
+    origin: Vec3,
+    f: &Frame,
+) -> (Vec3, f32) {
+    let light = &lights.lights[i];
+    let double_sided = light.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
+    let n = f.n;
+    let fv = light_vector_irradiance(
+        lights.triangles_of(i),
+        double_sided,
+        world.as_dvec3(),
+        n.as_dvec3(),
+    );
+    let e = fv.dot(n.as_dvec3()) as f32;
+    if e.is_nan() || e <= 0.0 {
+        return (Vec3::ZERO, 0.0);
+    }
+    let vis = if p.counts[0] > 0 {
+        area_visibility(p, lights, i, slot, scene, pixel, origin, n)
+    } else {
+        1.0
+    };
+    let radiance = v3(light.radiance_flux) * (e * vis);
+    let l_d = fv.normalize().as_vec3();
+    let (_, diffuse) = f.lobes(l_d);
+    // The representative point of the specular lobe (see the shader).
+    let c = v3(light.centroid_radius);
+    let radius = light.centroid_radius[3];
+    let nl = v3(light.normal_area);
+    let r = 2.0 * n.dot(f.v) * n - f.v;
+    let mut q = c;
+    let denom = r.dot(nl);
+    if nl.length() > 0.1 && denom.abs() > 1e-6 {
+        let t = (c - world).dot(nl) / denom;
+        if t > 0.0 {
+            q = world + r * t;
+        }
+    }
+    let mut off = q - c;
+    if nl.length() > 0.1 {
+        let u = nl.normalize();
+        off -= u * off.dot(u);
+    }
+    if off.length() > radius {
+        off *= radius / off.length();
+    }
+    let mut l_s = (c + off - world).normalize();
+    if l_s.dot(n) <= 1e-4 {
+        l_s = l_d;
+    }
+    let (ax, ay) = f.m.alphas();
+    let alpha = (ax * ay).sqrt() as f32;
+    let size =
+        (light.normal_area[3] / std::f32::consts::PI).sqrt() / (c - world).length().max(1e-4);
+    let widened = (alpha + 0.5 * size).min(1.0);
+    let norm = (alpha / widened).powi(2);
+    let (specular, _) = f.lobes(l_s);
+    ((specular * norm + diffuse) * radiance, luminance(radiance))
+}

@@ -1,0 +1,432 @@
+// Polygonal area lights and shadowed point and spot lights (docs/area-lights.md).
+//
+// Area lights: the unshadowed light of each polygon in closed form (Lambert's vector
+// irradiance of each front-facing triangle clipped to the surface's horizon: exact for the
+// diffuse lobe), the specular lobe at a representative point with Karis's widening, both times
+// a shadow factor: the ratio estimator of stochastic shadows (Heitz et al. 2018), shadow rays to
+// points sampled by area on the light, each weighted by its unshadowed integrand. Point and spot
+// lights: as the deferred lighting shades them, the brightest few per pixel times the fraction
+// of shadow rays to a disc of the light's radius that reach it. Rays: hikari::bvh.
+// Output: radiance in nits (rgb) and the illuminance in lux these lights bring to the surface,
+// shadowed (a), for the exposure meter. CPU twin: area_lights::reference.
+
+#import hikari::view::{View, world_from_depth}
+#import hikari::octahedral::oct_decode
+#import hikari::brdf::{BrdfMaterial, BrdfView, brdf_view, brdf_light_weights, brdf_apply_weights}
+#import hikari::scene_gpu::LightGpu
+#import hikari::bvh::{Ray, bvh_occluded}
+
+struct AreaLightParams {
+    // x: area lights; y: AREA_* flags; z: frame index; w: point and spot lights.
+    config: vec4<u32>,
+    // x: shadow rays per area light; y: area lights per pixel; z: shadowed point and spot
+    // lights per pixel; w: shadow rays per point or spot light.
+    counts: vec4<u32>,
+    // x: min flux (lm); y: point and spot radius (m); z: point and spot cut-off (lux); w: 0.
+    values: vec4<f32>,
+    // xy: this frame's random rotation of the sample pattern, in [0, 1).
+    rotation: vec4<f32>,
+}
+
+struct AreaLightGpu {
+    centroid_radius: vec4<f32>,
+    normal_area: vec4<f32>,
+    radiance_flux: vec4<f32>,
+    range: vec4<u32>,
+}
+
+struct AreaTriangleGpu {
+    p0_cdf: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+}
+
+const AREA_POLYGONS: u32 = 1u;
+const AREA_PUNCTUAL: u32 = 2u;
+const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
+const AREA_LIGHT_FORCED: u32 = 2u;
+const MAX_PER_PIXEL: u32 = 8u;
+const NONE: u32 = 0xffffffffu;
+const PI: f32 = 3.14159265358979;
+const MAX_RADIANCE: f32 = 65000.0;
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<uniform> params: AreaLightParams;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var gbuffer_normal: texture_2d<f32>;
+@group(0) @binding(4) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(5) var gbuffer_material: texture_2d<f32>;
+@group(0) @binding(6) var<storage, read> area_lights: array<AreaLightGpu>;
+@group(0) @binding(7) var<storage, read> area_triangles: array<AreaTriangleGpu>;
+@group(0) @binding(8) var<storage, read> lights: array<LightGpu>;
+@group(0) @binding(9) var out_radiance: texture_storage_2d<rgba16float, write>;
+
+// The sample pattern: Roberts's R2 sequence, shifted per pixel by interleaved gradient noise
+// (Jimenez 2014) and per frame by one random rotation shared by every pixel.
+fn sample_2d(pixel: vec2<u32>, i: u32) -> vec2<f32> {
+    let p = vec2<f32>(pixel);
+    let ign = fract(52.9829189 * fract(0.06711056 * p.x + 0.00583715 * p.y));
+    let ign2 = fract(52.9829189 * fract(0.06711056 * (p.x + 5.0) + 0.00583715 * (p.y + 7.0)));
+    let r2 = fract(f32(i) * vec2<f32>(0.7548776662, 0.5698402910));
+    return fract(r2 + vec2<f32>(ign, ign2) + params.rotation.xy);
+}
+
+// Half the angle-weighted edge normal of edge a -> b (unit vectors from the point), oriented
+// for a polygon whose front faces the point: Lambert's vector irradiance is the sum over edges.
+fn edge_vector(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    let c = cross(b, a);
+    let s = length(c);
+    let cos_t = dot(a, b);
+    let theta = atan2(s, cos_t);
+    let k = select(theta / s, 1.0, s < 1e-7);
+    return 0.5 * k * c;
+}
+
+// Vector irradiance per unit radiance of triangle q0 q1 q2 (relative to the point, front face
+// towards it), clipped to the upper hemisphere of n.
+fn triangle_vector_irradiance(q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var q = array<vec3<f32>, 3>(q0, q1, q2);
+    var out: array<vec3<f32>, 4>;
+    var count = 0u;
+    for (var i = 0u; i < 3u; i++) {
+        let a = q[i];
+        let b = q[(i + 1u) % 3u];
+        let da = dot(a, n);
+        let db = dot(b, n);
+        if da >= 0.0 {
+            out[count] = a;
+            count++;
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            out[count] = a + (b - a) * (da / (da - db));
+            count++;
+        }
+    }
+    var f = vec3<f32>(0.0);
+    if count < 3u {
+        return f;
+    }
+    for (var i = 0u; i < count; i++) {
+        let a = normalize(out[i]);
+        let b = normalize(out[(i + 1u) % count]);
+        f += edge_vector(a, b);
+    }
+    return f;
+}
+
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// Where a light's illuminance falls to the frame's cutoff, or its own range if nearer (as the
+// deferred lighting).
+fn light_range(light: LightGpu) -> f32 {
+    let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
+    return max(min(light.position_range.w, sqrt(peak / params.values.z)), 1e-3);
+}
+
+fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
+    let range = light_range(light);
+    let x = d2 / (range * range);
+    let window = clamp(1.0 - x * x, 0.0, 1.0);
+    var a = window * window / max(d2, 1e-4);
+    if light.direction_kind.w > 0.5 {
+        let s = clamp(dot(-l, light.direction_kind.xyz) * light.spot.x + light.spot.y, 0.0, 1.0);
+        a *= s * s;
+    }
+    return a;
+}
+
+fn orthonormal(n: vec3<f32>) -> vec3<f32> {
+    let a = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
+    return normalize(cross(n, a));
+}
+
+struct Sums {
+    a: vec3<f32>,
+    b: vec3<f32>,
+    c: vec3<f32>,
+    d: vec3<f32>,
+}
+
+var<private> sums: Sums;
+// Illuminance (lux) arriving from the lights shaded so far.
+var<private> lux: f32;
+
+fn add_light(w: vec4<f32>, e: vec3<f32>) {
+    sums.a += e * w.x;
+    sums.b += e * w.y;
+    sums.c += e * w.z;
+    sums.d += e * w.w;
+}
+
+// Fraction of the light of area light `i` that reaches `origin` unblocked (ratio estimator).
+fn area_visibility(i: u32, slot: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> f32 {
+    let light = area_lights[i];
+    let first = light.range.x;
+    let last = first + light.range.y - 1u;
+    let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
+    let rays = params.counts.x;
+    var num = 0.0;
+    var den = 0.0;
+    for (var s = 0u; s < rays; s++) {
+        let u = sample_2d(pixel, slot * rays + s);
+        var j = first;
+        var lo = 0.0;
+        loop {
+            let cdf = area_triangles[j].p0_cdf.w;
+            if u.x <= cdf || j >= last {
+                break;
+            }
+            lo = cdf;
+            j++;
+        }
+        let tri = area_triangles[j];
+        let hi = tri.p0_cdf.w;
+        let ux = clamp((u.x - lo) / max(hi - lo, 1e-12), 0.0, 1.0);
+        let su = sqrt(ux);
+        let p = tri.p0_cdf.xyz * (1.0 - su) + tri.p1.xyz * (su * (1.0 - u.y)) + tri.p2.xyz * (su * u.y);
+        let to_p = p - origin;
+        let dist = length(to_p);
+        if !(dist > 1e-6) {
+            continue;
+        }
+        let dir = to_p / dist;
+        let ng = normalize(cross(tri.p1.xyz - tri.p0_cdf.xyz, tri.p2.xyz - tri.p0_cdf.xyz));
+        var cos_l = -dot(dir, ng);
+        if double_sided {
+            cos_l = abs(cos_l);
+        }
+        let w = max(dot(dir, n), 0.0) * max(cos_l, 0.0) / (dist * dist);
+        if w > 0.0 {
+            let blocked = bvh_occluded(Ray(origin, 0.0, dir, dist * (1.0 - 1e-3)));
+            num += select(w, 0.0, blocked);
+            den += w;
+        }
+    }
+    return select(1.0, num / den, den > 0.0);
+}
+
+fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origin: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView) {
+    let light = area_lights[i];
+    let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
+    var f = vec3<f32>(0.0);
+    for (var j = light.range.x; j < light.range.x + light.range.y; j++) {
+        let tri = area_triangles[j];
+        let q0 = tri.p0_cdf.xyz - world;
+        var q1 = tri.p1.xyz - world;
+        var q2 = tri.p2.xyz - world;
+        let side = -dot(q0, cross(q1 - q0, q2 - q0));
+        if side <= 0.0 {
+            if !double_sided {
+                continue;
+            }
+            let t = q1;
+            q1 = q2;
+            q2 = t;
+        }
+        f += triangle_vector_irradiance(q0, q1, q2, n);
+    }
+    // Irradiance per unit radiance (sr): the light's projected solid angle.
+    let e = dot(f, n);
+    if !(e > 0.0) {
+        return;
+    }
+    var vis = 1.0;
+    if params.counts.x > 0u {
+        vis = area_visibility(i, slot, pixel, origin, n);
+    }
+    let radiance = light.radiance_flux.rgb * (e * vis);
+    lux += luminance(radiance);
+    // Diffuse lobes from the direction of the vector irradiance.
+    let l_d = normalize(f);
+    let w_d = brdf_light_weights(brdf, l_d) / max(dot(n, l_d), 1e-4);
+    // Specular at the representative point: the reflected ray's hit of the light's mean plane,
+    // pulled into the disc of the light's bounding radius; the lobe widened by the light's
+    // size seen from the point, its peak lowered to keep its energy (Karis 2013).
+    let c = light.centroid_radius.xyz;
+    let radius = light.centroid_radius.w;
+    let nl = light.normal_area.xyz;
+    let r = reflect(-v, n);
+    var p = c;
+    let denom = dot(r, nl);
+    if length(nl) > 0.1 && abs(denom) > 1e-6 {
+        let t = dot(c - world, nl) / denom;
+        if t > 0.0 {
+            p = world + r * t;
+        }
+    }
+    var off = p - c;
+    if length(nl) > 0.1 {
+        off -= normalize(nl) * dot(off, normalize(nl));
+    }
+    let lo = length(off);
+    if lo > radius {
+        off *= radius / lo;
+    }
+    var l_s = normalize(c + off - world);
+    if dot(l_s, n) <= 1e-4 {
+        l_s = l_d;
+    }
+    let alpha = sqrt(brdf.alphas.x * brdf.alphas.y);
+    let size = sqrt(light.normal_area.w / PI) / max(length(c - world), 1e-4);
+    let widened = min(alpha + 0.5 * size, 1.0);
+    let norm = (alpha / widened) * (alpha / widened);
+    let w_s = brdf_light_weights(brdf, l_s) * (norm / max(dot(n, l_s), 1e-4));
+    add_light(vec4<f32>(w_s.x, w_s.y, w_d.z, w_d.w), radiance);
+}
+
+// Fraction of shadow rays from `origin` to a disc of the light's radius facing it that pass.
+fn punctual_visibility(light: LightGpu, slot: u32, pixel: vec2<u32>, origin: vec3<f32>) -> f32 {
+    let rays = params.counts.w;
+    if rays == 0u {
+        return 1.0;
+    }
+    let to_light = light.position_range.xyz - origin;
+    let axis = normalize(to_light);
+    let t = orthonormal(axis);
+    let b = cross(axis, t);
+    var passed = 0u;
+    for (var s = 0u; s < rays; s++) {
+        let u = sample_2d(pixel, 64u + slot * rays + s);
+        let rho = params.values.y * sqrt(u.x);
+        let phi = 2.0 * PI * u.y;
+        let p = light.position_range.xyz + rho * (cos(phi) * t + sin(phi) * b);
+        let to_p = p - origin;
+        let dist = length(to_p);
+        if !bvh_occluded(Ray(origin, 0.0, to_p / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
+            passed++;
+        }
+    }
+    return f32(passed) / f32(rays);
+}
+
+fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
+    let world = world_from_depth(view, pixel, d);
+    let to_eye = view.position.xyz - world;
+    let v = normalize(to_eye);
+    let nt = textureLoad(gbuffer_normal, pixel, 0);
+    let n = oct_decode(nt.xy);
+    let ta = oct_decode(nt.zw);
+    let t = normalize(ta - n * dot(n, ta));
+    let b = cross(n, t);
+    let albedo = textureLoad(gbuffer_albedo, pixel, 0);
+    let mat = textureLoad(gbuffer_material, pixel, 0);
+    let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
+    let brdf = brdf_view(m, n, t, b, v);
+    // Off the surface by a thousandth of the distance to the eye (and a millimetre), which the
+    // depth buffer's reconstruction error stays well under.
+    let origin = world + n * (1e-3 + 1e-3 * length(to_eye));
+    sums = Sums(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    lux = 0.0;
+    let flags = params.config.y;
+
+    if (flags & AREA_POLYGONS) != 0u {
+        // The lights of largest flux / distance^2 here, at most counts.y, largest first.
+        var sel: array<u32, MAX_PER_PIXEL>;
+        var score: array<f32, MAX_PER_PIXEL>;
+        let keep = min(params.counts.y, MAX_PER_PIXEL);
+        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+            sel[k] = NONE;
+            score[k] = 0.0;
+        }
+        for (var i = 0u; i < params.config.x; i++) {
+            let light = area_lights[i];
+            if light.radiance_flux.w < params.values.x && (light.range.z & AREA_LIGHT_FORCED) == 0u {
+                continue;
+            }
+            let to_c = light.centroid_radius.xyz - world;
+            let r = light.centroid_radius.w;
+            // Wholly below the horizon, or wholly behind a one-sided light's mean plane.
+            if dot(to_c, n) < -r {
+                continue;
+            }
+            if (light.range.z & AREA_LIGHT_DOUBLE_SIDED) == 0u && length(light.normal_area.xyz) > 0.99 && dot(-to_c, light.normal_area.xyz) < -r {
+                continue;
+            }
+            var s = light.radiance_flux.w / max(dot(to_c, to_c), r * r);
+            var id = i;
+            for (var k = 0u; k < keep; k++) {
+                if s > score[k] {
+                    let ts = score[k];
+                    let ti = sel[k];
+                    score[k] = s;
+                    sel[k] = id;
+                    s = ts;
+                    id = ti;
+                }
+            }
+        }
+        for (var k = 0u; k < keep; k++) {
+            if sel[k] == NONE {
+                break;
+            }
+            shade_area_light(sel[k], k, pixel, world, origin, n, v, brdf);
+        }
+    }
+
+    if (flags & AREA_PUNCTUAL) != 0u {
+        var sel: array<u32, MAX_PER_PIXEL>;
+        var score: array<f32, MAX_PER_PIXEL>;
+        let keep = min(params.counts.z, MAX_PER_PIXEL);
+        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+            sel[k] = NONE;
+            score[k] = 0.0;
+        }
+        for (var i = 0u; i < params.config.w; i++) {
+            let light = lights[i];
+            let to_light = light.position_range.xyz - world;
+            let d2 = dot(to_light, to_light);
+            let l = to_light * inverseSqrt(max(d2, 1e-8));
+            var s = luminance(light.intensity.rgb) * light_attenuation(light, l, d2) * max(dot(n, l), 0.0);
+            var id = i;
+            for (var k = 0u; k < keep; k++) {
+                if s > score[k] {
+                    let ts = score[k];
+                    let ti = sel[k];
+                    score[k] = s;
+                    sel[k] = id;
+                    s = ts;
+                    id = ti;
+                }
+            }
+        }
+        for (var i = 0u; i < params.config.w; i++) {
+            let light = lights[i];
+            let to_light = light.position_range.xyz - world;
+            let d2 = dot(to_light, to_light);
+            let l = to_light * inverseSqrt(max(d2, 1e-8));
+            var e = light.intensity.rgb * light_attenuation(light, l, d2);
+            if !(luminance(e) > 0.0) {
+                continue;
+            }
+            for (var k = 0u; k < keep; k++) {
+                if sel[k] == i {
+                    e *= punctual_visibility(light, k, pixel, origin);
+                    break;
+                }
+            }
+            lux += luminance(e) * max(dot(n, l), 0.0);
+            add_light(brdf_light_weights(brdf, l), e);
+        }
+    }
+    return brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let size = textureDimensions(out_radiance);
+    let pixel = gid.xy;
+    if any(pixel >= size) {
+        return;
+    }
+    var radiance = vec3<f32>(0.0);
+    lux = 0.0;
+    let d = textureLoad(depth, pixel, 0).r;
+    if d > 0.0 && params.config.y != 0u {
+        radiance = shade(pixel, d);
+    }
+    // NaN fails every comparison, so this also turns NaN into 0.
+    let out = vec4<f32>(radiance, lux);
+    textureStore(out_radiance, pixel, select(vec4<f32>(0.0), min(out, vec4<f32>(MAX_RADIANCE)), out >= vec4<f32>(0.0)));
+}

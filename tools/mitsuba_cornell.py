@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""Reference for hikari's area lights: the classic Cornell box rendered by Mitsuba 3 with
+DIRECT lighting only (integrator `path`, max_depth = 2: the emitter seen, and one bounce to it),
+from the same published data as hikari's `cornell_data` (crates/hikari-scene/src/builtin.rs),
+with the same camera, light and albedos.
+
+    pip install mitsuba numpy
+    python3 tools/mitsuba_cornell.py [--size 64] [--spp 4096] \
+        [-o crates/hikari-render/tests/fixtures/mitsuba_cornell_direct_64.pfm]
+
+Output: a PFM (portable float map: "PF", width height, -1.0 for little-endian, then RGB f32
+rows from the bottom up), linear Rec.709 radiance in nits (Mitsuba's `rgb` variant with the
+radiance given in nits). The geometry, light and camera below are typed in from the published
+Cornell box data (Program of Computer Graphics, Cornell University), not taken from hikari.
+"""
+
+import argparse
+import os
+import tempfile
+
+import numpy as np
+
+FLOOR = [[552.8, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 559.2], [549.6, 0.0, 559.2]]
+CEILING = [[556.0, 548.8, 0.0], [556.0, 548.8, 559.2], [0.0, 548.8, 559.2], [0.0, 548.8, 0.0]]
+BACK = [[549.6, 0.0, 559.2], [0.0, 0.0, 559.2], [0.0, 548.8, 559.2], [556.0, 548.8, 559.2]]
+RIGHT_GREEN = [[0.0, 0.0, 559.2], [0.0, 0.0, 0.0], [0.0, 548.8, 0.0], [0.0, 548.8, 559.2]]
+LEFT_RED = [[552.8, 0.0, 0.0], [549.6, 0.0, 559.2], [556.0, 548.8, 559.2], [556.0, 548.8, 0.0]]
+LIGHT = [[343.0, 548.8, 227.0], [343.0, 548.8, 332.0], [213.0, 548.8, 332.0], [213.0, 548.8, 227.0]]
+SHORT_BLOCK = [
+    [[130.0, 165.0, 65.0], [82.0, 165.0, 225.0], [240.0, 165.0, 272.0], [290.0, 165.0, 114.0]],
+    [[290.0, 0.0, 114.0], [290.0, 165.0, 114.0], [240.0, 165.0, 272.0], [240.0, 0.0, 272.0]],
+    [[130.0, 0.0, 65.0], [130.0, 165.0, 65.0], [290.0, 165.0, 114.0], [290.0, 0.0, 114.0]],
+    [[82.0, 0.0, 225.0], [82.0, 165.0, 225.0], [130.0, 165.0, 65.0], [130.0, 0.0, 65.0]],
+    [[240.0, 0.0, 272.0], [240.0, 165.0, 272.0], [82.0, 165.0, 225.0], [82.0, 0.0, 225.0]],
+]
+TALL_BLOCK = [
+    [[423.0, 330.0, 247.0], [265.0, 330.0, 296.0], [314.0, 330.0, 456.0], [472.0, 330.0, 406.0]],
+    [[423.0, 0.0, 247.0], [423.0, 330.0, 247.0], [472.0, 330.0, 406.0], [472.0, 0.0, 406.0]],
+    [[472.0, 0.0, 406.0], [472.0, 330.0, 406.0], [314.0, 330.0, 456.0], [314.0, 0.0, 456.0]],
+    [[314.0, 0.0, 456.0], [314.0, 330.0, 456.0], [265.0, 330.0, 296.0], [265.0, 0.0, 296.0]],
+    [[265.0, 0.0, 296.0], [265.0, 330.0, 296.0], [423.0, 330.0, 247.0], [423.0, 0.0, 247.0]],
+]
+CAMERA = [278.0, 273.0, -800.0]
+FOCAL_MM, FILM_MM = 35.0, 25.0
+
+# Linear Rec.709 albedos commonly derived from the published reflectance spectra, and the
+# commonly used emission colour, scaled to a luminance of 5000 nits (hikari's CORNELL_LIGHT_NITS).
+WHITE, RED, GREEN = [0.725, 0.71, 0.68], [0.63, 0.065, 0.05], [0.14, 0.45, 0.091]
+EMISSION = np.array([17.0, 12.0, 4.0])
+LIGHT_NITS = 5000.0
+
+
+def quad_facing(q, facing):
+    """Metres, wound so that (p1 - p0) x (p2 - p0) points along `facing`."""
+    p = np.array(q) * 1e-3
+    n = np.cross(p[1] - p[0], p[2] - p[0]) + np.cross(p[2] - p[0], p[3] - p[0])
+    if np.dot(n, facing) < 0:
+        p = p[::-1]
+    return p
+
+
+def write_ply(path, quads):
+    verts = np.concatenate(quads)
+    with open(path, "w") as f:
+        f.write("ply\nformat ascii 1.0\n")
+        f.write(f"element vertex {len(verts)}\nproperty float x\nproperty float y\nproperty float z\n")
+        f.write(f"element face {2 * len(quads)}\nproperty list uchar int vertex_indices\nend_header\n")
+        for v in verts:
+            f.write(f"{v[0]:.9g} {v[1]:.9g} {v[2]:.9g}\n")
+        for i in range(len(quads)):
+            b = 4 * i
+            f.write(f"3 {b} {b + 1} {b + 2}\n3 {b} {b + 2} {b + 3}\n")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--size", type=int, default=64)
+    ap.add_argument("--spp", type=int, default=4096)
+    ap.add_argument("-o", default="crates/hikari-render/tests/fixtures/mitsuba_cornell_direct_64.pfm")
+    args = ap.parse_args()
+
+    import mitsuba as mi
+
+    mi.set_variant("scalar_rgb")
+    centre = np.array([0.278, 0.274, 0.280])
+    inward = lambda q: centre - np.mean(np.array(q) * 1e-3, axis=0)
+    tmp = tempfile.mkdtemp()
+    meshes = {}
+    walls = [quad_facing(q, inward(q)) for q in (FLOOR, CEILING, BACK)]
+    blocks = []
+    for block in (SHORT_BLOCK, TALL_BLOCK):
+        c = np.mean(np.array(block).reshape(-1, 3) * 1e-3, axis=0)
+        c[1] = 0.0
+        for q in block:
+            qc = np.mean(np.array(q) * 1e-3, axis=0)
+            out = np.array([0, 1.0, 0]) if all(p[1] == q[0][1] for p in q) else qc - np.array([c[0], qc[1], c[2]])
+            blocks.append(quad_facing(q, out))
+    light = quad_facing([[x, y - 0.5, z] for x, y, z in LIGHT], np.array([0, -1.0, 0]))
+    parts = {
+        "white": (walls, WHITE),
+        "red": ([quad_facing(LEFT_RED, inward(LEFT_RED))], RED),
+        "green": ([quad_facing(RIGHT_GREEN, inward(RIGHT_GREEN))], GREEN),
+        "blocks": (blocks, WHITE),
+    }
+    scene = {"type": "scene", "integrator": {"type": "path", "max_depth": 2}}
+    for name, (quads, albedo) in parts.items():
+        path = os.path.join(tmp, name + ".ply")
+        write_ply(path, quads)
+        scene[name] = {
+            "type": "ply",
+            "filename": path,
+            "face_normals": True,
+            "bsdf": {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": albedo}}},
+        }
+    lum = float(EMISSION @ np.array([0.2126, 0.7152, 0.0722]))
+    path = os.path.join(tmp, "light.ply")
+    write_ply(path, [light])
+    scene["light"] = {
+        "type": "ply",
+        "filename": path,
+        "face_normals": True,
+        "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": [0.0, 0.0, 0.0]}},
+        "emitter": {"type": "area", "radiance": {"type": "rgb", "value": list(EMISSION * LIGHT_NITS / lum)}},
+    }
+    cam = np.array(CAMERA) * 1e-3
+    fov = np.degrees(2 * np.arctan(0.5 * FILM_MM / FOCAL_MM))
+    scene["sensor"] = {
+        "type": "perspective",
+        "fov": fov,
+        "fov_axis": "y",
+        "near_clip": 0.01,
+        "to_world": mi.ScalarTransform4f().look_at(origin=list(cam), target=list(cam + [0, 0, 1.0]), up=[0, 1.0, 0]),
+        "sampler": {"type": "independent", "sample_count": args.spp},
+        "film": {
+            "type": "hdrfilm",
+            "width": args.size,
+            "height": args.size,
+            "rfilter": {"type": "box"},
+            "pixel_format": "rgb",
+        },
+    }
+    img = np.array(mi.render(mi.load_dict(scene)), dtype=np.float32)[:, :, :3]
+    os.makedirs(os.path.dirname(args.o) or ".", exist_ok=True)
+    tmp_out = args.o + ".tmp"
+    with open(tmp_out, "wb") as f:
+        f.write(f"PF\n{args.size} {args.size}\n-1.0\n".encode())
+        f.write(np.ascontiguousarray(img[::-1]).astype("<f4").tobytes())
+    os.replace(tmp_out, args.o)
+    print(f"wrote {args.o}: mean {img.mean(axis=(0, 1))} nits, fov_y {fov:.4f} deg")
+
+
+if __name__ == "__main__":
+    main()
