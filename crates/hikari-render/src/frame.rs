@@ -13,6 +13,7 @@ use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
+use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
@@ -80,6 +81,7 @@ pub struct FrameState {
 pub struct Techniques {
     pub raster: Rasterizer,
     pub sky: Sky,
+    pub irradiance_probes: IrradianceProbes,
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
@@ -94,6 +96,7 @@ impl Techniques {
         Ok(Self {
             raster: Rasterizer::new(ctx, &mut lib)?,
             sky: Sky::new(ctx, &mut lib)?,
+            irradiance_probes: IrradianceProbes::new(ctx, &mut lib)?,
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
@@ -109,6 +112,7 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
+    pub probes: ProbesFrame,
     /// Linear radiance in nits (Rgba16Float), for the EXR.
     pub hdr: Tex,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
@@ -145,7 +149,16 @@ pub fn record<'r>(
         s.camera.position.y.max(0.0) / 1000.0,
     )?;
 
-    // 4. Irradiance probes, 5. reflection probes, 6. clouds: their issues add them here.
+    // 4. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon.
+    let probes = t.irradiance_probes.record(
+        g,
+        &s.settings.irradiance_probes,
+        &sky,
+        s.sun.as_ref(),
+        s.camera.position,
+    )?;
+
+    // 5. Reflection probes, 6. clouds: their issues add them here.
 
     // 7. Sun shadow maps.
     let shadows = t.sun_shadows.record(
@@ -179,9 +192,10 @@ pub fn record<'r>(
     if sky.enabled {
         lighting.use_sky(s.settings.sky.sky);
     }
-    let hdr = t
-        .direct_lighting
-        .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
+    lighting.use_probes(probes.present);
+    let hdr = t.direct_lighting.record(
+        g, &gbuffer, &shadows, &sky, &probes, brdf, scene, &view, &lighting,
+    )?;
 
     // 12. Haze and 13. TAA: their issues add them here.
 
@@ -197,6 +211,7 @@ pub fn record<'r>(
         gbuffer,
         shadows,
         sky,
+        probes,
         hdr,
         ldr,
     })

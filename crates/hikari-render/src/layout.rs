@@ -30,7 +30,9 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows};
+    use crate::techniques::{
+        direct_lighting, irradiance_probes, placeholder_tonemap, sky, sun_shadows,
+    };
     use crate::view;
     vec![
         gpu_layout!(
@@ -159,6 +161,16 @@ pub fn all() -> Vec<StructLayout> {
             crate::scene_bvh::AlphaTriangle,
             "bvh/trace.wgsl",
             [uv, alpha]
+        ),
+        gpu_layout!(
+            irradiance_probes::RelightParams,
+            "irradiance_probes/relight.wgsl",
+            [light_dir, light_rgb, config, amounts]
+        ),
+        gpu_layout!(
+            irradiance_probes::gpu_data::ProbeLookupParams,
+            "direct_lighting/shade.wgsl",
+            [grid, grid_size, topology]
         ),
         gpu_layout!(
             hikari_bvh::TriangleRecord,

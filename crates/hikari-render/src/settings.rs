@@ -12,6 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
+pub use crate::techniques::irradiance_probes::settings::IrradianceProbesSettings;
 pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
@@ -189,6 +190,7 @@ register_settings! {
     direct_lighting: DirectLightingSettings,
     exposure: ExposureSettings,
     sky: SkySettings,
+    irradiance_probes: IrradianceProbesSettings,
 }
 
 impl Settings {

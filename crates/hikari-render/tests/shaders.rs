@@ -120,7 +120,13 @@ fn shared_modules_bind_in_groups_of_their_own() {
     let mut lib = ShaderLibrary::new(caps).unwrap();
     assert_eq!(
         lib.binding_sets("direct_lighting/shade.wgsl"),
-        ["brdf_tables", "sky", "sky_ambient", "sun_shadows"]
+        [
+            "brdf_tables",
+            "irradiance_probes",
+            "sky",
+            "sky_ambient",
+            "sun_shadows"
+        ]
     );
     assert!(
         lib.binding_sets("placeholder_tonemap/apply.wgsl")

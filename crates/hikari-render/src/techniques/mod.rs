@@ -5,6 +5,7 @@
 
 pub mod direct_lighting;
 pub mod gbuffer;
+pub mod irradiance_probes;
 pub mod placeholder_tonemap;
 pub mod sky;
 pub mod sun_shadows;
