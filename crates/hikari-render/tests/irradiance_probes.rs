@@ -684,12 +684,19 @@ fn the_frame_takes_ambient_light_from_the_probes() {
         let scale = w.coeffs[0].abs().max_element().max(1.0);
         for k in 0..9 {
             let d = (got.coeffs[k] - w.coeffs[k]).abs().max_element();
-            assert!(d <= 2e-3 * scale, "probe {p} coefficient {k}: {got:?} vs {w:?}");
+            assert!(
+                d <= 2e-3 * scale,
+                "probe {p} coefficient {k}: {got:?} vs {w:?}"
+            );
         }
     }
 
     let surfaces: Vec<usize> = (0..plain.len()).filter(|&i| plain[i].1).collect();
-    assert!(surfaces.len() > 200, "too few surface pixels: {}", surfaces.len());
+    assert!(
+        surfaces.len() > 200,
+        "too few surface pixels: {}",
+        surfaces.len()
+    );
     let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     let (mut sum_plain, mut sum_open) = (0.0f64, 0.0f64);
     for &i in &surfaces {
@@ -707,5 +714,8 @@ fn the_frame_takes_ambient_light_from_the_probes() {
     // Not equal: the sky's ambient derings the sky's radiance SH, the probes their irradiance
     // SH (a weaker window, so more contrast between up and down); a lost factor (pi, the
     // weather's balance) or a missing lookup would be far outside this.
-    assert!((ratio - 1.0).abs() < 0.15, "open probes vs the unoccluded sky: ratio {ratio}");
+    assert!(
+        (ratio - 1.0).abs() < 0.15,
+        "open probes vs the unoccluded sky: ratio {ratio}"
+    );
 }

@@ -9,6 +9,7 @@ use hikari_render::graph::TimestampMode;
 use hikari_render::{ContextOptions, GpuContext, Renderer, output};
 
 use crate::args::FrameArgs;
+use crate::probe_bake;
 use crate::report;
 use crate::scene_source::{self, ResolvedFrame};
 
@@ -34,6 +35,10 @@ pub struct RenderArgs {
     /// Folder for `--dump` files; defaults to the PNG's folder.
     #[arg(long)]
     pub dump_dir: Option<PathBuf>,
+    /// Irradiance-probe bake file [default: the cache under $XDG_CACHE_HOME/hikari, baked
+    /// on a miss].
+    #[arg(long)]
+    pub bake: Option<PathBuf>,
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
@@ -46,6 +51,17 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;
+    // The probes light only what the sky lights: without it, no bake is needed.
+    let probes = &settings.settings.irradiance_probes;
+    if probes.enabled && settings.settings.sky.enabled && settings.settings.sky.sky {
+        let bake = probe_bake::for_render(&scene, args.bake.as_deref())?;
+        renderer.set_probe_bake(Some(&bake));
+    } else if let Some(path) = &args.bake {
+        log::warn!(
+            "--bake {}: not used, the probes or the sky's light are off",
+            path.display()
+        );
+    }
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
     renderer.runtime.set_timestamps(if args.timings {
