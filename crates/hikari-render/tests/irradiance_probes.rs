@@ -101,12 +101,12 @@ fn kuhn_mesh(rng: &mut SmallRng, origin: Vec3, side: f32, n: usize) -> TetMesh {
         f
     };
     let mut adjacency = vec![[HULL; 4]; tets.len()];
-    for a in 0..tets.len() {
-        for ka in 0..4 {
+    for (a, neighbours) in adjacency.iter_mut().enumerate() {
+        for (ka, neighbour) in neighbours.iter_mut().enumerate() {
             let fa = face(&tets[a], ka);
             for (b, tb) in tets.iter().enumerate() {
                 if b != a && (0..4).any(|kb| face(tb, kb) == fa) {
-                    adjacency[a][ka] = b as u32;
+                    *neighbour = b as u32;
                 }
             }
         }
@@ -176,8 +176,8 @@ fn run_relight(
     };
     let chunks = budget::chunks(data, &all);
     let mut sky_buf = [[0.0f32; 4]; 18];
-    for k in 0..9 {
-        sky_buf[k] = sky.coeffs[k].extend(0.0).to_array();
+    for (b, c) in sky_buf.iter_mut().zip(&sky.coeffs) {
+        *b = c.extend(0.0).to_array();
     }
     let sky_b = buffer(ctx, "sky.sh", bytemuck::cast_slice(&sky_buf));
     let gaunt = buffer(ctx, "gaunt", bytemuck::cast_slice(&gaunt_table()));
@@ -238,7 +238,6 @@ fn relight_matches_the_cpu_twin() {
         direction: Vec3::new(0.5, 0.6, -0.3).normalize(),
         illuminance_lux: 90_000.0,
         color: Vec3::new(1.0, 0.95, 0.85),
-        ..hikari_scene::Sun::default()
     };
     let cases = [
         ("everything", settings_with(|_| {})),
@@ -573,7 +572,7 @@ fn the_update_budget_follows_the_talk() {
     assert_eq!((first.tiles.len(), first.meshes.len()), (100, 2));
     // The camera over tile (4, 6): its 3x3 neighbours are always in.
     let cam = data.tiles[6 * 10 + 4].centre_xz;
-    let mut seen = vec![false; 100];
+    let mut seen = [false; 100];
     for update in 1..=7u64 {
         let w = budget::frame_work(&data, update, cam, &s);
         assert_eq!(w.meshes, vec![(update % 2) as usize]);
