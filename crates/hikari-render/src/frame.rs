@@ -178,6 +178,10 @@ pub fn record<'r>(
         .gbuffer
         .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
 
+    // The probes' irradiance per pixel, only for `--dump irradiance_probes.pixels`.
+    t.irradiance_probes
+        .record_pixels_dump(g, &probes, &gbuffer, &view)?;
+
     // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
 
     // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the

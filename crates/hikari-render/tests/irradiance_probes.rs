@@ -647,6 +647,7 @@ fn the_frame_takes_ambient_light_from_the_probes() {
         "sky.sh".into(),
         "irradiance_probes.irradiance".into(),
         "gbuffer.depth".into(),
+        "irradiance_probes.pixels".into(),
     ]);
     let mut render = |bake: Option<&Bake>| {
         r.set_probe_bake(bake);
@@ -656,6 +657,22 @@ fn the_frame_takes_ambient_light_from_the_probes() {
         let irr: Vec<[f32; 4]> =
             bytemuck::pod_collect_to_vec(f.result.buffer("irradiance_probes.irradiance").unwrap());
         let depth = f.result.image("gbuffer.depth").unwrap().clone();
+        // The per-pixel dump: covered (alpha 1) exactly where there is a surface, once a bake
+        // is there; black where the probes see no sky.
+        if let Some(b) = bake {
+            let pixels = f.result.image("irradiance_probes.pixels").unwrap();
+            let open = b.tiles[0].probes[0].sky_visibility[0] > 0.0;
+            for y in 0..48 {
+                for x in 0..64 {
+                    let e = pixels.pixel(x, y);
+                    let surface = depth.pixel(x, y)[0] > 0.0;
+                    assert_eq!(e[3], if surface { 1.0 } else { 0.0 }, "pixel {x},{y}");
+                    if surface {
+                        assert_eq!(open, e[0] + e[1] + e[2] > 0.0, "pixel {x},{y}: {e:?}");
+                    }
+                }
+            }
+        }
         let px: Vec<(Vec3, bool)> = (0..48)
             .flat_map(|y| (0..64).map(move |x| (x, y)))
             .map(|(x, y)| {

@@ -26,12 +26,14 @@ use wgpu::util::DeviceExt;
 use hikari_probes::Bake;
 use hikari_scene::Sun;
 
+use super::gbuffer::GBuffer;
 use super::sky::SkyFrame;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{BindingSet, Buf, FrameGraph};
+use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
+use crate::view::View;
 use gpu_data::{PROBES_INTERIOR_MASK, ProbeGpuData, ProbeLookupParams};
 use settings::IrradianceProbesSettings;
 
@@ -117,8 +119,12 @@ struct State {
     updates: u64,
 }
 
+/// The dump of the probes' irradiance at every pixel (`pixels.wgsl`).
+pub const PIXELS_DUMP: &str = "irradiance_probes.pixels";
+
 pub struct IrradianceProbes {
     relight: ComputePipeline,
+    pixels: ComputePipeline,
     gaunt: wgpu::Buffer,
     /// Bound when there is no bake: one zero element each.
     empty: Arc<Uploaded>,
@@ -187,6 +193,7 @@ impl IrradianceProbes {
         );
         Ok(Self {
             relight: ComputePipeline::new(ctx, lib, "irradiance_probes/relight.wgsl", "main", &[])?,
+            pixels: ComputePipeline::new(ctx, lib, "irradiance_probes/pixels.wgsl", "main", &[])?,
             gaunt: storage(
                 ctx,
                 "irradiance_probes.gaunt",
@@ -287,5 +294,33 @@ impl IrradianceProbes {
             lookup,
             irradiance,
         })
+    }
+
+    /// The probes' irradiance at every pixel's surface ([`PIXELS_DUMP`], Rgba16Float: lux,
+    /// alpha 1 where probes cover it), recorded only when `--dump` asks for it.
+    pub fn record_pixels_dump<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        probes: &ProbesFrame,
+        gb: &GBuffer,
+        view: &View,
+    ) -> Result<Option<Tex>> {
+        if !g.rt.dumps.iter().any(|d| d == PIXELS_DUMP) {
+            return Ok(None);
+        }
+        let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
+        let out = g.texture(
+            PIXELS_DUMP,
+            TextureDesc::d2(w, h, wgpu::TextureFormat::Rgba16Float),
+        )?;
+        g.pass(PIXELS_DUMP)
+            .constants(view)
+            .read(gb.depth)
+            .read(gb.normal)
+            .read(gb.albedo)
+            .write(out)
+            .set(probes.lookup)
+            .dispatch_threads(&self.pixels, [w, h, 1])?;
+        Ok(Some(out))
     }
 }
