@@ -246,3 +246,24 @@ pub fn for_render(scene: &Scene, given: Option<&Path>) -> anyhow::Result<Bake> {
     }
     Ok(bake)
 }
+
+/// Gives `renderer` the scene's bake ([`for_render`]) when the frame's settings use the
+/// probes (they light only what the sky lights); `given` is `--bake`.
+pub fn attach(
+    renderer: &mut hikari_render::Renderer,
+    scene: &Scene,
+    settings: &hikari_render::FrameSettings,
+    given: Option<&Path>,
+) -> anyhow::Result<()> {
+    let s = &settings.settings;
+    if s.irradiance_probes.enabled && s.sky.enabled && s.sky.sky {
+        let bake = for_render(scene, given)?;
+        renderer.set_probe_bake(Some(&bake));
+    } else if let Some(path) = given {
+        log::warn!(
+            "--bake {}: not used, the probes or the sky's light are off",
+            path.display()
+        );
+    }
+    Ok(())
+}

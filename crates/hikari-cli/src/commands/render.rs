@@ -51,17 +51,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;
-    // The probes light only what the sky lights: without it, no bake is needed.
-    let probes = &settings.settings.irradiance_probes;
-    if probes.enabled && settings.settings.sky.enabled && settings.settings.sky.sky {
-        let bake = probe_bake::for_render(&scene, args.bake.as_deref())?;
-        renderer.set_probe_bake(Some(&bake));
-    } else if let Some(path) = &args.bake {
-        log::warn!(
-            "--bake {}: not used, the probes or the sky's light are off",
-            path.display()
-        );
-    }
+    probe_bake::attach(&mut renderer, &scene, &settings, args.bake.as_deref())?;
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
     renderer.runtime.set_timestamps(if args.timings {
