@@ -34,6 +34,19 @@ impl Hasher {
             self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
         }
     }
+    /// Bulk bytes (textures), eight at a time.
+    fn bytes(&mut self, data: &[u8]) {
+        let mut chunks = data.chunks_exact(8);
+        for c in &mut chunks {
+            let w = u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]);
+            self.0 = (self.0 ^ w)
+                .wrapping_mul(0x0000_0100_0000_01b3)
+                .rotate_left(29);
+        }
+        for &b in chunks.remainder() {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
     fn f32s(&mut self, v: impl IntoIterator<Item = f32>) {
         for x in v {
             self.word(x.to_bits());
@@ -42,7 +55,8 @@ impl Hasher {
 }
 
 /// The key of `scene`'s bake with `options`: a hash of everything the bake reads (geometry,
-/// instances, the materials' colours and alpha, the options and the baker's version).
+/// instances, the materials' colours, alpha and interior values, textures, the options and
+/// the baker's version).
 pub fn scene_key(scene: &Scene, options: &GridBakeOptions) -> SceneKey {
     let mut h = Hasher(0xcbf2_9ce4_8422_2325);
     h.word(BAKER_VERSION);
@@ -71,7 +85,23 @@ pub fn scene_key(scene: &Scene, options: &GridBakeOptions) -> SceneKey {
     }
     for mat in &scene.materials {
         h.f32s(mat.base_color.to_array());
-        h.f32s([mat.alpha, mat.metalness]);
+        h.f32s([mat.alpha, mat.metalness, mat.interior.unwrap_or(-1.0)]);
+        match mat.alpha_mode {
+            hikari_scene::AlphaMode::Opaque => h.word(0),
+            hikari_scene::AlphaMode::Mask { cutoff } => h.f32s([1.0, cutoff]),
+            hikari_scene::AlphaMode::Blend => h.word(2),
+        }
+        h.word(mat.double_sided as u32);
+        h.word(
+            mat.base_color_texture
+                .map_or(u32::MAX, |t| t.texture as u32),
+        );
+    }
+    // Cut-outs and albedo come from textures too.
+    for t in &scene.textures {
+        h.word(t.width);
+        h.word(t.height);
+        h.bytes(&t.data);
     }
     SceneKey::from_u64(h.0)
 }
