@@ -735,3 +735,31 @@ fn the_frame_takes_ambient_light_from_the_probes() {
         "open probes vs the unoccluded sky: ratio {ratio}"
     );
 }
+
+/// The grid's weights reproduce any function linear in x, y and z exactly (bilinear across
+/// columns, linear along each column between its own layer heights, whatever the ground under
+/// each column), at random points inside the grid; and they sum to 1.
+#[test]
+fn grid_weights_reproduce_linear_functions() {
+    let data = ProbeGpuData::new(&synthetic_bake(11));
+    let f = |p: Vec3| 3.0 + 0.7 * p.x - 1.3 * p.y + 0.4 * p.z;
+    let [x0, z0, spacing, _] = data.params.grid;
+    let (cols_x, cols_z) = (data.params.grid_size[0], data.params.grid_size[1]);
+    let mut rng = SmallRng::seed_from_u64(12);
+    for _ in 0..2000 {
+        let p = Vec3::new(
+            x0 + rng.random_range(0.0..(cols_x - 1) as f32 * spacing),
+            // Above every column's lowest layer (ground < 4 m, + 1.5 m) and below its highest.
+            rng.random_range(5.6..29.9),
+            z0 + rng.random_range(0.0..(cols_z - 1) as f32 * spacing),
+        );
+        let w = reference::grid_weights(&data, p);
+        let sum: f32 = w.iter().map(|x| x.1).sum();
+        assert!((sum - 1.0).abs() < 1e-5, "{p}: weights sum to {sum}");
+        let got: f32 = w
+            .iter()
+            .map(|&(k, wk)| wk * f(Vec3::from_slice(&data.positions[k as usize][..3])))
+            .sum();
+        assert!((got - f(p)).abs() < 2e-3, "{p}: {got} vs {}", f(p));
+    }
+}
