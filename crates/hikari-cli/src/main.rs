@@ -3,6 +3,7 @@
 mod args;
 mod commands;
 mod config;
+mod probe_bake;
 mod report;
 mod scene_source;
 
@@ -10,7 +11,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{bench_frame, bench_overhead, bench_rays, constants, info, render, sky};
+use commands::{
+    bake, bench_frame, bench_overhead, bench_rays, constants, info, probes, render, sky,
+};
 
 #[derive(Parser)]
 #[command(
@@ -30,6 +33,10 @@ enum Command {
     /// Write the sky of a date, time, place and weather as an equirectangular EXR (nits) and
     /// print its L2 SH and the sun and moon.
     Sky(sky::SkyCommandArgs),
+    /// Bake a scene's irradiance probes (CPU) into a bake file, by default the render cache.
+    Bake(bake::BakeArgs),
+    /// Print a scene's baked probes, or their values interpolated (and relit) at points, as JSON.
+    Probes(probes::ProbesArgs),
     /// Benchmarks that print per-pass GPU timings.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -70,6 +77,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Sky(args) => sky::run(args),
+        Command::Bake(args) => bake::run(args),
+        Command::Probes(args) => probes::run(args),
         Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(args),
         Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),

@@ -335,3 +335,166 @@ fn sky_writes_a_2_to_1_exr_and_its_json_names_sun_moon_and_sh() {
     );
     assert!(!bad.exists(), "nothing is written on bad input");
 }
+
+/// `hikari` with the bake cache in `cache` (never the user's own).
+fn hikari_cached(cache: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(args)
+        .env("XDG_CACHE_HOME", cache)
+        .output()
+        .expect("run hikari")
+}
+
+fn json_of(o: &Output) -> serde_json::Value {
+    assert!(o.status.success(), "{}", text(o));
+    serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(o)))
+}
+
+/// `hikari bake` writes a bake file and sums it up; `hikari probes` lists every probe with the
+/// issue's fields; a probe 30 m above the boxes sees the whole sky (sky visibility of a
+/// constant 1: l=0 coefficient 2 sqrt(pi), the rest 0, within the bake's Monte Carlo error);
+/// `--at` a probe's own position gives that probe's values, and with `--time` the relit
+/// irradiance there.
+#[test]
+fn bake_and_probes_write_and_list_the_bake() {
+    let dir = tmp("bake");
+    let file = dir.join("boxes.hikprobe");
+    let f = file.to_str().unwrap();
+    let summary = json_of(&hikari_cached(
+        &dir,
+        &["bake", "--scene", "boxes", "-o", f, "--json"],
+    ));
+    assert!(file.exists());
+    let tiles = summary["grid"]["tiles"].as_array().unwrap().len();
+    assert!(tiles >= 1);
+    assert_eq!(summary["grid"]["probes"], tiles * 768);
+    assert_eq!(summary["rays_per_probe"], 2048);
+    assert!(summary["seconds"].as_f64().unwrap() > 0.0);
+
+    let listed = json_of(&hikari_cached(
+        &dir,
+        &["probes", "--scene", "boxes", "--bake", f, "--json"],
+    ));
+    let probes = listed["probes"].as_array().unwrap();
+    assert_eq!(probes.len(), tiles * 768);
+    for p in probes.iter().take(50) {
+        assert_eq!(p["position"].as_array().unwrap().len(), 3);
+        assert!(p["interior"].is_boolean());
+        assert_eq!(p["sky_visibility"].as_array().unwrap().len(), 9);
+        let b = p["bounced_sky_visibility"].as_array().unwrap();
+        assert_eq!(b.len(), 9);
+        assert!(b.iter().all(|c| c.as_array().unwrap().len() == 3));
+        assert!(p["grid_tile"].is_array());
+    }
+    // The top layer stands 30 m over the ground: nothing of the boxes scene reaches that high.
+    let top = probes
+        .iter()
+        .find(|p| p["index"][2] == 2)
+        .expect("a top-layer probe");
+    let open = 2.0 * std::f64::consts::PI.sqrt();
+    let c: Vec<f64> = top["sky_visibility"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!((c[0] - open).abs() < 0.02 * open, "{c:?}");
+    assert!(c[1..].iter().all(|x| x.abs() < 0.02 * open), "{c:?}");
+
+    // At a probe's own position the interpolation is that probe.
+    let at = top["position"].as_array().unwrap();
+    let at = format!(
+        "{},{},{}",
+        at[0].as_f64().unwrap(),
+        at[1].as_f64().unwrap(),
+        at[2].as_f64().unwrap()
+    );
+    let o = hikari_cached(
+        &dir,
+        &[
+            "probes", "--scene", "boxes", "--bake", f, "--json", "--at", &at, "--time", "10:00",
+        ],
+    );
+    let v = json_of(&o);
+    let point = &v["points"][0];
+    assert_eq!(point["covered"], true);
+    let got: Vec<f64> = point["sky_visibility"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for k in 0..9 {
+        assert!((got[k] - c[k]).abs() < 1e-4, "{got:?} vs {c:?}");
+    }
+    assert_eq!(v["relit"], true);
+    let up = point["irradiance_up_lux"].as_array().unwrap();
+    assert!(up.iter().all(|x| x.as_f64().unwrap() > 100.0), "{point}");
+}
+
+/// Bad bake files: a given file that is missing, truncated or of another scene is an error
+/// naming the file and the problem; a bad file in the cache is baked again with a warning,
+/// and the cache then holds a good one.
+#[test]
+fn bad_bake_files_are_named_or_rebaked_never_a_panic() {
+    let dir = tmp("badbake");
+    let cache = dir.join("cache");
+    let png = dir.join("out.png");
+    let png = png.to_str().unwrap();
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render", "--scene", "boxes", "--width", "48", "--height", "32", "-o", png, "--no-exr",
+        ];
+        args.extend_from_slice(extra);
+        hikari_cached(&cache, &args)
+    };
+    let missing = dir.join("missing.hikprobe");
+    let o = render(&["--bake", missing.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success() && !t.contains("panicked"), "{t}");
+    assert!(t.contains("missing.hikprobe"), "{t}");
+
+    // A miss bakes and fills the cache.
+    let o = render(&[]);
+    assert!(o.status.success(), "{}", text(&o));
+    let cached: Vec<PathBuf> = std::fs::read_dir(cache.join("hikari"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "hikprobe"))
+        .collect();
+    assert_eq!(cached.len(), 1, "{cached:?}");
+    let good = std::fs::read(&cached[0]).unwrap();
+
+    // Truncated, given: an error naming the file and the problem.
+    let truncated = dir.join("truncated.hikprobe");
+    std::fs::write(&truncated, &good[..good.len() / 2]).unwrap();
+    let o = render(&["--bake", truncated.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success() && !t.contains("panicked"), "{t}");
+    assert!(
+        t.contains("truncated.hikprobe") && t.contains("truncated"),
+        "{t}"
+    );
+
+    // Another scene's bake, given.
+    let other = dir.join("other.hikprobe");
+    let o = hikari_cached(
+        &cache,
+        &["bake", "--scene", "cutout", "-o", other.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let o = render(&["--bake", other.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(!o.status.success() && !t.contains("panicked"), "{t}");
+    assert!(t.contains("other.hikprobe"), "{t}");
+
+    // Corrupt in the cache: a warning, a rebake, and a good cache again.
+    let mut bad = good.clone();
+    bad[200] ^= 0xff;
+    std::fs::write(&cached[0], &bad).unwrap();
+    let o = render(&[]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("baking the probes again"), "{t}");
+    assert_eq!(std::fs::read(&cached[0]).unwrap(), good);
+}

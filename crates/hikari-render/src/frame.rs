@@ -15,6 +15,7 @@ use crate::techniques::area_lights::{AreaLightParams, AreaLightScene, AreaLights
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
+use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::sky::{Sky, SkyFrame};
@@ -87,6 +88,7 @@ pub struct FrameState {
 pub struct Techniques {
     pub raster: Rasterizer,
     pub sky: Sky,
+    pub irradiance_probes: IrradianceProbes,
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
@@ -105,6 +107,7 @@ impl Techniques {
         Ok(Self {
             raster: Rasterizer::new(ctx, &mut lib)?,
             sky: Sky::new(ctx, &mut lib)?,
+            irradiance_probes: IrradianceProbes::new(ctx, &mut lib)?,
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
@@ -124,6 +127,7 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
+    pub probes: ProbesFrame,
     /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`).
     pub area_lights: Tex,
     /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA.
@@ -180,7 +184,16 @@ pub fn record<'r>(
         s.camera.position.y.max(0.0) / 1000.0,
     )?;
 
-    // 4. Irradiance probes, 5. reflection probes, 6. clouds: their issues add them here.
+    // 4. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon.
+    let probes = t.irradiance_probes.record(
+        g,
+        &s.settings.irradiance_probes,
+        &sky,
+        s.sun.as_ref(),
+        s.camera.position,
+    )?;
+
+    // 5. Reflection probes, 6. clouds: their issues add them here.
 
     // 7. Sun shadow maps.
     let shadows = t.sun_shadows.record(
@@ -200,6 +213,10 @@ pub fn record<'r>(
         .gbuffer
         .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
 
+    // The probes' irradiance per pixel, only for `--dump irradiance_probes.pixels`.
+    t.irradiance_probes
+        .record_pixels_dump(g, &probes, &gbuffer, &view)?;
+
     // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
 
     // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
@@ -214,6 +231,7 @@ pub fn record<'r>(
     if sky.enabled {
         lighting.use_sky(s.settings.sky.sky);
     }
+    lighting.use_probes(probes.present);
     // Area lights, and point and spot lights with ray-traced shadows (issue 18), added by the
     // deferred lighting, which then leaves the point and spot lights to them.
     //    `direct_lighting.punctual` switches point and spot lights off in both passes.
@@ -239,6 +257,7 @@ pub fn record<'r>(
         &gbuffer,
         &shadows,
         &sky,
+        &probes,
         brdf,
         scene,
         &view,
@@ -300,6 +319,7 @@ pub fn record<'r>(
         gbuffer,
         shadows,
         sky,
+        probes,
         area_lights,
         hdr,
         lit,

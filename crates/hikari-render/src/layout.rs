@@ -31,8 +31,8 @@ pub fn all() -> Vec<StructLayout> {
     use crate::raster;
     use crate::scene_gpu;
     use crate::techniques::{
-        direct_lighting, exposure, gi_denoiser, local_tonemap, placeholder_tonemap, sky,
-        sun_shadows, taa,
+        direct_lighting, exposure, gi_denoiser, irradiance_probes, local_tonemap,
+        placeholder_tonemap, sky, sun_shadows, taa,
     };
     use crate::view;
     vec![
@@ -208,6 +208,16 @@ pub fn all() -> Vec<StructLayout> {
             crate::scene_bvh::AlphaTriangle,
             "bvh/trace.wgsl",
             [uv, alpha]
+        ),
+        gpu_layout!(
+            irradiance_probes::RelightParams,
+            "irradiance_probes/relight.wgsl",
+            [light_dir, light_rgb, config, amounts]
+        ),
+        gpu_layout!(
+            irradiance_probes::gpu_data::ProbeLookupParams,
+            "direct_lighting/shade.wgsl",
+            [grid, grid_size, topology]
         ),
         gpu_layout!(
             hikari_bvh::TriangleRecord,

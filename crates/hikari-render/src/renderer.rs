@@ -46,6 +46,12 @@ impl Renderer {
         })
     }
 
+    /// Uses `bake`'s irradiance probes from the next frame on (`None`: none, the sky's SH
+    /// lights surfaces unoccluded). Non-finite numbers in the bake become 0.
+    pub fn set_probe_bake(&mut self, bake: Option<&hikari_probes::Bake>) {
+        self.techniques.irradiance_probes.set_bake(&self.ctx, bake);
+    }
+
     pub fn scene(&self) -> &SceneGpu {
         &self.scene
     }

@@ -15,6 +15,7 @@ pub use crate::techniques::area_lights::settings::AreaLightsSettings;
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::exposure::settings::ExposureSettings;
 pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
+pub use crate::techniques::irradiance_probes::settings::IrradianceProbesSettings;
 pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
@@ -197,6 +198,7 @@ register_settings! {
     taa: TaaSettings,
     gi_denoiser: GiDenoiserSettings,
     area_lights: AreaLightsSettings,
+    irradiance_probes: IrradianceProbesSettings,
 }
 
 impl Settings {

@@ -142,6 +142,7 @@ fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> 
                 [k.ambient_diffuse, k.ambient_specular]
             },
             background: sky_twin.as_ref(),
+            probe_irradiance: None,
         }
     });
 

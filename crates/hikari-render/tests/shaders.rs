@@ -120,7 +120,13 @@ fn shared_modules_bind_in_groups_of_their_own() {
     let mut lib = ShaderLibrary::new(caps).unwrap();
     assert_eq!(
         lib.binding_sets("direct_lighting/shade.wgsl"),
-        ["brdf_tables", "sky", "sky_ambient", "sun_shadows"]
+        [
+            "brdf_tables",
+            "irradiance_probes",
+            "sky",
+            "sky_ambient",
+            "sun_shadows"
+        ]
     );
     assert!(
         lib.binding_sets("placeholder_tonemap/apply.wgsl")
@@ -133,8 +139,8 @@ fn shared_modules_bind_in_groups_of_their_own() {
         &lib.binding_sets("direct_lighting/shade.wgsl"),
     )
     .unwrap();
-    assert_eq!(groups.len(), 5);
-    let names: Vec<&str> = groups[4]
+    assert_eq!(groups.len(), 6);
+    let names: Vec<&str> = groups[5]
         .iter()
         .map(|s| shader::undecorated(&s.name))
         .collect();

@@ -10,6 +10,7 @@ use hikari_render::graph::TimestampMode;
 use hikari_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
+use crate::probe_bake;
 use crate::report::{FrameTimings, ms};
 use crate::scene_source::{self, ResolvedFrame};
 
@@ -69,6 +70,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
     let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);
     let t0 = Instant::now();
     let mut renderer = Renderer::new(ctx, &scene)?;
+    probe_bake::attach(&mut renderer, &scene, &settings, None)?;
     renderer.runtime.set_timestamps(if a.frame_only {
         TimestampMode::Frame
     } else {

@@ -2,10 +2,12 @@
 //! `scene_source`, `report`, `config`) but never another command module: what two commands
 //! share moves into a shared module (`tests/command_modules.rs` checks this).
 
+pub mod bake;
 pub mod bench_frame;
 pub mod bench_overhead;
 pub mod bench_rays;
 pub mod constants;
 pub mod info;
+pub mod probes;
 pub mod render;
 pub mod sky;

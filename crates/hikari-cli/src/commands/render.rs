@@ -9,6 +9,7 @@ use hikari_render::graph::TimestampMode;
 use hikari_render::{ContextOptions, GpuContext, Renderer, output};
 
 use crate::args::FrameArgs;
+use crate::probe_bake;
 use crate::report;
 use crate::scene_source::{self, ResolvedFrame};
 
@@ -39,6 +40,10 @@ pub struct RenderArgs {
     /// Folder for `--dump` files; defaults to the PNG's folder.
     #[arg(long)]
     pub dump_dir: Option<PathBuf>,
+    /// Irradiance-probe bake file [default: the cache under $XDG_CACHE_HOME/hikari, baked
+    /// on a miss].
+    #[arg(long)]
+    pub bake: Option<PathBuf>,
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
@@ -51,6 +56,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;
+    probe_bake::attach(&mut renderer, &scene, &settings, args.bake.as_deref())?;
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
     renderer.runtime.set_timestamps(if args.timings {

@@ -8,6 +8,7 @@ pub mod direct_lighting;
 pub mod exposure;
 pub mod gbuffer;
 pub mod gi_denoiser;
+pub mod irradiance_probes;
 pub mod local_tonemap;
 pub mod placeholder_tonemap;
 pub mod sky;

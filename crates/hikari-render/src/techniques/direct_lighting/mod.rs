@@ -11,6 +11,7 @@ use glam::Vec3;
 use hikari_scene::Sun;
 
 use super::gbuffer::GBuffer;
+use super::irradiance_probes::ProbesFrame;
 use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
@@ -30,6 +31,8 @@ pub const LIGHTING_EMISSIVE: u32 = 4;
 pub const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8;
 /// The sky (`hikari::sky`) where depth is 0 and its SH (`hikari::sky_ambient`) as ambient light.
 pub const LIGHTING_SKY: u32 = 16;
+/// With `LIGHTING_SKY`: ambient diffuse from the irradiance probes where they cover a surface.
+pub const LIGHTING_PROBES: u32 = 32;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -111,6 +114,15 @@ impl LightingParams {
             self.config[1] |= LIGHTING_SKY;
         }
     }
+
+    /// Takes the ambient diffuse light from the irradiance probes when `present`.
+    pub fn use_probes(&mut self, present: bool) {
+        if present {
+            self.config[1] |= LIGHTING_PROBES;
+        } else {
+            self.config[1] &= !LIGHTING_PROBES;
+        }
+    }
 }
 
 /// What the lighting pass writes.
@@ -146,6 +158,7 @@ impl DirectLighting {
         gb: &GBuffer,
         shadows: &SunShadowMaps,
         sky: &SkyFrame,
+        probes: &ProbesFrame,
         brdf_tables: BindingSet,
         scene: &SceneInFrame,
         view: &View,
@@ -176,6 +189,7 @@ impl DirectLighting {
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)
+            .set(probes.lookup)
             .set(brdf_tables)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(LitFrame {

@@ -8,8 +8,8 @@ use hikari_math::sh::{Sh, zonal};
 use crate::reference::octahedral;
 use crate::scene_gpu::LightGpu;
 use crate::techniques::direct_lighting::{
-    LIGHTING_EMISSIVE, LIGHTING_PLACEHOLDER_AMBIENT, LIGHTING_PUNCTUAL, LIGHTING_SKY, LIGHTING_SUN,
-    LightingParams,
+    LIGHTING_EMISSIVE, LIGHTING_PLACEHOLDER_AMBIENT, LIGHTING_PROBES, LIGHTING_PUNCTUAL,
+    LIGHTING_SKY, LIGHTING_SUN, LightingParams,
 };
 use crate::techniques::sky::reference::SkyTwin;
 
@@ -50,6 +50,10 @@ pub struct SkyLight<'a> {
     /// The sky seen where depth is 0; `None` leaves sky pixels black. The twin has no sun or
     /// moon disk, so pixels on a disk differ from the shader's.
     pub background: Option<&'a SkyTwin<'a>>,
+    /// The irradiance probes' irradiance at the shaded point (lux, already times the diffuse
+    /// balance), when `LIGHTING_PROBES` is set and probes cover the point
+    /// (`irradiance_probes::reference::irradiance_at`); replaces the SH's diffuse term.
+    pub probe_irradiance: Option<Vec3>,
 }
 
 impl SkyLight<'_> {
@@ -178,7 +182,11 @@ pub fn shade_with_sky(
         radiance += (diffuse + specular_placeholder(p, &m, n, v)) * texel.material.w;
     }
     if let Some(sky) = sky {
-        let diffuse = m.base_color * (1.0 - m.metalness) / std::f32::consts::PI * sky.irradiance(n);
+        let ambient = match sky.probe_irradiance {
+            Some(e) if flags & LIGHTING_PROBES != 0 => e,
+            _ => sky.irradiance(n),
+        };
+        let diffuse = m.base_color * (1.0 - m.metalness) / std::f32::consts::PI * ambient;
         let r = 2.0 * n.dot(v) * n - v;
         let specular = fresnel_at(&m, n, v) * sky.specular(r, m.perceptual_roughness);
         radiance += (diffuse + specular) * texel.material.w;

@@ -12,6 +12,7 @@
 #import hikari::sun_shadows::sun_visibility
 #import hikari::sky::sky_background
 #import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_specular}
+#import hikari::irradiance_probes::probe_irradiance_at
 
 struct LightingParams {
     // xyz: unit vector towards the sun; w: illuminance in lux.
@@ -33,6 +34,7 @@ const LIGHTING_PUNCTUAL: u32 = 2u;
 const LIGHTING_EMISSIVE: u32 = 4u;
 const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8u;
 const LIGHTING_SKY: u32 = 16u;
+const LIGHTING_PROBES: u32 = 32u;
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: LightingParams;
@@ -230,12 +232,18 @@ fn main(
             illuminance += dot(ambient_placeholder(n), EXPOSURE_LUMA) * mat.w;
         }
         if (flags & LIGHTING_SKY) != 0u {
-            // Sky visibility 1 until the irradiance probes.
-            let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * sky_ambient_irradiance(n);
+            // The irradiance probes where they cover the surface (occluded sky, bounce, sun
+            // bounce; interior mask in albedo.a), else the sky's SH unoccluded.
+            var ambient = sky_ambient_irradiance(n);
+            if (flags & LIGHTING_PROBES) != 0u {
+                let probe = probe_irradiance_at(world, n, albedo.a);
+                ambient = select(ambient, probe.rgb, probe.w > 0.0);
+            }
+            let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient;
             let r = reflect(-v, n);
             let f = brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0));
             radiance += (diffuse + f * sky_ambient_specular(r, m.perceptual_roughness)) * mat.w;
-            illuminance += dot(sky_ambient_irradiance(n), EXPOSURE_LUMA) * mat.w;
+            illuminance += dot(ambient, EXPOSURE_LUMA) * mat.w;
         }
         if (flags & LIGHTING_EMISSIVE) != 0u {
             radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;

@@ -1,0 +1,326 @@
+//! Irradiance probes (issue 17, Ghost of Tsushima): a bake of hikari-probes (grid tiles and
+//! tetrahedral meshes of sky visibility and bounced sky visibility) uploaded once, relit on
+//! the GPU every frame from the sky's SH and the sun or moon, and looked up by the deferred
+//! lighting for its ambient diffuse light. docs/irradiance-probes.md.
+//!
+//! * [`gpu_data`]: the bake as flat buffers (NaN and Inf replaced with 0).
+//! * `irradiance_probes.relight` (`relight.wgsl`): the frame's share of the probes
+//!   ([`budget`]) relit into the persistent buffer `irradiance_probes.irradiance` (9 RGB
+//!   irradiance coefficients a probe, `vec4` each; `--dump` names it).
+//! * `hikari::irradiance_probes` (`lookup.wgsl`, binding set `irradiance_probes`):
+//!   irradiance at a position, normal and interior mask.
+//!
+//! CPU twins: [`reference`].
+
+pub mod budget;
+pub mod gpu_data;
+pub mod reference;
+pub mod settings;
+
+use std::sync::{Arc, Mutex};
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use hikari_probes::Bake;
+use hikari_scene::Sun;
+
+use super::gbuffer::GBuffer;
+use super::sky::SkyFrame;
+use crate::context::GpuContext;
+use crate::error::Result;
+use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
+use crate::shader::ShaderLibrary;
+use crate::view::View;
+use gpu_data::{PROBES_INTERIOR_MASK, ProbeGpuData, ProbeLookupParams};
+use settings::IrradianceProbesSettings;
+
+pub const RELIGHT_BOUNCE: u32 = 1;
+pub const RELIGHT_SUN_BOUNCE: u32 = 2;
+pub const RELIGHT_BOOST: u32 = 4;
+pub const RELIGHT_DERING: u32 = 8;
+
+/// The uniform of `relight.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct RelightParams {
+    /// Unit direction towards the sun or moon; w unused.
+    pub light_dir: [f32; 4],
+    /// The light's RGB irradiance on a surface facing it, lux; w: the sun-bounce scale.
+    pub light_rgb: [f32; 4],
+    /// Chunks in the work list, `RELIGHT_*` flags, 0, 0.
+    pub config: [u32; 4],
+    /// x: directionality boost amount.
+    pub amounts: [f32; 4],
+}
+
+impl RelightParams {
+    /// The parameters for `light` (the frame's sun or moon; `None`: no sun bounce) and the
+    /// settings' switches.
+    pub fn new(light: Option<&Sun>, s: &IrradianceProbesSettings, chunks: u32) -> Self {
+        let (dir, rgb) = match light {
+            Some(l) => (
+                l.direction.normalize_or(Vec3::Y),
+                l.color * l.illuminance_lux,
+            ),
+            None => (Vec3::Y, Vec3::ZERO),
+        };
+        let flags = [
+            (s.bounce, RELIGHT_BOUNCE),
+            (s.sun_bounce, RELIGHT_SUN_BOUNCE),
+            (s.boost, RELIGHT_BOOST),
+            (s.dering, RELIGHT_DERING),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .fold(0, |acc, (_, bit)| acc | bit);
+        Self {
+            light_dir: dir.extend(0.0).to_array(),
+            light_rgb: rgb.extend(s.sun_bounce_scale).to_array(),
+            config: [chunks, flags, 0, 0],
+            amounts: [s.boost_amount, 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+/// The dense 9x9x9 Gaunt table of hikari-math, as `relight.wgsl` reads it.
+pub fn gaunt_table() -> Vec<f32> {
+    let g = hikari_math::sh::product::gaunt_l2();
+    (0..729)
+        .map(|e| g[e / 81][(e / 9) % 9][e % 9] as f32)
+        .collect()
+}
+
+/// The probes of one frame, for the lighting.
+#[derive(Clone, Copy, Debug)]
+pub struct ProbesFrame {
+    /// Whether a bake is uploaded and the probes are on (else the lookup covers nothing).
+    pub present: bool,
+    /// Binding set `irradiance_probes` of `hikari::irradiance_probes`.
+    pub lookup: BindingSet,
+    /// `irradiance_probes.irradiance`: 9 RGB coefficients (vec4) a probe, lux.
+    pub irradiance: Buf,
+}
+
+struct Uploaded {
+    data: ProbeGpuData,
+    probe_data: wgpu::Buffer,
+    positions: wgpu::Buffer,
+    topology: wgpu::Buffer,
+    irradiance: wgpu::Buffer,
+    chunks: wgpu::Buffer,
+}
+
+struct State {
+    uploaded: Option<Arc<Uploaded>>,
+    /// Relights since the upload (0: the next relights everything).
+    updates: u64,
+}
+
+/// The dump of the probes' irradiance at every pixel (`pixels.wgsl`).
+pub const PIXELS_DUMP: &str = "irradiance_probes.pixels";
+
+pub struct IrradianceProbes {
+    relight: ComputePipeline,
+    pixels: ComputePipeline,
+    gaunt: wgpu::Buffer,
+    /// Bound when there is no bake: one zero element each.
+    empty: Arc<Uploaded>,
+    state: Mutex<State>,
+}
+
+fn storage(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
+    // wgpu binds no empty buffer: one zero vec4 stands in.
+    let pad = [0u8; 16];
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(name),
+            contents: if bytes.is_empty() { &pad } else { bytes },
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+fn upload(ctx: &GpuContext, data: ProbeGpuData) -> Uploaded {
+    let chunk_capacity = budget::chunks(
+        &data,
+        &budget::FrameWork {
+            tiles: (0..data.tiles.len()).collect(),
+            meshes: (0..data.meshes.len()).collect(),
+        },
+    )
+    .len()
+    .max(1);
+    let irradiance = vec![[0.0f32; 4]; data.probe_data.len()];
+    Uploaded {
+        probe_data: storage(
+            ctx,
+            "irradiance_probes.probes",
+            bytemuck::cast_slice(&data.probe_data),
+        ),
+        positions: storage(
+            ctx,
+            "irradiance_probes.positions",
+            bytemuck::cast_slice(&data.positions),
+        ),
+        topology: storage(
+            ctx,
+            "irradiance_probes.topology",
+            bytemuck::cast_slice(&data.topology),
+        ),
+        irradiance: storage(
+            ctx,
+            "irradiance_probes.irradiance",
+            bytemuck::cast_slice(&irradiance),
+        ),
+        chunks: storage(
+            ctx,
+            "irradiance_probes.chunks",
+            &vec![0u8; chunk_capacity * 8],
+        ),
+        data,
+    }
+}
+
+impl IrradianceProbes {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        let empty = hikari_probes::Bake::new(
+            Default::default(),
+            hikari_probes::BakeSettings::with_rays(1),
+        );
+        Ok(Self {
+            relight: ComputePipeline::new(ctx, lib, "irradiance_probes/relight.wgsl", "main", &[])?,
+            pixels: ComputePipeline::new(ctx, lib, "irradiance_probes/pixels.wgsl", "main", &[])?,
+            gaunt: storage(
+                ctx,
+                "irradiance_probes.gaunt",
+                bytemuck::cast_slice(&gaunt_table()),
+            ),
+            empty: Arc::new(upload(ctx, ProbeGpuData::new(&empty))),
+            state: Mutex::new(State {
+                uploaded: None,
+                updates: 0,
+            }),
+        })
+    }
+
+    /// Uploads `bake` (replacing any earlier one; `None` removes it). Non-finite numbers in it
+    /// become 0 (logged). The next frame relights every probe.
+    pub fn set_bake(&self, ctx: &GpuContext, bake: Option<&Bake>) {
+        let uploaded = bake.map(|b| {
+            let data = ProbeGpuData::new(b);
+            if data.replaced_non_finite > 0 {
+                log::warn!(
+                    "irradiance probes: {} non-finite numbers in the bake replaced with 0",
+                    data.replaced_non_finite
+                );
+            }
+            Arc::new(upload(ctx, data))
+        });
+        let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        st.uploaded = uploaded.filter(|u| u.data.probe_count() > 0);
+        st.updates = 0;
+    }
+
+    /// The uploaded bake's layout, if any.
+    pub fn data(&self) -> Option<ProbeGpuData> {
+        let st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        st.uploaded.as_ref().map(|u| u.data.clone())
+    }
+
+    /// Relights this frame's share of the probes and makes the lookup's binding set.
+    /// `light` is the frame's sun or moon; `camera` the camera's position (metres).
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        s: &IrradianceProbesSettings,
+        sky: &SkyFrame,
+        light: Option<&Sun>,
+        camera: Vec3,
+    ) -> Result<ProbesFrame> {
+        let (u, update) = {
+            let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+            match (&st.uploaded, s.enabled && sky.enabled) {
+                (Some(u), true) => {
+                    let out = (u.clone(), Some(st.updates));
+                    st.updates += 1;
+                    out
+                }
+                _ => (self.empty.clone(), None),
+            }
+        };
+        let irradiance = g.import_buffer("irradiance_probes.irradiance", &u.irradiance);
+        let positions = g.import_buffer("irradiance_probes.positions", &u.positions);
+        let topology = g.import_buffer("irradiance_probes.topology", &u.topology);
+        let mut params: ProbeLookupParams = u.data.params;
+        params.grid[3] = sky.knobs.ambient_diffuse;
+        if s.interior_mask {
+            params.grid_size[3] |= PROBES_INTERIOR_MASK;
+        }
+        if let Some(update) = update {
+            let work = budget::frame_work(&u.data, update, [camera.x, camera.z], s);
+            let chunks = budget::chunks(&u.data, &work);
+            if !chunks.is_empty() {
+                g.ctx()
+                    .queue
+                    .write_buffer(&u.chunks, 0, bytemuck::cast_slice(&chunks));
+                let chunk_buf = g.import_buffer("irradiance_probes.chunks", &u.chunks);
+                let gaunt = g.import_buffer("irradiance_probes.gaunt", &self.gaunt);
+                let probes = g.import_buffer("irradiance_probes.probes", &u.probe_data);
+                g.pass("irradiance_probes.relight")
+                    .constants(&RelightParams::new(light, s, chunks.len() as u32))
+                    .read(sky.sh)
+                    .read(gaunt)
+                    .read(chunk_buf)
+                    .read(probes)
+                    .write(irradiance)
+                    .dispatch(&self.relight, [chunks.len() as u32, 1, 1])?;
+            }
+        } else {
+            params.grid_size[3] = 0;
+        }
+        let lookup = g
+            .binding_set("irradiance_probes")
+            .constants(&params)
+            .read(irradiance)
+            .read(positions)
+            .read(topology)
+            .finish();
+        Ok(ProbesFrame {
+            present: update.is_some(),
+            lookup,
+            irradiance,
+        })
+    }
+
+    /// The probes' irradiance at every pixel's surface ([`PIXELS_DUMP`], Rgba16Float: lux,
+    /// alpha 1 where probes cover it), recorded only when `--dump` asks for it.
+    pub fn record_pixels_dump<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        probes: &ProbesFrame,
+        gb: &GBuffer,
+        view: &View,
+    ) -> Result<Option<Tex>> {
+        if !g.rt.dumps.iter().any(|d| d == PIXELS_DUMP) {
+            return Ok(None);
+        }
+        let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
+        let out = g.texture(
+            PIXELS_DUMP,
+            TextureDesc::d2(w, h, wgpu::TextureFormat::Rgba16Float),
+        )?;
+        g.pass(PIXELS_DUMP)
+            .constants(view)
+            .read(gb.depth)
+            .read(gb.normal)
+            .read(gb.albedo)
+            .write(out)
+            .set(probes.lookup)
+            .dispatch_threads(&self.pixels, [w, h, 1])?;
+        Ok(Some(out))
+    }
+}

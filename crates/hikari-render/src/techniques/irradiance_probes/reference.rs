@@ -1,0 +1,261 @@
+//! CPU twins of the probes' passes, on hikari-math's SH: the relight (`relight.wgsl`) and the
+//! lookup (`lookup.wgsl`), both over the arrays of [`ProbeGpuData`].
+
+use glam::Vec3;
+use hikari_math::sh::dering::{dering, directionality_boost};
+use hikari_math::sh::product::product_l2_mono;
+use hikari_math::sh::{Sh, ShL2, ShL2Rgb, basis, window, zonal};
+
+use super::gpu_data::{
+    COLUMNS, NO_TILE, PROBES_GRID, PROBES_INTERIOR_MASK, PROBES_PRESENT, ProbeGpuData, TILE_SIDE,
+};
+use super::{RELIGHT_BOOST, RELIGHT_BOUNCE, RELIGHT_DERING, RELIGHT_SUN_BOUNCE, RelightParams};
+use hikari_probes::HULL;
+
+/// The Sloan 2017 strength that leaves a projected delta with no negative lobe (hikari-math's
+/// deringing notes: a delta needs exactly 1/4).
+pub const LOBE_LAMBDA: f32 = 0.25;
+
+/// Steps of the walk through a mesh's tetrahedra before the point counts as outside it.
+pub const MAX_WALK_STEPS: u32 = 256;
+
+/// A point is inside a tetrahedron when no barycentric coordinate is below this.
+pub const INSIDE_EPSILON: f32 = 1e-5;
+
+/// Radiance SH of the sun's (or moon's) light bounced by an imaginary ground and an imaginary
+/// wall facing the light, as seen by a probe whose mean bounced visibility (relative to a
+/// white sky) is `mean_bounce`: each reflection's negated direction as a windowed delta,
+/// weighted by the cosine at its surface, times the light's RGB irradiance. The factor 2
+/// makes the ground's lobe the irradiance a Lambertian plane of albedo `2 * mean_bounce`
+/// (a probe above such a plane sees it over half the sphere) reflects.
+pub fn sun_bounce(to_light: Vec3, light_rgb: Vec3, mean_bounce: Vec3, scale: f32) -> ShL2Rgb {
+    let l = to_light;
+    let ground = Vec3::new(l.x, -l.y, l.z);
+    let wall = Vec3::new(-l.x, l.y, -l.z);
+    let ground_w = l.y.max(0.0);
+    let wall_w = if l.y > 0.0 {
+        Vec3::new(l.x, 0.0, l.z).length()
+    } else {
+        0.0
+    };
+    let strength = light_rgb * mean_bounce * (2.0 * scale);
+    let yg = basis::eval_l2(ground);
+    let yw = basis::eval_l2(wall);
+    let lobes: ShL2 = Sh::new(std::array::from_fn(|k| ground_w * yg[k] + wall_w * yw[k]))
+        .scale_bands(window::sloan2017(LOBE_LAMBDA));
+    Sh::new(lobes.coeffs.map(|c| strength * c))
+}
+
+/// One probe's irradiance SH (lux per unit normal direction, RGB) relit from the sky's
+/// radiance SH `sky` (nits), as `relight.wgsl` does: sky times visibility, plus bounced
+/// visibility times the sky's average and the sun bounce, each convolved with the cosine lobe
+/// and boosted separately, summed and deringed.
+pub fn relight_probe(
+    sky: &ShL2Rgb,
+    visibility: &ShL2,
+    bounced_visibility: &ShL2Rgb,
+    p: &RelightParams,
+) -> ShL2Rgb {
+    let flags = p.config[1];
+    let direct = product_l2_mono(sky, visibility);
+    let mut bounced = ShL2Rgb::zero();
+    if flags & RELIGHT_BOUNCE != 0 {
+        let mean_sky = sky.coeffs[0] * basis::C0 as f32;
+        bounced = Sh::new(bounced_visibility.coeffs.map(|c| c * mean_sky));
+    }
+    if flags & RELIGHT_SUN_BOUNCE != 0 {
+        let mean_bounce = bounced_visibility.coeffs[0] * basis::C0 as f32;
+        let to_light = Vec3::from_slice(&p.light_dir[..3]);
+        let rgb = Vec3::from_slice(&p.light_rgb[..3]);
+        let sun = sun_bounce(to_light, rgb, mean_bounce, p.light_rgb[3]);
+        bounced = Sh::new(std::array::from_fn(|k| bounced.coeffs[k] + sun.coeffs[k]));
+    }
+    let mut direct = zonal::irradiance(&direct);
+    let mut bounced = zonal::irradiance(&bounced);
+    if flags & RELIGHT_BOOST != 0 {
+        direct = directionality_boost(&direct, p.amounts[0]);
+        bounced = directionality_boost(&bounced, p.amounts[0]);
+    }
+    let total: ShL2Rgb = Sh::new(std::array::from_fn(|k| {
+        direct.coeffs[k] + bounced.coeffs[k]
+    }));
+    if flags & RELIGHT_DERING != 0 {
+        dering(&total).sh
+    } else {
+        total
+    }
+}
+
+/// Every probe of `data` relit: 9 RGB coefficients per probe, as the `irradiance` buffer.
+pub fn relight_all(data: &ProbeGpuData, sky: &ShL2Rgb, p: &RelightParams) -> Vec<ShL2Rgb> {
+    (0..data.probe_count())
+        .map(|i| {
+            let (v, b) = data.probe_sh(i);
+            relight_probe(sky, &v, &b, p)
+        })
+        .collect()
+}
+
+/// Barycentric coordinates of `p` in global tetrahedron `t` (vertex k's weight in entry k);
+/// `None` for a degenerate tetrahedron.
+pub fn barycentrics(data: &ProbeGpuData, t: u32, p: Vec3) -> Option<[f32; 4]> {
+    let off = data.params.topology[1] as usize + 4 * t as usize;
+    let v: [Vec3; 4] = std::array::from_fn(|k| {
+        Vec3::from_slice(&data.positions[data.topology[off + k] as usize][..3])
+    });
+    let (a, b, c, q) = (v[0] - v[3], v[1] - v[3], v[2] - v[3], p - v[3]);
+    let det = a.dot(b.cross(c));
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let b0 = q.dot(b.cross(c)) / det;
+    let b1 = a.dot(q.cross(c)) / det;
+    let b2 = a.dot(b.cross(q)) / det;
+    Some([b0, b1, b2, 1.0 - b0 - b1 - b2])
+}
+
+/// The tetrahedron of mesh `m` holding `p` and its barycentrics, found by walking from the
+/// mesh's first tetrahedron across the face opposite the most negative coordinate; `None`
+/// when the walk leaves the mesh (or `p` is outside the mesh's bounds).
+pub fn locate(data: &ProbeGpuData, m: usize, p: Vec3) -> Option<(u32, [f32; 4])> {
+    let mesh = &data.meshes[m];
+    if mesh.tets == 0 || (0..3).any(|a| p[a] < mesh.lo[a] || p[a] > mesh.hi[a]) {
+        return None;
+    }
+    let adj = data.params.topology[2] as usize;
+    let mut t = mesh.first_tet;
+    for _ in 0..MAX_WALK_STEPS {
+        let b = barycentrics(data, t, p).unwrap_or([-1.0, 0.0, 0.0, 0.0]);
+        let (k, min) =
+            b.iter().enumerate().fold(
+                (0, f32::MAX),
+                |acc, (k, &x)| if x < acc.1 { (k, x) } else { acc },
+            );
+        if min >= -INSIDE_EPSILON {
+            return Some((t, b));
+        }
+        let next = data.topology[adj + 4 * t as usize + k];
+        if next == HULL {
+            return None;
+        }
+        t = next;
+    }
+    None
+}
+
+/// Probe weights by the interior mask `mask`: each weight times `mask` for interior probes and
+/// `1 - mask` for exterior ones, renormalised; the weights as given (normalised) when that
+/// leaves nothing.
+pub fn masked_weights(weights: &[(u32, f32)], data: &ProbeGpuData, mask: f32) -> Vec<(u32, f32)> {
+    let masked: Vec<(u32, f32)> = weights
+        .iter()
+        .map(|&(p, w)| {
+            (
+                p,
+                w * if data.interior(p as usize) {
+                    mask
+                } else {
+                    1.0 - mask
+                },
+            )
+        })
+        .collect();
+    let sum: f32 = masked.iter().map(|x| x.1).sum();
+    if sum > 1e-6 {
+        return masked.into_iter().map(|(p, w)| (p, w / sum)).collect();
+    }
+    let sum: f32 = weights.iter().map(|x| x.1).sum();
+    weights
+        .iter()
+        .map(|&(p, w)| (p, w / sum.max(1e-12)))
+        .collect()
+}
+
+/// The grid's trilinear weights at `p`: bilinear over the four columns around it, and along
+/// each column linear between the two layers around `p`'s height (clamped to the lowest and
+/// highest). Columns of missing tiles drop out.
+pub fn grid_weights(data: &ProbeGpuData, p: Vec3) -> Vec<(u32, f32)> {
+    let prm = &data.params;
+    if prm.grid_size[3] & PROBES_GRID == 0 {
+        return Vec::new();
+    }
+    let cols = [prm.grid_size[0] as f32, prm.grid_size[1] as f32];
+    let g = [
+        (p.x - prm.grid[0]) / prm.grid[2],
+        (p.z - prm.grid[1]) / prm.grid[2],
+    ];
+    let mut i0 = [0u32; 2];
+    let mut f = [0.0f32; 2];
+    for a in 0..2 {
+        let gc = g[a].clamp(0.0, cols[a] - 1.0);
+        i0[a] = gc.floor().min((cols[a] - 2.0).max(0.0)) as u32;
+        f[a] = (gc - i0[a] as f32).clamp(0.0, 1.0);
+    }
+    let mut out = Vec::new();
+    for c in 0..4u32 {
+        let ci = [i0[0] + (c & 1), i0[1] + (c >> 1)];
+        if ci[0] >= prm.grid_size[0] || ci[1] >= prm.grid_size[1] {
+            continue;
+        }
+        let wx = if c & 1 == 1 { f[0] } else { 1.0 - f[0] };
+        let wz = if c >> 1 == 1 { f[1] } else { 1.0 - f[1] };
+        let side = TILE_SIDE as u32;
+        let tile = data.topology[((ci[1] / side) * prm.grid_size[2] + ci[0] / side) as usize];
+        if tile == NO_TILE {
+            continue;
+        }
+        let col = tile + (ci[1] % side) * side + ci[0] % side;
+        let h = |layer: u32| data.positions[(col + layer * COLUMNS as u32) as usize][1];
+        let upper = u32::from(p.y > h(1));
+        let (ha, hb) = (h(upper), h(upper + 1));
+        let t = ((p.y - ha) / (hb - ha).max(1e-4)).clamp(0.0, 1.0);
+        let base = col + upper * COLUMNS as u32;
+        out.push((base, wx * wz * (1.0 - t)));
+        out.push((base + COLUMNS as u32, wx * wz * t));
+    }
+    out
+}
+
+/// The probes and weights that light a point at `p`: the first mesh that holds it, else the
+/// grid; empty where no probe covers it.
+pub fn lookup_weights(data: &ProbeGpuData, p: Vec3) -> Vec<(u32, f32)> {
+    for m in 0..data.meshes.len() {
+        if let Some((t, b)) = locate(data, m, p) {
+            let off = data.params.topology[1] as usize + 4 * t as usize;
+            return (0..4)
+                .map(|k| (data.topology[off + k], b[k].max(0.0)))
+                .collect();
+        }
+    }
+    grid_weights(data, p)
+}
+
+/// Irradiance at `p` on a surface with normal `n` and interior mask `mask` from the relit
+/// probes (`irradiance`, one SH per probe), lux, clamped at 0 and times `params.grid.w`;
+/// `None` where no probe covers `p`. `params` carries the frame's flags and scale.
+pub fn irradiance_at(
+    data: &ProbeGpuData,
+    params: &super::gpu_data::ProbeLookupParams,
+    irradiance: &[ShL2Rgb],
+    p: Vec3,
+    n: Vec3,
+    mask: f32,
+) -> Option<Vec3> {
+    if params.grid_size[3] & PROBES_PRESENT == 0 {
+        return None;
+    }
+    let mut w = lookup_weights(data, p);
+    if w.iter().map(|x| x.1).sum::<f32>() <= 0.0 {
+        return None;
+    }
+    w = if params.grid_size[3] & PROBES_INTERIOR_MASK != 0 {
+        masked_weights(&w, data, mask)
+    } else {
+        masked_weights(&w, data, 0.5)
+    };
+    let e: Vec3 = w
+        .iter()
+        .map(|&(k, wk)| irradiance[k as usize].eval(n) * wk)
+        .sum();
+    Some(e.max(Vec3::ZERO) * params.grid[3])
+}

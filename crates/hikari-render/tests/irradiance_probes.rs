@@ -1,0 +1,767 @@
+//! The irradiance probes: the relight pass and the lookup on the GPU against their CPU twins
+//! (`irradiance_probes::reference`, on hikari-math's SH product, convolution, boost and
+//! deringing), tetrahedral point location and interior weights against brute force, the
+//! upload's NaN guard, and the update budget. A synthetic sky SH and a small synthetic bake
+//! (two grid tiles and a mesh of 2x2x2 cubes split into 6 tetrahedra each) keep the CPU
+//! driver fast.
+
+mod common;
+
+use glam::Vec3;
+use hikari_math::sh::{Sh, ShL2Rgb};
+use hikari_probes::{
+    Bake, BakeSettings, GridTile, HULL, ProbeSh, SceneKey, TILE_PROBE_COUNT, TetMesh,
+};
+use hikari_render::graph::GraphRuntime;
+use hikari_render::pipeline::ComputePipeline;
+use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::techniques::irradiance_probes::gpu_data::{
+    PROBES_INTERIOR_MASK, PROBES_PRESENT, ProbeGpuData, ProbeLookupParams,
+};
+use hikari_render::techniques::irradiance_probes::settings::IrradianceProbesSettings;
+use hikari_render::techniques::irradiance_probes::{RelightParams, budget, gaunt_table, reference};
+use hikari_render::wgpu::{self, util::DeviceExt};
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+
+fn random_probe(rng: &mut SmallRng) -> ProbeSh {
+    let mut p = ProbeSh::default();
+    for k in 0..9 {
+        p.sky_visibility[k] = if k == 0 {
+            rng.random_range(0.0..3.5)
+        } else {
+            rng.random_range(-0.8..0.8)
+        };
+        for c in 0..3 {
+            p.bounced_sky_visibility[k][c] = if k == 0 {
+                rng.random_range(0.0..1.2)
+            } else {
+                rng.random_range(-0.3..0.3)
+            };
+        }
+    }
+    p
+}
+
+fn tile(rng: &mut SmallRng, at: [i32; 2], spacing: f32) -> GridTile {
+    let size = spacing * 16.0;
+    GridTile {
+        tile: at,
+        origin_xz: [at[0] as f32 * size - 7.0, at[1] as f32 * size + 3.0],
+        ground_heights_m: (0..256).map(|_| rng.random_range(0.0..4.0)).collect(),
+        probes: (0..TILE_PROBE_COUNT).map(|_| random_probe(rng)).collect(),
+        interior: (0..TILE_PROBE_COUNT)
+            .map(|_| rng.random_bool(0.3))
+            .collect(),
+    }
+}
+
+/// `n` x `n` x `n` cubes of side `side` from `origin`, each split into the 6 tetrahedra of the
+/// Kuhn triangulation (one per ordering of the axes; conforming between cubes), with
+/// adjacency found by matching faces.
+fn kuhn_mesh(rng: &mut SmallRng, origin: Vec3, side: f32, n: usize) -> TetMesh {
+    let m = n + 1;
+    let index = |x: usize, y: usize, z: usize| ((z * m + y) * m + x) as u32;
+    let mut positions = Vec::new();
+    for z in 0..m {
+        for y in 0..m {
+            for x in 0..m {
+                positions
+                    .push((origin + side * Vec3::new(x as f32, y as f32, z as f32)).to_array());
+            }
+        }
+    }
+    let orders = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut tets = Vec::new();
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                for order in orders {
+                    let mut c = [x, y, z];
+                    let mut tet = [index(c[0], c[1], c[2]); 4];
+                    for (k, axis) in order.iter().enumerate() {
+                        c[*axis] += 1;
+                        tet[k + 1] = index(c[0], c[1], c[2]);
+                    }
+                    tets.push(tet);
+                }
+            }
+        }
+    }
+    let face = |tet: &[u32; 4], k: usize| {
+        let mut f: Vec<u32> = (0..4).filter(|&i| i != k).map(|i| tet[i]).collect();
+        f.sort_unstable();
+        f
+    };
+    let mut adjacency = vec![[HULL; 4]; tets.len()];
+    for (a, neighbours) in adjacency.iter_mut().enumerate() {
+        for (ka, neighbour) in neighbours.iter_mut().enumerate() {
+            let fa = face(&tets[a], ka);
+            for (b, tb) in tets.iter().enumerate() {
+                if b != a && (0..4).any(|kb| face(tb, kb) == fa) {
+                    *neighbour = b as u32;
+                }
+            }
+        }
+    }
+    let count = positions.len();
+    TetMesh {
+        id: 7,
+        positions,
+        probes: (0..count).map(|_| random_probe(rng)).collect(),
+        interior: (0..count).map(|_| rng.random_bool(0.5)).collect(),
+        tets,
+        adjacency,
+    }
+}
+
+fn synthetic_bake(seed: u64) -> Bake {
+    let mut rng = SmallRng::seed_from_u64(seed);
+    let settings = BakeSettings::with_rays(64);
+    let mut bake = Bake::new(SceneKey::from_u64(seed), settings);
+    bake.tiles
+        .push(tile(&mut rng, [0, 0], settings.grid_spacing_m));
+    bake.tiles
+        .push(tile(&mut rng, [1, 0], settings.grid_spacing_m));
+    bake.meshes
+        .push(kuhn_mesh(&mut rng, Vec3::new(40.0, 2.0, 50.0), 5.0, 2));
+    bake.complete = true;
+    bake
+}
+
+/// A sky with strong linear and quadratic terms (a bright side and a darker ground), nits.
+fn synthetic_sky(rng: &mut SmallRng) -> ShL2Rgb {
+    let base = Vec3::new(6000.0, 7000.0, 9000.0);
+    Sh::new(std::array::from_fn(|k| {
+        let s = match k {
+            0 => 1.0,
+            1..=3 => rng.random_range(-0.6..0.6),
+            _ => rng.random_range(-0.3..0.3),
+        };
+        base * s * Vec3::new(rng.random_range(0.9..1.1), 1.0, rng.random_range(0.9..1.1))
+    }))
+}
+
+fn buffer(ctx: &hikari_render::GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(name),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+fn sh_of(v: &[[f32; 4]]) -> ShL2Rgb {
+    Sh::new(std::array::from_fn(|k| Vec3::from_slice(&v[k][..3])))
+}
+
+/// Runs `relight.wgsl` over every probe of `data` and returns the irradiance buffer.
+fn run_relight(
+    ctx: &hikari_render::GpuContext,
+    pipeline: &ComputePipeline,
+    data: &ProbeGpuData,
+    sky: &ShL2Rgb,
+    params: &RelightParams,
+) -> Vec<[f32; 4]> {
+    let all = budget::FrameWork {
+        tiles: (0..data.tiles.len()).collect(),
+        meshes: (0..data.meshes.len()).collect(),
+    };
+    let chunks = budget::chunks(data, &all);
+    let mut sky_buf = [[0.0f32; 4]; 18];
+    for (b, c) in sky_buf.iter_mut().zip(&sky.coeffs) {
+        *b = c.extend(0.0).to_array();
+    }
+    let sky_b = buffer(ctx, "sky.sh", bytemuck::cast_slice(&sky_buf));
+    let gaunt = buffer(ctx, "gaunt", bytemuck::cast_slice(&gaunt_table()));
+    let chunk_b = buffer(ctx, "chunks", bytemuck::cast_slice(&chunks));
+    let probes = buffer(ctx, "probes", bytemuck::cast_slice(&data.probe_data));
+    let out = buffer(ctx, "irradiance", &vec![0u8; data.probe_data.len() * 16]);
+    let mut p = *params;
+    p.config[0] = chunks.len() as u32;
+    let mut rt = GraphRuntime::new();
+    let mut g = rt.begin_frame(ctx);
+    let sky_b = g.import_buffer("sky.sh", &sky_b);
+    let gaunt = g.import_buffer("gaunt", &gaunt);
+    let chunk_b = g.import_buffer("chunks", &chunk_b);
+    let probes = g.import_buffer("probes", &probes);
+    let out = g.import_buffer("irradiance_probes.irradiance", &out);
+    g.pass("irradiance_probes.relight")
+        .constants(&p)
+        .read(sky_b)
+        .read(gaunt)
+        .read(chunk_b)
+        .read(probes)
+        .write(out)
+        .dispatch(pipeline, [chunks.len() as u32, 1, 1])
+        .unwrap();
+    g.readback(out);
+    let r = g.execute().unwrap();
+    bytemuck::pod_collect_to_vec(r.buffer("irradiance_probes.irradiance").unwrap())
+}
+
+fn settings_with(f: impl FnOnce(&mut IrradianceProbesSettings)) -> IrradianceProbesSettings {
+    let mut s = IrradianceProbesSettings::default();
+    f(&mut s);
+    s
+}
+
+/// The relight pass against `reference::relight_probe` for every probe of the synthetic bake,
+/// with each part on and off. Tolerance: 2e-3 of the probe's largest band-0 coefficient (f32
+/// sums in another order; deringing's Newton steps). With deringing on, the window strength
+/// is a choice among eight: at most 1 % of probes may land on the neighbouring strength,
+/// within 15 % of their band-0 coefficient.
+#[test]
+fn relight_matches_the_cpu_twin() {
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        &mut lib,
+        "irradiance_probes/relight.wgsl",
+        "main",
+        &[],
+    )
+    .unwrap();
+    let data = ProbeGpuData::new(&synthetic_bake(17));
+    let mut rng = SmallRng::seed_from_u64(0x1E1_1600);
+    let sun = hikari_scene::Sun {
+        direction: Vec3::new(0.5, 0.6, -0.3).normalize(),
+        illuminance_lux: 90_000.0,
+        color: Vec3::new(1.0, 0.95, 0.85),
+    };
+    let cases = [
+        ("everything", settings_with(|_| {})),
+        ("no dering", settings_with(|s| s.dering = false)),
+        (
+            "no boost, no dering",
+            settings_with(|s| {
+                s.boost = false;
+                s.dering = false;
+            }),
+        ),
+        (
+            "sky only",
+            settings_with(|s| {
+                s.bounce = false;
+                s.sun_bounce = false;
+                s.boost = false;
+                s.dering = false;
+            }),
+        ),
+    ];
+    for (name, s) in cases {
+        let sky = synthetic_sky(&mut rng);
+        let params = RelightParams::new(Some(&sun), &s, 0);
+        let gpu = run_relight(&ctx, &pipeline, &data, &sky, &params);
+        let cpu = reference::relight_all(&data, &sky, &params);
+        let mut outliers = 0;
+        let mut worst = 0.0f32;
+        for (p, want) in cpu.iter().enumerate() {
+            let got = sh_of(&gpu[p * 9..p * 9 + 9]);
+            let scale = want.coeffs[0].abs().max_element().max(1.0);
+            let err = (0..9)
+                .map(|k| (got.coeffs[k] - want.coeffs[k]).abs().max_element())
+                .fold(0.0f32, f32::max)
+                / scale;
+            assert!(err.is_finite(), "{name}: probe {p} not finite");
+            if err > 2e-3 {
+                outliers += 1;
+                assert!(
+                    s.dering && err < 0.15,
+                    "{name}: probe {p}: relative error {err}: gpu {got:?} cpu {want:?}"
+                );
+            } else {
+                worst = worst.max(err);
+            }
+        }
+        assert!(
+            outliers * 100 <= cpu.len(),
+            "{name}: {outliers} of {} probes off by more than 2e-3",
+            cpu.len()
+        );
+        eprintln!("{name}: worst relative error {worst:.2e}, {outliers} dering outliers");
+    }
+}
+
+/// The relight's physics in closed form: an open-sky probe (visibility = the SH of 1) under a
+/// constant sky L has irradiance pi L on every normal; a probe with zero visibility and no
+/// bounce has none.
+#[test]
+fn relight_of_open_and_closed_probes_in_closed_form() {
+    let s = settings_with(|s| {
+        s.bounce = false;
+        s.sun_bounce = false;
+    });
+    let params = RelightParams::new(None, &s, 0);
+    let l = Vec3::new(1000.0, 2000.0, 3000.0);
+    let c0 = 2.0 * std::f32::consts::PI.sqrt();
+    let sky: ShL2Rgb = Sh::new(std::array::from_fn(|k| {
+        if k == 0 { l * c0 } else { Vec3::ZERO }
+    }));
+    let open = Sh::new(std::array::from_fn(|k| if k == 0 { c0 } else { 0.0 }));
+    let e = reference::relight_probe(&sky, &open, &ShL2Rgb::zero(), &params);
+    for n in [
+        Vec3::X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::new(0.3, -0.5, 0.8).normalize(),
+    ] {
+        let got = e.eval(n);
+        let want = std::f32::consts::PI * l;
+        assert!(
+            (got - want).abs().max_element() < 1e-3 * want.max_element(),
+            "{got} vs {want}"
+        );
+    }
+    let closed = reference::relight_probe(&sky, &Sh::zero(), &ShL2Rgb::zero(), &params);
+    assert!(closed.coeffs.iter().all(|c| c.abs().max_element() < 1e-6));
+}
+
+/// The lookup (`hikari::irradiance_probes` through `lookup_check.wgsl`) against
+/// `reference::irradiance_at`, at random points in and around the mesh and over the grid,
+/// with random normals and masks; tolerance 1e-3 of the value (plus 1e-3 lux).
+#[test]
+fn lookup_matches_the_cpu_twin() {
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        &mut lib,
+        "irradiance_probes/lookup_check.wgsl",
+        "main",
+        &[],
+    )
+    .unwrap();
+    let data = ProbeGpuData::new(&synthetic_bake(5));
+    let mut rng = SmallRng::seed_from_u64(99);
+    let sky = synthetic_sky(&mut rng);
+    let params = RelightParams::new(None, &IrradianceProbesSettings::default(), 0);
+    let irradiance = reference::relight_all(&data, &sky, &params);
+    let flat: Vec<[f32; 4]> = irradiance
+        .iter()
+        .flat_map(|sh| sh.coeffs.map(|c| c.extend(0.0).to_array()))
+        .collect();
+    let mut queries = Vec::new();
+    let mut points = Vec::new();
+    for i in 0..512 {
+        let p = if i % 2 == 0 {
+            Vec3::new(
+                rng.random_range(38.0..52.0),
+                rng.random_range(0.0..14.0),
+                rng.random_range(48.0..62.0),
+            )
+        } else {
+            Vec3::new(
+                rng.random_range(-20.0..420.0),
+                rng.random_range(-5.0..40.0),
+                rng.random_range(-20.0..220.0),
+            )
+        };
+        let n = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize_or(Vec3::Y);
+        let mask = [0.0, 1.0, 0.5, rng.random_range(0.0..1.0)][i % 4];
+        queries.push(p.extend(0.0).to_array());
+        queries.push(n.extend(mask).to_array());
+        points.push((p, n, mask));
+    }
+    for interior_mask in [true, false] {
+        let mut lp: ProbeLookupParams = data.params;
+        lp.grid[3] = 0.8;
+        if interior_mask {
+            lp.grid_size[3] |= PROBES_INTERIOR_MASK;
+        }
+        let q = buffer(&ctx, "queries", bytemuck::cast_slice(&queries));
+        let out = buffer(&ctx, "results", &vec![0u8; points.len() * 16]);
+        let irr = buffer(&ctx, "irradiance", bytemuck::cast_slice(&flat));
+        let pos = buffer(&ctx, "positions", bytemuck::cast_slice(&data.positions));
+        let topo = buffer(&ctx, "topology", bytemuck::cast_slice(&data.topology));
+        let mut rt = GraphRuntime::new();
+        let mut g = rt.begin_frame(&ctx);
+        let (q, out) = (
+            g.import_buffer("queries", &q),
+            g.import_buffer("results", &out),
+        );
+        let irr = g.import_buffer("irradiance", &irr);
+        let pos = g.import_buffer("positions", &pos);
+        let topo = g.import_buffer("topology", &topo);
+        let set = g
+            .binding_set("irradiance_probes")
+            .constants(&lp)
+            .read(irr)
+            .read(pos)
+            .read(topo)
+            .finish();
+        g.pass("test.lookup")
+            .read(q)
+            .write(out)
+            .set(set)
+            .dispatch_threads(&pipeline, [points.len() as u32, 1, 1])
+            .unwrap();
+        g.readback(out);
+        let r = g.execute().unwrap();
+        let got: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(r.buffer("results").unwrap());
+        let mut covered = 0;
+        for (i, (p, n, mask)) in points.iter().enumerate() {
+            let want = reference::irradiance_at(&data, &lp, &irradiance, *p, *n, *mask);
+            let g4 = got[i];
+            match want {
+                None => assert_eq!(g4, [0.0; 4], "point {p}: the twin finds no probe"),
+                Some(e) => {
+                    covered += 1;
+                    assert_eq!(g4[3], 1.0, "point {p}: the GPU finds no probe");
+                    let d = (Vec3::from_slice(&g4[..3]) - e).abs().max_element();
+                    assert!(
+                        d <= 1e-3 * e.max_element() + 1e-3,
+                        "point {p} n {n} mask {mask}: gpu {g4:?} cpu {e}"
+                    );
+                }
+            }
+        }
+        assert!(covered > 300, "only {covered} of the points are covered");
+    }
+}
+
+/// Walking the adjacency finds a tetrahedron holding the point whenever brute force over all
+/// tetrahedra finds one (and none when it finds none), and the interpolated, interior-masked
+/// value agrees with brute force's: barycentrics from a direct 4x4 solve, weights times w for
+/// interior probes and 1 - w for exterior ones, renormalised, the plain barycentrics where
+/// that leaves nothing.
+#[test]
+fn point_location_and_interior_weights_match_brute_force() {
+    let bake = synthetic_bake(3);
+    let data = ProbeGpuData::new(&bake);
+    let mesh = &bake.meshes[0];
+    let slot = data.meshes[0];
+    let value = |p: usize| (p as f32 * 0.37).sin();
+    let mut rng = SmallRng::seed_from_u64(4);
+    let (mut inside, mut outside) = (0, 0);
+    for _ in 0..4000 {
+        let p = Vec3::new(
+            rng.random_range(39.0..51.0),
+            rng.random_range(1.0..13.0),
+            rng.random_range(49.0..61.0),
+        );
+        let mask: f32 = [0.0, 1.0, rng.random_range(0.0..1.0)][rng.random_range(0..3)];
+        // Brute force: every tetrahedron, barycentrics by Gaussian elimination in f64.
+        let mut found = None;
+        for tet in &mesh.tets {
+            let v: Vec<glam::DVec3> = tet
+                .iter()
+                .map(|&i| glam::DVec3::from(mesh.positions[i as usize].map(f64::from)))
+                .collect();
+            let m = glam::DMat3::from_cols(v[0] - v[3], v[1] - v[3], v[2] - v[3]);
+            let b = m.inverse() * (p.as_dvec3() - v[3]);
+            let bary = [b.x, b.y, b.z, 1.0 - b.x - b.y - b.z];
+            if bary.iter().all(|&x| x >= -1e-9) {
+                found = Some((*tet, bary));
+                break;
+            }
+        }
+        let walked = reference::locate(&data, 0, p);
+        match found {
+            None => {
+                outside += 1;
+                assert!(
+                    walked.is_none(),
+                    "{p}: the walk found a tetrahedron brute force did not"
+                );
+            }
+            Some((tet, bary)) => {
+                inside += 1;
+                assert!(
+                    walked.is_some(),
+                    "{p}: the walk lost a point inside tetrahedra"
+                );
+                let masked: Vec<f64> = (0..4)
+                    .map(|k| {
+                        let interior = mesh.interior[tet[k] as usize];
+                        bary[k].max(0.0) * f64::from(if interior { mask } else { 1.0 - mask })
+                    })
+                    .collect();
+                let sum: f64 = masked.iter().sum();
+                let weights: Vec<f64> = if sum > 1e-6 {
+                    masked.iter().map(|w| w / sum).collect()
+                } else {
+                    bary.iter().map(|w| w.max(0.0)).collect()
+                };
+                let want: f64 = (0..4)
+                    .map(|k| weights[k] * f64::from(value(tet[k] as usize)))
+                    .sum();
+                let w = reference::lookup_weights(&data, p);
+                let w = reference::masked_weights(&w, &data, mask);
+                let got: f32 = w
+                    .iter()
+                    .map(|&(g, wk)| wk * value((g - slot.first_probe) as usize))
+                    .sum();
+                assert!(
+                    (f64::from(got) - want).abs() < 1e-4,
+                    "{p} mask {mask}: walked {got} brute force {want}"
+                );
+            }
+        }
+    }
+    assert!(
+        inside > 2000 && outside > 500,
+        "{inside} inside, {outside} outside"
+    );
+}
+
+/// NaN and Inf in a bake (possible in memory; files with them are refused) become 0 at upload.
+#[test]
+fn non_finite_numbers_in_a_bake_become_zero() {
+    let mut bake = synthetic_bake(8);
+    bake.tiles[0].probes[5].sky_visibility[2] = f32::NAN;
+    bake.tiles[1].probes[0].bounced_sky_visibility[4][1] = f32::INFINITY;
+    bake.tiles[0].ground_heights_m[3] = f32::NEG_INFINITY;
+    bake.meshes[0].probes[2].sky_visibility[0] = f32::NAN;
+    let data = ProbeGpuData::new(&bake);
+    // The infinite ground height reaches the three layers of its column.
+    assert_eq!(data.replaced_non_finite, 6);
+    assert!(data.probe_data.iter().flatten().all(|x| x.is_finite()));
+    assert!(data.positions.iter().flatten().all(|x| x.is_finite()));
+    assert_eq!(data.probe_data[5 * 9 + 2][3], 0.0);
+    assert_eq!(data.probe_data[(TILE_PROBE_COUNT) * 9 + 4][1], 0.0);
+    let mesh_probe = data.meshes[0].first_probe as usize + 2;
+    assert_eq!(data.probe_data[mesh_probe * 9][3], 0.0);
+    let sky = synthetic_sky(&mut SmallRng::seed_from_u64(1));
+    let params = RelightParams::new(None, &IrradianceProbesSettings::default(), 0);
+    for sh in reference::relight_all(&data, &sky, &params) {
+        assert!(sh.coeffs.iter().all(|c| c.is_finite()));
+    }
+    assert_ne!(data.params.grid_size[3] & PROBES_PRESENT, 0);
+}
+
+/// The talk's budget: everything on the first relight; afterwards the round robin's tiles plus
+/// the 3x3 around the camera, one mesh a frame, and every tile within ceil(tiles / per) frames.
+#[test]
+fn the_update_budget_follows_the_talk() {
+    let mut rng = SmallRng::seed_from_u64(2);
+    let settings = BakeSettings::with_rays(8);
+    let mut bake = Bake::new(SceneKey::default(), settings);
+    for z in 0..10 {
+        for x in 0..10 {
+            bake.tiles
+                .push(tile(&mut rng, [x, z], settings.grid_spacing_m));
+        }
+    }
+    bake.meshes.push(kuhn_mesh(&mut rng, Vec3::ZERO, 1.0, 1));
+    bake.meshes
+        .push(kuhn_mesh(&mut rng, Vec3::ONE * 3.0, 1.0, 1));
+    let data = ProbeGpuData::new(&bake);
+    let s = IrradianceProbesSettings {
+        tiles_per_frame: 16,
+        ..Default::default()
+    };
+    let first = budget::frame_work(&data, 0, [0.0, 0.0], &s);
+    assert_eq!((first.tiles.len(), first.meshes.len()), (100, 2));
+    // The camera over tile (4, 6): its 3x3 neighbours are always in.
+    let cam = data.tiles[6 * 10 + 4].centre_xz;
+    let mut seen = [false; 100];
+    for update in 1..=7u64 {
+        let w = budget::frame_work(&data, update, cam, &s);
+        assert_eq!(w.meshes, vec![(update % 2) as usize]);
+        for dz in -1..=1i32 {
+            for dx in -1..=1i32 {
+                let t = ((6 + dz) * 10 + 4 + dx) as usize;
+                assert!(
+                    w.tiles.contains(&t),
+                    "update {update}: camera tile {t} missing"
+                );
+            }
+        }
+        assert!(w.tiles.len() <= 16 + 9);
+        for t in w.tiles {
+            seen[t] = true;
+        }
+    }
+    assert!(
+        seen.iter().all(|&s| s),
+        "the round robin missed tiles in 7 frames"
+    );
+    let chunks = budget::chunks(&data, &first);
+    let total: u32 = chunks.iter().map(|c| c[1]).sum();
+    assert_eq!(total as usize, data.probe_count());
+    assert!(chunks.iter().all(|c| c[1] >= 1 && c[1] <= budget::CHUNK));
+}
+
+/// A bake that covers `scene` with one tile (spacing stretched to fit) whose probes all have
+/// visibility `visibility` (an SH of a constant) and no bounce.
+fn covering_bake(scene: &hikari_scene::Scene, visibility: f32) -> Bake {
+    let (lo, hi) = scene.bounds().unwrap();
+    let extent = (hi - lo).max_element() + 4.0;
+    let mut settings = BakeSettings::with_rays(1);
+    settings.grid_spacing_m = extent / 15.0;
+    settings.layer_heights_m = [0.0, 0.5 * extent, extent];
+    let mut bake = Bake::new(SceneKey::default(), settings);
+    let mut probe = ProbeSh::default();
+    probe.sky_visibility[0] = visibility * 2.0 * std::f32::consts::PI.sqrt();
+    bake.tiles.push(GridTile {
+        tile: [0, 0],
+        origin_xz: [lo.x - 2.0, lo.z - 2.0],
+        ground_heights_m: vec![lo.y - 2.0; 256],
+        probes: vec![probe; TILE_PROBE_COUNT],
+        interior: vec![false; TILE_PROBE_COUNT],
+    });
+    bake.complete = true;
+    bake
+}
+
+/// The frame with a bake: the first frame relights every probe as the twin does from the
+/// frame's own sky SH (read back), and surfaces take their ambient light from the probes: a
+/// bake of closed probes (no sky visible, no bounce) darkens every lit pixel that only ambient
+/// light reaches, and an open bake (visibility 1) lights the frame about as the unoccluded
+/// sky's SH does (within 15 %: the two dering different functions).
+#[test]
+fn the_frame_takes_ambient_light_from_the_probes() {
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let scene = hikari_scene::builtin::boxes();
+    let mut fs = common::small_frame_settings(&scene, 64, 48);
+    // One renderer draws three different lightings in a row: TAA would blend them.
+    fs.settings.taa.enabled = false;
+    fs.settings.sky.enabled = true;
+    fs.settings.sky.table_quality = 0;
+    fs.settings.sky.ambient_specular_scale = 0.0;
+    fs.settings.direct_lighting.sun = false;
+    fs.settings.direct_lighting.punctual = false;
+    fs.settings.direct_lighting.emissive = false;
+    fs.settings.irradiance_probes.sun_bounce = false;
+    fs.settings.irradiance_probes.boost = false;
+    let mut r = hikari_render::Renderer::new(ctx, &scene).unwrap();
+    r.runtime.set_dumps(vec![
+        "sky.sh".into(),
+        "irradiance_probes.irradiance".into(),
+        "gbuffer.depth".into(),
+        "irradiance_probes.pixels".into(),
+    ]);
+    let mut render = |bake: Option<&Bake>| {
+        r.set_probe_bake(bake);
+        let f = r.render(&fs, true).unwrap();
+        let hdr = f.hdr.unwrap();
+        let sky: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(f.result.buffer("sky.sh").unwrap());
+        let irr: Vec<[f32; 4]> =
+            bytemuck::pod_collect_to_vec(f.result.buffer("irradiance_probes.irradiance").unwrap());
+        let depth = f.result.image("gbuffer.depth").unwrap().clone();
+        // The per-pixel dump: covered (alpha 1) exactly where there is a surface, once a bake
+        // is there; black where the probes see no sky.
+        if let Some(b) = bake {
+            let pixels = f.result.image("irradiance_probes.pixels").unwrap();
+            let open = b.tiles[0].probes[0].sky_visibility[0] > 0.0;
+            for y in 0..48 {
+                for x in 0..64 {
+                    let e = pixels.pixel(x, y);
+                    let surface = depth.pixel(x, y)[0] > 0.0;
+                    assert_eq!(e[3], if surface { 1.0 } else { 0.0 }, "pixel {x},{y}");
+                    if surface {
+                        assert_eq!(open, e[0] + e[1] + e[2] > 0.0, "pixel {x},{y}: {e:?}");
+                    }
+                }
+            }
+        }
+        let px: Vec<(Vec3, bool)> = (0..48)
+            .flat_map(|y| (0..64).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                (
+                    Vec3::from_slice(&hdr.pixel(x, y)[..3]),
+                    depth.pixel(x, y)[0] > 0.0,
+                )
+            })
+            .collect();
+        (px, sky, irr)
+    };
+    let (plain, _, _) = render(None);
+    let closed_bake = covering_bake(&scene, 0.0);
+    let (closed, _, _) = render(Some(&closed_bake));
+    let open_bake = covering_bake(&scene, 1.0);
+    let (open, sky, irr) = render(Some(&open_bake));
+
+    // The relit buffer against the twin, from the sky SH the frame used (raw coefficients).
+    let data = ProbeGpuData::new(&open_bake);
+    let sky_sh = sh_of(&sky[..9]);
+    let params = RelightParams::new(None, &fs.settings.irradiance_probes, 0);
+    let want = reference::relight_all(&data, &sky_sh, &params);
+    for (p, w) in want.iter().enumerate() {
+        let got = sh_of(&irr[p * 9..p * 9 + 9]);
+        let scale = w.coeffs[0].abs().max_element().max(1.0);
+        for k in 0..9 {
+            let d = (got.coeffs[k] - w.coeffs[k]).abs().max_element();
+            assert!(
+                d <= 2e-3 * scale,
+                "probe {p} coefficient {k}: {got:?} vs {w:?}"
+            );
+        }
+    }
+
+    let surfaces: Vec<usize> = (0..plain.len()).filter(|&i| plain[i].1).collect();
+    assert!(
+        surfaces.len() > 200,
+        "too few surface pixels: {}",
+        surfaces.len()
+    );
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let (mut sum_plain, mut sum_open) = (0.0f64, 0.0f64);
+    for &i in &surfaces {
+        assert!(
+            lum(closed[i].0) <= 1e-3 * lum(plain[i].0) + 1e-3,
+            "pixel {i}: closed probes still light it: {} vs {}",
+            closed[i].0,
+            plain[i].0
+        );
+        sum_plain += f64::from(lum(plain[i].0));
+        sum_open += f64::from(lum(open[i].0));
+    }
+    assert!(sum_plain > 0.0);
+    let ratio = sum_open / sum_plain;
+    // Not equal: the sky's ambient derings the sky's radiance SH, the probes their irradiance
+    // SH (a weaker window, so more contrast between up and down); a lost factor (pi, the
+    // weather's balance) or a missing lookup would be far outside this.
+    assert!(
+        (ratio - 1.0).abs() < 0.15,
+        "open probes vs the unoccluded sky: ratio {ratio}"
+    );
+}
+
+/// The grid's weights reproduce any function linear in x, y and z exactly (bilinear across
+/// columns, linear along each column between its own layer heights, whatever the ground under
+/// each column), at random points inside the grid; and they sum to 1.
+#[test]
+fn grid_weights_reproduce_linear_functions() {
+    let data = ProbeGpuData::new(&synthetic_bake(11));
+    let f = |p: Vec3| 3.0 + 0.7 * p.x - 1.3 * p.y + 0.4 * p.z;
+    let [x0, z0, spacing, _] = data.params.grid;
+    let (cols_x, cols_z) = (data.params.grid_size[0], data.params.grid_size[1]);
+    let mut rng = SmallRng::seed_from_u64(12);
+    for _ in 0..2000 {
+        let p = Vec3::new(
+            x0 + rng.random_range(0.0..(cols_x - 1) as f32 * spacing),
+            // Above every column's lowest layer (ground < 4 m, + 1.5 m) and below its highest.
+            rng.random_range(5.6..29.9),
+            z0 + rng.random_range(0.0..(cols_z - 1) as f32 * spacing),
+        );
+        let w = reference::grid_weights(&data, p);
+        let sum: f32 = w.iter().map(|x| x.1).sum();
+        assert!((sum - 1.0).abs() < 1e-5, "{p}: weights sum to {sum}");
+        let got: f32 = w
+            .iter()
+            .map(|&(k, wk)| wk * f(Vec3::from_slice(&data.positions[k as usize][..3])))
+            .sum();
+        assert!((got - f(p)).abs() < 2e-3, "{p}: {got} vs {}", f(p));
+    }
+}
