@@ -14,6 +14,9 @@ use crate::shader::{self, ShaderLibrary};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
+use crate::techniques::ray_traced_gi::{
+    RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene, SkySource,
+};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::view::View;
@@ -74,6 +77,10 @@ impl FrameSettings {
 pub struct FrameState {
     pub shadow_cache: sun_shadows::ShadowCache,
     pub raster_queues: RasterQueues,
+    /// The scene's BVH for ray-traced GI, built when the technique is first on.
+    pub rtgi_scene: Option<SharedRtGiScene>,
+    /// Drop the ray-traced GI history next frame (a camera cut); cleared once used.
+    pub rtgi_reset: bool,
 }
 
 /// Every technique's pipelines, built once.
@@ -84,6 +91,7 @@ pub struct Techniques {
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
     pub placeholder_tonemap: PlaceholderTonemap,
+    pub ray_traced_gi: RayTracedGi,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
 }
@@ -99,6 +107,7 @@ impl Techniques {
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
+            ray_traced_gi: RayTracedGi::new(ctx, &mut lib)?,
         })
     }
 }
@@ -109,6 +118,10 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
+    /// Ray-traced GI and AO, accumulated (`None` with the technique off).
+    pub ray_traced_gi: Option<RtGiFrame>,
+    /// Its hit words and BVH queue.
+    pub ray_traced_gi_rays: Option<RtGiRays>,
     /// Linear radiance in nits (Rgba16Float), for the EXR.
     pub hdr: Tex,
     /// Display-encoded sRGB (Rgba8Unorm), for the PNG.
@@ -165,7 +178,45 @@ pub fn record<'r>(
         .gbuffer
         .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
 
-    // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
+    // 9. Ray-traced GI and AO (issue 18): one ray a pixel, pre-traced in screen space, the
+    //    rest through the BVH, lit, encoded and accumulated for the denoiser.
+    //    10. Denoising: its issue adds it here.
+    let mut ray_traced_gi = None;
+    let mut ray_traced_gi_rays = None;
+    if s.settings.ray_traced_gi.enabled {
+        let rt_scene = state.rtgi_scene.clone().ok_or_else(|| {
+            crate::error::RenderError::Graph(
+                "ray_traced_gi: the scene's BVH is not built (the Renderer builds it)".into(),
+            )
+        })?;
+        let sky_source = match (sky.enabled, s.settings.sky.sky) {
+            (true, true) => SkySource::Atmosphere,
+            (true, false) => SkySource::None,
+            (false, _) if s.settings.direct_lighting.placeholder_ambient => SkySource::Placeholder,
+            (false, _) => SkySource::None,
+        };
+        let params = RtGiParams::new(
+            &s.settings.ray_traced_gi,
+            g.frame_index(),
+            s.sun.as_ref(),
+            scene.light_count,
+            s.metered_lux_with_sky(sky.sky_lux),
+            sky_source,
+        );
+        let inputs = RtGiInputs {
+            gbuffer: &gbuffer,
+            sky: &sky,
+            lights: scene.lights,
+            view: &view,
+            params: &params,
+        };
+        let (frame, rays) = t
+            .ray_traced_gi
+            .record(g, &rt_scene, &inputs, state.rtgi_reset)?;
+        state.rtgi_reset = false;
+        ray_traced_gi = Some(frame);
+        ray_traced_gi_rays = Some(rays);
+    }
 
     // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
     //     sky's SH as ambient light, or the placeholders with the atmosphere off).
@@ -197,6 +248,8 @@ pub fn record<'r>(
         gbuffer,
         shadows,
         sky,
+        ray_traced_gi,
+        ray_traced_gi_rays,
         hdr,
         ldr,
     })

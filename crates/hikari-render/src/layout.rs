@@ -30,7 +30,9 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows};
+    use crate::techniques::{
+        direct_lighting, placeholder_tonemap, ray_traced_gi, sky, sun_shadows,
+    };
     use crate::view;
     vec![
         gpu_layout!(
@@ -111,6 +113,19 @@ pub fn all() -> Vec<StructLayout> {
                 white,
                 transmittance_size,
                 ground
+            ]
+        ),
+        gpu_layout!(
+            ray_traced_gi::RtGiParams,
+            "ray_traced_gi/shade.wgsl",
+            [
+                config,
+                distances,
+                pretrace,
+                sun,
+                sun_color,
+                sky_zenith,
+                sky_horizon
             ]
         ),
         gpu_layout!(

@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
+pub use crate::techniques::ray_traced_gi::settings::RayTracedGiSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
 
@@ -189,6 +190,7 @@ register_settings! {
     direct_lighting: DirectLightingSettings,
     exposure: ExposureSettings,
     sky: SkySettings,
+    ray_traced_gi: RayTracedGiSettings,
 }
 
 impl Settings {

@@ -6,5 +6,6 @@
 pub mod direct_lighting;
 pub mod gbuffer;
 pub mod placeholder_tonemap;
+pub mod ray_traced_gi;
 pub mod sky;
 pub mod sun_shadows;

@@ -1,0 +1,124 @@
+// Lights the GI rays' hits (Metro Exodus's "deferred lighting of hits"): regenerates each
+// pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
+// along the ray: on a miss the sky in that direction (no sun or moon disk: direct light is the
+// deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
+// moon (with a shadow ray), the sky's ambient light and the point and spot lights. The word
+// carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
+// as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+
+#import hikari::view::{View, world_from_depth}
+#import hikari::octahedral::oct_decode
+#import hikari::scene_gpu::LightGpu
+#import hikari::sh::{ShYCoCg, shy_encode}
+#import hikari::bvh::{Ray, bvh_occluded}
+#import hikari::sky::sky_background_no_disks
+#import hikari::sky_ambient::sky_ambient_irradiance
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray_direction, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_uniform_weight}
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<uniform> params: RtGiParams;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var gbuffer_normal: texture_2d<f32>;
+@group(0) @binding(4) var<storage, read> hits: array<u32>;
+@group(0) @binding(5) var<storage, read> lights: array<LightGpu>;
+@group(0) @binding(6) var out_y: texture_storage_2d<rgba16float, write>;
+// Co, Cg, AO (1 open), 0.
+@group(0) @binding(7) var out_cocg_ao: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(8) var out_hit_distance: texture_storage_2d<r16float, write>;
+
+const MAX_RADIANCE: f32 = 65000.0;
+
+fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
+    return mix(params.sky_horizon.rgb, params.sky_zenith.rgb, sqrt(clamp(dir.y, 0.0, 1.0)));
+}
+
+fn miss_radiance(dir: vec3<f32>) -> vec3<f32> {
+    let flags = params.config.y;
+    if (flags & RTGI_SKY) != 0u {
+        return sky_background_no_disks(dir);
+    }
+    if (flags & RTGI_PLACEHOLDER_SKY) != 0u {
+        return sky_placeholder(dir);
+    }
+    return vec3<f32>(0.0);
+}
+
+// Irradiance (lux) at x on a surface facing n.
+fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let flags = params.config.y;
+    var e = vec3<f32>(0.0);
+    let l = params.sun.xyz;
+    let c = dot(n, l);
+    if (flags & RTGI_SUN) != 0u && params.sun.w > 0.0 && c > 0.0 {
+        if !bvh_occluded(Ray(x, 0.0, l, 1.0e5)) {
+            e += params.sun_color.rgb * (params.sun.w * c);
+        }
+    }
+    if (flags & RTGI_SKY_AMBIENT) != 0u {
+        if (flags & RTGI_SKY) != 0u {
+            e += sky_ambient_irradiance(n);
+        } else if (flags & RTGI_PLACEHOLDER_SKY) != 0u {
+            e += RTGI_PI * 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb) * 0.5 * (1.0 + n.y);
+        }
+    }
+    if (flags & RTGI_PUNCTUAL) != 0u {
+        for (var i = 0u; i < min(params.config.w, arrayLength(&lights)); i++) {
+            let light = lights[i];
+            let to_light = light.position_range.xyz - x;
+            let d2 = max(dot(to_light, to_light), 1e-8);
+            let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
+            let range = max(min(light.position_range.w, sqrt(peak / params.distances.w)), 1e-3);
+            let r = d2 / (range * range);
+            let window = max(1.0 - r * r, 0.0);
+            let dir = to_light * inverseSqrt(d2);
+            var a = window * window * min(1.0 / d2, 1e4) * max(dot(n, dir), 0.0);
+            if light.direction_kind.w > 0.5 {
+                let s = clamp(dot(-dir, light.direction_kind.xyz) * light.spot.x + light.spot.y, 0.0, 1.0);
+                a *= s * s;
+            }
+            e += light.intensity.rgb * a;
+        }
+    }
+    return e;
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let size = textureDimensions(depth);
+    if any(gid.xy >= size) {
+        return;
+    }
+    let pixel = gid.xy;
+    let word = hits[pixel.y * size.x + pixel.x];
+    if word == RTGI_HIT_NOT_TRACED || word == RTGI_HIT_UNRESOLVED {
+        textureStore(out_y, pixel, vec4<f32>(0.0));
+        textureStore(out_cocg_ao, pixel, vec4<f32>(0.0, 0.0, 1.0, 0.0));
+        textureStore(out_hit_distance, pixel, vec4<f32>(0.0));
+        return;
+    }
+    let d = textureLoad(depth, pixel, 0).r;
+    let n = oct_decode(textureLoad(gbuffer_normal, pixel, 0).xy);
+    let world = world_from_depth(view, pixel, d);
+    let o = rtgi_ray_origin(world, n, view.position.xyz);
+    let ray = rtgi_ray_direction(pixel, params.config.x, n);
+    let dir = ray.xyz;
+    var radiance: vec3<f32>;
+    var ao = 1.0;
+    var distance = 0.0;
+    if rtgi_is_hit(word) {
+        distance = rtgi_hit_distance(word);
+        ao = select(1.0, 0.0, distance < params.distances.y);
+        // Back along the ray a little, off the surface it hit.
+        let x = o + dir * (distance - (1.0e-3 + 1.0e-3 * distance));
+        radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir);
+    } else {
+        radiance = miss_radiance(dir);
+    }
+    // NaN fails every comparison, so this also turns NaN into 0.
+    radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
+    let s = shy_encode(radiance, dir);
+    let w = rtgi_uniform_weight(ray.w);
+    textureStore(out_y, pixel, s.y * w);
+    textureStore(out_cocg_ao, pixel, vec4<f32>(s.co_cg * w, ao, 0.0));
+    textureStore(out_hit_distance, pixel, vec4<f32>(distance, 0.0, 0.0, 0.0));
+}
