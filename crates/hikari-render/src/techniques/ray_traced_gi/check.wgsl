@@ -22,6 +22,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ray = rtgi_cosine_direction(b.xyz, u);
     let word = rtgi_pack_hit(a.w, e.rgb);
     outputs[3u * c] = bitcast<vec4<u32>>(ray);
-    outputs[3u * c + 1u] = vec4<u32>(bitcast<vec2<u32>>(u), word, bitcast<u32>(rtgi_uniform_weight(ray.w)));
+    outputs[3u * c + 1u] = vec4<u32>(bitcast<vec2<u32>>(u), word, bitcast<u32>(rtgi_uniform_weight(u.x)));
     outputs[3u * c + 2u] = bitcast<vec4<u32>>(vec4<f32>(rtgi_hit_albedo(e.rgb, b.w), 0.0));
 }

@@ -479,6 +479,8 @@ impl RayTracedGi {
         if !valid {
             params.set_flag(FLAG_RESET, true);
         }
+        // The shader's module declares the noise set beside the uniform's struct.
+        let noise = self.noise_set(g);
         g.pass("ray_traced_gi.accumulate")
             .constants(view)
             .constants(&params)
@@ -496,6 +498,7 @@ impl RayTracedGi {
             .write(ao.cur)
             .write(len.cur)
             .write(vz.cur)
+            .set(noise)
             .dispatch_threads(&self.accumulate, [w, h, 1])?;
         Ok(RtGiFrame {
             gi_y: y.cur,

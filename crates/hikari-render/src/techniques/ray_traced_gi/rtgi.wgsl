@@ -50,9 +50,19 @@ fn rtgi_ray_direction(pixel: vec2<u32>, frame: u32, n: vec3<f32>) -> vec4<f32> {
     return rtgi_cosine_direction(n, rtgi_blue_noise_2d(pixel, frame));
 }
 
-// Cosine sample -> uniform-hemisphere estimator, the normalisation of the SH encoding.
-fn rtgi_uniform_weight(cos_theta: f32) -> f32 {
-    return 0.5 / max(cos_theta, 1.0e-3);
+// Cosine sample -> uniform-hemisphere estimator, the normalisation of the SH encoding: the
+// pdf ratio (1/2π) / (cos/π) = 1 / (2 cos), averaged over the 8-bit noise value's bin of u1
+// (cos² = 1 - u1), 256 (√(1 - k/256) - √(1 - (k+1)/256)). At the bin's midpoint instead the
+// grazing bins are under-weighted and the mean weight is 0.98, not 1.
+fn rtgi_uniform_weight(u1: f32) -> f32 {
+    let k = clamp(floor(u1 * 256.0), 0.0, 255.0);
+    return 256.0 * (sqrt(1.0 - k / 256.0) - sqrt(max(1.0 - (k + 1.0) / 256.0, 0.0)));
+}
+
+// The pixel's ray: direction (xyz) and its uniform-hemisphere weight (w).
+fn rtgi_ray(pixel: vec2<u32>, frame: u32, n: vec3<f32>) -> vec4<f32> {
+    let u = rtgi_blue_noise_2d(pixel, frame);
+    return vec4<f32>(rtgi_cosine_direction(n, u).xyz, rtgi_uniform_weight(u.x));
 }
 
 fn rtgi_ray_origin(world: vec3<f32>, n: vec3<f32>, camera: vec3<f32>) -> vec3<f32> {

@@ -88,7 +88,7 @@ impl TechniqueSettings for RayTracedGiSettings {
             Field {
                 key: "max_distance_m",
                 range: Range::Float {
-                    lo: 0.01,
+                    lo: 0.5,
                     hi: 60_000.0,
                 },
             },

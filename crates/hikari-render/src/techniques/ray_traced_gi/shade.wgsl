@@ -13,7 +13,7 @@
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::sky::sky_background_no_disks
 #import hikari::sky_ambient::sky_ambient_irradiance
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray_direction, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_uniform_weight}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -100,7 +100,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = oct_decode(textureLoad(gbuffer_normal, pixel, 0).xy);
     let world = world_from_depth(view, pixel, d);
     let o = rtgi_ray_origin(world, n, view.position.xyz);
-    let ray = rtgi_ray_direction(pixel, params.config.x, n);
+    let ray = rtgi_ray(pixel, params.config.x, n);
     let dir = ray.xyz;
     var radiance: vec3<f32>;
     var ao = 1.0;
@@ -117,7 +117,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // NaN fails every comparison, so this also turns NaN into 0.
     radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
     let s = shy_encode(radiance, dir);
-    let w = rtgi_uniform_weight(ray.w);
+    let w = ray.w;
     textureStore(out_y, pixel, s.y * w);
     textureStore(out_cocg_ao, pixel, vec4<f32>(s.co_cg * w, ao, 0.0));
     textureStore(out_hit_distance, pixel, vec4<f32>(distance, 0.0, 0.0, 0.0));
