@@ -678,3 +678,134 @@ fn pretrace_hits_agree_with_the_bvh() {
         assert!(img.rgba.iter().all(|p| p.iter().all(|v| v.is_finite())));
     }
 }
+
+/// A floor under a ceiling 2 m up, lit only by a point light between them (no sun, no sky):
+/// every GI ray from the floor hits the ceiling through the BVH. One frame without
+/// accumulation, each pixel against the twin: the same ray from the G-buffer's depth and
+/// normal, the ceiling's hit found analytically, the hit word's quantisation, the light as the
+/// shade pass applies it to a hit lit facing the ray, the encoding. Tolerance: the outputs
+/// are f16 (2^-11 relative) and the lighting a few f32 roundings, so 2^-9 of the pixel's
+/// luminance scale; the distance to an f16 ulp, AO exactly.
+#[test]
+fn hits_are_lit_like_the_twin() {
+    use hikari_scene::{Light, LightKind};
+    let ceiling_albedo = Vec3::new(0.8, 0.4, 0.2);
+    let scene = Scene {
+        meshes: vec![shapes::plane(400.0)],
+        materials: vec![
+            Material::diffuse("floor", Vec3::splat(0.5)),
+            Material::diffuse("ceiling", ceiling_albedo),
+        ],
+        instances: vec![
+            Instance {
+                mesh: 0,
+                material: 0,
+                transform: Mat4::IDENTITY,
+            },
+            Instance {
+                mesh: 0,
+                material: 1,
+                transform: Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0))
+                    * Mat4::from_rotation_x(std::f32::consts::PI),
+            },
+        ],
+        lights: vec![Light {
+            name: "bulb".into(),
+            kind: LightKind::Point,
+            position: Vec3::new(0.3, 1.0, 0.2),
+            direction: Vec3::NEG_Y,
+            intensity_cd: 50.0,
+            color: Vec3::ONE,
+            range: None,
+        }],
+        cameras: vec![Camera {
+            name: "down".into(),
+            position: Vec3::new(0.0, 1.5, 0.0),
+            target: Vec3::ZERO,
+            up: Vec3::Z,
+            ..Camera::default()
+        }],
+        sun: None,
+        ..Default::default()
+    };
+    let (w, h) = (64u32, 64u32);
+    let mut s = rtgi_settings(&scene, w, h);
+    s.sun = None;
+    s.settings.ray_traced_gi.accumulate = false;
+    let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let light = renderer.scene().cpu.lights[0];
+    let mut picked = None;
+    let mut r = renderer
+        .render_reading(&s, |o| {
+            let f = o.ray_traced_gi.unwrap();
+            picked = Some(f);
+            vec![
+                f.gi_y.into(),
+                f.gi_cocg.into(),
+                f.ao.into(),
+                f.hit_distance.into(),
+                o.gbuffer.depth.into(),
+                o.gbuffer.normal.into(),
+            ]
+        })
+        .unwrap();
+    let f = picked.unwrap();
+    let gy = r.take_image_of(f.gi_y).unwrap();
+    let gc = r.take_image_of(f.gi_cocg).unwrap();
+    let ga = r.take_image_of(f.ao).unwrap();
+    let gd = r.take_image_of(f.hit_distance).unwrap();
+    let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
+    let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
+    let view = View::new(&s.camera, w, h);
+    let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
+    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let mut lit = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let d = depth[i][0];
+            assert!(d > 0.0, "pixel ({x}, {y}) sees the floor");
+            let n = reference::oct_decode(Vec2::new(normal[i][0], normal[i][1]));
+            let world = reference::world_from_depth(inv_vp, [w, h], [x, y], d);
+            let o = reference::ray_origin(world, n, s.camera.position);
+            let (dir, weight) = reference::ray([x, y], 0, n);
+            let t = (2.0 - o.y) / dir.y;
+            let (radiance, t_q) = match unpack_hit(pack_hit(Some(t), ceiling_albedo)) {
+                HitWord::Hit { distance, albedo } if t < 250.0 => {
+                    // The BVH's t and the analytic one may round to neighbouring f16 values
+                    // (checked below); light the GPU's, so that the lighting is compared alone.
+                    let gpu_t = gd.rgba[i][0];
+                    let used = if (gpu_t - distance).abs() <= distance * 2f32.powi(-10) * 1.001 {
+                        gpu_t
+                    } else {
+                        distance
+                    };
+                    let p = o + dir * (used - (1e-3 + 1e-3 * used));
+                    let e = reference::punctual_irradiance(p, -dir, &light, cutoff);
+                    (albedo / std::f32::consts::PI * e, distance)
+                }
+                _ => (Vec3::ZERO, 0.0),
+            };
+            lit += (radiance.max_element() > 0.0) as u32;
+            let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
+            let got = [gy.rgba[i][0], gy.rgba[i][1], gy.rgba[i][2], gy.rgba[i][3], gc.rgba[i][0], gc.rgba[i][1]];
+            let scale = (want[0].abs() / C0 as f32).max(1e-6);
+            for k in 0..6 {
+                assert!(
+                    (got[k] - want[k]).abs() <= scale * 2f32.powi(-9),
+                    "pixel ({x}, {y}) value {k}: GPU {}, twin {} (t {t})",
+                    got[k],
+                    want[k]
+                );
+            }
+            // The BVH's t and the analytic one may round to neighbouring f16 values.
+            assert!(
+                (gd.rgba[i][0] - t_q).abs() <= t_q * 2f32.powi(-10) * 1.001,
+                "pixel ({x}, {y}) distance: GPU {}, twin {t_q} (t {t})",
+                gd.rgba[i][0]
+            );
+            assert_eq!(ga.rgba[i][0], if t_q > 0.0 && t_q < 50.0 { 0.0 } else { 1.0 });
+        }
+    }
+    assert!(lit > 3000, "only {lit} pixels' rays were lit");
+}

@@ -203,6 +203,38 @@ pub fn instance_albedos(scene: &Scene) -> Vec<[f32; 4]> {
         .collect()
 }
 
+/// `hikari::octahedral`'s `oct_decode`: the unit vector of an octahedral encoding in [-1, 1]².
+pub fn oct_decode(e: Vec2) -> Vec3 {
+    let mut v = Vec3::new(e.x, e.y, 1.0 - e.x.abs() - e.y.abs());
+    if v.z < 0.0 {
+        let s = |x: f32| if x >= 0.0 { 1.0 } else { -1.0 };
+        v = Vec3::new((1.0 - v.y.abs()) * s(v.x), (1.0 - v.x.abs()) * s(v.y), v.z);
+    }
+    v.normalize()
+}
+
+/// Irradiance (lux) from one point or spot light at `x` on a surface facing `n`, as the
+/// shade pass lights hits: inverse square held below 1e4, windowed to 0 at the light's range
+/// (its own, or where it falls below `cutoff_lux`), the spot cone, Lambert's cosine; no shadow.
+pub fn punctual_irradiance(x: Vec3, n: Vec3, light: &crate::scene_gpu::LightGpu, cutoff_lux: f32) -> Vec3 {
+    let pos = Vec3::from_slice(&light.position_range[..3]);
+    let intensity = Vec3::from_slice(&light.intensity[..3]);
+    let to_light = pos - x;
+    let d2 = to_light.length_squared().max(1e-8);
+    let peak = intensity.max_element();
+    let range = light.position_range[3].min((peak / cutoff_lux).sqrt()).max(1e-3);
+    let r = d2 / (range * range);
+    let window = (1.0 - r * r).max(0.0);
+    let dir = to_light / d2.sqrt();
+    let mut a = window * window * (1.0 / d2).min(1e4) * n.dot(dir).max(0.0);
+    if light.direction_kind[3] > 0.5 {
+        let axis = Vec3::from_slice(&light.direction_kind[..3]);
+        let s = ((-dir).dot(axis) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
+        a *= s * s;
+    }
+    intensity * a
+}
+
 /// The encoded sample of one ray: radiance `l` arriving along `dir` with weight `weight`
 /// ([`ray`]). Non-finite radiance gives a zero sample.
 pub fn encode_sample(l: Vec3, dir: Vec3, weight: f32) -> ShL1YCoCg {
