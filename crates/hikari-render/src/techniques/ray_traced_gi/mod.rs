@@ -303,6 +303,7 @@ pub struct RayTracedGi {
     shade: ComputePipeline,
     accumulate: ComputePipeline,
     check: ComputePipeline,
+    resolve_check: ComputePipeline,
     noise: wgpu::Buffer,
 }
 
@@ -324,6 +325,7 @@ impl RayTracedGi {
             shade: p(lib, "ray_traced_gi/shade.wgsl", &alpha)?,
             accumulate: p(lib, "ray_traced_gi/accumulate.wgsl", &[])?,
             check: p(lib, "ray_traced_gi/check.wgsl", &[])?,
+            resolve_check: p(lib, "ray_traced_gi/resolve_check.wgsl", &[])?,
             noise: storage_buffer(ctx, "ray_traced_gi.blue_noise", &BLUE_NOISE_64X64X64[..]),
         })
     }
@@ -524,6 +526,23 @@ impl RayTracedGi {
             .write(outputs)
             .set(noise)
             .dispatch(&self.check, [cases.div_ceil(64).max(1), 1, 1])
+    }
+
+    /// The verification kernel `ray_traced_gi/resolve_check.wgsl` of `hikari::rtgi_resolve`:
+    /// five vec4s a case in, two out (see the shader). `brdf_tables`: `BrdfTables::binding_set`.
+    pub fn record_resolve_check<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        inputs: Buf,
+        outputs: Buf,
+        cases: u32,
+        brdf_tables: BindingSet,
+    ) -> Result<()> {
+        g.pass("ray_traced_gi.resolve_check")
+            .read(inputs)
+            .write(outputs)
+            .set(brdf_tables)
+            .dispatch(&self.resolve_check, [cases.div_ceil(64).max(1), 1, 1])
     }
 }
 

@@ -216,13 +216,20 @@ pub fn oct_decode(e: Vec2) -> Vec3 {
 /// Irradiance (lux) from one point or spot light at `x` on a surface facing `n`, as the
 /// shade pass lights hits: inverse square held below 1e4, windowed to 0 at the light's range
 /// (its own, or where it falls below `cutoff_lux`), the spot cone, Lambert's cosine; no shadow.
-pub fn punctual_irradiance(x: Vec3, n: Vec3, light: &crate::scene_gpu::LightGpu, cutoff_lux: f32) -> Vec3 {
+pub fn punctual_irradiance(
+    x: Vec3,
+    n: Vec3,
+    light: &crate::scene_gpu::LightGpu,
+    cutoff_lux: f32,
+) -> Vec3 {
     let pos = Vec3::from_slice(&light.position_range[..3]);
     let intensity = Vec3::from_slice(&light.intensity[..3]);
     let to_light = pos - x;
     let d2 = to_light.length_squared().max(1e-8);
     let peak = intensity.max_element();
-    let range = light.position_range[3].min((peak / cutoff_lux).sqrt()).max(1e-3);
+    let range = light.position_range[3]
+        .min((peak / cutoff_lux).sqrt())
+        .max(1e-3);
     let r = d2 / (range * range);
     let window = (1.0 - r * r).max(0.0);
     let dir = to_light / d2.sqrt();
@@ -360,4 +367,28 @@ pub fn from_floats(f: [f32; 6]) -> ShL1YCoCg {
         },
         co_cg: Vec2::new(f[4], f[5]),
     }
+}
+
+/// `hikari::rtgi_resolve`'s diffuse: radiance of a white Lambertian surface facing `n`.
+pub fn resolve_diffuse(s: &ShL1YCoCg, n: Vec3) -> Vec3 {
+    s.resolve_diffuse(n)
+}
+
+/// `hikari::rtgi_resolve`'s specular: reflected radiance towards `v` of a GGX surface facing
+/// `n` (Fresnel F0 `f0`, GGX alpha `material_alpha`), the SH taken as one light from its
+/// dominant direction (the mirror direction if it has none) with the lobe widened by its loss
+/// of directionality and the irradiance it gives a plane facing that direction.
+pub fn resolve_specular(s: &ShL1YCoCg, n: Vec3, v: Vec3, f0: Vec3, material_alpha: f32) -> Vec3 {
+    use hikari_math::brdf::{fresnel, ggx, smith};
+    let l = s.dominant_direction().unwrap_or_else(|| (-v).reflect(n));
+    let alpha = s.specular_alpha(material_alpha) as f64;
+    let (n_l, n_v) = (n.dot(l) as f64, n.dot(v) as f64);
+    if n_l <= 0.0 || n_v <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let e = (std::f32::consts::PI * s.resolve_diffuse(l)).as_dvec3();
+    let h = (v + l).normalize();
+    let spec = ggx::ggx_ndf(n.dot(h) as f64, alpha) * smith::visibility(n_v, n_l, alpha);
+    let f = fresnel::fresnel_schlick(f0.as_dvec3(), v.dot(h).max(0.0) as f64);
+    (f * spec * e * n_l).as_vec3()
 }
