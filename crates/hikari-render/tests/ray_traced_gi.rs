@@ -491,6 +491,7 @@ struct Read {
     length: ImageRgba32,
     distance: ImageRgba32,
     hits: Vec<u32>,
+    instances: Vec<u32>,
     queue: Vec<u32>,
 }
 
@@ -508,6 +509,7 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
                 f.history_length.into(),
                 f.hit_distance.into(),
                 rays.hits.into(),
+                rays.hit_instances.into(),
                 rays.queue.into(),
             ]
         })
@@ -516,6 +518,7 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
     let words = |name: &str| -> Vec<u32> { bytemuck::pod_collect_to_vec(r.buffer(name).unwrap()) };
     let hits = words("ray_traced_gi.hits");
     let queue = words("ray_traced_gi.queue");
+    let instances = words("ray_traced_gi.hit_instances");
     Read {
         y: r.take_image_of(f.gi_y).unwrap(),
         cocg: r.take_image_of(f.gi_cocg).unwrap(),
@@ -523,6 +526,7 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
         length: r.take_image_of(f.history_length).unwrap(),
         distance: r.take_image_of(f.hit_distance).unwrap(),
         hits,
+        instances,
         queue,
     }
 }
@@ -619,7 +623,7 @@ fn open_floor_under_a_sky_accumulates_the_analytic_sh() {
 /// The pre-trace against the BVH: the same rays (frame 0) traced with the pre-trace and with
 /// the BVH alone. Where the pre-trace resolved a ray, the BVH finds a hit at about the same
 /// distance (within a screen-space step, taken as 25 % plus the 0.3 m thickness) with the same
-/// albedo, for at least 90 % of those rays.
+/// albedo and on the same instance, for at least 90 % of those rays.
 #[test]
 fn pretrace_hits_agree_with_the_bvh() {
     let scene = hikari_scene::builtin::boxes();
@@ -656,6 +660,7 @@ fn pretrace_hits_agree_with_the_bvh() {
         ) = (unpack_hit(a.hits[i]), unpack_hit(b.hits[i]))
             && (t1 - t2).abs() <= 0.25 * t2 + 0.3
             && (a1 - a2).abs().max_element() < 0.05
+            && a.instances[i] == b.instances[i]
         {
             agree += 1;
         }
@@ -679,22 +684,27 @@ fn pretrace_hits_agree_with_the_bvh() {
     }
 }
 
-/// A floor under a ceiling 2 m up, lit only by a point light between them (no sun, no sky):
+/// A floor under a glowing ceiling 2 m up, lit only by a point light between them and the
+/// ceiling's emission (no sun, no sky):
 /// every GI ray from the floor hits the ceiling through the BVH. One frame without
 /// accumulation, each pixel against the twin: the same ray from the G-buffer's depth and
 /// normal, the ceiling's hit found analytically, the hit word's quantisation, the light as the
-/// shade pass applies it to a hit lit facing the ray, the encoding. Tolerance: the outputs
+/// shade pass applies it to a hit lit facing the ray, the ceiling's emission, the encoding. Tolerance: the outputs
 /// are f16 (2^-11 relative) and the lighting a few f32 roundings, so 2^-9 of the pixel's
 /// luminance scale; the distance to an f16 ulp, AO exactly.
 #[test]
 fn hits_are_lit_like_the_twin() {
     use hikari_scene::{Light, LightKind};
     let ceiling_albedo = Vec3::new(0.8, 0.4, 0.2);
+    let ceiling_emission = Vec3::new(3.0, 2.0, 1.0);
     let scene = Scene {
         meshes: vec![shapes::plane(400.0)],
         materials: vec![
             Material::diffuse("floor", Vec3::splat(0.5)),
-            Material::diffuse("ceiling", ceiling_albedo),
+            Material {
+                emissive_nits: ceiling_emission,
+                ..Material::diffuse("ceiling", ceiling_albedo)
+            },
         ],
         instances: vec![
             Instance {
@@ -782,7 +792,10 @@ fn hits_are_lit_like_the_twin() {
                     };
                     let p = o + dir * (used - (1e-3 + 1e-3 * used));
                     let e = reference::punctual_irradiance(p, -dir, &light, cutoff);
-                    (albedo / std::f32::consts::PI * e, distance)
+                    (
+                        albedo / std::f32::consts::PI * e + ceiling_emission,
+                        distance,
+                    )
                 }
                 _ => (Vec3::ZERO, 0.0),
             };

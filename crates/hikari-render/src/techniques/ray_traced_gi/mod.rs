@@ -59,11 +59,13 @@ pub struct RtGiFrame {
     pub hit_distance: Tex,
 }
 
-/// The frame's ray buffers, for statistics and tests: one hit word a pixel, and the BVH queue
-/// (word 0: rays the pre-trace left; then their pixel indices).
+/// The frame's ray buffers, for statistics and tests: one hit word a pixel, the scene
+/// instance each hit is on (`u32::MAX`: none), and the BVH queue (word 0: rays the pre-trace
+/// left; then their pixel indices).
 #[derive(Clone, Copy, Debug)]
 pub struct RtGiRays {
     pub hits: Buf,
+    pub hit_instances: Buf,
     pub queue: Buf,
 }
 
@@ -186,7 +188,8 @@ pub struct RtGiScene {
     alpha_instances: wgpu::Buffer,
     alpha_triangles: wgpu::Buffer,
     alpha_textures: wgpu::Texture,
-    instance_albedo: wgpu::Buffer,
+    /// [`reference::instance_table`].
+    instance_table: wgpu::Buffer,
     /// Nodes on the longest TLAS root-to-leaf path.
     pub tlas_depth: u32,
 }
@@ -232,7 +235,7 @@ impl RtGiScene {
         let tlas = Tlas::build(&instances, &all, &blases).map_err(bvh_error)?;
         let packed = PackedBlases::new(&blases);
         let alpha = BvhAlpha::for_scene(scene);
-        let albedo = non_empty(&reference::instance_albedos(scene));
+        let table = non_empty(&reference::instance_table(scene));
         let nodes: Vec<WideNode> = non_empty(&packed.nodes);
         let tris: Vec<TriangleRecord> = non_empty(&packed.triangles);
         let tlas_nodes: Vec<WideNode> = non_empty(&tlas.nodes);
@@ -248,15 +251,12 @@ impl RtGiScene {
             alpha_instances: b("bvh.alpha_instances", bytemuck::cast_slice(&alpha_inst)),
             alpha_triangles: b("bvh.alpha_triangles", bytemuck::cast_slice(&alpha_tri)),
             alpha_textures: color_textures.clone(),
-            instance_albedo: b(
-                "ray_traced_gi.instance_albedo",
-                bytemuck::cast_slice(&albedo),
-            ),
+            instance_table: b("ray_traced_gi.instance_table", bytemuck::cast_slice(&table)),
             tlas_depth: tlas.stats.depth,
         })
     }
 
-    /// The BVH's buffers in a frame, and the per-instance albedo table.
+    /// The BVH's buffers in a frame, and the per-instance table (albedo, emission).
     pub fn import(&self, g: &mut FrameGraph<'_>) -> (BvhBuffers, Buf) {
         (
             BvhBuffers {
@@ -268,7 +268,7 @@ impl RtGiScene {
                 alpha_triangles: g.import_buffer("bvh.alpha_triangles", &self.alpha_triangles),
                 alpha_textures: g.import_texture("bvh.alpha_textures", &self.alpha_textures),
             },
-            g.import_buffer("ray_traced_gi.instance_albedo", &self.instance_albedo),
+            g.import_buffer("ray_traced_gi.instance_table", &self.instance_table),
         )
     }
 }
@@ -380,8 +380,9 @@ impl RayTracedGi {
         let view = inputs.view;
         let params = inputs.params;
         let hits = g.buffer("ray_traced_gi.hits", pixels * 4)?;
+        let hit_instances = g.buffer("ray_traced_gi.hit_instances", pixels * 4)?;
         let queue = g.buffer("ray_traced_gi.queue", (pixels + 1) * 4)?;
-        let (bvh, albedo) = scene.import(g);
+        let (bvh, table) = scene.import(g);
 
         g.pass("ray_traced_gi.clear")
             .write(queue)
@@ -396,7 +397,9 @@ impl RayTracedGi {
             .read(gb.albedo)
             .read(gb.material)
             .read(gb.motion)
+            .read(gb.instance)
             .write(hits)
+            .write(hit_instances)
             .write(queue)
             .set(noise)
             .dispatch_threads(&self.pretrace, [w, h, 1])?;
@@ -415,7 +418,8 @@ impl RayTracedGi {
                 .read(gb.normal)
                 .read(queue)
                 .write(hits)
-                .read(albedo)
+                .write(hit_instances)
+                .read(table)
                 .set(noise)
                 .set(bvh_set)
                 .dispatch(&self.trace, [gx as u32, gy as u32, 1])?;
@@ -435,6 +439,8 @@ impl RayTracedGi {
             .read(gb.depth)
             .read(gb.normal)
             .read(hits)
+            .read(hit_instances)
+            .read(table)
             .read(inputs.lights)
             .write(raw_y)
             .write(raw_cocg_ao)
@@ -448,7 +454,11 @@ impl RayTracedGi {
             y: raw_y,
             cocg_ao: raw_cocg_ao,
             hit_distance,
-            rays: RtGiRays { hits, queue },
+            rays: RtGiRays {
+                hits,
+                hit_instances,
+                queue,
+            },
         })
     }
 

@@ -14,9 +14,16 @@
 @group(0) @binding(4) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(5) var gbuffer_material: texture_2d<f32>;
 @group(0) @binding(6) var gbuffer_motion: texture_2d<f32>;
-@group(0) @binding(7) var<storage, read_write> hits: array<u32>;
+@group(0) @binding(7) var gbuffer_instance: texture_2d<u32>;
+@group(0) @binding(8) var<storage, read_write> hits: array<u32>;
+// The scene instance of each hit (0xffffffff: none), for its emission.
+@group(0) @binding(9) var<storage, read_write> hit_instances: array<u32>;
 // Word 0: count; then pixel indices.
-@group(0) @binding(8) var<storage, read_write> queue: array<atomic<u32>>;
+@group(0) @binding(10) var<storage, read_write> queue: array<atomic<u32>>;
+
+const NO_INSTANCE: u32 = 0xffffffffu;
+// The pixel the pre-trace hit, if any.
+var<private> hit_pixel: vec2<u32>;
 
 fn to_pixel(h: vec4<f32>) -> vec2<f32> {
     let ndc = h.xy / h.w;
@@ -64,6 +71,7 @@ fn march(o: vec3<f32>, dir: vec3<f32>) -> u32 {
                 return RTGI_HIT_UNRESOLVED;
             }
             let x = mix(o / h0.w, e / h1.w, k) / inv_w;
+            hit_pixel = p;
             let base = textureLoad(gbuffer_albedo, p, 0).rgb;
             let metal = textureLoad(gbuffer_material, p, 0).y;
             return rtgi_pack_hit(length(x - o), rtgi_hit_albedo(base, metal));
@@ -85,6 +93,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // NaN fails every comparison: a bad G-buffer texel traces nothing.
     if !(d > 0.0 && d <= 1.0) || !all(n == n) || !(dot(n, n) > 0.5) {
         hits[i] = RTGI_HIT_NOT_TRACED;
+        hit_instances[i] = NO_INSTANCE;
         return;
     }
     let world = world_from_depth(view, pixel, d);
@@ -95,6 +104,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (flags & RTGI_PRETRACE) != 0u {
         word = march(o, dir);
     }
+    var instance = NO_INSTANCE;
+    if word != RTGI_HIT_UNRESOLVED {
+        instance = textureLoad(gbuffer_instance, hit_pixel, 0).x;
+    }
+    hit_instances[i] = instance;
     if word == RTGI_HIT_UNRESOLVED {
         if (flags & RTGI_BVH) != 0u {
             let slot = atomicAdd(&queue[0], 1u);

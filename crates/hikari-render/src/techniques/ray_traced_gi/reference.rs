@@ -182,23 +182,28 @@ pub fn texture_mean(t: &Texture) -> Vec3 {
     )
 }
 
-/// Per-instance albedo for BVH hits (the simple version of Metro's table): each instance's
-/// material base colour factor times its base colour texture's mean, through [`hit_albedo`].
-/// Metro renders each mesh-material pair from six directions instead; not done yet.
-pub fn instance_albedos(scene: &Scene) -> Vec<[f32; 4]> {
+/// Per-instance data for hits, two records an instance: `[albedo, 0]` and `[emission, 0]`.
+/// Albedo (the simple version of Metro's table): the material's base colour factor times its
+/// base colour texture's mean, through [`hit_albedo`]; Metro renders each mesh-material pair
+/// from six directions instead (not done). Emission: the material's emitted luminance (nits)
+/// times its emissive texture's mean.
+pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
     let means: Vec<Vec3> = scene.textures.iter().map(texture_mean).collect();
+    let mean_of = |r: Option<hikari_scene::TextureRef>| {
+        r.and_then(|r| means.get(r.texture).copied())
+            .unwrap_or(Vec3::ONE)
+    };
     scene
         .instances
         .iter()
-        .map(|i| {
+        .flat_map(|i| {
             let m = &scene.materials[i.material];
-            let tex = m
-                .base_color_texture
-                .and_then(|r| means.get(r.texture).copied())
-                .unwrap_or(Vec3::ONE);
-            hit_albedo(m.base_color * tex, m.metalness)
-                .extend(0.0)
-                .to_array()
+            let albedo = hit_albedo(m.base_color * mean_of(m.base_color_texture), m.metalness);
+            let emission = m.emissive_nits * mean_of(m.emissive_texture);
+            [
+                albedo.extend(0.0).to_array(),
+                emission.extend(0.0).to_array(),
+            ]
         })
         .collect()
 }

@@ -2,7 +2,8 @@
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
 // along the ray: on a miss the sky in that direction (no sun or moon disk: direct light is the
 // deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
-// moon (with a shadow ray), the sky's ambient light and the point and spot lights. The word
+// moon (with a shadow ray), the sky's ambient light and the point and spot lights, plus the
+// emission of the hit's instance (its material's, textures averaged). The word
 // carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
 // as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
 
@@ -20,11 +21,14 @@
 @group(0) @binding(2) var depth: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(4) var<storage, read> hits: array<u32>;
-@group(0) @binding(5) var<storage, read> lights: array<LightGpu>;
-@group(0) @binding(6) var out_y: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(5) var<storage, read> hit_instances: array<u32>;
+// Per scene instance: albedo, then emission in nits (reference::instance_table).
+@group(0) @binding(6) var<storage, read> instance_table: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> lights: array<LightGpu>;
+@group(0) @binding(8) var out_y: texture_storage_2d<rgba16float, write>;
 // Co, Cg, AO (1 open), 0.
-@group(0) @binding(7) var out_cocg_ao: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(8) var out_hit_distance: texture_storage_2d<r16float, write>;
+@group(0) @binding(9) var out_cocg_ao: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(10) var out_hit_distance: texture_storage_2d<r16float, write>;
 
 const MAX_RADIANCE: f32 = 65000.0;
 
@@ -111,6 +115,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Back along the ray a little, off the surface it hit.
         let x = o + dir * (distance - (1.0e-3 + 1.0e-3 * distance));
         radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir);
+        let instance = hit_instances[pixel.y * size.x + pixel.x];
+        if 2u * instance + 1u < arrayLength(&instance_table) {
+            radiance += instance_table[2u * instance + 1u].rgb;
+        }
     } else {
         radiance = miss_radiance(dir);
     }
