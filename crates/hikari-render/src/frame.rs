@@ -206,6 +206,7 @@ pub fn record<'r>(
         let inputs = RtGiInputs {
             gbuffer: &gbuffer,
             sky: &sky,
+            shadows: &shadows,
             lights: scene.lights,
             view: &view,
             params: &params,

@@ -912,3 +912,33 @@ fn resolve_helpers_match_the_cpu_twin() {
     }
     assert!(nonzero > 500, "only {nonzero} cases with visible specular");
 }
+
+/// The sun's shadow at hits from the shadow maps (inside a cascade) against shadow rays
+/// through the BVH, two independent methods, on `boxes` by day: the same rays (frame 0, no
+/// accumulation). The maps filter (PCF) and are coarse here (256 texels over 40 m), so pixels
+/// whose hit lies near a shadow's edge differ; the image means of c0 agree within 3 % and
+/// at least 85 % of pixels within 10 % of the mean. Some pixels must differ, or the maps were
+/// not used.
+#[test]
+fn hit_shadows_from_maps_agree_with_shadow_rays() {
+    let scene = hikari_scene::builtin::boxes();
+    let mut s = rtgi_settings(&scene, 64, 64);
+    s.settings.ray_traced_gi.accumulate = false;
+    let mut maps = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let a = render(&mut maps, &s);
+    s.settings.ray_traced_gi.shadow_maps = false;
+    let mut rays = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let b = render(&mut rays, &s);
+    let n = a.y.rgba.len();
+    let mean = |r: &Read| r.y.rgba.iter().map(|p| p[0] as f64).sum::<f64>() as f32 / n as f32;
+    let (ma, mb) = (mean(&a), mean(&b));
+    let close = (0..n)
+        .filter(|&i| (a.y.rgba[i][0] - b.y.rgba[i][0]).abs() <= 0.1 * mb)
+        .count();
+    let differ = (0..n).filter(|&i| a.y.rgba[i][0] != b.y.rgba[i][0]).count();
+    eprintln!("c0 mean: maps {ma}, rays {mb}; {close} of {n} close, {differ} differ");
+    assert!(mb > 0.0);
+    assert!((ma / mb - 1.0).abs() < 0.03, "maps {ma}, rays {mb}");
+    assert!(close as f32 >= 0.85 * n as f32, "{close} of {n}");
+    assert!(differ > 0, "the shadow maps were not used");
+}

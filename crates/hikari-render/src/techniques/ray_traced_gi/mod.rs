@@ -34,6 +34,7 @@ use super::direct_lighting::{
 };
 use super::gbuffer::GBuffer;
 use super::sky::SkyFrame;
+use super::sun_shadows::SunShadowMaps;
 use crate::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -82,6 +83,8 @@ pub const FLAG_ACCUMULATE: u32 = 64;
 pub const FLAG_RESET: u32 = 128;
 /// Hits are lit by the sky's ambient light (or the placeholder's).
 pub const FLAG_SKY_AMBIENT: u32 = 256;
+/// The sun's shadow at hits from its shadow maps inside a cascade (else a shadow ray).
+pub const FLAG_SHADOW_MAPS: u32 = 512;
 
 /// Uniform of every ray-traced GI pass (`RtGiParams` in `rtgi.wgsl`).
 #[repr(C)]
@@ -135,6 +138,7 @@ impl RtGiParams {
             (s.punctual, FLAG_PUNCTUAL),
             (s.accumulate, FLAG_ACCUMULATE),
             (s.sky, FLAG_SKY_AMBIENT),
+            (s.shadow_maps, FLAG_SHADOW_MAPS),
         ]
         .iter()
         .filter(|(on, _)| *on)
@@ -278,6 +282,7 @@ impl RtGiScene {
 pub struct RtGiInputs<'a> {
     pub gbuffer: &'a GBuffer,
     pub sky: &'a SkyFrame,
+    pub shadows: &'a SunShadowMaps,
     /// `SceneInFrame::lights`.
     pub lights: Buf,
     pub view: &'a View,
@@ -449,6 +454,7 @@ impl RayTracedGi {
             .set(bvh_set)
             .set(inputs.sky.lookup)
             .set(inputs.sky.ambient)
+            .set(inputs.shadows.lookup)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(RtGiRaw {
             y: raw_y,

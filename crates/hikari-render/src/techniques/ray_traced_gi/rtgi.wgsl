@@ -147,3 +147,4 @@ const RTGI_PUNCTUAL: u32 = 32u;
 const RTGI_ACCUMULATE: u32 = 64u;
 const RTGI_RESET: u32 = 128u;
 const RTGI_SKY_AMBIENT: u32 = 256u;
+const RTGI_SHADOW_MAPS: u32 = 512u;

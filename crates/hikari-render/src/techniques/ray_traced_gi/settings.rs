@@ -25,8 +25,11 @@ pub struct RayTracedGiSettings {
     pub max_distance_m: f32,
     /// Hits nearer than this occlude for AO, in metres.
     pub ao_max_distance_m: f32,
-    /// Lights at hits: the sun or moon (with a shadow ray).
+    /// Lights at hits: the sun or moon.
     pub sun: bool,
+    /// The sun's shadow at hits from its shadow maps inside a cascade; off, or outside
+    /// every cascade: a shadow ray through the BVH.
+    pub shadow_maps: bool,
     /// Lights at hits: the sky's ambient light (misses always take the sky).
     pub sky: bool,
     /// Lights at hits: point and spot lights (unshadowed).
@@ -54,6 +57,7 @@ impl Default for RayTracedGiSettings {
             max_distance_m: 250.0,
             ao_max_distance_m: 50.0,
             sun: true,
+            shadow_maps: true,
             sky: true,
             punctual: true,
             accumulate: true,

@@ -2,7 +2,7 @@
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
 // along the ray: on a miss the sky in that direction (no sun or moon disk: direct light is the
 // deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
-// moon (with a shadow ray), the sky's ambient light and the point and spot lights, plus the
+// moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light and the point and spot lights, plus the
 // emission of the hit's instance (its material's, textures averaged). The word
 // carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
 // as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
@@ -13,8 +13,9 @@
 #import hikari::sh::{ShYCoCg, shy_encode}
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::sky::sky_background_no_disks
+#import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -47,6 +48,29 @@ fn miss_radiance(dir: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 
+// Whether the sun shadow maps cover x (the cascade selection of `sun_visibility`).
+fn in_a_cascade(x: vec3<f32>, n: vec3<f32>) -> bool {
+    let res = shadow.config.y;
+    let margin = (shadow.config.z + 2.0) / res;
+    for (var c = 0u; c < u32(shadow.config.x); c++) {
+        let p = x + n * (shadow.texel_world[c] * shadow.config.w);
+        let s = shadow.light_view_proj[c] * vec4<f32>(p, 1.0);
+        let uv = vec2<f32>(s.x * 0.5 + 0.5, 0.5 - s.y * 0.5);
+        if all(uv > vec2<f32>(margin)) && all(uv < vec2<f32>(1.0 - margin)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The sun's visibility at x: the shadow maps inside a cascade, else a shadow ray.
+fn sun_visible(x: vec3<f32>, n: vec3<f32>) -> f32 {
+    if (params.config.y & RTGI_SHADOW_MAPS) != 0u && in_a_cascade(x, n) {
+        return sun_visibility(x, n);
+    }
+    return select(1.0, 0.0, bvh_occluded(Ray(x, 0.0, params.sun.xyz, 1.0e5)));
+}
+
 // Irradiance (lux) at x on a surface facing n.
 fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let flags = params.config.y;
@@ -54,9 +78,7 @@ fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let l = params.sun.xyz;
     let c = dot(n, l);
     if (flags & RTGI_SUN) != 0u && params.sun.w > 0.0 && c > 0.0 {
-        if !bvh_occluded(Ray(x, 0.0, l, 1.0e5)) {
-            e += params.sun_color.rgb * (params.sun.w * c);
-        }
+        e += params.sun_color.rgb * (params.sun.w * c * sun_visible(x, n));
     }
     if (flags & RTGI_SKY_AMBIENT) != 0u {
         if (flags & RTGI_SKY) != 0u {
