@@ -622,7 +622,7 @@ fn open_floor_under_a_sky_accumulates_the_analytic_sh() {
 
 /// The pre-trace against the BVH: the same rays (frame 0) traced with the pre-trace and with
 /// the BVH alone. Where the pre-trace resolved a ray, the BVH finds a hit at about the same
-/// distance (within a screen-space step, taken as 25 % plus the 0.3 m thickness) with the same
+/// distance (the crossing is bisected four times within a step: 10 % plus 0.15 m) with the same
 /// albedo and on the same instance, for at least 90 % of those rays.
 #[test]
 fn pretrace_hits_agree_with_the_bvh() {
@@ -658,7 +658,7 @@ fn pretrace_hits_agree_with_the_bvh() {
                 albedo: a2,
             },
         ) = (unpack_hit(a.hits[i]), unpack_hit(b.hits[i]))
-            && (t1 - t2).abs() <= 0.25 * t2 + 0.3
+            && (t1 - t2).abs() <= 0.1 * t2 + 0.15
             && (a1 - a2).abs().max_element() < 0.05
             && a.instances[i] == b.instances[i]
         {
@@ -941,4 +941,27 @@ fn hit_shadows_from_maps_agree_with_shadow_rays() {
     assert!((ma / mb - 1.0).abs() < 0.03, "maps {ma}, rays {mb}");
     assert!(close as f32 >= 0.85 * n as f32, "{close} of {n}");
     assert!(differ > 0, "the shadow maps were not used");
+}
+
+/// Not a check: prints the fraction of rays the pre-trace resolves in the village's first
+/// camera at 320 x 180 (`cargo test --test ray_traced_gi -- --ignored --nocapture`).
+#[test]
+#[ignore = "a measurement; the village's BVH takes a while to build unoptimised"]
+fn village_pretrace_fraction() {
+    let scene = hikari_scene::builtin::village();
+    let s = rtgi_settings(&scene, 320, 180);
+    let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let r = render(&mut renderer, &s);
+    let traced = r
+        .hits
+        .iter()
+        .filter(|&&w| w != reference::HIT_NOT_TRACED)
+        .count();
+    let queued = r.queue[0] as usize;
+    eprintln!(
+        "village, camera {}: pre-trace resolved {} of {traced} rays ({:.1} %)",
+        s.camera.name,
+        traced - queued,
+        100.0 * (traced - queued) as f32 / traced.max(1) as f32
+    );
 }

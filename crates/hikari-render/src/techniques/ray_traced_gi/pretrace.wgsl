@@ -1,7 +1,9 @@
 // Screen-space pre-trace (Metro Exodus): the pixel's GI ray marched against the depth buffer
-// at a constant screen-space step. A hit takes its distance and the G-buffer's albedo; a ray
-// it cannot resolve (off screen, behind a surface by more than the thickness, or longer than
-// the march) goes into the queue for the BVH. Output: one hit word a pixel.
+// at a constant screen-space step. A step that goes from in front of the surface (or within
+// the thickness behind it) to behind it is a hit, which takes its distance and the G-buffer's
+// albedo and instance; a ray it cannot resolve (off screen, behind a surface by more than the
+// thickness for a whole step, or longer than the march) goes into the queue for the BVH.
+// Output: one hit word a pixel.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
@@ -52,6 +54,10 @@ fn march(o: vec3<f32>, dir: vec3<f32>) -> u32 {
     let step = params.pretrace.x;
     let steps = min(u32(params.pretrace.y), u32(ceil(span / step)));
     let size = vec2<f32>(view.viewport.xy);
+    // The ray's view depth at the previous step: a step whose segment spans the surface's
+    // depth (from in front, within the thickness, to behind) hits it, however long the step
+    // is in depth.
+    var prev_z = h0.w;
     for (var i = 1u; i <= steps; i++) {
         let k = min(f32(i) * step / span, 1.0);
         let s = mix(s0, s1, k);
@@ -62,18 +68,36 @@ fn march(o: vec3<f32>, dir: vec3<f32>) -> u32 {
         let inv_w = mix(1.0 / h0.w, 1.0 / h1.w, k);
         let ray_z = 1.0 / inv_w;
         let p = vec2<u32>(s);
+        let z_before = prev_z;
+        prev_z = ray_z;
         if textureLoad(depth, p, 0).r <= 0.0 {
             continue;
         }
         let surf_z = textureLoad(gbuffer_motion, p, 0).z;
         if ray_z > surf_z * 1.002 {
-            if ray_z > surf_z + params.pretrace.z {
+            if min(z_before, ray_z) > surf_z + params.pretrace.z {
+                // Behind the surface all along the step: what is there is unknown.
                 return RTGI_HIT_UNRESOLVED;
             }
-            let x = mix(o / h0.w, e / h1.w, k) / inv_w;
-            hit_pixel = p;
-            let base = textureLoad(gbuffer_albedo, p, 0).rgb;
-            let metal = textureLoad(gbuffer_material, p, 0).y;
+            // Bisect the step for where the ray crosses the depth buffer.
+            var lo = select(0.0, min(f32(i - 1u) * step / span, 1.0), i > 1u);
+            var hi = k;
+            var q = p;
+            for (var b = 0u; b < 4u; b++) {
+                let mid = 0.5 * (lo + hi);
+                let pm = vec2<u32>(clamp(mix(s0, s1, mid), vec2<f32>(0.0), size - 1.0));
+                let zm = 1.0 / mix(1.0 / h0.w, 1.0 / h1.w, mid);
+                if textureLoad(depth, pm, 0).r > 0.0 && zm > textureLoad(gbuffer_motion, pm, 0).z {
+                    hi = mid;
+                    q = pm;
+                } else {
+                    lo = mid;
+                }
+            }
+            hit_pixel = q;
+            let x = mix(o / h0.w, e / h1.w, hi) / mix(1.0 / h0.w, 1.0 / h1.w, hi);
+            let base = textureLoad(gbuffer_albedo, q, 0).rgb;
+            let metal = textureLoad(gbuffer_material, q, 0).y;
             return rtgi_pack_hit(length(x - o), rtgi_hit_albedo(base, metal));
         }
     }
