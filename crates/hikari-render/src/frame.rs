@@ -234,6 +234,10 @@ pub fn record<'r>(
     let hdr = t
         .direct_lighting
         .record(g, &gbuffer, &shadows, &sky, brdf, scene, &view, &lighting)?;
+    if ray_traced_gi.is_some() {
+        // The lit image lights next frame's GI hits where they were visible.
+        t.ray_traced_gi.keep_lit(g, hdr, size)?;
+    }
 
     // 12. Haze and 13. TAA: their issues add them here.
 

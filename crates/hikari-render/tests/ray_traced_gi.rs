@@ -965,3 +965,34 @@ fn village_pretrace_fraction() {
         100.0 * (traced - queued) as f32 / traced.max(1) as f32
     );
 }
+
+/// Reusing last frame's lit image for hits it saw, against lighting every hit: `boxes`, no
+/// accumulation, the second frame of a still camera (same rays in both renderers). The lit
+/// image holds the full shading seen from the camera (specular, textures, occlusion) where
+/// the computed light is diffuse from the hit's quantised albedo facing the ray, so only the
+/// image means are compared (within 25 %); pixels must differ, or nothing was reused, and on
+/// the first frame (no lit image yet) the two are identical.
+#[test]
+fn reused_lit_image_agrees_with_computed_light() {
+    let scene = hikari_scene::builtin::boxes();
+    let mut s = rtgi_settings(&scene, 64, 64);
+    s.settings.ray_traced_gi.accumulate = false;
+    let mut reuse = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let a0 = render(&mut reuse, &s);
+    let a1 = render(&mut reuse, &s);
+    s.settings.ray_traced_gi.reuse_lit = false;
+    let mut compute = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let b0 = render(&mut compute, &s);
+    let b1 = render(&mut compute, &s);
+    assert_eq!(a0.y.rgba, b0.y.rgba, "frame 0 has no lit image to reuse");
+    let n = a1.y.rgba.len();
+    let mean = |r: &Read| r.y.rgba.iter().map(|p| p[0] as f64).sum::<f64>() as f32 / n as f32;
+    let (ma, mb) = (mean(&a1), mean(&b1));
+    let differ = (0..n)
+        .filter(|&i| a1.y.rgba[i][0] != b1.y.rgba[i][0])
+        .count();
+    eprintln!("c0 mean: reused {ma}, computed {mb}; {differ} of {n} pixels differ");
+    assert!(differ > 50, "only {differ} pixels took the lit image");
+    assert!((ma / mb - 1.0).abs() < 0.25, "reused {ma}, computed {mb}");
+    assert!(a1.y.rgba.iter().all(|p| p.iter().all(|v| v.is_finite())));
+}

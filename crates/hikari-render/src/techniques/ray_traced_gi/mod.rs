@@ -85,6 +85,8 @@ pub const FLAG_RESET: u32 = 128;
 pub const FLAG_SKY_AMBIENT: u32 = 256;
 /// The sun's shadow at hits from its shadow maps inside a cascade (else a shadow ray).
 pub const FLAG_SHADOW_MAPS: u32 = 512;
+/// Hits visible last frame take last frame's lit image there.
+pub const FLAG_REUSE_LIT: u32 = 1024;
 
 /// Uniform of every ray-traced GI pass (`RtGiParams` in `rtgi.wgsl`).
 #[repr(C)]
@@ -139,6 +141,7 @@ impl RtGiParams {
             (s.accumulate, FLAG_ACCUMULATE),
             (s.sky, FLAG_SKY_AMBIENT),
             (s.shadow_maps, FLAG_SHADOW_MAPS),
+            (s.reuse_lit, FLAG_REUSE_LIT),
         ]
         .iter()
         .filter(|(on, _)| *on)
@@ -309,6 +312,7 @@ pub struct RayTracedGi {
     accumulate: ComputePipeline,
     check: ComputePipeline,
     resolve_check: ComputePipeline,
+    keep_lit: ComputePipeline,
     noise: wgpu::Buffer,
 }
 
@@ -331,6 +335,7 @@ impl RayTracedGi {
             accumulate: p(lib, "ray_traced_gi/accumulate.wgsl", &[])?,
             check: p(lib, "ray_traced_gi/check.wgsl", &[])?,
             resolve_check: p(lib, "ray_traced_gi/resolve_check.wgsl", &[])?,
+            keep_lit: p(lib, "ray_traced_gi/keep_lit.wgsl", &[])?,
             noise: storage_buffer(ctx, "ray_traced_gi.blue_noise", &BLUE_NOISE_64X64X64[..]),
         })
     }
@@ -436,6 +441,17 @@ impl RayTracedGi {
         let raw_y = tex(g, "ray_traced_gi.raw_y", Y_FORMAT)?;
         let raw_cocg_ao = tex(g, "ray_traced_gi.raw_cocg_ao", Y_FORMAT)?;
         let hit_distance = tex(g, "ray_traced_gi.hit_distance", SCALAR_FORMAT)?;
+        // Last frame's lit image and view depth (zeros, and not used, on a first frame).
+        let lit = g.history_texture("ray_traced_gi.lit", TextureDesc::d2(w, h, Y_FORMAT))?;
+        let vz = g.history_texture(
+            "ray_traced_gi.view_depth",
+            TextureDesc::d2(w, h, VIEW_DEPTH_FORMAT),
+        )?;
+        let mut params = *params;
+        if !(lit.valid && vz.valid) {
+            params.set_flag(FLAG_REUSE_LIT, false);
+        }
+        let params = &params;
         let noise = self.noise_set(g);
         let bvh_set = bvh.binding_set(g);
         g.pass("ray_traced_gi.shade")
@@ -450,6 +466,8 @@ impl RayTracedGi {
             .write(raw_y)
             .write(raw_cocg_ao)
             .write(hit_distance)
+            .read(lit.prev)
+            .read(vz.prev)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)
@@ -466,6 +484,19 @@ impl RayTracedGi {
                 queue,
             },
         })
+    }
+
+    /// Keeps the frame's lit image (`direct_lighting.radiance`) for the next frame's lighting
+    /// of hits (`reuse_lit`); call after the deferred lighting.
+    pub fn keep_lit<'r>(&'r self, g: &mut FrameGraph<'r>, lit: Tex, size: [u32; 2]) -> Result<()> {
+        let hist = g.history_texture(
+            "ray_traced_gi.lit",
+            TextureDesc::d2(size[0], size[1], Y_FORMAT),
+        )?;
+        g.pass("ray_traced_gi.keep_lit")
+            .read(lit)
+            .write(hist.cur)
+            .dispatch_threads(&self.keep_lit, [size[0], size[1], 1])
     }
 
     /// Temporal accumulation of a raw signal (`raw_y`: Rgba16Float L1 SH; `raw_cocg_ao`:

@@ -148,3 +148,4 @@ const RTGI_ACCUMULATE: u32 = 64u;
 const RTGI_RESET: u32 = 128u;
 const RTGI_SKY_AMBIENT: u32 = 256u;
 const RTGI_SHADOW_MAPS: u32 = 512u;
+const RTGI_REUSE_LIT: u32 = 1024u;

@@ -30,6 +30,9 @@ pub struct RayTracedGiSettings {
     /// The sun's shadow at hits from its shadow maps inside a cascade; off, or outside
     /// every cascade: a shadow ray through the BVH.
     pub shadow_maps: bool,
+    /// Hits seen last frame take last frame's lit image there (Metro's "first bounce from all
+    /// lights"); the others are lit as below.
+    pub reuse_lit: bool,
     /// Lights at hits: the sky's ambient light (misses always take the sky).
     pub sky: bool,
     /// Lights at hits: point and spot lights (unshadowed).
@@ -58,6 +61,7 @@ impl Default for RayTracedGiSettings {
             ao_max_distance_m: 50.0,
             sun: true,
             shadow_maps: true,
+            reuse_lit: true,
             sky: true,
             punctual: true,
             accumulate: true,

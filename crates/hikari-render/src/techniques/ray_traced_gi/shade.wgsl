@@ -1,6 +1,6 @@
 // Lights the GI rays' hits (Metro Exodus's "deferred lighting of hits"): regenerates each
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
-// along the ray: on a miss the sky in that direction (no sun or moon disk: direct light is the
+// along the ray: where the hit was visible last frame, last frame's lit image there; on a miss the sky in that direction (no sun or moon disk: direct light is the
 // deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
 // moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light and the point and spot lights, plus the
 // emission of the hit's instance (its material's, textures averaged). The word
@@ -15,7 +15,7 @@
 #import hikari::sky::sky_background_no_disks
 #import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -30,6 +30,9 @@
 // Co, Cg, AO (1 open), 0.
 @group(0) @binding(9) var out_cocg_ao: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(10) var out_hit_distance: texture_storage_2d<r16float, write>;
+// Last frame's lit image (nits) and view depth (`ray_traced_gi.lit`, `.view_depth`).
+@group(0) @binding(11) var prev_lit: texture_2d<f32>;
+@group(0) @binding(12) var prev_view_depth: texture_2d<f32>;
 
 const MAX_RADIANCE: f32 = 65000.0;
 
@@ -69,6 +72,34 @@ fn sun_visible(x: vec3<f32>, n: vec3<f32>) -> f32 {
         return sun_visibility(x, n);
     }
     return select(1.0, 0.0, bvh_occluded(Ray(x, 0.0, params.sun.xyz, 1.0e5)));
+}
+
+// Last frame's lit image where x was visible then (on screen, and its view depth within 1 %
+// of the depth stored there), as radiance towards that camera; w = 0 where it was not.
+fn reused_lit(x: vec3<f32>) -> vec4<f32> {
+    if (params.config.y & RTGI_REUSE_LIT) == 0u {
+        return vec4<f32>(0.0);
+    }
+    let c = view.prev_view_proj * vec4<f32>(x, 1.0);
+    if !(c.w > 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let ndc = c.xy / c.w;
+    let size = vec2<f32>(textureDimensions(prev_lit));
+    let s = vec2<f32>((ndc.x * 0.5 + 0.5) * size.x, (0.5 - ndc.y * 0.5) * size.y);
+    if any(s < vec2<f32>(0.0)) || any(s >= size) {
+        return vec4<f32>(0.0);
+    }
+    let p = vec2<u32>(s);
+    let z = textureLoad(prev_view_depth, p, 0).x;
+    if !(abs(z - c.w) <= 0.01 * c.w) {
+        return vec4<f32>(0.0);
+    }
+    let l = textureLoad(prev_lit, p, 0).rgb;
+    if !all(l >= vec3<f32>(0.0)) || !all(l <= vec3<f32>(65000.0)) {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(l, 1.0);
 }
 
 // Irradiance (lux) at x on a surface facing n.
@@ -136,10 +167,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         ao = select(1.0, 0.0, distance < params.distances.y);
         // Back along the ray a little, off the surface it hit.
         let x = o + dir * (distance - (1.0e-3 + 1.0e-3 * distance));
-        radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir);
-        let instance = hit_instances[pixel.y * size.x + pixel.x];
-        if 2u * instance + 1u < arrayLength(&instance_table) {
-            radiance += instance_table[2u * instance + 1u].rgb;
+        // The talk's "first bounce from all lights": the lit image where the hit was seen.
+        let lit = reused_lit(o + dir * distance);
+        if lit.w > 0.0 {
+            radiance = lit.rgb;
+        } else {
+            radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir);
+            let instance = hit_instances[pixel.y * size.x + pixel.x];
+            if 2u * instance + 1u < arrayLength(&instance_table) {
+                radiance += instance_table[2u * instance + 1u].rgb;
+            }
         }
     } else {
         radiance = miss_radiance(dir);
