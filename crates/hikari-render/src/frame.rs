@@ -18,6 +18,9 @@ use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
+use crate::techniques::ray_traced_gi::{
+    RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene, SkySource,
+};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::techniques::taa::{self, Taa};
@@ -82,6 +85,10 @@ pub struct FrameState {
     /// Where the last frame's camera was, to tell a cut (a new camera that claims it did not
     /// move) from a still frame: temporal techniques drop their history on a cut.
     pub last_camera: Option<[f32; 6]>,
+    /// The scene's BVH for ray-traced GI, built when the technique is first on.
+    pub rtgi_scene: Option<SharedRtGiScene>,
+    /// Drop the ray-traced GI history next frame (a camera cut); cleared once used.
+    pub rtgi_reset: bool,
 }
 
 /// Every technique's pipelines, built once.
@@ -97,6 +104,7 @@ pub struct Techniques {
     pub exposure: Exposure,
     pub local_tonemap: LocalTonemap,
     pub placeholder_tonemap: PlaceholderTonemap,
+    pub ray_traced_gi: RayTracedGi,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
 }
@@ -117,6 +125,7 @@ impl Techniques {
             exposure: Exposure::new(ctx, &mut lib)?,
             local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
             placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
+            ray_traced_gi: RayTracedGi::new(ctx, &mut lib)?,
         })
     }
 }
@@ -130,6 +139,10 @@ pub struct FrameOutputs {
     pub probes: ProbesFrame,
     /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`).
     pub area_lights: Tex,
+    /// Ray-traced GI and AO, accumulated (`None` with the technique off).
+    pub ray_traced_gi: Option<RtGiFrame>,
+    /// Its hit words and BVH queue.
+    pub ray_traced_gi_rays: Option<RtGiRays>,
     /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA.
     pub hdr: Tex,
     /// The lit image before TAA.
@@ -217,7 +230,46 @@ pub fn record<'r>(
     t.irradiance_probes
         .record_pixels_dump(g, &probes, &gbuffer, &view)?;
 
-    // 9. Ray tracing and 10. denoising: the ray-tracing issues add them here.
+    // 9. Ray-traced GI and AO (issue 18): one ray a pixel, pre-traced in screen space, the
+    //    rest through the BVH, lit, encoded and accumulated for the denoiser.
+    //    10. Denoising: its issue adds it here.
+    let mut ray_traced_gi = None;
+    let mut ray_traced_gi_rays = None;
+    if s.settings.ray_traced_gi.enabled {
+        let rt_scene = state.rtgi_scene.clone().ok_or_else(|| {
+            crate::error::RenderError::Graph(
+                "ray_traced_gi: the scene's BVH is not built (the Renderer builds it)".into(),
+            )
+        })?;
+        let sky_source = match (sky.enabled, s.settings.sky.sky) {
+            (true, true) => SkySource::Atmosphere,
+            (true, false) => SkySource::None,
+            (false, _) if s.settings.direct_lighting.placeholder_ambient => SkySource::Placeholder,
+            (false, _) => SkySource::None,
+        };
+        let params = RtGiParams::new(
+            &s.settings.ray_traced_gi,
+            g.frame_index(),
+            s.sun.as_ref(),
+            scene.light_count,
+            s.metered_lux_with_sky(sky.sky_lux),
+            sky_source,
+        );
+        let inputs = RtGiInputs {
+            gbuffer: &gbuffer,
+            sky: &sky,
+            shadows: &shadows,
+            lights: scene.lights,
+            view: &view,
+            params: &params,
+        };
+        let (frame, rays) =
+            t.ray_traced_gi
+                .record(g, &rt_scene, &inputs, state.rtgi_reset || camera_cut)?;
+        state.rtgi_reset = false;
+        ray_traced_gi = Some(frame);
+        ray_traced_gi_rays = Some(rays);
+    }
 
     // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
     //     sky's SH as ambient light, or the placeholders with the atmosphere off).
@@ -264,6 +316,10 @@ pub fn record<'r>(
         &lighting,
         area_lights,
     )?;
+    if ray_traced_gi.is_some() {
+        // The lit image lights next frame's GI hits where they were visible.
+        t.ray_traced_gi.keep_lit(g, lit_frame.radiance, size)?;
+    }
 
     // 12. Haze: its issue adds it here.
 
@@ -321,6 +377,8 @@ pub fn record<'r>(
         sky,
         probes,
         area_lights,
+        ray_traced_gi,
+        ray_traced_gi_rays,
         hdr,
         lit,
         illuminance: lit_frame.illuminance,

@@ -32,7 +32,7 @@ pub fn all() -> Vec<StructLayout> {
     use crate::scene_gpu;
     use crate::techniques::{
         direct_lighting, exposure, gi_denoiser, irradiance_probes, local_tonemap,
-        placeholder_tonemap, sky, sun_shadows, taa,
+        placeholder_tonemap, ray_traced_gi, sky, sun_shadows, taa,
     };
     use crate::view;
     vec![
@@ -120,6 +120,19 @@ pub fn all() -> Vec<StructLayout> {
                 white,
                 transmittance_size,
                 ground
+            ]
+        ),
+        gpu_layout!(
+            ray_traced_gi::RtGiParams,
+            "ray_traced_gi/shade.wgsl",
+            [
+                config,
+                distances,
+                pretrace,
+                sun,
+                sun_color,
+                sky_zenith,
+                sky_horizon
             ]
         ),
         gpu_layout!(

@@ -28,6 +28,8 @@ pub struct Renderer {
     scene: SceneGpu,
     /// The scene's area lights and the BVH of its shadow rays.
     area_lights: AreaLightScene,
+    /// The scene as given, for the ray tracer's BVH (built on first use).
+    scene_source: Scene,
     state: FrameState,
 }
 
@@ -41,6 +43,7 @@ impl Renderer {
             runtime: GraphRuntime::new(),
             techniques,
             scene: scene_gpu,
+            scene_source: scene.clone(),
             state: FrameState::default(),
             ctx,
         })
@@ -64,6 +67,11 @@ impl Renderer {
     /// The rasteriser's queue sizes, which grow by themselves; for tests and tuning.
     pub fn raster_queues(&mut self) -> &mut RasterQueues {
         &mut self.state.raster_queues
+    }
+
+    /// Drops temporal history next frame (a camera cut).
+    pub fn cut_camera(&mut self) {
+        self.state.rtgi_reset = true;
     }
 
     /// Renders one frame; with `read_images`, copies the HDR and LDR results back.
@@ -132,6 +140,15 @@ impl Renderer {
         }
         if let Some(sun) = &settings.sun {
             sun.validate().map_err(|e| invalid("sun", e))?;
+        }
+        if settings.settings.ray_traced_gi.enabled && self.state.rtgi_scene.is_none() {
+            self.state.rtgi_scene = Some(std::sync::Arc::new(
+                crate::techniques::ray_traced_gi::RtGiScene::new(
+                    &self.ctx,
+                    &self.scene_source,
+                    &self.scene.textures.color,
+                )?,
+            ));
         }
         let binding_limit = self.ctx.limits.max_storage_buffer_binding_size;
         for _ in 0..MAX_QUEUE_RETRIES {

@@ -17,6 +17,7 @@ pub use crate::techniques::exposure::settings::ExposureSettings;
 pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
 pub use crate::techniques::irradiance_probes::settings::IrradianceProbesSettings;
 pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
+pub use crate::techniques::ray_traced_gi::settings::RayTracedGiSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
 pub use crate::techniques::taa::settings::TaaSettings;
@@ -199,6 +200,7 @@ register_settings! {
     gi_denoiser: GiDenoiserSettings,
     area_lights: AreaLightsSettings,
     irradiance_probes: IrradianceProbesSettings,
+    ray_traced_gi: RayTracedGiSettings,
 }
 
 impl Settings {

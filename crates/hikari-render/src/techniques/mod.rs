@@ -11,6 +11,7 @@ pub mod gi_denoiser;
 pub mod irradiance_probes;
 pub mod local_tonemap;
 pub mod placeholder_tonemap;
+pub mod ray_traced_gi;
 pub mod sky;
 pub mod sun_shadows;
 pub mod taa;

@@ -1,0 +1,85 @@
+// Temporal accumulation of the raw GI and AO before denoising: the history is reprojected by
+// the G-buffer's motion vector (nearest texel), rejected off screen, where not finite, or
+// where its view depth differs from where this point was seen last frame by more than the
+// tolerance; the speed is 1 / length, the length growing while the history stays valid, up to
+// a cap. Non-finite input is replaced where it enters. CPU twin: reference::accumulate_pixel.
+
+#import hikari::view::{View, world_from_depth}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_ACCUMULATE, RTGI_RESET}
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<uniform> params: RtGiParams;
+@group(0) @binding(2) var depth: texture_2d<f32>;
+@group(0) @binding(3) var gbuffer_motion: texture_2d<f32>;
+@group(0) @binding(4) var raw_y: texture_2d<f32>;
+@group(0) @binding(5) var raw_cocg_ao: texture_2d<f32>;
+@group(0) @binding(6) var prev_y: texture_2d<f32>;
+@group(0) @binding(7) var prev_cocg: texture_2d<f32>;
+@group(0) @binding(8) var prev_ao: texture_2d<f32>;
+@group(0) @binding(9) var prev_length: texture_2d<f32>;
+@group(0) @binding(10) var prev_depth: texture_2d<f32>;
+@group(0) @binding(11) var out_y: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(12) var out_cocg: texture_storage_2d<rg16float, write>;
+@group(0) @binding(13) var out_ao: texture_storage_2d<r16float, write>;
+@group(0) @binding(14) var out_length: texture_storage_2d<r16float, write>;
+@group(0) @binding(15) var out_depth: texture_storage_2d<r32float, write>;
+
+fn finite4(v: vec4<f32>) -> bool {
+    // NaN fails ==; infinities fail the bound.
+    return all(v == v) && all(abs(v) <= vec4<f32>(3.0e38));
+}
+
+fn store(p: vec2<u32>, y: vec4<f32>, cocg: vec2<f32>, ao: f32, len: f32, z: f32) {
+    textureStore(out_y, p, y);
+    textureStore(out_cocg, p, vec4<f32>(cocg, 0.0, 0.0));
+    textureStore(out_ao, p, vec4<f32>(ao, 0.0, 0.0, 0.0));
+    textureStore(out_length, p, vec4<f32>(len, 0.0, 0.0, 0.0));
+    textureStore(out_depth, p, vec4<f32>(z, 0.0, 0.0, 0.0));
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let size = textureDimensions(depth);
+    if any(gid.xy >= size) {
+        return;
+    }
+    let pixel = gid.xy;
+    let d = textureLoad(depth, pixel, 0).r;
+    if !(d > 0.0) {
+        store(pixel, vec4<f32>(0.0), vec2<f32>(0.0), 1.0, 0.0, 0.0);
+        return;
+    }
+    var y = textureLoad(raw_y, pixel, 0);
+    var cocg_ao = textureLoad(raw_cocg_ao, pixel, 0);
+    if !finite4(y) || !finite4(vec4<f32>(cocg_ao.xy, 0.0, 0.0)) {
+        y = vec4<f32>(0.0);
+        cocg_ao = vec4<f32>(0.0, 0.0, cocg_ao.zw);
+    }
+    var ao = select(1.0, clamp(cocg_ao.z, 0.0, 1.0), finite4(vec4<f32>(cocg_ao.z)));
+    let motion = textureLoad(gbuffer_motion, pixel, 0).xyz;
+    let z = select(0.0, motion.z, finite4(vec4<f32>(motion.z)));
+    let world = world_from_depth(view, pixel, d);
+    let flags = params.config.y;
+    let prev = vec2<f32>(pixel) + 0.5 + motion.xy;
+    let sizef = vec2<f32>(size);
+    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || !finite4(vec4<f32>(motion, 0.0)) || !finite4(vec4<f32>(world, 0.0))
+        || any(prev < vec2<f32>(0.0)) || any(prev >= sizef) {
+        store(pixel, y, cocg_ao.xy, ao, 1.0, z);
+        return;
+    }
+    let q = vec2<u32>(prev);
+    let hy = textureLoad(prev_y, q, 0);
+    let hc = textureLoad(prev_cocg, q, 0).xy;
+    let ha = textureLoad(prev_ao, q, 0).x;
+    let hl = textureLoad(prev_length, q, 0).x;
+    let hz = textureLoad(prev_depth, q, 0).x;
+    let expected = (view.prev_view_proj * vec4<f32>(world, 1.0)).w;
+    if !finite4(hy) || !finite4(vec4<f32>(hc, ha, hl)) || !finite4(vec4<f32>(hz)) || !(hl >= 1.0)
+        || !(abs(hz - expected) <= params.distances.z * abs(expected)) {
+        store(pixel, y, cocg_ao.xy, ao, 1.0, z);
+        return;
+    }
+    let len = min(hl + 1.0, f32(params.config.z));
+    let speed = 1.0 / len;
+    store(pixel, mix(hy, y, speed), mix(hc, cocg_ao.xy, speed), mix(ha, ao, speed), len, z);
+}

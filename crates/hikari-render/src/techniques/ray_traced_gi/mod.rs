@@ -1,0 +1,597 @@
+//! Ray-traced diffuse GI and AO at one ray a pixel (Metro Exodus, GDC 2019): the ray of each
+//! pixel from a 64x64x64 blue-noise set, a screen-space pre-trace against the depth buffer,
+//! the rays it cannot resolve traced through the scene's BVH, the hits lit in a pass of their
+//! own, the result encoded as luminance L1 SH + CoCg and accumulated over frames. The output,
+//! [`RtGiFrame`], is what the denoiser (`gi_denoiser`) reads. Passes, in order:
+//!
+//! | pass | does | writes |
+//! |---|---|---|
+//! | `ray_traced_gi.clear` | empties the BVH queue | `ray_traced_gi.queue` |
+//! | `ray_traced_gi.pretrace` | screen-space march | `ray_traced_gi.hits` (one word a pixel), the queue |
+//! | `ray_traced_gi.trace` | BVH closest hit of the queued rays | `ray_traced_gi.hits` |
+//! | `ray_traced_gi.shade` | lights hits, sky for misses, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
+//! | `ray_traced_gi.accumulate` | temporal accumulation | `ray_traced_gi.gi_y`, `.gi_cocg`, `.ao`, `.history_length`, `.view_depth` |
+//!
+//! Every texture above can be dumped by that name. The hit word packs the distance (f16, bits
+//! 0-15) and the hit's albedo (√albedo as R5G6B5, bits 16-31); see [`reference::pack_hit`].
+//! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
+
+pub mod reference;
+pub mod settings;
+
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use hikari_bvh::{BuildOptions, InstanceRecord, PackedBlases, Tlas, TriangleRecord, WideNode};
+use hikari_math::sampling::blue_noise::BLUE_NOISE_64X64X64;
+use hikari_scene::{Scene, Sun};
+use naga_oil::compose::ShaderDefValue;
+use wgpu::util::DeviceExt;
+
+use super::direct_lighting::{
+    LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH,
+};
+use super::gbuffer::GBuffer;
+use super::sky::SkyFrame;
+use super::sun_shadows::SunShadowMaps;
+use crate::bvh_trace::BvhBuffers;
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
+use crate::scene_bvh::{self, AlphaInstance, AlphaTriangle, BvhAlpha};
+use crate::shader::ShaderLibrary;
+use crate::view::View;
+pub use settings::RayTracedGiSettings;
+
+/// The ray-traced GI signal of a frame (interfaces.md), all full resolution.
+#[derive(Clone, Copy, Debug)]
+pub struct RtGiFrame {
+    /// Rgba16Float: luminance as L1 SH (c0, y, z, x), `ShL1YCoCg`'s normalisation.
+    pub gi_y: Tex,
+    /// Rg16Float: mean (Co, Cg).
+    pub gi_cocg: Tex,
+    /// R16Float: frames in the history (1 fresh; 0 where there is no surface).
+    pub history_length: Tex,
+    /// R16Float: ambient occlusion, 1 open.
+    pub ao: Tex,
+    /// R16Float: this frame's hit distance in metres, 0 for no hit or not traced.
+    pub hit_distance: Tex,
+}
+
+/// The frame's ray buffers, for statistics and tests: one hit word a pixel, the scene
+/// instance each hit is on (`u32::MAX`: none), and the BVH queue (word 0: rays the pre-trace
+/// left; then their pixel indices).
+#[derive(Clone, Copy, Debug)]
+pub struct RtGiRays {
+    pub hits: Buf,
+    pub hit_instances: Buf,
+    pub queue: Buf,
+}
+
+pub const FLAG_PRETRACE: u32 = 1;
+pub const FLAG_BVH: u32 = 2;
+pub const FLAG_SUN: u32 = 4;
+/// Misses take the atmosphere's sky (`hikari::sky`).
+pub const FLAG_SKY: u32 = 8;
+/// Misses take the placeholder sky (the atmosphere is off).
+pub const FLAG_PLACEHOLDER_SKY: u32 = 16;
+pub const FLAG_PUNCTUAL: u32 = 32;
+pub const FLAG_ACCUMULATE: u32 = 64;
+/// Drop the history this frame (camera cut).
+pub const FLAG_RESET: u32 = 128;
+/// Hits are lit by the sky's ambient light (or the placeholder's).
+pub const FLAG_SKY_AMBIENT: u32 = 256;
+/// The sun's shadow at hits from its shadow maps inside a cascade (else a shadow ray).
+pub const FLAG_SHADOW_MAPS: u32 = 512;
+/// Hits visible last frame take last frame's lit image there.
+pub const FLAG_REUSE_LIT: u32 = 1024;
+
+/// Uniform of every ray-traced GI pass (`RtGiParams` in `rtgi.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RtGiParams {
+    /// Frame index, `FLAG_*`, history length cap, light count.
+    pub config: [u32; 4],
+    /// GI ray length (m), AO distance (m), history depth tolerance, light cut-off (lux).
+    pub distances: [f32; 4],
+    /// Pre-trace step (px), steps at most, thickness (m), length (m).
+    pub pretrace: [f32; 4],
+    /// Unit vector towards the sun or moon; illuminance in lux.
+    pub sun: [f32; 4],
+    /// Its colour (luminance 1).
+    pub sun_color: [f32; 4],
+    /// Placeholder sky radiance in nits at the zenith and the horizon.
+    pub sky_zenith: [f32; 4],
+    pub sky_horizon: [f32; 4],
+}
+
+/// Where the sky for misses and ambient light comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkySource {
+    /// The atmosphere (`hikari::sky`, `hikari::sky_ambient`).
+    Atmosphere,
+    /// The placeholder gradient of direct lighting (atmosphere off).
+    Placeholder,
+    /// Black (the sky's light is off).
+    None,
+}
+
+impl RtGiParams {
+    /// `metered_lux` as for direct lighting's light cut-off.
+    pub fn new(
+        s: &RayTracedGiSettings,
+        frame: u64,
+        sun: Option<&Sun>,
+        light_count: u32,
+        metered_lux: f32,
+        sky: SkySource,
+    ) -> Self {
+        let (dir, lux, color) = match sun {
+            Some(s) => (s.direction.normalize(), s.illuminance_lux, s.color),
+            None => (Vec3::Y, 0.0, Vec3::ONE),
+        };
+        let sky_scale = lux / Sun::DEFAULT_LUX;
+        let mut flags = [
+            (s.pretrace, FLAG_PRETRACE),
+            (s.bvh_trace, FLAG_BVH),
+            (s.sun, FLAG_SUN),
+            (s.punctual, FLAG_PUNCTUAL),
+            (s.accumulate, FLAG_ACCUMULATE),
+            (s.sky, FLAG_SKY_AMBIENT),
+            (s.shadow_maps, FLAG_SHADOW_MAPS),
+            (s.reuse_lit, FLAG_REUSE_LIT),
+        ]
+        .iter()
+        .filter(|(on, _)| *on)
+        .fold(0, |acc, (_, bit)| acc | bit);
+        flags |= match sky {
+            SkySource::Atmosphere => FLAG_SKY,
+            SkySource::Placeholder => FLAG_PLACEHOLDER_SKY,
+            SkySource::None => 0,
+        };
+        Self {
+            config: [frame as u32, flags, s.max_history, light_count],
+            distances: [
+                s.max_distance_m,
+                s.ao_max_distance_m,
+                s.depth_tolerance,
+                (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX),
+            ],
+            pretrace: [
+                s.pretrace_step_px,
+                s.pretrace_max_steps as f32,
+                s.pretrace_thickness_m,
+                s.pretrace_max_distance_m,
+            ],
+            sun: dir.extend(lux).to_array(),
+            sun_color: color.extend(1.0).to_array(),
+            sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky_scale).extend(0.0).to_array(),
+            sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
+        }
+    }
+
+    pub fn flags(&self) -> u32 {
+        self.config[1]
+    }
+
+    pub fn set_flag(&mut self, flag: u32, on: bool) {
+        if on {
+            self.config[1] |= flag;
+        } else {
+            self.config[1] &= !flag;
+        }
+    }
+}
+
+/// The scene's BVH (built once, static: no refit or per-frame culling yet) with its cut-out
+/// data and the per-instance albedo table, on the GPU.
+pub struct RtGiScene {
+    blas_nodes: wgpu::Buffer,
+    triangles: wgpu::Buffer,
+    tlas_nodes: wgpu::Buffer,
+    instances: wgpu::Buffer,
+    alpha_instances: wgpu::Buffer,
+    alpha_triangles: wgpu::Buffer,
+    alpha_textures: wgpu::Texture,
+    /// [`reference::instance_table`].
+    instance_table: wgpu::Buffer,
+    /// Nodes on the longest TLAS root-to-leaf path.
+    pub tlas_depth: u32,
+}
+
+impl std::fmt::Debug for RtGiScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RtGiScene")
+            .field("tlas_depth", &self.tlas_depth)
+            .finish_non_exhaustive()
+    }
+}
+
+fn storage_buffer(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(name),
+            contents: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+/// Zero-sized bindings are not allowed: an empty list is uploaded as one zeroed record, which
+/// a zeroed (childless) node never reaches.
+fn non_empty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
+    if v.is_empty() {
+        vec![T::zeroed()]
+    } else {
+        v.to_vec()
+    }
+}
+
+impl RtGiScene {
+    /// Builds the BVH of `scene` on the CPU (hikari-bvh) and uploads it, with the cut-out data
+    /// and `color_textures` (`SceneGpu::textures.color`, for the alpha test).
+    pub fn new(ctx: &GpuContext, scene: &Scene, color_textures: &wgpu::Texture) -> Result<Self> {
+        let bvh_error = |e: hikari_bvh::BvhError| RenderError::Pass {
+            pass: "ray_traced_gi".into(),
+            message: format!("building the scene's BVH: {e}"),
+        };
+        let blases = scene_bvh::blases(scene, &BuildOptions::default()).map_err(bvh_error)?;
+        let instances = scene_bvh::instances(scene);
+        let all: Vec<u32> = (0..instances.len() as u32).collect();
+        let tlas = Tlas::build(&instances, &all, &blases).map_err(bvh_error)?;
+        let packed = PackedBlases::new(&blases);
+        let alpha = BvhAlpha::for_scene(scene);
+        let table = non_empty(&reference::instance_table(scene));
+        let nodes: Vec<WideNode> = non_empty(&packed.nodes);
+        let tris: Vec<TriangleRecord> = non_empty(&packed.triangles);
+        let tlas_nodes: Vec<WideNode> = non_empty(&tlas.nodes);
+        let records: Vec<InstanceRecord> = non_empty(&tlas.instances);
+        let alpha_inst: Vec<AlphaInstance> = non_empty(&alpha.instances);
+        let alpha_tri: Vec<AlphaTriangle> = non_empty(&alpha.triangles);
+        let b = |name: &str, bytes: &[u8]| storage_buffer(ctx, name, bytes);
+        Ok(Self {
+            blas_nodes: b("bvh.blas_nodes", bytemuck::cast_slice(&nodes)),
+            triangles: b("bvh.triangles", bytemuck::cast_slice(&tris)),
+            tlas_nodes: b("bvh.tlas_nodes", bytemuck::cast_slice(&tlas_nodes)),
+            instances: b("bvh.instances", bytemuck::cast_slice(&records)),
+            alpha_instances: b("bvh.alpha_instances", bytemuck::cast_slice(&alpha_inst)),
+            alpha_triangles: b("bvh.alpha_triangles", bytemuck::cast_slice(&alpha_tri)),
+            alpha_textures: color_textures.clone(),
+            instance_table: b("ray_traced_gi.instance_table", bytemuck::cast_slice(&table)),
+            tlas_depth: tlas.stats.depth,
+        })
+    }
+
+    /// The BVH's buffers in a frame, and the per-instance table (albedo, emission).
+    pub fn import(&self, g: &mut FrameGraph<'_>) -> (BvhBuffers, Buf) {
+        (
+            BvhBuffers {
+                blas_nodes: g.import_buffer("bvh.blas_nodes", &self.blas_nodes),
+                triangles: g.import_buffer("bvh.triangles", &self.triangles),
+                tlas_nodes: g.import_buffer("bvh.tlas_nodes", &self.tlas_nodes),
+                instances: g.import_buffer("bvh.instances", &self.instances),
+                alpha_instances: g.import_buffer("bvh.alpha_instances", &self.alpha_instances),
+                alpha_triangles: g.import_buffer("bvh.alpha_triangles", &self.alpha_triangles),
+                alpha_textures: g.import_texture("bvh.alpha_textures", &self.alpha_textures),
+            },
+            g.import_buffer("ray_traced_gi.instance_table", &self.instance_table),
+        )
+    }
+}
+
+/// What the passes read of the frame.
+#[derive(Clone, Copy)]
+pub struct RtGiInputs<'a> {
+    pub gbuffer: &'a GBuffer,
+    pub sky: &'a SkyFrame,
+    pub shadows: &'a SunShadowMaps,
+    /// `SceneInFrame::lights`.
+    pub lights: Buf,
+    pub view: &'a View,
+    pub params: &'a RtGiParams,
+}
+
+/// The raw (unaccumulated) signal of a frame.
+#[derive(Clone, Copy, Debug)]
+pub struct RtGiRaw {
+    /// Rgba16Float: this frame's sample, luminance L1 SH.
+    pub y: Tex,
+    /// Rgba16Float: Co, Cg, AO, 0.
+    pub cocg_ao: Tex,
+    /// R16Float, metres.
+    pub hit_distance: Tex,
+    pub rays: RtGiRays,
+}
+
+pub struct RayTracedGi {
+    clear: ComputePipeline,
+    pretrace: ComputePipeline,
+    trace: ComputePipeline,
+    shade: ComputePipeline,
+    accumulate: ComputePipeline,
+    check: ComputePipeline,
+    resolve_check: ComputePipeline,
+    keep_lit: ComputePipeline,
+    noise: wgpu::Buffer,
+}
+
+pub const Y_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const COCG_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
+pub const SCALAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
+pub const VIEW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+impl RayTracedGi {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        let alpha = [("BVH_ALPHA", ShaderDefValue::Bool(true))];
+        let p = |lib: &mut ShaderLibrary, path: &str, defs: &[(&str, ShaderDefValue)]| {
+            ComputePipeline::new(ctx, lib, path, "main", defs)
+        };
+        Ok(Self {
+            clear: p(lib, "ray_traced_gi/clear.wgsl", &[])?,
+            pretrace: p(lib, "ray_traced_gi/pretrace.wgsl", &[])?,
+            trace: p(lib, "ray_traced_gi/trace.wgsl", &alpha)?,
+            shade: p(lib, "ray_traced_gi/shade.wgsl", &alpha)?,
+            accumulate: p(lib, "ray_traced_gi/accumulate.wgsl", &[])?,
+            check: p(lib, "ray_traced_gi/check.wgsl", &[])?,
+            resolve_check: p(lib, "ray_traced_gi/resolve_check.wgsl", &[])?,
+            keep_lit: p(lib, "ray_traced_gi/keep_lit.wgsl", &[])?,
+            noise: storage_buffer(ctx, "ray_traced_gi.blue_noise", &BLUE_NOISE_64X64X64[..]),
+        })
+    }
+
+    /// The binding set `rtgi_noise` of `hikari::ray_traced_gi`.
+    pub fn noise_set(&self, g: &mut FrameGraph<'_>) -> BindingSet {
+        let b = g.import_buffer("ray_traced_gi.blue_noise", &self.noise);
+        g.binding_set("rtgi_noise").read(b).finish()
+    }
+
+    /// The whole technique: rays, pre-trace, BVH, lighting of hits, accumulation. `reset`
+    /// drops the history (a camera cut); a resize drops it by itself.
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        scene: &RtGiScene,
+        inputs: &RtGiInputs<'_>,
+        reset: bool,
+    ) -> Result<(RtGiFrame, RtGiRays)> {
+        let raw = self.record_raw(g, scene, inputs)?;
+        let mut params = *inputs.params;
+        if reset {
+            params.set_flag(FLAG_RESET, true);
+        }
+        let gb = inputs.gbuffer;
+        let frame = self.record_accumulate(
+            g,
+            inputs.view,
+            &params,
+            gb.depth,
+            gb.motion,
+            raw.y,
+            raw.cocg_ao,
+            raw.hit_distance,
+        )?;
+        Ok((frame, raw.rays))
+    }
+
+    /// Rays, pre-trace, BVH and the lighting of hits: this frame's raw sample a pixel.
+    pub fn record_raw<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        scene: &RtGiScene,
+        inputs: &RtGiInputs<'_>,
+    ) -> Result<RtGiRaw> {
+        let [w, h] = [
+            inputs.view.viewport[0] as u32,
+            inputs.view.viewport[1] as u32,
+        ];
+        let pixels = w as u64 * h as u64;
+        let gb = inputs.gbuffer;
+        let view = inputs.view;
+        let params = inputs.params;
+        let hits = g.buffer("ray_traced_gi.hits", pixels * 4)?;
+        let hit_instances = g.buffer("ray_traced_gi.hit_instances", pixels * 4)?;
+        let queue = g.buffer("ray_traced_gi.queue", (pixels + 1) * 4)?;
+        let (bvh, table) = scene.import(g);
+
+        g.pass("ray_traced_gi.clear")
+            .write(queue)
+            .dispatch(&self.clear, [1, 1, 1])?;
+
+        let noise = self.noise_set(g);
+        g.pass("ray_traced_gi.pretrace")
+            .constants(view)
+            .constants(params)
+            .read(gb.depth)
+            .read(gb.normal)
+            .read(gb.albedo)
+            .read(gb.material)
+            .read(gb.motion)
+            .read(gb.instance)
+            .write(hits)
+            .write(hit_instances)
+            .write(queue)
+            .set(noise)
+            .dispatch_threads(&self.pretrace, [w, h, 1])?;
+
+        if params.flags() & FLAG_BVH != 0 {
+            let noise = self.noise_set(g);
+            let bvh_set = bvh.binding_set(g);
+            let total = pixels.div_ceil(64).max(1);
+            let max = g.ctx().limits.max_compute_workgroups_per_dimension.max(1) as u64;
+            let gy = total.div_ceil(max);
+            let gx = total.div_ceil(gy);
+            g.pass("ray_traced_gi.trace")
+                .constants(view)
+                .constants(params)
+                .read(gb.depth)
+                .read(gb.normal)
+                .read(queue)
+                .write(hits)
+                .write(hit_instances)
+                .read(table)
+                .set(noise)
+                .set(bvh_set)
+                .dispatch(&self.trace, [gx as u32, gy as u32, 1])?;
+        }
+
+        let tex = |g: &mut FrameGraph<'r>, name: &str, format| {
+            g.texture(name, TextureDesc::d2(w, h, format))
+        };
+        let raw_y = tex(g, "ray_traced_gi.raw_y", Y_FORMAT)?;
+        let raw_cocg_ao = tex(g, "ray_traced_gi.raw_cocg_ao", Y_FORMAT)?;
+        let hit_distance = tex(g, "ray_traced_gi.hit_distance", SCALAR_FORMAT)?;
+        // Last frame's lit image and view depth (zeros, and not used, on a first frame).
+        let lit = g.history_texture("ray_traced_gi.lit", TextureDesc::d2(w, h, Y_FORMAT))?;
+        let vz = g.history_texture(
+            "ray_traced_gi.view_depth",
+            TextureDesc::d2(w, h, VIEW_DEPTH_FORMAT),
+        )?;
+        let mut params = *params;
+        if !(lit.valid && vz.valid) {
+            params.set_flag(FLAG_REUSE_LIT, false);
+        }
+        let params = &params;
+        let noise = self.noise_set(g);
+        let bvh_set = bvh.binding_set(g);
+        g.pass("ray_traced_gi.shade")
+            .constants(view)
+            .constants(params)
+            .read(gb.depth)
+            .read(gb.normal)
+            .read(hits)
+            .read(hit_instances)
+            .read(table)
+            .read(inputs.lights)
+            .write(raw_y)
+            .write(raw_cocg_ao)
+            .write(hit_distance)
+            .read(lit.prev)
+            .read(vz.prev)
+            .set(noise)
+            .set(bvh_set)
+            .set(inputs.sky.lookup)
+            .set(inputs.sky.ambient)
+            .set(inputs.shadows.lookup)
+            .dispatch_threads(&self.shade, [w, h, 1])?;
+        Ok(RtGiRaw {
+            y: raw_y,
+            cocg_ao: raw_cocg_ao,
+            hit_distance,
+            rays: RtGiRays {
+                hits,
+                hit_instances,
+                queue,
+            },
+        })
+    }
+
+    /// Keeps the frame's lit image (`direct_lighting.radiance`) for the next frame's lighting
+    /// of hits (`reuse_lit`); call after the deferred lighting.
+    pub fn keep_lit<'r>(&'r self, g: &mut FrameGraph<'r>, lit: Tex, size: [u32; 2]) -> Result<()> {
+        let hist = g.history_texture(
+            "ray_traced_gi.lit",
+            TextureDesc::d2(size[0], size[1], Y_FORMAT),
+        )?;
+        g.pass("ray_traced_gi.keep_lit")
+            .read(lit)
+            .write(hist.cur)
+            .dispatch_threads(&self.keep_lit, [size[0], size[1], 1])
+    }
+
+    /// Temporal accumulation of a raw signal (`raw_y`: Rgba16Float L1 SH; `raw_cocg_ao`:
+    /// Rgba16Float Co, Cg, AO) against the history kept under `ray_traced_gi.*`. `depth` and
+    /// `motion` are the G-buffer's. `FLAG_RESET` or a resize starts the history again.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_accumulate<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        view: &View,
+        params: &RtGiParams,
+        depth: Tex,
+        motion: Tex,
+        raw_y: Tex,
+        raw_cocg_ao: Tex,
+        hit_distance: Tex,
+    ) -> Result<RtGiFrame> {
+        let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
+        let hist = |g: &mut FrameGraph<'r>, name: &str, format| {
+            g.history_texture(name, TextureDesc::d2(w, h, format))
+        };
+        let y = hist(g, "ray_traced_gi.gi_y", Y_FORMAT)?;
+        let cocg = hist(g, "ray_traced_gi.gi_cocg", COCG_FORMAT)?;
+        let ao = hist(g, "ray_traced_gi.ao", SCALAR_FORMAT)?;
+        let len = hist(g, "ray_traced_gi.history_length", SCALAR_FORMAT)?;
+        let vz = hist(g, "ray_traced_gi.view_depth", VIEW_DEPTH_FORMAT)?;
+        let valid = y.valid && cocg.valid && ao.valid && len.valid && vz.valid;
+        let mut params = *params;
+        if !valid {
+            params.set_flag(FLAG_RESET, true);
+        }
+        // The shader's module declares the noise set beside the uniform's struct.
+        let noise = self.noise_set(g);
+        g.pass("ray_traced_gi.accumulate")
+            .constants(view)
+            .constants(&params)
+            .read(depth)
+            .read(motion)
+            .read(raw_y)
+            .read(raw_cocg_ao)
+            .read(y.prev)
+            .read(cocg.prev)
+            .read(ao.prev)
+            .read(len.prev)
+            .read(vz.prev)
+            .write(y.cur)
+            .write(cocg.cur)
+            .write(ao.cur)
+            .write(len.cur)
+            .write(vz.cur)
+            .set(noise)
+            .dispatch_threads(&self.accumulate, [w, h, 1])?;
+        Ok(RtGiFrame {
+            gi_y: y.cur,
+            gi_cocg: cocg.cur,
+            history_length: len.cur,
+            ao: ao.cur,
+            hit_distance,
+        })
+    }
+
+    /// The verification kernel `ray_traced_gi/check.wgsl`: `cases` records of three vec4s in
+    /// `inputs`, as many out in `outputs` (see the shader).
+    pub fn record_check<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        inputs: Buf,
+        outputs: Buf,
+        cases: u32,
+    ) -> Result<()> {
+        let noise = self.noise_set(g);
+        g.pass("ray_traced_gi.check")
+            .read(inputs)
+            .write(outputs)
+            .set(noise)
+            .dispatch(&self.check, [cases.div_ceil(64).max(1), 1, 1])
+    }
+
+    /// The verification kernel `ray_traced_gi/resolve_check.wgsl` of `hikari::rtgi_resolve`:
+    /// five vec4s a case in, two out (see the shader). `brdf_tables`: `BrdfTables::binding_set`.
+    pub fn record_resolve_check<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        inputs: Buf,
+        outputs: Buf,
+        cases: u32,
+        brdf_tables: BindingSet,
+    ) -> Result<()> {
+        g.pass("ray_traced_gi.resolve_check")
+            .read(inputs)
+            .write(outputs)
+            .set(brdf_tables)
+            .dispatch(&self.resolve_check, [cases.div_ceil(64).max(1), 1, 1])
+    }
+}
+
+/// A shared handle, so that the frame state can keep the scene's BVH between frames.
+pub type SharedRtGiScene = Arc<RtGiScene>;

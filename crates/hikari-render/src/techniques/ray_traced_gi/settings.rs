@@ -1,0 +1,137 @@
+//! Settings of the ray-traced GI and AO signal (`[ray_traced_gi]`).
+
+use serde::{Deserialize, Serialize};
+
+use crate::settings::{Field, Preset, Range, TechniqueSettings};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RayTracedGiSettings {
+    /// Runs the technique at all (one diffuse ray a pixel, lit, encoded, accumulated).
+    pub enabled: bool,
+    /// Screen-space pre-trace against the depth buffer before the BVH.
+    pub pretrace: bool,
+    /// Screen-space step of the pre-trace, in pixels.
+    pub pretrace_step_px: f32,
+    /// Steps of the pre-trace at most.
+    pub pretrace_max_steps: u32,
+    /// How far behind the depth buffer a ray may be and still hit it, in metres.
+    pub pretrace_thickness_m: f32,
+    /// Length of ray the pre-trace marches, in metres.
+    pub pretrace_max_distance_m: f32,
+    /// Trace what the pre-trace left through the BVH (off: those rays count as misses).
+    pub bvh_trace: bool,
+    /// Longest GI ray (the near field), in metres.
+    pub max_distance_m: f32,
+    /// Hits nearer than this occlude for AO, in metres.
+    pub ao_max_distance_m: f32,
+    /// Lights at hits: the sun or moon.
+    pub sun: bool,
+    /// The sun's shadow at hits from its shadow maps inside a cascade; off, or outside
+    /// every cascade: a shadow ray through the BVH.
+    pub shadow_maps: bool,
+    /// Hits seen last frame take last frame's lit image there (Metro's "first bounce from all
+    /// lights"); the others are lit as below.
+    pub reuse_lit: bool,
+    /// Lights at hits: the sky's ambient light (misses always take the sky).
+    pub sky: bool,
+    /// Lights at hits: point and spot lights (unshadowed).
+    pub punctual: bool,
+    /// Temporal accumulation (off: every frame is fresh, history length 1).
+    pub accumulate: bool,
+    /// Frames of history at most (the accumulation speed's floor is 1 / this).
+    pub max_history: u32,
+    /// History is rejected where its view depth differs from the reprojected point's by more
+    /// than this fraction.
+    pub depth_tolerance: f32,
+}
+
+impl Default for RayTracedGiSettings {
+    fn default() -> Self {
+        Self {
+            // Off until the deferred lighting resolves it (nothing reads it yet).
+            enabled: false,
+            pretrace: true,
+            pretrace_step_px: 4.0,
+            pretrace_max_steps: 16,
+            pretrace_thickness_m: 0.3,
+            pretrace_max_distance_m: 10.0,
+            bvh_trace: true,
+            max_distance_m: 250.0,
+            ao_max_distance_m: 50.0,
+            sun: true,
+            shadow_maps: true,
+            reuse_lit: true,
+            sky: true,
+            punctual: true,
+            accumulate: true,
+            max_history: 32,
+            depth_tolerance: 0.05,
+        }
+    }
+}
+
+impl TechniqueSettings for RayTracedGiSettings {
+    fn fields() -> &'static [Field] {
+        const F: &[Field] = &[
+            Field {
+                key: "pretrace_step_px",
+                range: Range::Float { lo: 0.5, hi: 64.0 },
+            },
+            Field {
+                key: "pretrace_max_steps",
+                range: Range::Int { lo: 1, hi: 256 },
+            },
+            Field {
+                key: "pretrace_thickness_m",
+                range: Range::Float { lo: 0.0, hi: 100.0 },
+            },
+            Field {
+                key: "pretrace_max_distance_m",
+                range: Range::Float {
+                    lo: 0.0,
+                    hi: 10_000.0,
+                },
+            },
+            Field {
+                key: "max_distance_m",
+                range: Range::Float {
+                    lo: 0.5,
+                    hi: 60_000.0,
+                },
+            },
+            Field {
+                key: "ao_max_distance_m",
+                range: Range::Float {
+                    lo: 0.0,
+                    hi: 60_000.0,
+                },
+            },
+            Field {
+                key: "max_history",
+                range: Range::Int { lo: 1, hi: 1024 },
+            },
+            Field {
+                key: "depth_tolerance",
+                range: Range::Float { lo: 0.0, hi: 10.0 },
+            },
+        ];
+        F
+    }
+
+    fn preset(p: Preset) -> Self {
+        match p {
+            Preset::Low => Self {
+                pretrace_max_steps: 8,
+                max_distance_m: 100.0,
+                ..Self::default()
+            },
+            Preset::Medium | Preset::High => Self::default(),
+            Preset::Ultra => Self {
+                pretrace_step_px: 2.0,
+                pretrace_max_steps: 32,
+                ..Self::default()
+            },
+        }
+    }
+}
