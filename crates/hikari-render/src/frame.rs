@@ -12,9 +12,11 @@ use crate::scene_gpu::SceneGpu;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::area_lights::{AreaLightParams, AreaLightScene, AreaLights};
+use crate::techniques::direct_lighting::GiLight;
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
+use crate::techniques::gi_denoiser::{DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
@@ -100,6 +102,9 @@ pub struct Techniques {
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
     pub area_lights: AreaLights,
+    /// `None` where the adapter cannot write the GI signal's 16-bit formats from compute: the
+    /// lighting then resolves the accumulated signal undenoised.
+    pub gi_denoiser: Option<GiDenoiser>,
     pub taa: Taa,
     pub exposure: Exposure,
     pub local_tonemap: LocalTonemap,
@@ -120,6 +125,9 @@ impl Techniques {
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             area_lights: AreaLights::new(ctx, &mut lib)?,
+            gi_denoiser: GiDenoiser::new(ctx, &mut lib)
+                .inspect_err(|e| log::warn!("GI denoiser unavailable: {e}"))
+                .ok(),
             brdf_tables: BrdfTables::new(ctx),
             taa: Taa::new(ctx, &mut lib)?,
             exposure: Exposure::new(ctx, &mut lib)?,
@@ -141,6 +149,8 @@ pub struct FrameOutputs {
     pub area_lights: Tex,
     /// Ray-traced GI and AO, accumulated (`None` with the technique off).
     pub ray_traced_gi: Option<RtGiFrame>,
+    /// The GI and AO after the denoisers (`None` with ray-traced GI or the denoiser off).
+    pub denoised_gi: Option<DenoisedGi>,
     /// Its hit words and BVH queue.
     pub ray_traced_gi_rays: Option<RtGiRays>,
     /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA.
@@ -271,6 +281,40 @@ pub fn record<'r>(
         ray_traced_gi_rays = Some(rays);
     }
 
+    // 10. Denoising: the two-pass GI denoiser and the AO denoiser, then the signal the deferred
+    //     lighting resolves.
+    let mut denoised_gi = None;
+    let gi_light = match &ray_traced_gi {
+        Some(rt) if t.gi_denoiser.is_some() => {
+            let d = t.gi_denoiser.as_ref().unwrap().record(
+                g,
+                &s.settings.gi_denoiser,
+                &view,
+                GiDenoiserGeometry::from(&gbuffer),
+                &GiDenoiserInput {
+                    gi_y: rt.gi_y,
+                    gi_cocg: rt.gi_cocg,
+                    history_length: rt.history_length,
+                    ao: rt.ao,
+                    hit_distance: rt.hit_distance,
+                },
+                size,
+            )?;
+            denoised_gi = Some(d);
+            Some(GiLight {
+                y: d.gi_y,
+                cocg: d.gi_cocg,
+                ao: d.ao,
+            })
+        }
+        Some(rt) => Some(GiLight {
+            y: rt.gi_y,
+            cocg: rt.gi_cocg,
+            ao: rt.ao,
+        }),
+        None => None,
+    };
+
     // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
     //     sky's SH as ambient light, or the placeholders with the atmosphere off).
     let brdf = t.brdf_tables.binding_set(g);
@@ -284,6 +328,12 @@ pub fn record<'r>(
         lighting.use_sky(s.settings.sky.sky);
     }
     lighting.use_probes(probes.present);
+    if gi_light.is_some() {
+        lighting.use_ray_traced_gi(
+            s.settings.ray_traced_gi.near_field_m,
+            s.settings.ray_traced_gi.near_field_blend,
+        );
+    }
     // Area lights, and point and spot lights with ray-traced shadows (issue 18), added by the
     // deferred lighting, which then leaves the point and spot lights to them.
     //    `direct_lighting.punctual` switches point and spot lights off in both passes.
@@ -315,6 +365,7 @@ pub fn record<'r>(
         &view,
         &lighting,
         area_lights,
+        gi_light.as_ref(),
     )?;
     if ray_traced_gi.is_some() {
         // The lit image lights next frame's GI hits where they were visible.
@@ -378,6 +429,7 @@ pub fn record<'r>(
         probes,
         area_lights,
         ray_traced_gi,
+        denoised_gi,
         ray_traced_gi_rays,
         hdr,
         lit,

@@ -33,6 +33,18 @@ pub const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8;
 pub const LIGHTING_SKY: u32 = 16;
 /// With `LIGHTING_SKY`: ambient diffuse from the irradiance probes where they cover a surface.
 pub const LIGHTING_PROBES: u32 = 32;
+/// Ambient light from the ray-traced GI within the near field (`cutoff.y` metres), blended
+/// into the probes' or the sky's over the last `cutoff.z` of it; AO darkens the far field.
+pub const LIGHTING_RTGI: u32 = 64;
+
+/// The ray-traced GI signal the deferred lighting resolves (denoised, or accumulated when the
+/// denoiser is off): luminance L1 SH (Rgba16Float), CoCg (Rg16Float) and AO (R16Float).
+#[derive(Clone, Copy, Debug)]
+pub struct GiLight {
+    pub y: Tex,
+    pub cocg: Tex,
+    pub ao: Tex,
+}
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -43,7 +55,9 @@ pub struct LightingParams {
     pub sky_horizon: [f32; 4],
     /// Number of lights, `LIGHTING_*` flags, 0, 0.
     pub config: [u32; 4],
-    /// x: illuminance in lux below which a punctual light is cut off this frame; yzw unused.
+    /// x: illuminance in lux below which a punctual light is cut off this frame; y: the
+    /// ray-traced GI's near field in metres; z: the fraction of it over which the GI blends
+    /// into the far field; w unused.
     pub cutoff: [f32; 4],
 }
 
@@ -102,6 +116,14 @@ impl LightingParams {
 
 impl LightingParams {
     /// Leaves the point and spot lights out (another pass shades them, with shadows).
+    /// Ambient light from the ray-traced GI within `near_field_m` of the camera, blended into
+    /// the far field's (probes or sky) over the last `blend` fraction of it.
+    pub fn use_ray_traced_gi(&mut self, near_field_m: f32, blend: f32) {
+        self.config[1] |= LIGHTING_RTGI;
+        self.cutoff[1] = near_field_m;
+        self.cutoff[2] = blend.clamp(1e-3, 1.0);
+    }
+
     pub fn skip_punctual(&mut self) {
         self.config[1] &= !LIGHTING_PUNCTUAL;
     }
@@ -164,6 +186,7 @@ impl DirectLighting {
         view: &View,
         params: &LightingParams,
         area_lights: Tex,
+        gi: Option<&GiLight>,
     ) -> Result<LitFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
@@ -186,6 +209,10 @@ impl DirectLighting {
             .write(radiance)
             .write(illuminance)
             .read(area_lights)
+            // Without GI the shader reads none of these: any float texture fills the slots.
+            .read(gi.map_or(gb.normal, |g| g.y))
+            .read(gi.map_or(gb.normal, |g| g.cocg))
+            .read(gi.map_or(gb.normal, |g| g.ao))
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)

@@ -13,6 +13,7 @@
 #import hikari::sky::sky_background
 #import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_specular}
 #import hikari::irradiance_probes::probe_irradiance_at
+#import hikari::rtgi_resolve::{rtgi_signal, rtgi_resolve_diffuse, rtgi_resolve_specular}
 
 struct LightingParams {
     // xyz: unit vector towards the sun; w: illuminance in lux.
@@ -35,6 +36,7 @@ const LIGHTING_EMISSIVE: u32 = 4u;
 const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8u;
 const LIGHTING_SKY: u32 = 16u;
 const LIGHTING_PROBES: u32 = 32u;
+const LIGHTING_RTGI: u32 = 64u;
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: LightingParams;
@@ -51,6 +53,10 @@ const LIGHTING_PROBES: u32 = 32u;
 // Radiance of the area lights and shadowed point and spot lights (area_lights.shade), nits;
 // alpha: the lux they bring to the surface.
 @group(0) @binding(10) var area_light_radiance: texture_2d<f32>;
+// The ray-traced GI (LIGHTING_RTGI): luminance L1 SH, CoCg, AO.
+@group(0) @binding(11) var gi_y: texture_2d<f32>;
+@group(0) @binding(12) var gi_cocg: texture_2d<f32>;
+@group(0) @binding(13) var gi_ao: texture_2d<f32>;
 
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
@@ -226,25 +232,41 @@ fn main(
             illuminance += dot(e, EXPOSURE_LUMA) * max(dot(n, l), 0.0);
         }
         radiance = brdf_apply_weights(brdf, sum_a, sum_b, sum_c, sum_d);
+        // Image-based light of the far field: irradiance (for the diffuse) and reflected
+        // radiance (specular).
+        var ambient = vec3<f32>(0.0);
+        var ambient_specular = vec3<f32>(0.0);
         if (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u {
-            let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient_placeholder(n);
-            radiance += (diffuse + specular_placeholder(m, n, v)) * mat.w;
-            illuminance += dot(ambient_placeholder(n), EXPOSURE_LUMA) * mat.w;
+            ambient += ambient_placeholder(n);
+            ambient_specular += specular_placeholder(m, n, v);
         }
         if (flags & LIGHTING_SKY) != 0u {
             // The irradiance probes where they cover the surface (occluded sky, bounce, sun
             // bounce; interior mask in albedo.a), else the sky's SH unoccluded.
-            var ambient = sky_ambient_irradiance(n);
+            var sky_e = sky_ambient_irradiance(n);
             if (flags & LIGHTING_PROBES) != 0u {
                 let probe = probe_irradiance_at(world, n, albedo.a);
-                ambient = select(ambient, probe.rgb, probe.w > 0.0);
+                sky_e = select(sky_e, probe.rgb, probe.w > 0.0);
             }
-            let diffuse = albedo.rgb * (1.0 - m.metalness) / PI * ambient;
+            ambient += sky_e;
             let r = reflect(-v, n);
             let f = brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0));
-            radiance += (diffuse + f * sky_ambient_specular(r, m.perceptual_roughness)) * mat.w;
-            illuminance += dot(ambient, EXPOSURE_LUMA) * mat.w;
+            ambient_specular += f * sky_ambient_specular(r, m.perceptual_roughness);
         }
+        if (flags & LIGHTING_RTGI) != 0u {
+            // Near field: the ray-traced GI (whose misses see the sky) replaces the far field's
+            // light, which AO darkens where the two blend.
+            let far = smoothstep(params.cutoff.y * (1.0 - params.cutoff.z), params.cutoff.y, length(world - view.position.xyz));
+            let ao = textureLoad(gi_ao, pixel, 0).x;
+            let signal = rtgi_signal(textureLoad(gi_y, pixel, 0), textureLoad(gi_cocg, pixel, 0).xy);
+            let near_e = rtgi_resolve_diffuse(signal, n) * PI;
+            let alpha = m.perceptual_roughness * m.perceptual_roughness;
+            let near_specular = rtgi_resolve_specular(signal, n, v, brdf_material_f0(m), alpha);
+            ambient = mix(near_e, ambient * ao, far);
+            ambient_specular = mix(near_specular, ambient_specular * ao, far);
+        }
+        radiance += (albedo.rgb * (1.0 - m.metalness) / PI * ambient + ambient_specular) * mat.w;
+        illuminance += dot(ambient, EXPOSURE_LUMA) * mat.w;
         if (flags & LIGHTING_EMISSIVE) != 0u {
             radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;
         }

@@ -44,6 +44,11 @@ pub struct RayTracedGiSettings {
     /// History is rejected where its view depth differs from the reprojected point's by more
     /// than this fraction.
     pub depth_tolerance: f32,
+    /// The deferred lighting takes its ambient light from the GI within this distance of the
+    /// camera (metres) and from the probes or the sky beyond.
+    pub near_field_m: f32,
+    /// The fraction of the near field over which the GI blends into the far field.
+    pub near_field_blend: f32,
 }
 
 impl Default for RayTracedGiSettings {
@@ -67,6 +72,8 @@ impl Default for RayTracedGiSettings {
             accumulate: true,
             max_history: 32,
             depth_tolerance: 0.05,
+            near_field_m: 250.0,
+            near_field_blend: 0.2,
         }
     }
 }
@@ -106,6 +113,17 @@ impl TechniqueSettings for RayTracedGiSettings {
                     lo: 0.0,
                     hi: 60_000.0,
                 },
+            },
+            Field {
+                key: "near_field_m",
+                range: Range::Float {
+                    lo: 0.0,
+                    hi: 100_000.0,
+                },
+            },
+            Field {
+                key: "near_field_blend",
+                range: Range::Float { lo: 0.001, hi: 1.0 },
             },
             Field {
                 key: "max_history",
