@@ -13,9 +13,9 @@ use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
-use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
+use crate::techniques::tonemap::{self, Tonemap, TonemapInputs};
 use crate::view::View;
 
 /// What a frame depends on besides the scene.
@@ -83,7 +83,7 @@ pub struct Techniques {
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
-    pub placeholder_tonemap: PlaceholderTonemap,
+    pub tonemap: Tonemap,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
 }
@@ -98,7 +98,7 @@ impl Techniques {
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
             brdf_tables: BrdfTables::new(ctx),
-            placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
+            tonemap: Tonemap::new(ctx, &mut lib)?,
         })
     }
 }
@@ -185,12 +185,22 @@ pub fn record<'r>(
 
     // 12. Haze and 13. TAA: their issues add them here.
 
-    // 14. Exposure and tonemap (placeholder).
-    let ldr = t.placeholder_tonemap.record(
+    // 14. Exposure (a fixed EV100 until the exposure technique), then the tonemap: Purkinje
+    //     shift, white balance, the curve in the tonemapping space, LUT grade, dither.
+    let exposure = tonemap::placeholder_exposure_buffer(
         g,
-        hdr,
+        s.ev100_with_sky(sky.sky_lux),
+        s.metered_lux_with_sky(sky.sky_lux),
+    )?;
+    let ldr = t.tonemap.record(
+        g,
+        &s.settings.tonemap,
+        TonemapInputs {
+            hdr,
+            exposure,
+            log2_gain: None,
+        },
         size,
-        &TonemapParams::from_ev100(s.ev100_with_sky(sky.sky_lux)),
     )?;
 
     Ok(FrameOutputs {

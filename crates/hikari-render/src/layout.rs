@@ -30,7 +30,7 @@ pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
     use crate::raster;
     use crate::scene_gpu;
-    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows};
+    use crate::techniques::{direct_lighting, placeholder_tonemap, sky, sun_shadows, tonemap};
     use crate::view;
     vec![
         gpu_layout!(
@@ -127,6 +127,22 @@ pub fn all() -> Vec<StructLayout> {
             placeholder_tonemap::TonemapParams,
             "placeholder_tonemap/apply.wgsl",
             [exposure]
+        ),
+        gpu_layout!(
+            tonemap::TonemapParams,
+            "tonemap/apply.wgsl",
+            [
+                lmsr_from_rgb,
+                rgb_from_lms_gain,
+                purkinje_fade,
+                tonemap_from_rec709,
+                rec709_from_tonemap,
+                curve,
+                curve_shoulder,
+                lut_domain_min,
+                lut_domain_max,
+                switches
+            ]
         ),
         gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),
         gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),

@@ -15,6 +15,7 @@ pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::placeholder_tonemap::settings::ExposureSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
+pub use crate::techniques::tonemap::settings::TonemapSettings;
 
 /// Named quality levels, as game renderers offer them: each sets the resolutions, ray and
 /// sample counts and update budgets of every technique. `High` is the default.
@@ -189,6 +190,7 @@ register_settings! {
     direct_lighting: DirectLightingSettings,
     exposure: ExposureSettings,
     sky: SkySettings,
+    tonemap: TonemapSettings,
 }
 
 impl Settings {

@@ -8,3 +8,4 @@ pub mod gbuffer;
 pub mod placeholder_tonemap;
 pub mod sky;
 pub mod sun_shadows;
+pub mod tonemap;
