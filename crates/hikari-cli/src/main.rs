@@ -10,7 +10,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use commands::{bench_frame, bench_overhead, bench_rays, constants, info, render, sky};
+use commands::{bench_frame, bench_overhead, bench_rays, constants, info, lut, render, sky};
 
 #[derive(Parser)]
 #[command(
@@ -37,6 +37,9 @@ enum Command {
     Constants(constants::ConstantsArgs),
     /// Print the GPU adapter, its features and limits.
     Info,
+    /// Grading with 3D LUTs: read a grade back from a graded screenshot, or apply one.
+    #[command(subcommand)]
+    Lut(lut::LutCommand),
 }
 
 /// `hikari bench ...`: benchmarks print numbers; they never pass or fail.
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
         Command::Constants(args) => constants::run(args),
         Command::Info => info::run(),
+        Command::Lut(command) => lut::run(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

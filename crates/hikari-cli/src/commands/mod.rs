@@ -7,5 +7,6 @@ pub mod bench_overhead;
 pub mod bench_rays;
 pub mod constants;
 pub mod info;
+pub mod lut;
 pub mod render;
 pub mod sky;

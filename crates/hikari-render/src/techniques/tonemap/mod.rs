@@ -248,6 +248,11 @@ pub fn upload_lut(ctx: &GpuContext, lut: &CubeLut) -> wgpu::Texture {
     )
 }
 
+/// The `.cube` file `s` grades with: its `lut`, unless `grade` is off.
+pub fn graded_by(s: &TonemapSettings) -> Option<&Path> {
+    s.lut.as_deref().filter(|_| s.grade).map(Path::new)
+}
+
 pub struct Tonemap {
     apply: ComputePipeline,
     lut: Mutex<Option<Arc<LoadedLut>>>,
@@ -286,8 +291,8 @@ impl Tonemap {
 
     /// The LUT that `s` grades with, read from its file (cached), if any.
     pub fn grade(&self, ctx: &GpuContext, s: &TonemapSettings) -> Result<Option<CubeLut>> {
-        Ok(match &s.lut {
-            Some(p) => Some(self.lut(ctx, Path::new(p))?.lut.clone()),
+        Ok(match graded_by(s) {
+            Some(p) => Some(self.lut(ctx, p)?.lut.clone()),
             None => None,
         })
     }
@@ -300,8 +305,8 @@ impl Tonemap {
         inputs: TonemapInputs,
         size: [u32; 2],
     ) -> Result<Tex> {
-        let loaded = match &s.lut {
-            Some(p) => Some(self.lut(g.ctx(), Path::new(p))?),
+        let loaded = match graded_by(s) {
+            Some(p) => Some(self.lut(g.ctx(), p)?),
             None => None,
         };
         let params = TonemapParams::new(

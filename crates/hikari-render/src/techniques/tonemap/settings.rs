@@ -12,13 +12,18 @@ pub struct TonemapSettings {
     /// The rods' colour shift at low light (Cao et al. 2008, as in Ghost of Tsushima), computed
     /// at absolute scene luminance before exposure; negligible in daylight.
     pub purkinje: bool,
-    /// Scale of the Purkinje colour change (1: the talk's constants as they are).
+    /// Scale of the Purkinje colour change (1: the talk's constants as they are). The talk
+    /// does not give its receptor normalisation; with hikari-math's (a white of 1 cd/m² gives
+    /// LMSR ≈ 1) strength 1 turns a moonlit grey into (1, 8.5, 36) times itself, so the
+    /// default is 0.1: clearly blue at night, readable (docs/tonemapping.md).
     pub purkinje_strength: f32,
     /// Rod response, in cd/m² of scotopic-weighted luminance, at which the shift is halved:
     /// the change is multiplied by `sat / (sat + rod)`, so the rods fade out of daylight as
     /// they saturate (Cao et al. 2008 let the rods' input fall with light; the talk keeps it
-    /// constant, which still moves a 5 000 cd/m² grey by 2 %). 5 cd/m² is the top of the
-    /// mesopic range (CIE 191:2010); 0 turns the fade off (the talk's formula unchanged).
+    /// constant, which still moves a 5 000 cd/m² grey by 2 %). The mesopic range is
+    /// 0.005 to 5 cd/m² (CIE 191:2010); 0.5 keeps night scenes (below 0.05) within 10 % of
+    /// the talk and lamp-lit streets (a few cd/m²) mildly shifted. 0 turns the fade off
+    /// (the talk's formula unchanged).
     pub purkinje_rod_saturation: f32,
     /// Whether `white` is applied.
     pub white_balance: bool,
@@ -42,6 +47,8 @@ pub struct TonemapSettings {
     /// A `.cube` 3D LUT (Adobe Cube LUT 1.0) graded on sRGB-encoded values, applied after the
     /// curve; absent: no grade (identity). A relative path is taken from the working folder.
     pub lut: Option<String>,
+    /// Whether the `lut` grades the image (off: no grade, the file is not read).
+    pub grade: bool,
     /// Triangular-distributed dither of ±0.5/255 before the 8-bit store, against banding.
     pub dither: bool,
 }
@@ -50,8 +57,8 @@ impl Default for TonemapSettings {
     fn default() -> Self {
         Self {
             purkinje: true,
-            purkinje_strength: 1.0,
-            purkinje_rod_saturation: 5.0,
+            purkinje_strength: 0.1,
+            purkinje_rod_saturation: 0.5,
             white_balance: true,
             white: [1.0, 1.0, 1.0],
             curve: true,
@@ -63,6 +70,7 @@ impl Default for TonemapSettings {
             curve_toe: 1.33,
             curve_black: 0.0,
             lut: None,
+            grade: true,
             dither: true,
         }
     }
@@ -92,7 +100,10 @@ impl TechniqueSettings for TonemapSettings {
             },
             Field {
                 key: "curve_linear_start",
-                range: Range::Float { lo: 0.01, hi: 0.45 },
+                range: Range::Float {
+                    lo: 0.015625,
+                    hi: 0.45,
+                },
             },
             Field {
                 key: "curve_linear_length",
@@ -104,7 +115,7 @@ impl TechniqueSettings for TonemapSettings {
             },
             Field {
                 key: "curve_black",
-                range: Range::Float { lo: 0.0, hi: 0.2 },
+                range: Range::Float { lo: 0.0, hi: 0.25 },
             },
         ]
     }
