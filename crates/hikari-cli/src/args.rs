@@ -145,7 +145,7 @@ pub struct ExposureArgs {
 pub struct TonemapArgs {
     /// The colour white becomes, linear Rec.709 `R,G,B`, each > 0: `1,0.9,0.75` warms the
     /// image, `0.8,0.9,1` cools it (`tonemap.white`).
-    #[arg(long, value_name = "R,G,B")]
+    #[arg(long, value_name = "R,G,B", allow_hyphen_values = true)]
     pub white: Option<String>,
     /// Grades the image with a 3D LUT in Adobe's `.cube` format (`tonemap.lut`).
     #[arg(long, value_name = "FILE.cube")]

@@ -26,7 +26,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to a PNG (display) and a linear EXR (radiance in nits).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Write the sky of a date, time, place and weather as an equirectangular EXR (nits) and
     /// print its L2 SH and the sun and moon.
     Sky(sky::SkyCommandArgs),
@@ -46,7 +46,7 @@ enum Command {
 #[derive(Subcommand, Debug)]
 enum BenchCommand {
     /// Render N frames of a scene and print per-pass GPU median/min/max.
-    Frame(bench_frame::BenchFrameArgs),
+    Frame(Box<bench_frame::BenchFrameArgs>),
     /// Frame-graph overhead: frames of N near-empty passes, CPU and GPU cost per pass.
     Overhead(bench_overhead::OverheadArgs),
     /// BVH build times and GPU ray throughput (Grays/s) for closest and any hit.
@@ -71,9 +71,9 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => render::run(args),
+        Command::Render(args) => render::run(*args),
         Command::Sky(args) => sky::run(args),
-        Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(args),
+        Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(*args),
         Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
         Command::Constants(args) => constants::run(args),

@@ -51,7 +51,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let strip_lut = if args.lut_screenshot {
         if StripLayout::for_width(settings.width).is_none() {
             anyhow::bail!(
-                "--lut-screenshot needs an image at least 64 px wide for its LUT strip; --width is {}",
+                "--lut-screenshot needs an image at least 32 px wide for its LUT strip; --width is {}",
                 settings.width
             );
         }

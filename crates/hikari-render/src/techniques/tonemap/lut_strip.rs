@@ -1,17 +1,19 @@
 //! The talk's grading workflow: a screenshot carries a 32x32x32 LUT strip, the artist grades
 //! the whole PNG in any photo editor, and the grade is read back from the strip.
 //!
-//! Layout: a band appended below the image, as wide as the image. Lattice point (r, g, b) of
-//! the 32³ grid is a 2x2 block of equal pixels; blue slice `b` is a 64x64 tile with red
-//! growing rightwards and green downwards; tiles run left to right, `width / 64` (at most 32)
-//! to a row, and wrap. The band is `64 · ceil(32 / tiles per row)` pixels high; what the
-//! tiles leave uncovered is black. An image must be at least 64 px wide.
+//! Layout: a band appended below the image, as wide as the image, holding the 32³ lattice
+//! twice. Each copy is 32 tiles of 32x32 pixels, one per blue slice, with red growing
+//! rightwards and green downwards; copy 0 holds slice `b` in tile `b`, copy 1 in tile
+//! `63 - b`, so each lattice point sits in two distant pixels. Tiles run left to right,
+//! `width / 32` (at most 64) to a row, and wrap; the band is `32 · ceil(64 / tiles per row)`
+//! pixels high (64 at 1280 wide); what the tiles leave uncovered is black. An image must be
+//! at least 32 px wide.
 //!
 //! The strip holds the LUT the screenshot was graded with (identity if none), so the grade
 //! read back is the old grade followed by the artist's. A photo editor applies the same
-//! function to equal colours, so the four pixels of a block stay equal under any grade; a
-//! block whose pixels differ by more than [`BLOCK_TOLERANCE`] is damage (painting, resizing,
-//! cropping) and refused.
+//! function to equal colours, so the two copies of a lattice point stay equal under any
+//! grade; where they differ by more than [`COPY_TOLERANCE`] the strip was damaged (painting,
+//! resizing, cropping), and where most differ there is no strip at all.
 
 use std::path::Path;
 
@@ -20,12 +22,11 @@ use crate::graph::ImageRgba32;
 
 /// The strip's LUT size (the talk's 32x32x32).
 pub const STRIP_SIZE: u32 = 32;
-/// Pixels per lattice point along each side.
-pub const BLOCK: u32 = 2;
-/// Largest difference, in 8-bit steps, between the pixels of one block of a graded strip
-/// (editors that dither may move one pixel by a step).
-pub const BLOCK_TOLERANCE: u8 = 2;
-const TILE: u32 = STRIP_SIZE * BLOCK;
+/// Largest difference, in 8-bit steps, between the two copies of a lattice point in a graded
+/// strip (editors that dither may move a pixel by a step).
+pub const COPY_TOLERANCE: u8 = 2;
+const TILE: u32 = STRIP_SIZE;
+const TILES: u32 = 2 * STRIP_SIZE;
 
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum StripError {
@@ -47,18 +48,19 @@ pub struct StripLayout {
 
 impl StripLayout {
     pub fn for_width(width: u32) -> Option<Self> {
-        let tiles_per_row = (width / TILE).min(STRIP_SIZE);
+        let tiles_per_row = (width / TILE).min(TILES);
         (tiles_per_row > 0).then(|| Self {
             tiles_per_row,
-            height: TILE * STRIP_SIZE.div_ceil(tiles_per_row),
+            height: TILE * TILES.div_ceil(tiles_per_row),
         })
     }
 
-    /// Top-left pixel (within the band) of lattice point `(r, g, b)`'s block.
-    pub fn block(&self, r: u32, g: u32, b: u32) -> (u32, u32) {
-        let tx = b % self.tiles_per_row;
-        let ty = b / self.tiles_per_row;
-        (tx * TILE + r * BLOCK, ty * TILE + g * BLOCK)
+    /// The pixel (within the band) of lattice point `(r, g, b)` in copy 0 or 1.
+    pub fn pixel(&self, copy: u32, r: u32, g: u32, b: u32) -> (u32, u32) {
+        let tile = if copy == 0 { b } else { TILES - 1 - b };
+        let tx = tile % self.tiles_per_row;
+        let ty = tile / self.tiles_per_row;
+        (tx * TILE + r, ty * TILE + g)
     }
 }
 
@@ -106,12 +108,9 @@ pub fn embed(img: &ImageRgba32, lut: &CubeLut) -> Option<ImageRgba32> {
         for g in 0..STRIP_SIZE {
             for r in 0..STRIP_SIZE {
                 let c = lut.sample([r as f32 * step, g as f32 * step, b as f32 * step]);
-                let (x0, y0) = layout.block(r, g, b);
-                for dy in 0..BLOCK {
-                    for dx in 0..BLOCK {
-                        let y = (img.height + y0 + dy) as usize;
-                        rgba[y * w + (x0 + dx) as usize] = [c[0], c[1], c[2], 1.0];
-                    }
+                for copy in 0..2 {
+                    let (x, y) = layout.pixel(copy, r, g, b);
+                    rgba[(img.height + y) as usize * w + x as usize] = [c[0], c[1], c[2], 1.0];
                 }
             }
         }
@@ -152,35 +151,41 @@ pub fn extract(img: &Rgba8Image, file: &str) -> Result<CubeLut, StripError> {
     for b in 0..STRIP_SIZE {
         for g in 0..STRIP_SIZE {
             for r in 0..STRIP_SIZE {
-                let (x0, y0) = layout.block(r, g, b);
                 let mut sum = [0u32; 3];
                 let mut lo = [255u8; 3];
                 let mut hi = [0u8; 3];
-                for dy in 0..BLOCK {
-                    for dx in 0..BLOCK {
-                        let p = img.pixels[(top + y0 + dy) as usize * w + (x0 + dx) as usize];
-                        for k in 0..3 {
-                            sum[k] += p[k] as u32;
-                            lo[k] = lo[k].min(p[k]);
-                            hi[k] = hi[k].max(p[k]);
-                        }
+                for copy in 0..2 {
+                    let (x, y) = layout.pixel(copy, r, g, b);
+                    let p = img.pixels[(top + y) as usize * w + x as usize];
+                    for k in 0..3 {
+                        sum[k] += p[k] as u32;
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
                     }
                 }
-                if (0..3).any(|k| hi[k] - lo[k] > BLOCK_TOLERANCE) {
+                if (0..3).any(|k| hi[k] - lo[k] > COPY_TOLERANCE) {
                     damaged += 1;
-                    first_damage.get_or_insert((x0, top + y0));
+                    let (x, y) = layout.pixel(0, r, g, b);
+                    first_damage.get_or_insert((x, top + y));
                 }
-                let n = (BLOCK * BLOCK) as f32 * 255.0;
-                data.push(sum.map(|s| s as f32 / n));
+                data.push(sum.map(|s| s as f32 / (2.0 * 255.0)));
             }
         }
+    }
+    if damaged * 2 > data.len() {
+        return Err(missing(format!(
+            "the two copies of the lattice in the bottom {} px disagree at {damaged} of {} points",
+            layout.height,
+            data.len()
+        )));
     }
     if let Some((x, y)) = first_damage {
         return Err(StripError::Damaged {
             file: file.into(),
             message: format!(
-                "{damaged} of {} 2x2 blocks hold different colours, the first at pixel ({x}, {y}); \
-                 grade colours only, without resizing, cropping or painting over the band",
+                "the two copies of {damaged} of {} lattice points differ, the first at pixel \
+                 ({x}, {y}); grade colours only, without resizing, cropping or painting over the \
+                 band",
                 data.len()
             ),
         });
@@ -262,7 +267,7 @@ mod tests {
 
     #[test]
     fn the_lut_read_back_from_a_graded_screenshot_is_the_grade() {
-        for width in [64u32, 200, 2100] {
+        for width in [32u32, 200, 2100] {
             let shot = embed(&image(width, 20), &CubeLut::identity(32)).unwrap();
             let mut px = to_rgba8(&shot);
             // The artist grades the whole 8-bit PNG.
@@ -297,11 +302,11 @@ mod tests {
     fn a_missing_or_damaged_strip_is_an_error() {
         let plain = to_rgba8(&image(200, 800));
         let e = extract(&plain, "plain.png").unwrap_err().to_string();
-        assert!(e.contains("plain.png") && e.contains("damaged"), "{e}");
-        let narrow = to_rgba8(&image(40, 300));
+        assert!(e.contains("plain.png") && e.contains("no LUT strip"), "{e}");
+        let narrow = to_rgba8(&image(20, 300));
         let e = extract(&narrow, "narrow.png").unwrap_err().to_string();
         assert!(
-            e.contains("no LUT strip") && e.contains("40 px wide"),
+            e.contains("no LUT strip") && e.contains("20 px wide"),
             "{e}"
         );
         let black = Rgba8Image {
@@ -317,5 +322,15 @@ mod tests {
         px.pixels[i] = [255, 0, 255, 255];
         let e = extract(&px, "painted.png").unwrap_err().to_string();
         assert!(e.contains("damaged") && e.contains("1 of 32768"), "{e}");
+        // A smooth gradient (which a test of neighbouring pixels would take for a strip).
+        let gradient = Rgba8Image {
+            width: 200,
+            height: 800,
+            pixels: (0..200 * 800)
+                .map(|i| [(i % 200) as u8, (i / 200 % 256) as u8, 7, 255])
+                .collect(),
+        };
+        let e = extract(&gradient, "gradient.png").unwrap_err().to_string();
+        assert!(e.contains("no LUT strip"), "{e}");
     }
 }
