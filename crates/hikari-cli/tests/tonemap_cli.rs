@@ -42,8 +42,8 @@ fn grade_png(src: &Path, dst: &Path) {
     let mut img = image::open(src).unwrap().to_rgba8();
     for p in img.pixels_mut() {
         let c = grade([p[0], p[1], p[2]].map(|v| v as f32 / 255.0));
-        for k in 0..3 {
-            p.0[k] = (c[k] * 255.0).round() as u8;
+        for (channel, v) in p.0.iter_mut().zip(c) {
+            *channel = (v * 255.0).round() as u8;
         }
     }
     img.save(dst).unwrap();

@@ -19,7 +19,7 @@ struct TonemapParams {
     // xyz: the LUT's domain; w: its size.
     lut_domain_min: vec4<f32>,
     lut_domain_max: vec4<f32>,
-    // x: switch bits (1 Purkinje, 2 local gain, 4 curve, 8 LUT, 16 dither); y: frame index.
+    // x: switch bits (1 Purkinje, 2 local gain, 4 curve, 8 LUT, 16 dither); y: dither seed.
     switches: vec4<u32>,
 }
 
@@ -92,8 +92,8 @@ fn pcg(v: u32) -> u32 {
 }
 
 // Triangular noise in [-0.5, 0.5] / 255, the same for the three channels.
-fn dither(p: vec2<u32>, frame: u32) -> f32 {
-    let h1 = pcg(p.x + pcg(p.y + pcg(frame)));
+fn dither(p: vec2<u32>, seed: u32) -> f32 {
+    let h1 = pcg(p.x + pcg(p.y + pcg(seed)));
     let h2 = pcg(h1);
     let u1 = f32(h1 >> 8u) / 16777216.0;
     let u2 = f32(h2 >> 8u) / 16777216.0;

@@ -105,12 +105,13 @@ pub fn curve_constants(s: &TonemapSettings) -> [f32; 3] {
 
 impl TonemapParams {
     /// The uniforms for `s`; `lut` is the grade's size and domain if one is applied,
-    /// `local_gain` whether a local tonemap gain texture is bound, `frame` seeds the dither.
+    /// `local_gain` whether a local tonemap gain texture is bound, `dither_seed` picks the
+    /// dither pattern.
     pub fn new(
         s: &TonemapSettings,
         lut: Option<&CubeLut>,
         local_gain: bool,
-        frame: u32,
+        dither_seed: u32,
     ) -> Result<Self> {
         let pk = PurkinjeMatrices::new();
         let mut lmsr = [[0f32; 4]; 4];
@@ -151,7 +152,7 @@ impl TonemapParams {
             curve_shoulder: [s.curve_black, s0, s1, cp],
             lut_domain_min: [dmin[0], dmin[1], dmin[2], n],
             lut_domain_max: [dmax[0], dmax[1], dmax[2], 0.0],
-            switches: [switches, frame, 0, 0],
+            switches: [switches, dither_seed, 0, 0],
         })
     }
 }
@@ -313,7 +314,9 @@ impl Tonemap {
             s,
             loaded.as_ref().map(|l| &l.lut),
             inputs.log2_gain.is_some(),
-            g.frame_index() as u32,
+            // One fixed pattern: a frame's image depends on its input alone (renders of the
+            // same input are bitwise equal), and nothing after this pass averages frames.
+            0,
         )?;
         let gain = match inputs.log2_gain {
             Some(t) => t,

@@ -60,9 +60,9 @@ fn pcg(v: u32) -> u32 {
     (word >> 22) ^ word
 }
 
-/// The dither added at pixel `(x, y)` of frame `frame`: triangular in [-0.5, 0.5] / 255.
-pub fn dither(x: u32, y: u32, frame: u32) -> f32 {
-    let h1 = pcg(x.wrapping_add(pcg(y.wrapping_add(pcg(frame)))));
+/// The dither added at pixel `(x, y)` with seed `seed`: triangular in [-0.5, 0.5] / 255.
+pub fn dither(x: u32, y: u32, seed: u32) -> f32 {
+    let h1 = pcg(x.wrapping_add(pcg(y.wrapping_add(pcg(seed)))));
     let h2 = pcg(h1);
     let u1 = (h1 >> 8) as f32 / 16_777_216.0;
     let u2 = (h2 >> 8) as f32 / 16_777_216.0;
