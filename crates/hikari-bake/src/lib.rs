@@ -4,7 +4,7 @@
 //! global pool; `RAYON_NUM_THREADS` sets its size). [`bake_scene`] (and [`bake_scene_resume`],
 //! [`bake_to_file`]) bakes the grid and the tetrahedral meshes of [`volumes`] into a
 //! `hikari_probes::Bake`: sky visibility, bounced sky visibility ([`transport`]) and interior
-//! flags ([`scene_bake`]); docs/irradiance-probes-bake.md describes it all. Below, the grid and
+//! flags ([`scene_bake`]); docs/irradiance-probes.md describes it all. Below, the grid and
 //! [`bake_grid_sky_visibility`], the first, grid-only entry point (kept).
 //!
 //! ```

@@ -139,6 +139,110 @@ pub struct ExposureArgs {
     pub ev100: Option<f32>,
 }
 
+/// The final image's flags, each a settings override (flags win over `--set` and the file):
+/// `--white`, `--lut`, `--exposure-compensation` and the on/off switches.
+#[derive(Args, Debug, Clone, Default)]
+pub struct TonemapArgs {
+    /// The colour white becomes, linear Rec.709 `R,G,B`, each > 0: `1,0.9,0.75` warms the
+    /// image, `0.8,0.9,1` cools it (`tonemap.white`).
+    #[arg(long, value_name = "R,G,B", allow_hyphen_values = true)]
+    pub white: Option<String>,
+    /// Grades the image with a 3D LUT in Adobe's `.cube` format (`tonemap.lut`).
+    #[arg(long, value_name = "FILE.cube")]
+    pub lut: Option<PathBuf>,
+    /// Exposure compensation in EV, added to the metered exposure
+    /// (`exposure.compensation_ev`).
+    #[arg(long, value_name = "EV", allow_negative_numbers = true)]
+    pub exposure_compensation: Option<f64>,
+    /// No local tonemapping (`local_tonemap.enabled = false`).
+    #[arg(long)]
+    pub no_tonemap_local: bool,
+    /// No Purkinje shift (`tonemap.purkinje = false`).
+    #[arg(long)]
+    pub no_purkinje: bool,
+    /// No white balance (`tonemap.white_balance = false`).
+    #[arg(long)]
+    pub no_white_balance: bool,
+    /// No tone curve: the tonemapping space is clipped at 1 (`tonemap.curve = false`).
+    #[arg(long)]
+    pub no_tone_curve: bool,
+    /// No LUT grade, even if the settings name one (`tonemap.grade = false`).
+    #[arg(long)]
+    pub no_grade: bool,
+    /// No dither before the 8-bit PNG (`tonemap.dither = false`).
+    #[arg(long)]
+    pub no_dither: bool,
+}
+
+impl TonemapArgs {
+    /// The flags as `table.key = value` settings overrides (TOML values). A bad `--white` or
+    /// `--lut` is an error naming the flag.
+    pub fn overrides(&self) -> anyhow::Result<Vec<(String, String)>> {
+        let mut out = Vec::new();
+        let mut set = |k: &str, v: String| out.push((k.to_string(), v));
+        if let Some(w) = &self.white {
+            let rgb = parse_white(w)?;
+            set(
+                "tonemap.white",
+                format!("[{}, {}, {}]", rgb[0], rgb[1], rgb[2]),
+            );
+        }
+        if let Some(p) = &self.lut {
+            hikari_render::techniques::tonemap::cube::CubeLut::read(p)
+                .map_err(|e| anyhow::anyhow!("--lut: {e}"))?;
+            set(
+                "tonemap.lut",
+                toml::Value::String(p.display().to_string()).to_string(),
+            );
+        }
+        if let Some(ev) = self.exposure_compensation {
+            if !ev.is_finite() {
+                anyhow::bail!("--exposure-compensation {ev} is not a finite number of EV");
+            }
+            set("exposure.compensation_ev", format!("{ev:?}"));
+        }
+        for (on, key) in [
+            (self.no_tonemap_local, "local_tonemap.enabled"),
+            (self.no_purkinje, "tonemap.purkinje"),
+            (self.no_white_balance, "tonemap.white_balance"),
+            (self.no_tone_curve, "tonemap.curve"),
+            (self.no_grade, "tonemap.grade"),
+            (self.no_dither, "tonemap.dither"),
+        ] {
+            if on {
+                set(key, "false".into());
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// `R,G,B`: three finite numbers > 0 (a white that is black, negative or NaN balances
+/// nothing).
+pub fn parse_white(s: &str) -> anyhow::Result<[f32; 3]> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        anyhow::bail!(
+            "--white {s:?}: expected three numbers R,G,B (linear Rec.709), e.g. 1,0.9,0.8"
+        );
+    }
+    let mut rgb = [0f32; 3];
+    for (k, p) in parts.iter().enumerate() {
+        let v: f32 = p
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--white {s:?}: `{p}` is not a number"))?;
+        if !(v.is_finite() && v > 0.0) {
+            anyhow::bail!(
+                "--white {s:?}: {} is {v}; each component must be a finite number > 0 \
+                 (white cannot become black, negative or NaN)",
+                ["red", "green", "blue"][k]
+            );
+        }
+        rgb[k] = v;
+    }
+    Ok(rgb)
+}
+
 /// `--json`: machine-readable output.
 #[derive(Args, Debug, Clone, Default)]
 pub struct JsonArgs {
@@ -163,4 +267,6 @@ pub struct FrameArgs {
     pub config: ConfigArgs,
     #[command(flatten)]
     pub exposure: ExposureArgs,
+    #[command(flatten)]
+    pub tonemap: TonemapArgs,
 }

@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    bake, bench_frame, bench_overhead, bench_rays, constants, info, probes, render, sky,
+    bake, bench_frame, bench_overhead, bench_rays, constants, info, lut, probes, render, sky,
 };
 
 #[derive(Parser)]
@@ -29,7 +29,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to a PNG (display) and a linear EXR (radiance in nits).
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Write the sky of a date, time, place and weather as an equirectangular EXR (nits) and
     /// print its L2 SH and the sun and moon.
     Sky(sky::SkyCommandArgs),
@@ -44,13 +44,16 @@ enum Command {
     Constants(constants::ConstantsArgs),
     /// Print the GPU adapter, its features and limits.
     Info,
+    /// Grading with 3D LUTs: read a grade back from a graded screenshot, or apply one.
+    #[command(subcommand)]
+    Lut(lut::LutCommand),
 }
 
 /// `hikari bench ...`: benchmarks print numbers; they never pass or fail.
 #[derive(Subcommand, Debug)]
 enum BenchCommand {
     /// Render N frames of a scene and print per-pass GPU median/min/max.
-    Frame(bench_frame::BenchFrameArgs),
+    Frame(Box<bench_frame::BenchFrameArgs>),
     /// Frame-graph overhead: frames of N near-empty passes, CPU and GPU cost per pass.
     Overhead(bench_overhead::OverheadArgs),
     /// BVH build times and GPU ray throughput (Grays/s) for closest and any hit.
@@ -75,15 +78,16 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => render::run(args),
+        Command::Render(args) => render::run(*args),
         Command::Sky(args) => sky::run(args),
         Command::Bake(args) => bake::run(args),
         Command::Probes(args) => probes::run(args),
-        Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(args),
+        Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(*args),
         Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
         Command::Constants(args) => constants::run(args),
         Command::Info => info::run(),
+        Command::Lut(command) => lut::run(command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -259,9 +259,21 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
         args.camera.camera.as_deref(),
         file.camera.as_deref(),
     )?;
+    let overrides: Vec<(String, String)> = args
+        .config
+        .overrides
+        .iter()
+        .cloned()
+        .chain(args.tonemap.overrides()?)
+        .collect();
     let mut settings = file
-        .settings_with(args.config.preset, &args.config.overrides)
+        .settings_with(args.config.preset, &overrides)
         .context("settings")?;
+    // A bad grade fails here, before the GPU starts and before anything is written.
+    if let Some(p) = hikari_render::techniques::tonemap::graded_by(&settings.tonemap) {
+        hikari_render::techniques::tonemap::cube::CubeLut::read(p)
+            .map_err(|e| anyhow::anyhow!("settings `tonemap.lut`: {e}"))?;
+    }
     if let Some(t) = &file.time {
         settings.sky.time = t.clone();
         hikari_render::settings::TechniqueSettings::validate(&settings.sky, "sky")

@@ -19,13 +19,13 @@ use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::gi_denoiser::{DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
-use crate::techniques::placeholder_tonemap::{PlaceholderTonemap, TonemapParams};
 use crate::techniques::ray_traced_gi::{
     RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene, SkySource,
 };
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::techniques::taa::{self, Taa};
+use crate::techniques::tonemap::{Tonemap, TonemapInputs};
 use crate::view::View;
 
 /// What a frame depends on besides the scene.
@@ -42,9 +42,9 @@ pub struct FrameSettings {
 }
 
 impl FrameSettings {
-    /// Exposure of the placeholder tonemap: the configured EV100, else the incident-light
-    /// meter rule EV100 = log2(E * 100 / C) with C = 250 (ISO 2720) on the sun's illuminance,
-    /// floored at 20 lux so that nights are exposed for their lamps, not for the moon.
+    /// The CPU meter (the exposure when the `exposure` technique is off): the configured
+    /// EV100, else the incident-light meter rule EV100 = log2(E * 100 / C) with C = 250
+    /// (ISO 2720) on the sun's illuminance.
     pub fn ev100(&self) -> f32 {
         self.ev100_with_sky(0.0)
     }
@@ -57,15 +57,15 @@ impl FrameSettings {
             .unwrap_or_else(|| (self.metered_lux_with_sky(sky_lux) * 100.0 / 250.0).log2())
     }
 
-    /// The illuminance the exposure is set for: the configured EV100's, else the sun's,
-    /// at least 20 lux.
+    /// The illuminance the CPU meter reads: the configured EV100's, else the sun's.
     pub fn metered_lux(&self) -> f32 {
         self.metered_lux_with_sky(0.0)
     }
 
     /// The illuminance the exposure is set for, with the sky's own light (`sky_lux` on a
-    /// horizontal plane): the configured EV100's, else the larger of the sun's and the sky's,
-    /// at least 20 lux. At dawn and dusk the sky outshines the low sun.
+    /// horizontal plane): the configured EV100's, else the larger of the sun's and the sky's
+    /// (at least a thousandth of a lux, so that a scene without either stays finite). At dawn
+    /// and dusk the sky outshines the low sun; the punctual lights' cut-off follows it.
     pub fn metered_lux_with_sky(&self, sky_lux: f32) -> f32 {
         match self.settings.exposure.ev100 {
             Some(ev) => 2f32.powf(ev) * 250.0 / 100.0,
@@ -74,7 +74,7 @@ impl FrameSettings {
                 .as_ref()
                 .map_or(0.0, |s| s.illuminance_lux)
                 .max(sky_lux)
-                .max(20.0),
+                .max(1e-3),
         }
     }
 }
@@ -108,8 +108,8 @@ pub struct Techniques {
     pub taa: Taa,
     pub exposure: Exposure,
     pub local_tonemap: LocalTonemap,
-    pub placeholder_tonemap: PlaceholderTonemap,
     pub ray_traced_gi: RayTracedGi,
+    pub tonemap: Tonemap,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
 }
@@ -132,8 +132,8 @@ impl Techniques {
             taa: Taa::new(ctx, &mut lib)?,
             exposure: Exposure::new(ctx, &mut lib)?,
             local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
-            placeholder_tonemap: PlaceholderTonemap::new(ctx, &mut lib)?,
             ray_traced_gi: RayTracedGi::new(ctx, &mut lib)?,
+            tonemap: Tonemap::new(ctx, &mut lib)?,
         })
     }
 }
@@ -384,8 +384,8 @@ pub fn record<'r>(
         lit
     };
 
-    // 14. Exposure, metered on the illuminance; the local tonemap's gain; the tonemap
-    //     (placeholder, with its own exposure until the tonemap issue reads `exposure.value`).
+    // 14. Exposure, metered on the illuminance; the local tonemap's gain; the tonemap: Purkinje
+    //     shift, white balance, the curve in the tonemapping space, LUT grade, dither.
     let exposure = t.exposure.record(
         g,
         hdr,
@@ -415,11 +415,15 @@ pub fn record<'r>(
             .local_tonemap
             .look_for(&s.settings.sky.weather, sun_elevation_deg),
     )?;
-    let ldr = t.placeholder_tonemap.record(
+    let ldr = t.tonemap.record(
         g,
-        hdr,
+        &s.settings.tonemap,
+        TonemapInputs {
+            hdr,
+            exposure: exposure.value,
+            log2_gain: Some(local_tonemap.log2_gain),
+        },
         size,
-        &TonemapParams::from_ev100(s.ev100_with_sky(sky.sky_lux)),
     )?;
 
     Ok(FrameOutputs {

@@ -31,8 +31,8 @@ pub fn all() -> Vec<StructLayout> {
     use crate::raster;
     use crate::scene_gpu;
     use crate::techniques::{
-        direct_lighting, exposure, gi_denoiser, irradiance_probes, local_tonemap,
-        placeholder_tonemap, ray_traced_gi, sky, sun_shadows, taa,
+        direct_lighting, exposure, gi_denoiser, irradiance_probes, local_tonemap, ray_traced_gi,
+        sky, sun_shadows, taa, tonemap,
     };
     use crate::view;
     vec![
@@ -146,11 +146,6 @@ pub fn all() -> Vec<StructLayout> {
             [balance]
         ),
         gpu_layout!(
-            placeholder_tonemap::TonemapParams,
-            "placeholder_tonemap/apply.wgsl",
-            [exposure]
-        ),
-        gpu_layout!(
             sky::gpu_build::TableBuildParams,
             "sky/tables.wgsl",
             [
@@ -189,6 +184,22 @@ pub fn all() -> Vec<StructLayout> {
             local_tonemap::BlurParams,
             "local_tonemap/blur_grid.wgsl",
             [sigma, config]
+        ),
+        gpu_layout!(
+            tonemap::TonemapParams,
+            "tonemap/apply.wgsl",
+            [
+                lmsr_from_rgb,
+                rgb_from_lms_gain,
+                purkinje_fade,
+                tonemap_from_rec709,
+                rec709_from_tonemap,
+                curve,
+                curve_shoulder,
+                lut_domain_min,
+                lut_domain_max,
+                switches
+            ]
         ),
         gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),
         gpu_layout!(graph_check::EmptyParams, "graph_check/empty.wgsl", [value]),

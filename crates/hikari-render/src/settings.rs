@@ -21,6 +21,7 @@ pub use crate::techniques::ray_traced_gi::settings::RayTracedGiSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
 pub use crate::techniques::taa::settings::TaaSettings;
+pub use crate::techniques::tonemap::settings::TonemapSettings;
 
 /// Named quality levels, as game renderers offer them: each sets the resolutions, ray and
 /// sample counts and update budgets of every technique. `High` is the default.
@@ -201,6 +202,7 @@ register_settings! {
     area_lights: AreaLightsSettings,
     irradiance_probes: IrradianceProbesSettings,
     ray_traced_gi: RayTracedGiSettings,
+    tonemap: TonemapSettings,
 }
 
 impl Settings {

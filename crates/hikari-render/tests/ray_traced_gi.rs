@@ -1046,5 +1046,8 @@ fn the_lighting_resolves_gi_near_and_the_far_field_beyond() {
         );
     }
     let lum = |v: Vec3| v.dot(Vec3::new(0.2126, 0.7152, 0.0722));
-    assert!(lum(far) / lum(near) > 1.08, "the two fields differ: {near} vs {far}");
+    assert!(
+        lum(far) / lum(near) > 1.08,
+        "the two fields differ: {near} vs {far}"
+    );
 }

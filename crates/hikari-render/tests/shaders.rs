@@ -128,10 +128,7 @@ fn shared_modules_bind_in_groups_of_their_own() {
             "sun_shadows"
         ]
     );
-    assert!(
-        lib.binding_sets("placeholder_tonemap/apply.wgsl")
-            .is_empty()
-    );
+    assert!(lib.binding_sets("taa/resolve.wgsl").is_empty());
     let module = lib.module("direct_lighting/shade.wgsl", &[]).unwrap();
     let groups = hikari_render::pipeline::reflect_groups(
         "direct_lighting/shade.wgsl",

@@ -8,6 +8,7 @@ pub mod bench_overhead;
 pub mod bench_rays;
 pub mod constants;
 pub mod info;
+pub mod lut;
 pub mod probes;
 pub mod render;
 pub mod sky;

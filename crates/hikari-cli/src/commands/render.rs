@@ -6,6 +6,7 @@ use anyhow::Context;
 use clap::Args;
 
 use hikari_render::graph::TimestampMode;
+use hikari_render::techniques::tonemap::{self, cube::CubeLut, lut_strip, lut_strip::StripLayout};
 use hikari_render::{ContextOptions, GpuContext, Renderer, output};
 
 use crate::args::FrameArgs;
@@ -44,6 +45,10 @@ pub struct RenderArgs {
     /// on a miss].
     #[arg(long)]
     pub bake: Option<PathBuf>,
+    /// Append a 32x32x32 LUT strip below the PNG (the current grade, identity if none) to
+    /// grade in a photo editor; `hikari lut extract` reads the grade back (docs/tonemapping.md).
+    #[arg(long)]
+    pub lut_screenshot: bool,
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
@@ -53,6 +58,22 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         description,
     } = scene_source::resolve(&args.frame)?;
     log::info!("{}", description.line());
+    let strip_lut = if args.lut_screenshot {
+        if StripLayout::for_width(settings.width).is_none() {
+            anyhow::bail!(
+                "--lut-screenshot needs an image at least 32 px wide for its LUT strip; --width is {}",
+                settings.width
+            );
+        }
+        Some(match tonemap::graded_by(&settings.settings.tonemap) {
+            Some(p) => {
+                CubeLut::read(p).map_err(|e| anyhow::anyhow!("settings `tonemap.lut`: {e}"))?
+            }
+            None => CubeLut::identity(lut_strip::STRIP_SIZE as usize),
+        })
+    } else {
+        None
+    };
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;
@@ -75,7 +96,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let frame = renderer.render(&settings, true)?;
 
     let png = &args.output;
-    output::write_png(png, frame.ldr.as_ref().context("no LDR image")?)?;
+    let ldr = frame.ldr.as_ref().context("no LDR image")?;
+    match &strip_lut {
+        Some(lut) => {
+            let shot = lut_strip::embed(ldr, lut).context("the LUT strip does not fit")?;
+            output::write_png(png, &shot)?;
+        }
+        None => output::write_png(png, ldr)?,
+    }
     println!("wrote {}", png.display());
     if !args.no_exr {
         let exr = args

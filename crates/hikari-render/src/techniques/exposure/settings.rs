@@ -10,8 +10,8 @@ pub struct ExposureSettings {
     /// A fixed exposure value at ISO 100 that overrides everything below (meter, highlights,
     /// compensation, adaptation); absent: metered.
     pub ev100: Option<f32>,
-    /// Off: the exposure the placeholder meter gives (the sun and the sky on the ground, at
-    /// least 20 lux), no metering of the image.
+    /// Off: the exposure the CPU meter gives (the sun and the sky on the ground,
+    /// `FrameSettings::metered_lux_with_sky`), no metering of the image.
     pub enabled: bool,
     /// Exposure compensation in EV (stops): +1 makes the image twice as bright.
     pub compensation_ev: f32,

@@ -2,7 +2,7 @@
 //! the temporally accumulated GI (luminance L1 SH + CoCg, denoised together), the first
 //! without a normal weight and a 6 m base radius, the second with the normal weight and 3 m,
 //! and the AO denoiser (adaptive sampling, two pixels a thread). How and why:
-//! docs/ray-traced-gi-denoiser.md. CPU twin: [`reference`].
+//! docs/ray-traced-gi.md. CPU twin: [`reference`].
 //!
 //! Dumps: `gi_denoiser.pass1_y`, `gi_denoiser.pass1_cocg` (after the first pass),
 //! `gi_denoiser.pass2_y`, `gi_denoiser.pass2_cocg` (after the second), `gi_denoiser.ao`. A pass
