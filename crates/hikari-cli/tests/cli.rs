@@ -335,3 +335,138 @@ fn sky_writes_a_2_to_1_exr_and_its_json_names_sun_moon_and_sh() {
     );
     assert!(!bad.exists(), "nothing is written on bad input");
 }
+
+/// Issue 16's bad input, each on `hikari sky` (flags) and in a settings file (`[sky]` fields):
+/// the error names the flag or field and its allowed range, the exit is non-zero, and nothing
+/// is written.
+#[test]
+fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
+    let dir = tmp("sky-bad");
+    let out = dir.join("bad.exr");
+    let o = out.to_str().unwrap();
+    let flags: &[(&[&str], &[&str])] = &[
+        (&["--date", "1899-12-31"], &["--date 1899-12-31", "1900"]),
+        (&["--date", "2101-01-01"], &["--date 2101-01-01", "2100"]),
+        (&["--date", "2024-02-30"], &["--date 2024-02-30"]),
+        (&["--time", "24:00"], &["--time 24:00", "23:59:59"]),
+        (&["--time", "12:60"], &["--time 12:60", "23:59:59"]),
+        (&["--lat", "90.5"], &["--lat 90.5", "-90 to 90"]),
+        (&["--lat", "NaN"], &["--lat NaN", "-90 to 90"]),
+        (&["--lon", "-180.5"], &["--lon -180.5", "-180 to 180"]),
+        (&["--lon", "181"], &["--lon 181", "-180 to 180"]),
+        (&["--utc-offset", "15"], &["--utc-offset 15", "-14 to 14"]),
+        (
+            &["--weather", "snowy"],
+            &["--weather snowy", "clear, hazy, overcast"],
+        ),
+        (&["--width", "7"], &["--width 7", "8 to 8192"]),
+        (&["--table-quality", "3"], &["--table-quality 3", "0 to 2"]),
+        (
+            &["--dump-table", "rayleigh_multiple"],
+            &["--dump-table rayleigh_multiple", "ground_irradiance"],
+        ),
+    ];
+    for (flag, needles) in flags {
+        let mut args = vec!["sky", "-o", o];
+        args.extend_from_slice(flag);
+        // Small sizes, so that a case that wrongly passes ends quickly.
+        for (name, small) in [("--width", "16"), ("--table-quality", "0")] {
+            if !flag.contains(&name) {
+                args.extend([name, small]);
+            }
+        }
+        for needle in *needles {
+            assert_clean_failure(&args, needle);
+        }
+        assert!(!out.exists(), "{flag:?}: nothing is written on bad input");
+    }
+
+    // The same checks reach the settings file's `[sky]` table (render reads it before any GPU
+    // work, so these fail fast).
+    let png = dir.join("bad.png");
+    let fields: &[(&str, &[&str])] = &[
+        ("date = \"1899-12-31\"", &["`sky.date`", "1900"]),
+        ("date = \"2100-12-32\"", &["`sky.date`"]),
+        ("time = \"24:00\"", &["`sky.time`", "23:59:59"]),
+        ("latitude_deg = -91.0", &["`sky.latitude_deg`", "-90 to 90"]),
+        (
+            "longitude_deg = 180.5",
+            &["`sky.longitude_deg`", "-180 to 180"],
+        ),
+        ("utc_offset_h = -14.5", &["`sky.utc_offset_h`", "-14 to 14"]),
+        (
+            "weather = \"foggy\"",
+            &["`sky.weather`", "clear, hazy, overcast"],
+        ),
+        (
+            "sky_brightness_scale = -1.0",
+            &["`sky.sky_brightness_scale`", "0 to 16"],
+        ),
+        ("latitude_deg = nan", &["`sky.latitude_deg`", "-90 to 90"]),
+    ];
+    for (line, needles) in fields {
+        let config = dir.join("sky.toml");
+        std::fs::write(&config, format!("[sky]\n{line}\n")).unwrap();
+        for needle in *needles {
+            assert_clean_failure(
+                &[
+                    "render",
+                    "--config",
+                    config.to_str().unwrap(),
+                    "-o",
+                    png.to_str().unwrap(),
+                ],
+                needle,
+            );
+        }
+        assert!(!png.exists(), "{line}: nothing is written on bad input");
+    }
+}
+
+/// `--dump-table NAME` writes the atmosphere's tables by name, each the size the table quality
+/// gives it (hikari-render's `table_sizes(0)`), z slices stacked; transmittances lie in (0, 1].
+#[test]
+fn sky_dumps_its_tables_by_name() {
+    let dir = tmp("sky-tables");
+    let out = dir.join("sky.exr");
+    let o = hikari(&[
+        "sky",
+        "--table-quality",
+        "0",
+        "--width",
+        "16",
+        "--dump-table",
+        "transmittance",
+        "--dump-table",
+        "irradiance_mie",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let read = |name: &str| {
+        exr::prelude::read_first_rgba_layer_from_file(
+            dir.join(format!("atmosphere.{name}.exr")),
+            |r, _| (r.width(), vec![[0f32; 3]; r.width() * r.height()]),
+            |(w, px), p, (r, g, b, _): (f32, f32, f32, f32)| px[p.y() * *w + p.x()] = [r, g, b],
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
+    let t = read("transmittance");
+    assert_eq!(
+        (t.layer_data.size.0, t.layer_data.size.1),
+        (64, 16),
+        "[mu, r]"
+    );
+    let (_, px) = &t.layer_data.channel_data.pixels;
+    assert!(
+        px.iter().flatten().all(|c| *c > 0.0 && *c <= 1.0),
+        "transmittance outside (0, 1]"
+    );
+    let m = read("irradiance_mie");
+    assert_eq!(
+        (m.layer_data.size.0, m.layer_data.size.1),
+        (32, 16 * 8),
+        "[mu, mu_s, r] with r stacked"
+    );
+    assert!(!dir.join("atmosphere.rayleigh.exr").exists());
+}

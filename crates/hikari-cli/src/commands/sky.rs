@@ -21,6 +21,7 @@ use clap::Args;
 use glam::Vec3;
 use serde_json::json;
 
+use hikari_atmosphere::{Tables, table::Table};
 use hikari_render::graph::ImageRgba32;
 use hikari_render::output;
 use hikari_render::settings::SkySettings;
@@ -41,8 +42,30 @@ pub struct SkyCommandArgs {
     /// Atmosphere table resolution, 0 to 2 (2: the full tables).
     #[arg(long, default_value_t = 2)]
     pub table_quality: u32,
+    /// Also write this atmosphere table as `atmosphere.NAME.exr` (repeatable): one of
+    /// transmittance, rayleigh, rayleigh_single, mie, scattering_distance, irradiance_rayleigh,
+    /// irradiance_mie, ground_irradiance. Raw texels in the working colour space, per unit
+    /// solar illuminance; a 3D table's z slices are stacked top to bottom.
+    #[arg(long = "dump-table", value_name = "NAME")]
+    pub dump_tables: Vec<String>,
+    /// Folder for `--dump-table` files; defaults to the EXR's folder.
+    #[arg(long)]
+    pub dump_dir: Option<PathBuf>,
     #[command(flatten)]
     pub json: JsonArgs,
+}
+
+/// A table as an image: x across, y down, z slices stacked below one another.
+fn table_image(name: &str, t: &Table) -> ImageRgba32 {
+    let [nx, ny, nz] = t.size;
+    ImageRgba32 {
+        name: format!("atmosphere.{name}"),
+        texture: None,
+        width: nx as u32,
+        height: (ny * nz) as u32,
+        format: hikari_render::wgpu::TextureFormat::Rgba32Float,
+        rgba: t.data.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(),
+    }
 }
 
 const SH_NAMES: [&str; 9] = [
@@ -57,6 +80,16 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
         anyhow::bail!(
             "--table-quality {} is outside the range 0 to 2",
             a.table_quality
+        );
+    }
+    if let Some(bad) = a
+        .dump_tables
+        .iter()
+        .find(|n| !Tables::NAMES.contains(&n.as_str()))
+    {
+        anyhow::bail!(
+            "--dump-table {bad}: no atmosphere table of that name; there are: {}",
+            Tables::NAMES.join(", ")
         );
     }
     let mut s = SkySettings {
@@ -96,6 +129,23 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
     };
     let (_, sh) = twin.sh();
     output::write_exr(&a.output, &img).with_context(|| format!("{}", a.output.display()))?;
+    let dump_dir = a.dump_dir.clone().unwrap_or_else(|| {
+        a.output
+            .parent()
+            .map(PathBuf::from)
+            .unwrap_or_else(|| PathBuf::from("."))
+    });
+    for name in &a.dump_tables {
+        let table = atmosphere
+            .tables
+            .by_name(name)
+            .expect("names checked above");
+        let path = output::write_dump(&dump_dir, &table_image(name, table))
+            .with_context(|| format!("--dump-table {name}"))?;
+        if !a.json.json {
+            println!("wrote {}", path.display());
+        }
+    }
 
     let body = |b: &sky::lights::Body, lux: f32| {
         json!({
