@@ -470,3 +470,130 @@ fn sky_dumps_its_tables_by_name() {
     );
     assert!(!dir.join("atmosphere.rayleigh.exr").exists());
 }
+
+/// `--no-sun --no-sky` and the settings file's `[sky] sun = false, sky = false` turn off the
+/// directional light and the sky's light alike: the same image, far darker than the village's
+/// sunlit noon (what is left is its own lamps).
+#[test]
+fn no_sun_and_no_sky_from_flags_or_the_settings_file() {
+    let dir = tmp("no-sun");
+    let config = dir.join("off.toml");
+    std::fs::write(&config, "[sky]\nsun = false\nsky = false\n").unwrap();
+    let render = |name: &str, extra: &[&str]| {
+        let png = dir.join(format!("{name}.png"));
+        let mut args = vec![
+            "render",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--ev100",
+            "14",
+            "--set",
+            "sky.table_quality=0",
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = hikari(&args);
+        assert!(o.status.success(), "{name}: {}", text(&o));
+        exr::prelude::read_first_rgba_layer_from_file(
+            dir.join(format!("{name}.exr")),
+            |res, _| vec![[0f32; 3]; res.width() * res.height()],
+            |v, pos, (r, g, b, _): (f32, f32, f32, f32)| v[pos.y() * 48 + pos.x()] = [r, g, b],
+        )
+        .unwrap()
+        .layer_data
+        .channel_data
+        .pixels
+    };
+    let mean = |px: &[[f32; 3]]| {
+        px.iter()
+            .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+            .sum::<f32>()
+            / px.len() as f32
+    };
+    let on = render("on", &[]);
+    let flags = render("flags", &["--no-sun", "--no-sky"]);
+    let file = render("file", &["--config", config.to_str().unwrap()]);
+    assert!(flags == file, "the flags and the settings file differ");
+    let (on, off) = (mean(&on), mean(&flags));
+    assert!(on > 100.0, "a sunlit noon: mean {on} nits");
+    assert!(off < 0.02 * on, "lights off: mean {off} nits against {on}");
+}
+
+/// The EXR's layout, checked against the ephemeris (`--json`, itself held to PyEphem in
+/// hikari-math's tests): a low morning sun brightens the sky most in its own column (columns
+/// from north clockwise), above the horizon (rows from the zenith down); below the horizon the
+/// ground is its albedo (the clear weather's 0.1) lit by the sun and the sky, at least the
+/// direct sun's share albedo · E / π.
+#[test]
+fn sky_exr_rows_columns_and_ground_follow_the_sun() {
+    let dir = tmp("sky-layout");
+    let (w, h) = (128usize, 64usize);
+    let run = |time: &str| {
+        let out = dir.join(format!("{}.exr", time.replace(':', "")));
+        let o = hikari(&[
+            "sky",
+            "--table-quality",
+            "0",
+            "--width",
+            "128",
+            "--time",
+            time,
+            "--json",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let px = exr::prelude::read_first_rgba_layer_from_file(
+            &out,
+            |res, _| vec![0f32; res.width() * res.height()],
+            move |v, p, (r, g, b, _): (f32, f32, f32, f32)| {
+                v[p.y() * w + p.x()] = 0.2126 * r + 0.7152 * g + 0.0722 * b
+            },
+        )
+        .unwrap()
+        .layer_data
+        .channel_data
+        .pixels;
+        (v, px)
+    };
+
+    let (v, px) = run("07:00");
+    let (az, el) = (
+        v["sun"]["azimuth_deg"].as_f64().unwrap(),
+        v["sun"]["elevation_deg"].as_f64().unwrap(),
+    );
+    assert!(
+        (5.0..40.0).contains(&el) && (40.0..110.0).contains(&az),
+        "{v}"
+    );
+    let best = (0..w * h / 2)
+        .max_by(|a, b| px[*a].total_cmp(&px[*b]))
+        .unwrap();
+    let (x, y) = (best % w, best / w);
+    let col_az = (x as f64 + 0.5) * 360.0 / w as f64;
+    let row_el = 90.0 - (y as f64 + 0.5) * 180.0 / h as f64;
+    let px_deg = 360.0 / w as f64;
+    assert!(
+        (col_az - az).abs() <= 1.5 * px_deg,
+        "brightest sky at azimuth {col_az}, the sun at {az}"
+    );
+    assert!(
+        (row_el - el).abs() <= 20.0,
+        "brightest sky at elevation {row_el}, the sun at {el}"
+    );
+
+    let (v, px) = run("12:30");
+    let sun_lux = v["sun"]["illuminance_lux"].as_f64().unwrap() as f32;
+    let nadir = &px[(h - 1) * w..];
+    let direct_share = 0.1 * sun_lux / std::f32::consts::PI;
+    for (x, l) in nadir.iter().enumerate() {
+        assert!(
+            (0.95 * direct_share..1.5 * direct_share).contains(l),
+            "ground at column {x}: {l} nits, the direct sun alone gives {direct_share}"
+        );
+    }
+}
