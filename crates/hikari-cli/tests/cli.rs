@@ -381,9 +381,27 @@ fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
         assert!(!out.exists(), "{flag:?}: nothing is written on bad input");
     }
 
+    // The same flags on render and bench frame.
+    let png = dir.join("bad.png");
+    let p = png.to_str().unwrap();
+    let frame_flags: &[(&[&str], &str)] = &[
+        (&["render", "-o", p, "--lon", "181"], "--lon 181"),
+        (&["render", "-o", p, "--date", "1899-12-31"], "1900"),
+        (&["render", "-o", p, "--lat", "-90.01"], "-90 to 90"),
+        (
+            &["bench", "frame", "--weather", "snowy"],
+            "clear, hazy, overcast",
+        ),
+        (&["bench", "frame", "--utc-offset", "-15"], "-14 to 14"),
+        (&["bench", "frame", "--time", "24:00:00"], "23:59:59"),
+    ];
+    for (args, needle) in frame_flags {
+        assert_clean_failure(args, needle);
+    }
+    assert!(!png.exists());
+
     // The same checks reach the settings file's `[sky]` table (render reads it before any GPU
     // work, so these fail fast).
-    let png = dir.join("bad.png");
     let fields: &[(&str, &[&str])] = &[
         ("date = \"1899-12-31\"", &["`sky.date`", "1900"]),
         ("date = \"2100-12-32\"", &["`sky.date`"]),
