@@ -359,6 +359,10 @@ fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
             &["--weather", "snowy"],
             &["--weather snowy", "clear, hazy, overcast"],
         ),
+        (
+            &["--color-space", "srgb"],
+            &["--color-space srgb", "lms_rayleigh, rec709"],
+        ),
         (&["--width", "7"], &["--width 7", "8 to 8192"]),
         (&["--table-quality", "3"], &["--table-quality 3", "0 to 2"]),
         (
@@ -421,6 +425,10 @@ fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
             &["`sky.sky_brightness_scale`", "0 to 16"],
         ),
         ("latitude_deg = nan", &["`sky.latitude_deg`", "-90 to 90"]),
+        (
+            "color_space = \"xyz\"",
+            &["`sky.color_space`", "lms_rayleigh, rec709"],
+        ),
     ];
     for (line, needles) in fields {
         let config = dir.join("sky.toml");
@@ -614,4 +622,38 @@ fn sky_exr_rows_columns_and_ground_follow_the_sun() {
             "ground at column {x}: {l} nits, the direct sun alone gives {direct_share}"
         );
     }
+}
+
+/// `--color-space rec709` runs the same sky with Bruneton's Rec.709 coefficients (the talk's
+/// comparison): still a blue noon sky, another SH than the LMS Rayleigh default.
+#[test]
+fn sky_runs_in_either_colour_space() {
+    let dir = tmp("sky-space");
+    let run = |space: &str| {
+        let out = dir.join(format!("{space}.exr"));
+        let o = hikari(&[
+            "sky",
+            "--table-quality",
+            "0",
+            "--width",
+            "16",
+            "--color-space",
+            space,
+            "--json",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["color_space"], space);
+        let sh0: Vec<f64> = v["sh"][0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect();
+        assert!(sh0[2] > sh0[0], "{space}: a blue sky, {v}");
+        sh0
+    };
+    assert_ne!(run("lms_rayleigh"), run("rec709"));
 }

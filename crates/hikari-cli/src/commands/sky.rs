@@ -42,6 +42,10 @@ pub struct SkyCommandArgs {
     /// Atmosphere table resolution, 0 to 2 (2: the full tables).
     #[arg(long, default_value_t = 2)]
     pub table_quality: u32,
+    /// The atmosphere's colour space: lms_rayleigh (the talk's) or rec709 (Bruneton's
+    /// coefficients, to compare) [default: lms_rayleigh].
+    #[arg(long)]
+    pub color_space: Option<String>,
     /// Also write this atmosphere table as `atmosphere.NAME.exr` (repeatable): one of
     /// transmittance, rayleigh, rayleigh_single, mie, scattering_distance, irradiance_rayleigh,
     /// irradiance_mie, ground_irradiance. Raw texels in the working colour space, per unit
@@ -97,8 +101,14 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
         ..SkySettings::default()
     };
     a.sky.apply(&mut s)?;
-    let weather = s.weather().map_err(|e| anyhow::anyhow!("{e}"))?;
-    let atmosphere = sky::atmosphere_for(&weather.atmosphere(), s.table_sizes())?;
+    if let Some(c) = &a.color_space {
+        s.color_space = c.clone();
+        s.color_space()
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("--color-space {c}"))?;
+    }
+    let params = s.atmosphere().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let atmosphere = sky::atmosphere_for(&params, s.table_sizes())?;
     let mut l = SkyLights::new(&s).map_err(|e| anyhow::anyhow!("{e}"))?;
     if !s.sky {
         l.sun.extraterrestrial_lux = 0.0;
@@ -164,6 +174,7 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
             "date": s.date, "time": s.time, "utc_offset_h": s.utc_offset_h,
             "latitude_deg": s.latitude_deg, "longitude_deg": s.longitude_deg,
             "weather": s.weather,
+            "color_space": s.color_space,
             "sun": body(&l.sun, sun_lux),
             "moon": moon,
             "sh_convention": "real orthonormal L2, no Condon-Shortley phase, index l(l+1)+m; axes +Y up, +Z north, +X west; radiance coefficients in nits",
