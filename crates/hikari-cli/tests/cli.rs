@@ -370,6 +370,9 @@ fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
             &["--dump-table rayleigh_multiple", "ground_irradiance"],
         ),
     ];
+    let png = dir.join("bad.png");
+    assert_clean_failure(&["sky", "-o", png.to_str().unwrap()], "ending in .exr");
+    assert!(!png.exists());
     for (flag, needles) in flags {
         let mut args = vec!["sky", "-o", o];
         args.extend_from_slice(flag);
@@ -386,7 +389,6 @@ fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
     }
 
     // The same flags on render and bench frame.
-    let png = dir.join("bad.png");
     let p = png.to_str().unwrap();
     let frame_flags: &[(&[&str], &str)] = &[
         (&["render", "-o", p, "--lon", "181"], "--lon 181"),

@@ -80,6 +80,16 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
     if !(8..=8192).contains(&a.width) || !a.width.is_multiple_of(2) {
         anyhow::bail!("--width {} is outside the range 8 to 8192 (even)", a.width);
     }
+    if !a
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        anyhow::bail!(
+            "-o {}: hikari sky writes OpenEXR; give a file name ending in .exr",
+            a.output.display()
+        );
+    }
     if a.table_quality > 2 {
         anyhow::bail!(
             "--table-quality {} is outside the range 0 to 2",
