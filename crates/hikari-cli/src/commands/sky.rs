@@ -156,10 +156,9 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
             .unwrap_or_else(|| PathBuf::from("."))
     });
     for name in &a.dump_tables {
-        let table = atmosphere
-            .tables
-            .by_name(name)
-            .expect("names checked above");
+        let Some(table) = atmosphere.tables.by_name(name) else {
+            anyhow::bail!("--dump-table {name}: no atmosphere table of that name");
+        };
         let path = output::write_dump(&dump_dir, &table_image(name, table))
             .with_context(|| format!("--dump-table {name}"))?;
         if !a.json.json {
