@@ -99,6 +99,36 @@ pub struct Tables {
     pub sizes: TableSizes,
 }
 
+impl Tables {
+    /// The tables' names, as `docs/atmosphere.md` lists them and `hikari sky --dump-table`
+    /// takes them.
+    pub const NAMES: [&'static str; 8] = [
+        "transmittance",
+        "rayleigh",
+        "rayleigh_single",
+        "mie",
+        "scattering_distance",
+        "irradiance_rayleigh",
+        "irradiance_mie",
+        "ground_irradiance",
+    ];
+
+    /// The table called `name` (one of [`Tables::NAMES`]), or `None`.
+    pub fn by_name(&self, name: &str) -> Option<&Table> {
+        Some(match name {
+            "transmittance" => &self.transmittance,
+            "rayleigh" => &self.rayleigh,
+            "rayleigh_single" => &self.rayleigh_single,
+            "mie" => &self.mie,
+            "scattering_distance" => &self.scattering_distance,
+            "irradiance_rayleigh" => &self.irradiance_rayleigh,
+            "irradiance_mie" => &self.irradiance_mie,
+            "ground_irradiance" => &self.ground_irradiance,
+            _ => return None,
+        })
+    }
+}
+
 pub(crate) struct Ctx<'a> {
     pub p: &'a AtmosphereParams,
     pub shell: Shell,

@@ -178,3 +178,25 @@ fn bad_parameters_name_the_field() {
     let toml_like: Result<AtmosphereParams, _> = serde_json::from_str(r#"{"mie_gee": 0.5}"#);
     assert!(toml_like.is_err(), "unknown fields are refused");
 }
+
+#[test]
+fn every_table_name_finds_its_own_table() {
+    let a = Atmosphere::with_sizes(AtmosphereParams::default(), small()).unwrap();
+    let t = &a.tables;
+    let fields = [
+        &t.transmittance,
+        &t.rayleigh,
+        &t.rayleigh_single,
+        &t.mie,
+        &t.scattering_distance,
+        &t.irradiance_rayleigh,
+        &t.irradiance_mie,
+        &t.ground_irradiance,
+    ];
+    assert_eq!(hikari_atmosphere::Tables::NAMES.len(), fields.len());
+    for (name, field) in hikari_atmosphere::Tables::NAMES.iter().zip(fields) {
+        let got = t.by_name(name).unwrap_or_else(|| panic!("{name}"));
+        assert!(std::ptr::eq(got, field), "{name} names another table");
+    }
+    assert!(t.by_name("Rayleigh").is_none() && t.by_name("").is_none());
+}

@@ -498,3 +498,327 @@ fn bad_bake_files_are_named_or_rebaked_never_a_panic() {
     assert!(t.contains("baking the probes again"), "{t}");
     assert_eq!(std::fs::read(&cached[0]).unwrap(), good);
 }
+
+/// Issue 16's bad input, each on `hikari sky` (flags) and in a settings file (`[sky]` fields):
+/// the error names the flag or field and its allowed range, the exit is non-zero, and nothing
+/// is written.
+#[test]
+fn sky_bad_input_names_the_flag_or_field_and_its_range_and_writes_nothing() {
+    let dir = tmp("sky-bad");
+    let out = dir.join("bad.exr");
+    let o = out.to_str().unwrap();
+    let flags: &[(&[&str], &[&str])] = &[
+        (&["--date", "1899-12-31"], &["--date 1899-12-31", "1900"]),
+        (&["--date", "2101-01-01"], &["--date 2101-01-01", "2100"]),
+        (&["--date", "2024-02-30"], &["--date 2024-02-30"]),
+        (&["--time", "24:00"], &["--time 24:00", "23:59:59"]),
+        (&["--time", "12:60"], &["--time 12:60", "23:59:59"]),
+        (&["--lat", "90.5"], &["--lat 90.5", "-90 to 90"]),
+        (&["--lat", "NaN"], &["--lat NaN", "-90 to 90"]),
+        (&["--lon", "-180.5"], &["--lon -180.5", "-180 to 180"]),
+        (&["--lon", "181"], &["--lon 181", "-180 to 180"]),
+        (&["--utc-offset", "15"], &["--utc-offset 15", "-14 to 14"]),
+        (
+            &["--weather", "snowy"],
+            &["--weather snowy", "clear, hazy, overcast"],
+        ),
+        (
+            &["--color-space", "srgb"],
+            &["--color-space srgb", "lms_rayleigh, rec709"],
+        ),
+        (&["--width", "7"], &["--width 7", "8 to 8192"]),
+        (&["--table-quality", "3"], &["--table-quality 3", "0 to 2"]),
+        (
+            &["--dump-table", "rayleigh_multiple"],
+            &["--dump-table rayleigh_multiple", "ground_irradiance"],
+        ),
+    ];
+    let png = dir.join("bad.png");
+    assert_clean_failure(&["sky", "-o", png.to_str().unwrap()], "ending in .exr");
+    assert!(!png.exists());
+    for (flag, needles) in flags {
+        let mut args = vec!["sky", "-o", o];
+        args.extend_from_slice(flag);
+        // Small sizes, so that a case that wrongly passes ends quickly.
+        for (name, small) in [("--width", "16"), ("--table-quality", "0")] {
+            if !flag.contains(&name) {
+                args.extend([name, small]);
+            }
+        }
+        for needle in *needles {
+            assert_clean_failure(&args, needle);
+        }
+        assert!(!out.exists(), "{flag:?}: nothing is written on bad input");
+    }
+
+    // The same flags on render and bench frame.
+    let p = png.to_str().unwrap();
+    let frame_flags: &[(&[&str], &str)] = &[
+        (&["render", "-o", p, "--lon", "181"], "--lon 181"),
+        (&["render", "-o", p, "--date", "1899-12-31"], "1900"),
+        (&["render", "-o", p, "--lat", "-90.01"], "-90 to 90"),
+        (
+            &["bench", "frame", "--weather", "snowy"],
+            "clear, hazy, overcast",
+        ),
+        (&["bench", "frame", "--utc-offset", "-15"], "-14 to 14"),
+        (&["bench", "frame", "--time", "24:00:00"], "23:59:59"),
+    ];
+    for (args, needle) in frame_flags {
+        assert_clean_failure(args, needle);
+    }
+    assert!(!png.exists());
+
+    // The same checks reach the settings file's `[sky]` table (render reads it before any GPU
+    // work, so these fail fast).
+    let fields: &[(&str, &[&str])] = &[
+        ("date = \"1899-12-31\"", &["`sky.date`", "1900"]),
+        ("date = \"2100-12-32\"", &["`sky.date`"]),
+        ("time = \"24:00\"", &["`sky.time`", "23:59:59"]),
+        ("latitude_deg = -91.0", &["`sky.latitude_deg`", "-90 to 90"]),
+        (
+            "longitude_deg = 180.5",
+            &["`sky.longitude_deg`", "-180 to 180"],
+        ),
+        ("utc_offset_h = -14.5", &["`sky.utc_offset_h`", "-14 to 14"]),
+        (
+            "weather = \"foggy\"",
+            &["`sky.weather`", "clear, hazy, overcast"],
+        ),
+        (
+            "sky_brightness_scale = -1.0",
+            &["`sky.sky_brightness_scale`", "0 to 16"],
+        ),
+        ("latitude_deg = nan", &["`sky.latitude_deg`", "-90 to 90"]),
+        (
+            "color_space = \"xyz\"",
+            &["`sky.color_space`", "lms_rayleigh, rec709"],
+        ),
+    ];
+    for (line, needles) in fields {
+        let config = dir.join("sky.toml");
+        std::fs::write(&config, format!("[sky]\n{line}\n")).unwrap();
+        for needle in *needles {
+            assert_clean_failure(
+                &[
+                    "render",
+                    "--config",
+                    config.to_str().unwrap(),
+                    "-o",
+                    png.to_str().unwrap(),
+                ],
+                needle,
+            );
+        }
+        assert!(!png.exists(), "{line}: nothing is written on bad input");
+    }
+}
+
+/// `--dump-table NAME` writes the atmosphere's tables by name, each the size the table quality
+/// gives it (hikari-render's `table_sizes(0)`), z slices stacked; transmittances lie in (0, 1].
+#[test]
+fn sky_dumps_its_tables_by_name() {
+    let dir = tmp("sky-tables");
+    let out = dir.join("sky.exr");
+    let o = hikari(&[
+        "sky",
+        "--table-quality",
+        "0",
+        "--width",
+        "16",
+        "--dump-table",
+        "transmittance",
+        "--dump-table",
+        "irradiance_mie",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let read = |name: &str| {
+        exr::prelude::read_first_rgba_layer_from_file(
+            dir.join(format!("atmosphere.{name}.exr")),
+            |r, _| (r.width(), vec![[0f32; 3]; r.width() * r.height()]),
+            |(w, px), p, (r, g, b, _): (f32, f32, f32, f32)| px[p.y() * *w + p.x()] = [r, g, b],
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
+    let t = read("transmittance");
+    assert_eq!(
+        (t.layer_data.size.0, t.layer_data.size.1),
+        (64, 16),
+        "[mu, r]"
+    );
+    let (_, px) = &t.layer_data.channel_data.pixels;
+    assert!(
+        px.iter().flatten().all(|c| *c > 0.0 && *c <= 1.0),
+        "transmittance outside (0, 1]"
+    );
+    let m = read("irradiance_mie");
+    assert_eq!(
+        (m.layer_data.size.0, m.layer_data.size.1),
+        (32, 16 * 8),
+        "[mu, mu_s, r] with r stacked"
+    );
+    assert!(!dir.join("atmosphere.rayleigh.exr").exists());
+}
+
+/// `--no-sun --no-sky` and the settings file's `[sky] sun = false, sky = false` turn off the
+/// directional light and the sky's light alike: the same image, far darker than the village's
+/// sunlit noon (what is left is its own lamps).
+#[test]
+fn no_sun_and_no_sky_from_flags_or_the_settings_file() {
+    let dir = tmp("no-sun");
+    let config = dir.join("off.toml");
+    std::fs::write(&config, "[sky]\nsun = false\nsky = false\n").unwrap();
+    let render = |name: &str, extra: &[&str]| {
+        let png = dir.join(format!("{name}.png"));
+        let mut args = vec![
+            "render",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--ev100",
+            "14",
+            "--set",
+            "sky.table_quality=0",
+            "-o",
+            png.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = hikari(&args);
+        assert!(o.status.success(), "{name}: {}", text(&o));
+        exr::prelude::read_first_rgba_layer_from_file(
+            dir.join(format!("{name}.exr")),
+            |res, _| vec![[0f32; 3]; res.width() * res.height()],
+            |v, pos, (r, g, b, _): (f32, f32, f32, f32)| v[pos.y() * 48 + pos.x()] = [r, g, b],
+        )
+        .unwrap()
+        .layer_data
+        .channel_data
+        .pixels
+    };
+    let mean = |px: &[[f32; 3]]| {
+        px.iter()
+            .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+            .sum::<f32>()
+            / px.len() as f32
+    };
+    let on = render("on", &[]);
+    let flags = render("flags", &["--no-sun", "--no-sky"]);
+    let file = render("file", &["--config", config.to_str().unwrap()]);
+    assert!(flags == file, "the flags and the settings file differ");
+    let (on, off) = (mean(&on), mean(&flags));
+    assert!(on > 100.0, "a sunlit noon: mean {on} nits");
+    assert!(off < 0.02 * on, "lights off: mean {off} nits against {on}");
+}
+
+/// The EXR's layout, checked against the ephemeris (`--json`, itself held to PyEphem in
+/// hikari-math's tests): a low morning sun brightens the sky most in its own column (columns
+/// from north clockwise), above the horizon (rows from the zenith down); below the horizon the
+/// ground is its albedo (the clear weather's 0.1) lit by the sun and the sky, at least the
+/// direct sun's share albedo · E / π.
+#[test]
+fn sky_exr_rows_columns_and_ground_follow_the_sun() {
+    let dir = tmp("sky-layout");
+    let (w, h) = (128usize, 64usize);
+    let run = |time: &str| {
+        let out = dir.join(format!("{}.exr", time.replace(':', "")));
+        let o = hikari(&[
+            "sky",
+            "--table-quality",
+            "0",
+            "--width",
+            "128",
+            "--time",
+            time,
+            "--json",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let px = exr::prelude::read_first_rgba_layer_from_file(
+            &out,
+            |res, _| vec![0f32; res.width() * res.height()],
+            move |v, p, (r, g, b, _): (f32, f32, f32, f32)| {
+                v[p.y() * w + p.x()] = 0.2126 * r + 0.7152 * g + 0.0722 * b
+            },
+        )
+        .unwrap()
+        .layer_data
+        .channel_data
+        .pixels;
+        (v, px)
+    };
+
+    let (v, px) = run("07:00");
+    let (az, el) = (
+        v["sun"]["azimuth_deg"].as_f64().unwrap(),
+        v["sun"]["elevation_deg"].as_f64().unwrap(),
+    );
+    assert!(
+        (5.0..40.0).contains(&el) && (40.0..110.0).contains(&az),
+        "{v}"
+    );
+    let best = (0..w * h / 2)
+        .max_by(|a, b| px[*a].total_cmp(&px[*b]))
+        .unwrap();
+    let (x, y) = (best % w, best / w);
+    let col_az = (x as f64 + 0.5) * 360.0 / w as f64;
+    let row_el = 90.0 - (y as f64 + 0.5) * 180.0 / h as f64;
+    let px_deg = 360.0 / w as f64;
+    assert!(
+        (col_az - az).abs() <= 1.5 * px_deg,
+        "brightest sky at azimuth {col_az}, the sun at {az}"
+    );
+    assert!(
+        (row_el - el).abs() <= 20.0,
+        "brightest sky at elevation {row_el}, the sun at {el}"
+    );
+
+    let (v, px) = run("12:30");
+    let sun_lux = v["sun"]["illuminance_lux"].as_f64().unwrap() as f32;
+    let nadir = &px[(h - 1) * w..];
+    let direct_share = 0.1 * sun_lux / std::f32::consts::PI;
+    for (x, l) in nadir.iter().enumerate() {
+        assert!(
+            (0.95 * direct_share..1.5 * direct_share).contains(l),
+            "ground at column {x}: {l} nits, the direct sun alone gives {direct_share}"
+        );
+    }
+}
+
+/// `--color-space rec709` runs the same sky with Bruneton's Rec.709 coefficients (the talk's
+/// comparison): still a blue noon sky, another SH than the LMS Rayleigh default.
+#[test]
+fn sky_runs_in_either_colour_space() {
+    let dir = tmp("sky-space");
+    let run = |space: &str| {
+        let out = dir.join(format!("{space}.exr"));
+        let o = hikari(&[
+            "sky",
+            "--table-quality",
+            "0",
+            "--width",
+            "16",
+            "--color-space",
+            space,
+            "--json",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        assert_eq!(v["color_space"], space);
+        let sh0: Vec<f64> = v["sh"][0]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect();
+        assert!(sh0[2] > sh0[0], "{space}: a blue sky, {v}");
+        sh0
+    };
+    assert_ne!(run("lms_rayleigh"), run("rec709"));
+}

@@ -260,6 +260,11 @@ fn the_tables_are_rebuilt_only_when_the_weather_changes() {
     steps.push(("back on the GPU", built(&s), false));
     s.settings.sky.weather = "clear".into();
     steps.push(("clear", built(&s), true));
+    // The colour space is part of the atmosphere: Bruneton's Rec.709 tables are other tables.
+    s.settings.sky.color_space = "rec709".into();
+    steps.push(("clear in Rec.709", built(&s), true));
+    s.settings.sky.time = "06:00".into();
+    steps.push(("Rec.709, another time", built(&s), false));
     for (what, got, want) in steps {
         assert_eq!(got, want, "{what}: sky.tables.* passes recorded: {got}");
     }

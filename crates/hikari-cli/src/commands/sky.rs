@@ -21,6 +21,7 @@ use clap::Args;
 use glam::Vec3;
 use serde_json::json;
 
+use hikari_atmosphere::{Tables, table::Table};
 use hikari_render::graph::ImageRgba32;
 use hikari_render::output;
 use hikari_render::settings::SkySettings;
@@ -41,8 +42,34 @@ pub struct SkyCommandArgs {
     /// Atmosphere table resolution, 0 to 2 (2: the full tables).
     #[arg(long, default_value_t = 2)]
     pub table_quality: u32,
+    /// The atmosphere's colour space: lms_rayleigh (the talk's) or rec709 (Bruneton's
+    /// coefficients, to compare) [default: lms_rayleigh].
+    #[arg(long)]
+    pub color_space: Option<String>,
+    /// Also write this atmosphere table as `atmosphere.NAME.exr` (repeatable): one of
+    /// transmittance, rayleigh, rayleigh_single, mie, scattering_distance, irradiance_rayleigh,
+    /// irradiance_mie, ground_irradiance. Raw texels in the working colour space, per unit
+    /// solar illuminance; a 3D table's z slices are stacked top to bottom.
+    #[arg(long = "dump-table", value_name = "NAME")]
+    pub dump_tables: Vec<String>,
+    /// Folder for `--dump-table` files; defaults to the EXR's folder.
+    #[arg(long)]
+    pub dump_dir: Option<PathBuf>,
     #[command(flatten)]
     pub json: JsonArgs,
+}
+
+/// A table as an image: x across, y down, z slices stacked below one another.
+fn table_image(name: &str, t: &Table) -> ImageRgba32 {
+    let [nx, ny, nz] = t.size;
+    ImageRgba32 {
+        name: format!("atmosphere.{name}"),
+        texture: None,
+        width: nx as u32,
+        height: (ny * nz) as u32,
+        format: hikari_render::wgpu::TextureFormat::Rgba32Float,
+        rgba: t.data.iter().map(|c| [c[0], c[1], c[2], 1.0]).collect(),
+    }
 }
 
 const SH_NAMES: [&str; 9] = [
@@ -53,10 +80,30 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
     if !(8..=8192).contains(&a.width) || !a.width.is_multiple_of(2) {
         anyhow::bail!("--width {} is outside the range 8 to 8192 (even)", a.width);
     }
+    if !a
+        .output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        anyhow::bail!(
+            "-o {}: hikari sky writes OpenEXR; give a file name ending in .exr",
+            a.output.display()
+        );
+    }
     if a.table_quality > 2 {
         anyhow::bail!(
             "--table-quality {} is outside the range 0 to 2",
             a.table_quality
+        );
+    }
+    if let Some(bad) = a
+        .dump_tables
+        .iter()
+        .find(|n| !Tables::NAMES.contains(&n.as_str()))
+    {
+        anyhow::bail!(
+            "--dump-table {bad}: no atmosphere table of that name; there are: {}",
+            Tables::NAMES.join(", ")
         );
     }
     let mut s = SkySettings {
@@ -64,8 +111,14 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
         ..SkySettings::default()
     };
     a.sky.apply(&mut s)?;
-    let weather = s.weather().map_err(|e| anyhow::anyhow!("{e}"))?;
-    let atmosphere = sky::atmosphere_for(&weather.atmosphere(), s.table_sizes())?;
+    if let Some(c) = &a.color_space {
+        s.color_space = c.clone();
+        s.color_space()
+            .map_err(|e| anyhow::anyhow!("{e}"))
+            .with_context(|| format!("--color-space {c}"))?;
+    }
+    let params = s.atmosphere().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let atmosphere = sky::atmosphere_for(&params, s.table_sizes())?;
     let mut l = SkyLights::new(&s).map_err(|e| anyhow::anyhow!("{e}"))?;
     if !s.sky {
         l.sun.extraterrestrial_lux = 0.0;
@@ -96,6 +149,22 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
     };
     let (_, sh) = twin.sh();
     output::write_exr(&a.output, &img).with_context(|| format!("{}", a.output.display()))?;
+    let dump_dir = a.dump_dir.clone().unwrap_or_else(|| {
+        a.output
+            .parent()
+            .map(PathBuf::from)
+            .unwrap_or_else(|| PathBuf::from("."))
+    });
+    for name in &a.dump_tables {
+        let Some(table) = atmosphere.tables.by_name(name) else {
+            anyhow::bail!("--dump-table {name}: no atmosphere table of that name");
+        };
+        let path = output::write_dump(&dump_dir, &table_image(name, table))
+            .with_context(|| format!("--dump-table {name}"))?;
+        if !a.json.json {
+            println!("wrote {}", path.display());
+        }
+    }
 
     let body = |b: &sky::lights::Body, lux: f32| {
         json!({
@@ -114,6 +183,7 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
             "date": s.date, "time": s.time, "utc_offset_h": s.utc_offset_h,
             "latitude_deg": s.latitude_deg, "longitude_deg": s.longitude_deg,
             "weather": s.weather,
+            "color_space": s.color_space,
             "sun": body(&l.sun, sun_lux),
             "moon": moon,
             "sh_convention": "real orthonormal L2, no Condon-Shortley phase, index l(l+1)+m; axes +Y up, +Z north, +X west; radiance coefficients in nits",

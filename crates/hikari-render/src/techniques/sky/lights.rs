@@ -93,7 +93,7 @@ impl SkyLights {
     pub fn new(s: &SkySettings) -> Result<Self, SettingError> {
         let when = s.date_time()?;
         let place = s.place()?;
-        let atmosphere = s.weather()?.atmosphere();
+        let atmosphere = s.atmosphere()?;
         Ok(Self::from_ephemeris(
             &sun_and_moon(&when, &place),
             &atmosphere,

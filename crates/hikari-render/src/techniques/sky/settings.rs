@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use hikari_atmosphere::{AtmosphereParams, TableSizes};
+use hikari_atmosphere::{AtmosphereParams, ColorSpace, TableSizes};
 use hikari_math::astro::{DateTime, Place};
 
 use crate::settings::{Field, Preset, Range, SettingError, TechniqueSettings};
@@ -32,6 +32,10 @@ pub struct SkySettings {
     pub longitude_deg: f64,
     /// A weather preset: `clear`, `hazy` or `overcast` ([`Weather::NAMES`]).
     pub weather: String,
+    /// The colour space the atmosphere is computed in: `lms_rayleigh` (the talk's LMS Rayleigh
+    /// space, the default) or `rec709` (linear Rec.709 with Bruneton's coefficients, to compare
+    /// the two as the talk does). Changing it rebuilds the tables.
+    pub color_space: String,
     /// Resolution of the atmosphere's tables: 0 the smallest (tests), 1 medium, 2 the
     /// atmosphere crate's defaults. The tables are built on the CPU when the weather changes.
     pub table_quality: u32,
@@ -64,6 +68,7 @@ impl Default for SkySettings {
             latitude_deg: Place::TSUSHIMA.latitude_deg(),
             longitude_deg: Place::TSUSHIMA.longitude_deg(),
             weather: "clear".into(),
+            color_space: "lms_rayleigh".into(),
             table_quality: 2,
             tables_on_gpu: true,
             sky_brightness_scale: 1.0,
@@ -116,6 +121,26 @@ impl SkySettings {
         })
     }
 
+    /// The colour space named by [`SkySettings::color_space`].
+    pub fn color_space(&self) -> Result<ColorSpace, SettingError> {
+        match self.color_space.as_str() {
+            "lms_rayleigh" => Ok(ColorSpace::LmsRayleigh),
+            "rec709" => Ok(ColorSpace::Rec709),
+            _ => Err(SettingError {
+                field: "sky.color_space".into(),
+                value: format!("{:?}", self.color_space),
+                allowed: "lms_rayleigh, rec709".into(),
+            }),
+        }
+    }
+
+    /// The atmosphere's parameters: the weather's, computed in [`SkySettings::color_space`].
+    pub fn atmosphere(&self) -> Result<AtmosphereParams, SettingError> {
+        let mut p = self.weather()?.atmosphere();
+        p.color_space = self.color_space()?;
+        Ok(p)
+    }
+
     /// The artist knobs of the weather with the sun `sun_elevation_deg` above the horizon
     /// ([`Weather::knobs_at`]), times this file's scales.
     pub fn knobs(&self, sun_elevation_deg: f64) -> Result<ArtistKnobs, SettingError> {
@@ -128,10 +153,10 @@ impl SkySettings {
         })
     }
 
-    /// What the sky's tables are built from and cached by: the weather's atmosphere and the
-    /// table sizes. Neither the time nor the knobs enter it.
+    /// What the sky's tables are built from and cached by: the weather's atmosphere in the
+    /// chosen colour space, and the table sizes. Neither the time nor the knobs enter it.
     pub fn table_key(&self) -> Result<(AtmosphereParams, TableSizes), SettingError> {
-        Ok((self.weather()?.atmosphere(), self.table_sizes()))
+        Ok((self.atmosphere()?, self.table_sizes()))
     }
 
     /// The atmosphere's table sizes for [`SkySettings::table_quality`].
@@ -224,6 +249,7 @@ impl TechniqueSettings for SkySettings {
         self.date_time()?;
         self.place()?;
         self.weather()?;
+        self.color_space()?;
         Ok(())
     }
 }
@@ -249,6 +275,7 @@ mod tests {
         bad(|s| s.latitude_deg = f64::NAN, "sky.latitude_deg");
         bad(|s| s.utc_offset_h = 15.0, "sky.utc_offset_h");
         bad(|s| s.weather = "snowy".into(), "sky.weather");
+        bad(|s| s.color_space = "srgb".into(), "sky.color_space");
         bad(|s| s.table_quality = 3, "sky.table_quality");
         bad(
             |s| s.sky_brightness_scale = -0.1,
@@ -309,6 +336,33 @@ mod tests {
             at("12:00", "clear").table_key().unwrap(),
             at("12:00", "hazy").table_key().unwrap()
         );
+    }
+
+    /// `color_space = "rec709"` computes the same weather with Bruneton's Rec.709
+    /// coefficients (the talk's comparison): another table key, the same weather otherwise.
+    #[test]
+    fn the_colour_space_setting_reaches_the_atmosphere() {
+        let lms = at("12:00", "hazy");
+        let rec = SkySettings {
+            color_space: "rec709".into(),
+            ..lms.clone()
+        };
+        rec.validate("sky").unwrap();
+        let (a, b) = (lms.atmosphere().unwrap(), rec.atmosphere().unwrap());
+        assert_eq!(a.color_space, ColorSpace::LmsRayleigh);
+        assert_eq!(b.color_space, ColorSpace::Rec709);
+        assert_eq!(
+            b.rayleigh(),
+            hikari_math::color::rayleigh::RAYLEIGH_REC709_BRUNETON
+        );
+        assert_eq!(
+            AtmosphereParams {
+                color_space: ColorSpace::LmsRayleigh,
+                ..b.clone()
+            },
+            a
+        );
+        assert_ne!(lms.table_key().unwrap(), rec.table_key().unwrap());
     }
 
     #[test]
