@@ -153,9 +153,14 @@ mod tests {
         assert!(format!("{e:#}").contains("cascade"), "{e:#}");
         let e = parse("[direct_lighting]\nsun = \"yes\"\n").unwrap_err();
         assert!(
-            format!("{e:#}").contains("sun") || format!("{e:#}").contains("bool"),
+            format!("{e:#}").contains("direct_lighting.sun")
+                && format!("{e:#}").contains("boolean"),
             "{e:#}"
         );
+        let e = parse("[sky]\nweather = 3\n").unwrap_err();
+        assert!(format!("{e:#}").contains("sky.weather"), "{e:#}");
+        // An integer where a float is expected is fine.
+        assert!(parse("[sun_shadows]\nmax_distance_m = 100\n").is_ok());
         assert!(parse("width = -3\n").is_err());
         let e = parse("[shadows]\ncascades = 2\n").unwrap_err();
         assert!(format!("{e:#}").contains("shadows"), "{e:#}");

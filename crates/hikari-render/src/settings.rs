@@ -254,13 +254,18 @@ impl Settings {
                 });
             }
         }
+        // A value of the wrong type: name the first field whose TOML type differs from the
+        // preset's (serde's own message names no field).
+        let reference = base_types(&Self::preset(preset));
         let settings: Settings =
-            toml::Value::Table(merged)
+            toml::Value::Table(merged.clone())
                 .try_into()
-                .map_err(|e: toml::de::Error| SettingError {
-                    field: "settings".into(),
-                    value: "?".into(),
-                    allowed: e.message().trim().to_string(),
+                .map_err(|e: toml::de::Error| {
+                    wrong_type(&merged, &reference).unwrap_or_else(|| SettingError {
+                        field: "settings".into(),
+                        value: "?".into(),
+                        allowed: e.message().trim().to_string(),
+                    })
                 })?;
         settings.validate()?;
         Ok(settings)
@@ -270,6 +275,40 @@ impl Settings {
     pub fn to_toml(&self) -> String {
         toml::to_string(self).unwrap_or_default()
     }
+}
+
+/// The preset's settings as a TOML table, whose value types the file's must match.
+fn base_types(preset: &Settings) -> toml::Table {
+    match toml::Value::try_from(preset) {
+        Ok(toml::Value::Table(t)) => t,
+        _ => toml::Table::new(),
+    }
+}
+
+/// The first `table.key` of `merged` whose value has another TOML type than the reference's
+/// (integers are accepted where floats are expected).
+fn wrong_type(merged: &toml::Table, reference: &toml::Table) -> Option<SettingError> {
+    for (table, values) in merged {
+        let (Some(values), Some(want)) = (
+            values.as_table(),
+            reference.get(table).and_then(|t| t.as_table()),
+        ) else {
+            continue;
+        };
+        for (key, v) in values {
+            let Some(w) = want.get(key) else { continue };
+            let same = std::mem::discriminant(v) == std::mem::discriminant(w)
+                || (v.is_integer() && w.is_float());
+            if !same {
+                return Some(SettingError {
+                    field: format!("{table}.{key}"),
+                    value: v.to_string(),
+                    allowed: format!("a {} like {w}", w.type_str()),
+                });
+            }
+        }
+    }
+    None
 }
 
 /// Copies `over` into `base`, table by table, key by key.
