@@ -118,10 +118,9 @@ fn sky_mu_s_a(mu_s: f32) -> f32 {
 }
 
 // The light-angle texel coordinate in [0, 1] of the scattering tables (`Shell::x_mu_s`), texel
-// centred.
-fn sky_u_mu_s(mu_s: f32) -> f32 {
+// centred; `big_a` is sky_mu_s_a(SKY_MU_S_MIN), computed once by the caller.
+fn sky_u_mu_s(mu_s: f32, big_a: f32) -> f32 {
     let a = sky_mu_s_a(mu_s);
-    let big_a = sky_mu_s_a(SKY_MU_S_MIN);
     return sky_coord(clamp(max(1.0 - a / big_a, 0.0) / (1.0 + a), 0.0, 1.0), sky.table.y);
 }
 
@@ -144,6 +143,24 @@ fn sky_trilinear(mie: bool, uvw: vec3<f32>) -> vec4<f32> {
         let pick = vec3<bool>((k & 1) != 0, (k & 2) != 0, (k & 4) != 0);
         let w = select(1.0 - f, f, pick);
         out += (w.x * w.y * w.z) * sky_load_single(mie, select(i0, i1, pick));
+    }
+    return out;
+}
+
+// The Rayleigh (x) and Mie (y) scattering distances (alpha of the two single-scattering
+// tables), trilinear with the weights shared.
+fn sky_scattering_distances(uvw: vec3<f32>) -> vec2<f32> {
+    let size = vec3<f32>(textureDimensions(sky_mie_single));
+    let t = clamp(uvw * size - 0.5, vec3<f32>(0.0), size - 1.0);
+    let i0 = vec3<i32>(floor(t));
+    let i1 = min(i0 + 1, vec3<i32>(size) - 1);
+    let f = t - vec3<f32>(i0);
+    var out = vec2<f32>(0.0);
+    for (var k = 0; k < 8; k++) {
+        let pick = vec3<bool>((k & 1) != 0, (k & 2) != 0, (k & 4) != 0);
+        let w = select(1.0 - f, f, pick);
+        let c = select(i0, i1, pick);
+        out += (w.x * w.y * w.z) * vec2<f32>(textureLoad(sky_rayleigh_single, c, 0).w, textureLoad(sky_mie_single, c, 0).w);
     }
     return out;
 }
@@ -290,12 +307,12 @@ fn sky_single(r0: f32, rho2_0: f32, mu0: f32, mu_s0: f32, nu: f32) -> SkySingle 
         k = SKY_DISTANCE_SCALE_SHADOWED;
     }
     let uv = sky_scattering_uv(r, rho2, mu);
-    let uvw = vec3<f32>(uv.x, sky_u_mu_s(mu_s), uv.y);
+    let big_a = sky_mu_s_a(SKY_MU_S_MIN);
     // Rayleigh (x) and Mie (y) scattering distances, scaled.
-    let de = vec2<f32>(sky_trilinear(false, uvw).w, sky_trilinear(true, uvw).w) * k;
+    let de = sky_scattering_distances(vec3<f32>(uv.x, sky_u_mu_s(mu_s, big_a), uv.y)) * k;
     let shifted = clamp((r * mu_s + de * nu) / max(r + de * mu, vec2<f32>(1.0)), vec2<f32>(-1.0), vec2<f32>(1.0));
-    let ray = sky_trilinear(false, vec3<f32>(uv.x, sky_u_mu_s(shifted.x), uv.y)).rgb;
-    let mie = sky_trilinear(true, vec3<f32>(uv.x, sky_u_mu_s(shifted.y), uv.y)).rgb;
+    let ray = sky_trilinear(false, vec3<f32>(uv.x, sky_u_mu_s(shifted.x, big_a), uv.y)).rgb;
+    let mie = sky_trilinear(true, vec3<f32>(uv.x, sky_u_mu_s(shifted.y, big_a), uv.y)).rgb;
     return SkySingle(ray * tl, mie * tl);
 }
 
