@@ -226,6 +226,33 @@ impl Atmosphere {
         [std::array::from_fn(|k| ray[k] * pr + mie[k] * pm), ray, mie]
     }
 
+    /// Single Rayleigh and Mie inscattering divided by their phases (working space, per unit
+    /// sun illuminance, sr⁻¹) from radius `r_km` (from the planet's centre) along a ray of
+    /// zenith cosine `mu`, for a light of zenith cosine `mu_s` at cosine `nu` from the ray, with
+    /// the run-time Earth-shadow and azimuth terms that [`Atmosphere::sky_radiance`] applies
+    /// (docs/atmosphere.md, *Run-time azimuth terms*). The frame's sky (hikari-render's
+    /// `lookup.wgsl` and its CPU twin) adds these to the multiple scattering
+    /// (`rayleigh − rayleigh_single`) read without them.
+    pub fn single_scattering(
+        &self,
+        r_km: f64,
+        mu: f64,
+        mu_s: f64,
+        nu: f64,
+    ) -> ([f64; 3], [f64; 3]) {
+        let t = &self.tables;
+        self.ctx().single_parts(
+            &t.transmittance,
+            &t.rayleigh_single,
+            &t.mie,
+            &t.scattering_distance,
+            r_km,
+            mu.clamp(-1.0, 1.0),
+            mu_s.clamp(-1.0, 1.0),
+            nu.clamp(-1.0, 1.0),
+        )
+    }
+
     /// The talk's "irradiance" tables at a point: light that Rayleigh and Mie scatter toward
     /// `view_dir` divided by their phases, before density (working space, per unit sun
     /// illuminance, lux per lux). Multiply by `β ρ(h) p(ν)` and the sun's illuminance.

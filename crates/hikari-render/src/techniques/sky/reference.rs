@@ -26,8 +26,10 @@ pub fn catmull_rom(f: f64) -> [f64; 4] {
 }
 
 /// `sky.resample` for one table: [mu, mu_s, r] at texel coordinate `t` along mu_s (t = u n −
-/// 0.5), cubic, negative values clamped to 0, into a [mu, r] table.
-pub fn resample(table: &Table, t: f32) -> Table {
+/// 0.5), cubic, negative values clamped to 0, into a [mu, r] table. With `minus`, the
+/// difference `table − minus` is resampled (the pass resamples `rayleigh − rayleigh_single`,
+/// the multiple scattering).
+pub fn resample(table: &Table, minus: Option<&Table>, t: f32) -> Table {
     let [nmu, nmus, nr] = table.size;
     let t = f64::from(t).clamp(0.0, (nmus - 1) as f64);
     let i = t.floor() as isize;
@@ -39,8 +41,9 @@ pub fn resample(table: &Table, t: f32) -> Table {
             for (k, wk) in w.iter().enumerate() {
                 let j = (i - 1 + k as isize).clamp(0, nmus as isize - 1) as usize;
                 let v = table.at(mu, j, r);
+                let m = minus.map_or([0.0; 3], |m| m.at(mu, j, r));
                 for c in 0..3 {
-                    sum[c] += wk * v[c];
+                    sum[c] += wk * (v[c] - m[c]);
                 }
             }
             data.push(sum.map(|v| v.max(0.0) as f32));
@@ -52,12 +55,13 @@ pub fn resample(table: &Table, t: f32) -> Table {
     }
 }
 
-/// The sky of one frame on the CPU: the parameters and the four resampled tables.
+/// The sky of one frame on the CPU: the parameters and the resampled multiple scattering.
 pub struct SkyTwin<'a> {
     pub atmosphere: &'a Atmosphere,
     pub params: SkyParams,
-    /// Sun Rayleigh, sun Mie, moon Rayleigh, moon Mie.
-    pub layers: [Table; 4],
+    /// The multiple scattering (`rayleigh − rayleigh_single`) at the sun's and at the moon's
+    /// angle.
+    pub layers: [Table; 2],
 }
 
 fn v3(a: [f32; 4]) -> Vec3 {
@@ -72,10 +76,8 @@ impl<'a> SkyTwin<'a> {
             atmosphere,
             params,
             layers: [
-                resample(&t.rayleigh, cs),
-                resample(&t.mie, cs),
-                resample(&t.rayleigh, cm),
-                resample(&t.mie, cm),
+                resample(&t.rayleigh, Some(&t.rayleigh_single), cs),
+                resample(&t.rayleigh, Some(&t.rayleigh_single), cm),
             ],
         }
     }
@@ -90,7 +92,9 @@ impl<'a> SkyTwin<'a> {
         f64::from(s[0]) + f64::from(s[3]).clamp(0.0, f64::from(s[1]) - f64::from(s[0]) - 1e-3)
     }
 
-    /// `sky_inscatter`: Rec.709 nits from direction `dir`, without the disks or the ground.
+    /// `sky_inscatter`: Rec.709 nits from direction `dir`, without the disks or the ground: the
+    /// resampled multiple scattering plus the single scattering with the Earth-shadow and
+    /// azimuth terms, read by hikari-atmosphere's own [`Atmosphere::single_scattering`].
     pub fn inscatter(&self, dir: Vec3) -> Vec3 {
         let d = dir.as_dvec3().normalize();
         let shell = self.shell();
@@ -105,12 +109,14 @@ impl<'a> SkyTwin<'a> {
             if light[3] <= 0.0 {
                 continue;
             }
-            let nu = d.dot(v3(*light).as_dvec3());
-            let ray = self.layers[2 * k].sample(u_mu, u_r, 0.5);
-            let mie = self.layers[2 * k + 1].sample(u_mu, u_r, 0.5);
+            let l = v3(*light).as_dvec3();
+            let nu = d.dot(l).clamp(-1.0, 1.0);
+            let multiple = self.layers[k].sample(u_mu, u_r, 0.5);
+            let (single, mie) = self.atmosphere.single_scattering(r, mu, l.y, nu);
             let (pr, pm) = (phase::rayleigh(nu), phase::cornette_shanks(nu, g));
             for c in 0..3 {
-                working[c] += (ray[c] * pr + mie[c] * pm) * white[c] * f64::from(light[3]);
+                let ray = multiple[c] + single[c];
+                working[c] += (ray * pr + mie[c] * pm) * white[c] * f64::from(light[3]);
             }
         }
         self.atmosphere.to_rec709(working).max(Vec3::ZERO) * self.params.light_coords[2]

@@ -4,7 +4,7 @@
 // regions at the offsets in `p.offsets*`, each region laid out as hikari-atmosphere's `Table`:
 // x fastest, then y, then z) and is sampled by hand with the CPU's rules (texel centres at
 // (i + 0.5) / n, clamp to edge, (tri)linear), so a lookup here reads what the CPU's reads.
-// `store` copies the three tables the sky samples into its textures.
+// `store` copies the four tables the sky samples into its textures.
 //
 // Where f32 would lose digits on the Earth's 6360 km radius, the formulas are rearranged
 // (differences of squares as products, radii as r + q / (sqrt(r^2 + q) + r)); the values are
@@ -53,6 +53,7 @@ struct TableBuildParams {
 @group(0) @binding(2) var out_rayleigh: texture_storage_3d<rgba32float, write>;
 @group(0) @binding(3) var out_mie: texture_storage_3d<rgba32float, write>;
 @group(0) @binding(4) var out_transmittance: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(5) var out_rayleigh_single: texture_storage_3d<rgba32float, write>;
 
 const PI: f32 = 3.14159265358979;
 // Steps of the transmittance integral (the CPU's `transmittance_to_top(.., 500)`).
@@ -684,8 +685,9 @@ fn irradiance(@builtin(global_invocation_id) gid: vec3<u32>) {
     work[p.offsets2.w + i] = vec4<f32>(direct + sample3(p.offsets2.y, nd, uvw) / mie_phase(nu), 0.0);
 }
 
-// The sky's textures (Rayleigh of all orders, Mie single, transmittance) and the ground
-// irradiance summed over the orders that ran.
+// The sky's textures (Rayleigh of all orders; Rayleigh single with the Rayleigh scattering
+// distance in alpha; Mie single with the Mie scattering distance in alpha; transmittance) and
+// the ground irradiance summed over the orders that ran.
 @compute @workgroup_size(64, 1, 1)
 fn store(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -694,8 +696,10 @@ fn store(@builtin(global_invocation_id) gid: vec3<u32>) {
         let t = scat_texel(i);
         let c = vec3<u32>(i % n.x, (i / n.x) % n.y, i / (n.x * n.y));
         let ray = work[p.offsets0.y + i].xyz + work[p.offsets1.y + i].xyz / rayleigh_phase(t.mu * t.mu_s);
+        let distance = work[p.offsets0.w + i].xy;
         textureStore(out_rayleigh, c, vec4<f32>(ray, 0.0));
-        textureStore(out_mie, c, vec4<f32>(work[p.offsets0.z + i].xyz, 0.0));
+        textureStore(out_rayleigh_single, c, vec4<f32>(work[p.offsets0.y + i].xyz, distance.x));
+        textureStore(out_mie, c, vec4<f32>(work[p.offsets0.z + i].xyz, distance.y));
     }
     let nt = p.sizes_2d.xy;
     if i < nt.x * nt.y {
