@@ -297,10 +297,10 @@ fn render_into(dir: &Path, extra: &[&str]) -> Output {
 
 /// The exposure's and the local tonemap's flags end to end, through `hikari render`:
 /// `--exposure-compensation EV` lowers the metered EV100 by exactly EV (its definition: +1 is
-/// twice as bright), brightens the PNG and leaves the EXR (linear radiance) alone;
-/// `--no-tonemap-local` gives the image of `--set local_tonemap.enabled=false` and not the
-/// default one; out-of-range or non-finite values are refused naming the flag or field, with
-/// nothing written.
+/// twice as bright), brightens the PNG and leaves the EXR (linear radiance) alone; `--ev100`
+/// wins over it; `--no-tonemap-local` gives the image of `--set local_tonemap.enabled=false`
+/// and not the default one; out-of-range or non-finite values are refused naming the flag or
+/// field, with nothing written.
 #[test]
 fn exposure_compensation_and_no_tonemap_local_act_end_to_end() {
     let dir = tmp("flags");
@@ -322,6 +322,10 @@ fn exposure_compensation_and_no_tonemap_local_act_end_to_end() {
     let (_, hdr_a) = read_exr(&base.join("out.exr"));
     let (_, hdr_b) = read_exr(&brighter.join("out.exr"));
     assert_eq!(hdr_a, hdr_b, "the EXR is radiance, before exposure");
+    let fixed = dir.join("fixed");
+    let o = render_into(&fixed, &["--ev100", "9.25", "--exposure-compensation", "3"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(ev100(&fixed), 9.25, "a fixed EV100 wins over everything");
 
     let flag = dir.join("flag");
     let o = render_into(&flag, &["--no-tonemap-local"]);
