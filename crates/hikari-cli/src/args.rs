@@ -133,8 +133,9 @@ pub struct ConfigArgs {
 /// `--ev100`: a fixed exposure.
 #[derive(Args, Debug, Clone, Default)]
 pub struct ExposureArgs {
-    /// Placeholder exposure: EV at ISO 100 (sunny day about 15, overcast 12, interior 7)
-    /// [default: metered from the sun].
+    /// A fixed exposure: EV at ISO 100 (sunny day about 15, overcast 12, interior 7); wins
+    /// over the meter, the adaptation and `--exposure-compensation` [default: metered on the
+    /// illuminance of what the camera sees].
     #[arg(long, allow_negative_numbers = true)]
     pub ev100: Option<f32>,
 }

@@ -242,3 +242,196 @@ fn bad_white_lut_or_strip_is_an_error_naming_it_and_nothing_is_written() {
     assert!(text(&o).contains("bad.cube:3"), "{}", text(&o));
     assert!(!cube.exists() && !dir.join("x.png").exists());
 }
+
+/// A `--dump`ed EXR as (width, rgba texels).
+fn read_exr(path: &Path) -> (usize, Vec<[f32; 4]>) {
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![[0f32; 4]; res.width() * res.height()]),
+        |(w, v), pos, (r, g, b, a): (f32, f32, f32, f32)| v[pos.y() * *w + pos.x()] = [r, g, b, a],
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    img.layer_data.channel_data.pixels
+}
+
+/// A `--dump`ed buffer as little-endian words.
+fn read_words(path: &Path) -> Vec<[u8; 4]> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(bytes.len() % 4, 0, "{}", path.display());
+    bytes.chunks(4).map(|c| c.try_into().unwrap()).collect()
+}
+
+fn ev100(dir: &Path) -> f32 {
+    f32::from_le_bytes(read_words(&dir.join("exposure.value.bin"))[1])
+}
+
+fn mean_png(path: &Path) -> f64 {
+    let img = image::open(path).unwrap().to_rgb8();
+    img.pixels()
+        .flat_map(|p| p.0)
+        .map(|v| v as f64)
+        .sum::<f64>()
+        / (3 * img.width() * img.height()) as f64
+}
+
+/// One frame of the boxes at 64x40 into `dir`, dumping the exposure's value.
+fn render_into(dir: &Path, extra: &[&str]) -> Output {
+    std::fs::create_dir_all(dir).unwrap();
+    let png = dir.join("out.png");
+    let mut args = vec![
+        "render",
+        "--width",
+        "64",
+        "--height",
+        "40",
+        "--frames",
+        "1",
+        "-o",
+        s(&png),
+        "--dump",
+        "exposure.value",
+    ];
+    args.extend_from_slice(extra);
+    hikari(&args)
+}
+
+/// The exposure's and the local tonemap's flags end to end, through `hikari render`:
+/// `--exposure-compensation EV` lowers the metered EV100 by exactly EV (its definition: +1 is
+/// twice as bright), brightens the PNG and leaves the EXR (linear radiance) alone; `--ev100`
+/// wins over it; `--no-tonemap-local` gives the image of `--set local_tonemap.enabled=false`
+/// and not the default one; out-of-range or non-finite values are refused naming the flag or
+/// field, with nothing written.
+#[test]
+fn exposure_compensation_and_no_tonemap_local_act_end_to_end() {
+    let dir = tmp("flags");
+    let base = dir.join("base");
+    let o = render_into(&base, &[]);
+    assert!(o.status.success(), "{}", text(&o));
+    let brighter = dir.join("brighter");
+    let o = render_into(&brighter, &["--exposure-compensation", "1.5"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let (a, b) = (ev100(&base), ev100(&brighter));
+    assert!(
+        a.is_finite() && (a - b - 1.5).abs() < 1e-4,
+        "EV100 {a} -> {b}"
+    );
+    assert!(
+        mean_png(&brighter.join("out.png")) > mean_png(&base.join("out.png")) + 5.0,
+        "the PNG brightens"
+    );
+    let (_, hdr_a) = read_exr(&base.join("out.exr"));
+    let (_, hdr_b) = read_exr(&brighter.join("out.exr"));
+    assert_eq!(hdr_a, hdr_b, "the EXR is radiance, before exposure");
+    let fixed = dir.join("fixed");
+    let o = render_into(&fixed, &["--ev100", "9.25", "--exposure-compensation", "3"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(ev100(&fixed), 9.25, "a fixed EV100 wins over everything");
+
+    let flag = dir.join("flag");
+    let o = render_into(&flag, &["--no-tonemap-local"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let set = dir.join("set");
+    let o = render_into(&set, &["--set", "local_tonemap.enabled=false"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let png = |d: &Path| {
+        image::open(d.join("out.png"))
+            .unwrap()
+            .to_rgba8()
+            .into_raw()
+    };
+    assert_eq!(png(&flag), png(&set), "the flag is the setting");
+    assert_ne!(
+        png(&flag),
+        png(&base),
+        "the local tonemap changes the boxes"
+    );
+
+    let bad = dir.join("bad");
+    for (args, names) in [
+        (
+            &["--exposure-compensation", "nan"][..],
+            "--exposure-compensation",
+        ),
+        (
+            &["--exposure-compensation", "inf"][..],
+            "--exposure-compensation",
+        ),
+        (&["--exposure-compensation", "40"][..], "compensation_ev"),
+        (&["--set", "local_tonemap.contrast=-1"][..], "contrast"),
+        (
+            &["--set", "exposure.adapt_up_ev_per_s=nan"][..],
+            "adapt_up_ev_per_s",
+        ),
+    ] {
+        let o = render_into(&bad, args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(text(&o).contains(names), "{args:?}: {}", text(&o));
+        assert!(!bad.join("out.png").exists(), "{args:?} wrote a PNG");
+    }
+}
+
+/// The intermediates dump by name: the exposure's two histograms (128 u32 counts each: every
+/// pixel in the luminance one, the surface pixels in the illuminance one), the filled and
+/// blurred bilateral grid (64x32x64, slices stacked vertically: each pixel adds a weight of
+/// one in all, so the filled grid's weights sum to the pixel count), the cells' mean log
+/// luminance and its wide blur, and the gain.
+#[test]
+fn the_intermediates_dump_by_name() {
+    let dir = tmp("dumps");
+    let names = [
+        "exposure.histogram",
+        "local_tonemap.grid",
+        "local_tonemap.grid_blurred",
+        "local_tonemap.coarse",
+        "local_tonemap.wide",
+        "local_tonemap.log2_gain",
+    ];
+    let mut args = Vec::new();
+    for n in names {
+        args.extend(["--dump", n]);
+    }
+    let o = render_into(&dir, &args);
+    assert!(o.status.success(), "{}", text(&o));
+    let pixels = 64 * 40;
+
+    let counts: Vec<u32> = read_words(&dir.join("exposure.histogram.bin"))
+        .into_iter()
+        .map(u32::from_le_bytes)
+        .collect();
+    assert_eq!(counts.len(), 256);
+    let (illuminance, luminance) = counts.split_at(128);
+    assert_eq!(luminance.iter().sum::<u32>(), pixels);
+    let surface = illuminance.iter().sum::<u32>();
+    assert!(surface > 0 && surface < pixels, "{surface} surface pixels");
+
+    let (w, grid) = read_exr(&dir.join("local_tonemap.grid.exr"));
+    assert_eq!((w, grid.len()), (64, 64 * 32 * 64));
+    let weight: f64 = grid.iter().map(|t| t[1] as f64).sum();
+    assert!(
+        (weight - pixels as f64).abs() < 1e-3,
+        "grid weight {weight}"
+    );
+    // Σ w V over Σ w is a log luminance inside the grid's range.
+    let wv: f64 = grid.iter().map(|t| t[0] as f64).sum();
+    assert!((0.0..=24.0).contains(&(wv / weight)), "{}", wv / weight);
+    let (_, blurred) = read_exr(&dir.join("local_tonemap.grid_blurred.exr"));
+    assert_eq!(blurred.len(), grid.len());
+    assert!(blurred.iter().flatten().all(|v| v.is_finite()));
+    assert_ne!(blurred, grid);
+
+    let (w, coarse) = read_exr(&dir.join("local_tonemap.coarse.exr"));
+    assert_eq!((w, coarse.len()), (64, 64 * 32));
+    let coarse_weight: f64 = coarse.iter().map(|t| t[1] as f64).sum();
+    assert!(
+        (coarse_weight - pixels as f64).abs() < 1e-3,
+        "{coarse_weight}"
+    );
+    let (w, wide) = read_exr(&dir.join("local_tonemap.wide.exr"));
+    assert_eq!((w, wide.len()), (256, 256 * 128));
+    assert!(wide.iter().all(|t| t[0].is_finite()));
+
+    let (w, gain) = read_exr(&dir.join("local_tonemap.log2_gain.exr"));
+    assert_eq!((w, gain.len()), (64, pixels as usize));
+    assert!(gain.iter().all(|t| t[0].is_finite()));
+    assert!(gain.iter().any(|t| t[0] != 0.0), "the gain is not all zero");
+}

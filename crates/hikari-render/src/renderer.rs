@@ -31,7 +31,13 @@ pub struct Renderer {
     /// The scene as given, for the ray tracer's BVH (built on first use).
     scene_source: Scene,
     state: FrameState,
+    /// Interactive mode: when the last frame began, for the exposure's adaptation.
+    interactive_clock: Option<Option<std::time::Instant>>,
 }
+
+/// The longest frame time the exposure adapts over in one step (`exposure.frame_seconds`'s
+/// limit): after a longer stall the exposure moves as if 8 s had passed.
+const MAX_FRAME_SECONDS: f32 = 8.0;
 
 impl Renderer {
     pub fn new(ctx: GpuContext, scene: &Scene) -> Result<Self> {
@@ -45,6 +51,7 @@ impl Renderer {
             scene: scene_gpu,
             scene_source: scene.clone(),
             state: FrameState::default(),
+            interactive_clock: None,
             ctx,
         })
     }
@@ -97,8 +104,11 @@ impl Renderer {
     /// for its queue counts. Interactive: frames do not wait for each other; queues are sized
     /// from the counts of a frame or two before, with headroom, and a frame that overflowed
     /// is shown as it is (missing a few triangles for a frame) while the queues grow.
+    /// Interactive frames also adapt the exposure over the wall-clock time since the previous
+    /// frame began, unless the settings give `exposure.frame_seconds` themselves.
     pub fn set_interactive(&mut self, interactive: bool) {
         self.runtime.set_wait_for_readbacks(!interactive);
+        self.interactive_clock = interactive.then_some(None);
     }
 
     /// Renders one frame and copies back whatever `pick` names of its resources (G-buffer
@@ -110,6 +120,19 @@ impl Renderer {
         settings: &FrameSettings,
         mut pick: impl FnMut(&FrameOutputs) -> Vec<Res>,
     ) -> Result<FrameResult> {
+        let timed;
+        let settings = match &mut self.interactive_clock {
+            Some(last) if settings.settings.exposure.frame_seconds == 0.0 => {
+                let now = std::time::Instant::now();
+                let seconds = last.map_or(0.0, |t| (now - t).as_secs_f32().min(MAX_FRAME_SECONDS));
+                *last = Some(now);
+                let mut s = settings.clone();
+                s.settings.exposure.frame_seconds = seconds;
+                timed = s;
+                &timed
+            }
+            _ => settings,
+        };
         settings
             .settings
             .validate()

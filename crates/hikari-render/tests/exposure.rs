@@ -269,3 +269,49 @@ fn black_and_white_albedo_get_the_same_exposure() {
     );
     assert!(white[2] > 0.0 && white[2].is_finite());
 }
+
+/// An interactive renderer adapts over the wall-clock time between frames: after the target
+/// falls by 3 EV (compensation +3), the exposure falls by `adapt_down_ev_per_s` times the time
+/// since the previous frame began (bounded by what this test measures around the calls), not
+/// all the way; an offline renderer (`frame_seconds` 0) snaps to the new target.
+#[test]
+fn interactive_frames_adapt_over_their_wall_clock_time() {
+    use std::time::{Duration, Instant};
+    let scene = hikari_scene::builtin::boxes();
+    let mut s = common::small_frame_settings(&scene, 64, 40);
+    s.settings.taa.enabled = false;
+    let speed = s.settings.exposure.adapt_down_ev_per_s;
+    let ev = |r: &mut Renderer, s: &hikari_render::FrameSettings| {
+        value(
+            &r.render_reading(s, |o| vec![o.exposure.value.into()])
+                .unwrap(),
+        )[1]
+    };
+    let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
+    renderer.set_interactive(true);
+    let target = ev(&mut renderer, &s);
+    let a = Instant::now();
+    assert!(
+        (ev(&mut renderer, &s) - target).abs() < 1e-4,
+        "a still target holds"
+    );
+    let b = Instant::now();
+    std::thread::sleep(Duration::from_millis(400));
+    s.settings.exposure.compensation_ev = 3.0;
+    let c = Instant::now();
+    let moved = target - ev(&mut renderer, &s);
+    let d = Instant::now();
+    let (least, most) = ((c - b).as_secs_f32() * speed, (d - a).as_secs_f32() * speed);
+    assert!(
+        moved >= least - 1e-3 && moved <= most.min(3.0) + 1e-3,
+        "fell {moved} EV, expected {least} to {most}"
+    );
+    assert!(moved < 3.0 - 1e-3 || most >= 3.0, "snapped: {moved}");
+
+    let mut offline = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let snapped = ev(&mut offline, &s);
+    assert!(
+        (target - snapped - 3.0).abs() < 1e-4,
+        "{target} -> {snapped}"
+    );
+}

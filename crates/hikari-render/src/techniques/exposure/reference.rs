@@ -172,6 +172,46 @@ mod tests {
         }
     }
 
+    /// The highlight rule against its definition: 5 % of the pixels are a fire of luminance
+    /// L under the same 1000 lux. Below the limit the fire changes nothing (luminance takes no
+    /// part); above it, EV100 rises by `highlight_strength` × (log2(L × scale) − limit), within
+    /// the bins' widths (1/8 EV for the illuminance mean, 3/8 for the fire's percentile).
+    #[test]
+    fn only_highlights_over_the_limit_raise_the_exposure() {
+        let s = ExposureSettings::default();
+        let p = params(&s);
+        let off = params(&ExposureSettings {
+            highlights: false,
+            ..s.clone()
+        });
+        let lux = 1000.0f32;
+        let grey = [0.18 * lux / std::f32::consts::PI; 3];
+        let ev_of = |fire_nits: f32, p: &ExposureParams| {
+            let radiance: Vec<[f32; 3]> = (0..1000)
+                .map(|i| if i % 20 == 0 { [fire_nits; 3] } else { grey })
+                .collect();
+            value(&meter(&radiance, &[lux; 1000], p), None, p)[1]
+        };
+        let ev0 = (lux / 2.5).log2();
+        let tolerance = 0.125 * (1.0 + s.highlight_strength) + 0.375 * s.highlight_strength;
+        for over_ev in [-3.0f32, 2.0, 4.0, 8.0] {
+            // The fire exposed at ev0 is 2^(limit + over_ev).
+            let nits = 1.2 * (ev0 + s.highlight_limit_ev + over_ev).exp2();
+            let plain = ev_of(nits, &off);
+            assert!((plain - ev0).abs() <= 0.125 + 1e-4, "{plain} vs {ev0}");
+            let got = ev_of(nits, &p);
+            if over_ev < 0.0 {
+                assert_eq!(got, plain, "a fire under the limit counts for nothing");
+            } else {
+                let want = ev0 + s.highlight_strength * over_ev;
+                assert!(
+                    (got - want).abs() <= tolerance,
+                    "{over_ev} EV over: {got} vs {want}"
+                );
+            }
+        }
+    }
+
     #[test]
     fn adaptation_moves_at_its_speeds_and_a_fixed_ev_wins() {
         let mut s = ExposureSettings {

@@ -38,7 +38,8 @@ pub struct ExposureSettings {
     /// more slowly than to light.
     pub adapt_down_ev_per_s: f32,
     /// Seconds between frames that adaptation assumes; 0: every frame snaps to its target
-    /// (still renders). An interactive viewer sets it to its frame time.
+    /// (still renders). An interactive renderer (`Renderer::set_interactive`) leaves 0 and
+    /// measures each frame's wall-clock time itself.
     pub frame_seconds: f32,
     /// The exposure never goes outside these EV100 (-10 to 0 and 8 to 30, so a 0.05 lux night,
     /// EV100 -5.6, and noon, about 15, always fit).
