@@ -11,7 +11,7 @@ use hikari_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
 use crate::probe_bake;
-use crate::report::{FrameTimings, ms};
+use crate::report::{BvhUpdates, FrameTimings, ms};
 use crate::scene_source::{self, ResolvedFrame};
 
 #[derive(Args, Debug)]
@@ -81,6 +81,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         renderer.render(&settings, false)?;
     }
     let mut timings = FrameTimings::default();
+    let mut bvh = BvhUpdates::default();
     for _ in 0..a.frames {
         if a.dolly != 0.0 {
             let step = settings.camera.forward() * a.dolly;
@@ -90,6 +91,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         }
         let f = renderer.render(&settings, false)?;
         timings.add(&f.result);
+        bvh.add(renderer.scene_rt_stats());
     }
     let summary = timings.summary();
     let triangles = renderer.scene().triangles;
@@ -112,6 +114,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             "passes": summary.passes_json(),
             "frame_gpu_ms": summary.span_ms.map(|s| s.json()),
             "frame_cpu_encode_us": summary.encode_us.json(),
+            "scene_bvh_update": bvh.json(),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
@@ -127,5 +130,6 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         triangles
     );
     summary.print_table();
+    bvh.print();
     Ok(())
 }
