@@ -8,7 +8,7 @@ use hikari_bvh::reference::{closest_hit_instances, closest_hit_mesh, random_dir,
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Ray};
 use hikari_render::scene_bvh;
-use hikari_render::scene_rt::{FrameBvh, SceneRtSettings};
+use hikari_render::scene_rt::{FrameBvh, SceneRtSettings, kept_instances};
 use hikari_scene::{Deformation, Instance, Light, Material, Mesh, Scene, shapes};
 
 /// A tapered column, vertically subdivided so that a sway bends it.
@@ -109,14 +109,33 @@ fn culled_tlas_finds_the_closest_hits_of_every_instance_inside_the_kept_region()
     let meshes = scene_bvh::meshes(&scene);
     let inv = vp.inverse();
     let mut rng = SplitMix64::new(18);
+    // What the bare frustum keeps: hits outside it show that the margin is needed and kept.
+    let (tight, _) = kept_instances(
+        &bvh.instances,
+        &bvh.blases,
+        camera,
+        &vp,
+        &SceneRtSettings {
+            cull_margin_m: 0.0,
+            keep_radius_m: 0.0,
+            ..Default::default()
+        },
+    );
+    let mut beyond_frustum = 0;
     let mut hits = 0;
     let ground = (scene.instances.len() - 1) as u32;
-    for k in 0..3000 {
+    for k in 0..6000 {
         // Half the rays start on screen (a random pixel, a random depth up to 80 m) and travel
         // at most the margin; half start within `keep_radius - length` of the camera, in any
         // direction, behind it too.
         let (origin, len) = if k % 2 == 0 {
-            let ndc = Vec3::new(rng.next_f32() * 2.0 - 1.0, rng.next_f32() * 2.0 - 1.0, 1.0);
+            // Every other one near the left or right edge, where neighbours lie just outside.
+            let x = if k % 4 == 0 {
+                (0.85 + 0.15 * rng.next_f32()) * if rng.next_f32() < 0.5 { -1.0 } else { 1.0 }
+            } else {
+                rng.next_f32() * 2.0 - 1.0
+            };
+            let ndc = Vec3::new(x, rng.next_f32() * 2.0 - 1.0, 1.0);
             let far = inv.project_point3(ndc.truncate().extend(0.5));
             let dir = (far - camera).normalize();
             (
@@ -132,11 +151,17 @@ fn culled_tlas_finds_the_closest_hits_of_every_instance_inside_the_kept_region()
         let got = frame.gi.closest_hit(&bvh.blases, &ray);
         let want = closest_hit_instances(&meshes, &bvh.instances, None, &ray);
         hits += usize::from(want.is_some_and(|h| h.instance != ground));
+        beyond_frustum +=
+            usize::from(k % 2 == 0 && want.is_some_and(|h| !tight.contains(&h.instance)));
         if let Err(e) = same_hit(got, want) {
             panic!("ray {k} {ray:?}: {e}");
         }
     }
-    assert!(hits > 150, "only {hits} rays hit a box or a tree");
+    assert!(hits > 300, "only {hits} rays hit a box or a tree");
+    assert!(
+        beyond_frustum > 20,
+        "only {beyond_frustum} on-screen rays hit outside the bare frustum"
+    );
 }
 
 #[test]
@@ -270,4 +295,138 @@ fn lamp_shells_stay_out_of_the_shadow_tlas_only() {
     assert!(has(&f.gi));
     assert!(!has(&f.shadow));
     assert_eq!(f.gi.instances.len(), f.shadow.instances.len() + 1);
+}
+
+mod common;
+
+/// The reverse-Z depth the G-buffer holds where the pixel-centre ray of `cam` first meets
+/// `meshes` placed by `instances` (brute force), 0 for the sky.
+fn cpu_depth(
+    cam: &hikari_scene::Camera,
+    w: u32,
+    h: u32,
+    meshes: &[hikari_bvh::Mesh],
+    instances: &[hikari_bvh::Instance],
+) -> Vec<f32> {
+    let inv = (cam.projection(w as f32 / h as f32) * cam.view()).inverse();
+    let fwd = cam.forward();
+    let mut out = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let ndc = Vec2::new(
+                (x as f32 + 0.5) / w as f32 * 2.0 - 1.0,
+                1.0 - (y as f32 + 0.5) / h as f32 * 2.0,
+            );
+            let p = inv.project_point3(ndc.extend(0.5));
+            let dir = (p - cam.position).normalize();
+            let ray = Ray::new(cam.position, dir, 0.0, f32::INFINITY);
+            out.push(
+                closest_hit_instances(meshes, instances, None, &ray)
+                    .map_or(0.0, |hit| cam.near / (hit.t * dir.dot(fwd))),
+            );
+        }
+    }
+    out
+}
+
+/// A tree swaying 2 m seen from the side: the G-buffer's depth matches a brute-force cast of
+/// the deformed mesh at t (and of the rest pose with no time, and again after going back),
+/// the frame's stats say the tree was refitted once, and the depth at t differs from the rest
+/// pose's, so the raster really moved.
+#[test]
+fn the_raster_and_the_bvh_draw_the_deformed_tree() {
+    let mut scene = Scene {
+        materials: vec![Material::diffuse("grey", Vec3::splat(0.5))],
+        meshes: vec![shapes::plane(40.0)],
+        instances: vec![Instance {
+            mesh: 0,
+            material: 0,
+            transform: Mat4::IDENTITY,
+        }],
+        cameras: vec![hikari_scene::Camera {
+            position: Vec3::new(0.0, 3.0, 12.0),
+            target: Vec3::new(0.0, 3.0, 0.0),
+            ..Default::default()
+        }],
+        sun: Some(hikari_scene::Sun::default()),
+        ..Default::default()
+    };
+    let mut t = tree(6.0, 0.0);
+    if let Some(Deformation::Sway { amplitude_m, .. }) = &mut t.deformation {
+        *amplitude_m = 2.0;
+    }
+    scene.meshes.push(t);
+    scene.instances.push(Instance {
+        mesh: 1,
+        material: 0,
+        transform: Mat4::IDENTITY,
+    });
+    let (w, h) = (64, 48);
+    let mut s = common::small_frame_settings(&scene, w, h);
+    s.settings.taa.enabled = false;
+    s.settings.ray_traced_gi.enabled = true;
+    let mut renderer = hikari_render::Renderer::new(common::gpu_context(), &scene).unwrap();
+    let depth = |renderer: &mut hikari_render::Renderer, s: &hikari_render::FrameSettings| {
+        let mut tex = None;
+        let mut r = renderer
+            .render_reading(s, |o| {
+                tex = Some(o.gbuffer.depth);
+                vec![o.gbuffer.depth.into()]
+            })
+            .unwrap();
+        let img = r.take_image_of(tex.unwrap()).unwrap();
+        img.rgba.iter().map(|p| p[0]).collect::<Vec<f32>>()
+    };
+    let instances = scene_bvh::instances(&scene);
+    let rest_meshes = scene_bvh::meshes(&scene);
+    let time = 0.6; // a quarter period at 0.4 Hz: the full 2 m
+    let mut moved_meshes = rest_meshes.clone();
+    moved_meshes[1].positions = scene.meshes[1].deformed(time).0;
+    let cam = &scene.cameras[0];
+    let want_rest = cpu_depth(cam, w, h, &rest_meshes, &instances);
+    let want_moved = cpu_depth(cam, w, h, &moved_meshes, &instances);
+    let differ = |a: &[f32], b: &[f32]| {
+        a.iter()
+            .zip(b)
+            .filter(|(x, y)| (*x - *y).abs() > 1e-3 * x.abs().max(1e-3))
+            .count()
+    };
+    let pixels = (w * h) as usize;
+    let allowed = common::allowed_differences(pixels).max(pixels / 100);
+    assert!(
+        differ(&want_rest, &want_moved) > 100,
+        "the sway must move many pixels for this test to mean anything"
+    );
+
+    let rest = depth(&mut renderer, &s);
+    let stats = renderer.scene_rt_stats().unwrap();
+    assert_eq!((stats.refits_done, stats.refits_pending), (0, 0));
+    assert!(
+        differ(&rest, &want_rest) <= allowed,
+        "rest pose: {}",
+        differ(&rest, &want_rest)
+    );
+
+    s.settings.scene_rt.time_s = Some(time);
+    let moved = depth(&mut renderer, &s);
+    let stats = renderer.scene_rt_stats().unwrap();
+    assert_eq!(
+        (stats.refits_done, stats.refits_pending),
+        (1, 0),
+        "{stats:?}"
+    );
+    assert!(stats.raster_ms > 0.0 && stats.upload_bytes > 0, "{stats:?}");
+    let n = differ(&moved, &want_moved);
+    assert!(
+        n <= allowed,
+        "at t = {time} s: {n} pixels off the deformed mesh's depth"
+    );
+    assert_eq!(renderer.scene_rt().cpu.shown_time(1), Some(time));
+
+    // Same time again: nothing to refit; then back to the rest pose.
+    depth(&mut renderer, &s);
+    assert_eq!(renderer.scene_rt_stats().unwrap().refits_done, 0);
+    s.settings.scene_rt.time_s = None;
+    let back = depth(&mut renderer, &s);
+    assert!(differ(&back, &want_rest) <= allowed);
 }
