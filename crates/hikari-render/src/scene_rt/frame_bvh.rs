@@ -94,6 +94,8 @@ pub struct FrameBvh {
     /// The rest-pose meshes that deform (only those: the others never change).
     rest: Vec<hikari_scene::Mesh>,
     animated: Vec<Animated>,
+    /// Per entry of `animated`: the last pose computed (time, positions, normals).
+    poses: Vec<Option<(Option<f32>, (Vec<Vec3>, Vec<Vec3>))>>,
     /// Per scene mesh: its entry in `animated`.
     animated_of_mesh: Vec<Option<usize>>,
     scheduler: RefitScheduler,
@@ -201,6 +203,7 @@ impl FrameBvh {
             instances,
             casters,
             rest,
+            poses: (0..animated.len()).map(|_| None).collect(),
             animated,
             animated_of_mesh,
             builder: TlasBuilder::default(),
@@ -222,24 +225,21 @@ impl FrameBvh {
             .and_then(|a| self.animated[a].shown)
     }
 
-    /// Unit normals of deforming scene mesh `mesh` at `time` (`None`: the rest pose).
-    pub fn normals_at(&self, mesh: usize, time: Option<f32>) -> Option<Vec<Vec3>> {
+    /// Positions and unit normals of deforming scene mesh `mesh` at `time` (`None`: the rest
+    /// pose). The last pose asked for is kept per mesh, so the refit and the raster of one
+    /// frame deform each mesh once.
+    pub fn pose_at(&mut self, mesh: usize, time: Option<f32>) -> Option<&(Vec<Vec3>, Vec<Vec3>)> {
         let a = self.animated_of_mesh.get(mesh).copied().flatten()?;
-        let rest = &self.rest[a];
-        Some(match time {
-            None => rest.normals.clone(),
-            Some(t) => rest.deformed(t).1,
-        })
-    }
-
-    /// Positions of deforming scene mesh `mesh` at `time` (`None`: the rest pose).
-    pub fn positions_at(&self, mesh: usize, time: Option<f32>) -> Option<Vec<Vec3>> {
-        let a = self.animated_of_mesh.get(mesh).copied().flatten()?;
-        let rest = &self.rest[a];
-        Some(match time {
-            None => rest.positions.clone(),
-            Some(t) => rest.deformed(t).0,
-        })
+        let fresh = matches!(&self.poses[a], Some((t, _)) if *t == time);
+        if !fresh {
+            let rest = &self.rest[a];
+            let pose = match time {
+                None => (rest.positions.clone(), rest.normals.clone()),
+                Some(t) => rest.deformed(t),
+            };
+            self.poses[a] = Some((time, pose));
+        }
+        self.poses[a].as_ref().map(|(_, p)| p)
     }
 
     /// One frame: culls around `camera` (world position) seen through `view_proj`, touches
@@ -309,9 +309,10 @@ impl FrameBvh {
                 if self.animated[a].shown == target {
                     continue;
                 }
-                let Some(positions) = self.positions_at(mesh, target) else {
+                let Some((positions, _)) = self.pose_at(mesh, target) else {
                     continue;
                 };
+                let positions = positions.clone();
                 self.blases[mesh].refit(&positions)?;
                 self.animated[a].shown = target;
                 refitted.push(mesh);

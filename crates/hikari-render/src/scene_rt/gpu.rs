@@ -252,9 +252,7 @@ impl SceneRt {
         let mut bytes = 0;
         let meshes: Vec<usize> = self.cpu.animated_meshes().collect();
         for m in meshes {
-            let (Some(positions), Some(normals)) =
-                (self.cpu.positions_at(m, time), self.cpu.normals_at(m, time))
-            else {
+            let Some((positions, normals)) = self.cpu.pose_at(m, time) else {
                 continue;
             };
             let base = self.vertex_base[m];
@@ -268,7 +266,7 @@ impl SceneRt {
             let p4: Vec<[f32; 4]> = positions.iter().map(|p| p.extend(1.0).to_array()).collect();
             let attrs: Vec<VertexAttr> = rest
                 .iter()
-                .zip(&normals)
+                .zip(normals.iter())
                 .map(|(a, n)| VertexAttr {
                     normal: snorm16x2(octahedral::encode(n.normalize_or(glam::Vec3::Y))),
                     ..*a
