@@ -64,6 +64,9 @@ impl FrameBvhStats {
     }
 }
 
+/// Positions and unit normals of a mesh at one time.
+type Pose = (Vec<Vec3>, Vec<Vec3>);
+
 /// One deforming scene mesh.
 struct Animated {
     mesh: usize,
@@ -95,7 +98,7 @@ pub struct FrameBvh {
     rest: Vec<hikari_scene::Mesh>,
     animated: Vec<Animated>,
     /// Per entry of `animated`: the last pose computed (time, positions, normals).
-    poses: Vec<Option<(Option<f32>, (Vec<Vec3>, Vec<Vec3>))>>,
+    poses: Vec<Option<(Option<f32>, Pose)>>,
     /// Per scene mesh: its entry in `animated`.
     animated_of_mesh: Vec<Option<usize>>,
     scheduler: RefitScheduler,
@@ -228,7 +231,7 @@ impl FrameBvh {
     /// Positions and unit normals of deforming scene mesh `mesh` at `time` (`None`: the rest
     /// pose). The last pose asked for is kept per mesh, so the refit and the raster of one
     /// frame deform each mesh once.
-    pub fn pose_at(&mut self, mesh: usize, time: Option<f32>) -> Option<&(Vec<Vec3>, Vec<Vec3>)> {
+    pub fn pose_at(&mut self, mesh: usize, time: Option<f32>) -> Option<&Pose> {
         let a = self.animated_of_mesh.get(mesh).copied().flatten()?;
         let fresh = matches!(&self.poses[a], Some((t, _)) if *t == time);
         if !fresh {
