@@ -221,3 +221,63 @@ mod tests {
         );
     }
 }
+
+/// The scene BVH's per-frame update (`Renderer::scene_rt_stats`) over many frames.
+#[derive(Default)]
+pub struct BvhUpdates {
+    frames: Vec<hikari_render::scene_rt::FrameBvhStats>,
+}
+
+impl BvhUpdates {
+    pub fn add(&mut self, s: Option<hikari_render::scene_rt::FrameBvhStats>) {
+        self.frames.extend(s);
+    }
+
+    fn stats(&self, f: impl Fn(&hikari_render::scene_rt::FrameBvhStats) -> f64) -> Stats {
+        Stats::of(self.frames.iter().map(f).collect()).unwrap_or_default()
+    }
+
+    /// Median, min and max of each quantity; `null` when no frame reported one.
+    pub fn json(&self) -> serde_json::Value {
+        if self.frames.is_empty() {
+            return serde_json::Value::Null;
+        }
+        json!({
+            "tlas_cpu_ms": self.stats(|s| s.tlas_ms).json(),
+            "refit_cpu_ms": self.stats(|s| s.refit_ms).json(),
+            "raster_vertices_cpu_ms": self.stats(|s| s.raster_ms).json(),
+            "upload_bytes": self.stats(|s| s.upload_bytes as f64).json(),
+            "instances_kept": self.stats(|s| s.instances_kept as f64).json(),
+            "instances_culled": self.stats(|s| s.instances_culled as f64).json(),
+            "refits_done": self.stats(|s| s.refits_done as f64).json(),
+            "refit_vertices": self.stats(|s| s.refit_vertices as f64).json(),
+            "refits_pending": self.stats(|s| s.refits_pending as f64).json(),
+        })
+    }
+
+    /// Lines under the pass table: each quantity's median (min to max).
+    pub fn print(&self) {
+        if self.frames.is_empty() {
+            return;
+        }
+        println!("scene BVH update (CPU, per frame: median, min to max)");
+        let row = |name: &str, s: Stats, digits: usize| {
+            println!(
+                "  {name:<28} {:>12.digits$} ({:.digits$} to {:.digits$})",
+                s.median, s.min, s.max
+            );
+        };
+        row("TLAS build + culling ms", self.stats(|s| s.tlas_ms), 3);
+        row("deform + refit ms", self.stats(|s| s.refit_ms), 3);
+        row("raster vertices ms", self.stats(|s| s.raster_ms), 3);
+        row("upload bytes", self.stats(|s| s.upload_bytes as f64), 0);
+        row("instances kept", self.stats(|s| s.instances_kept as f64), 0);
+        row(
+            "instances culled",
+            self.stats(|s| s.instances_culled as f64),
+            0,
+        );
+        row("refits done", self.stats(|s| s.refits_done as f64), 0);
+        row("refits pending", self.stats(|s| s.refits_pending as f64), 0);
+    }
+}

@@ -104,6 +104,12 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     );
     assert_clean_failure(&["render", "--width", "banana"], "invalid value");
     assert_clean_failure(&["bench", "frame", "--frames", "0"], "--frames");
+    assert_clean_failure(&["bench", "frame", "--time-step", "NaN"], "--time-step");
+    assert_clean_failure(&["bench", "frame", "--time-step", "11"], "--time-step");
+    assert_clean_failure(
+        &["render", "--set", "scene_rt.cull_margin_m=-1"],
+        "scene_rt.cull_margin_m",
+    );
     let dir = tmp("bad");
     let out = dir.join("x.png");
     let config = dir.join("bad.toml");

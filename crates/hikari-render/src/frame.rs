@@ -9,6 +9,7 @@ use crate::error::Result;
 use crate::graph::{FrameGraph, Tex};
 use crate::raster::{RasterQueues, Rasterizer};
 use crate::scene_gpu::SceneGpu;
+use crate::scene_rt::SceneRt;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::area_lights::{AreaLightParams, AreaLightScene, AreaLights};
@@ -87,7 +88,7 @@ pub struct FrameState {
     /// Where the last frame's camera was, to tell a cut (a new camera that claims it did not
     /// move) from a still frame: temporal techniques drop their history on a cut.
     pub last_camera: Option<[f32; 6]>,
-    /// The scene's BVH for ray-traced GI, built when the technique is first on.
+    /// The per-instance table of ray-traced GI, built when the technique is first on.
     pub rtgi_scene: Option<SharedRtGiScene>,
     /// Drop the ray-traced GI history next frame (a camera cut); cleared once used.
     pub rtgi_reset: bool,
@@ -170,9 +171,13 @@ pub fn record<'r>(
     t: &'r Techniques,
     scene: &'r SceneGpu,
     area: &'r AreaLightScene,
+    rt: &'r SceneRt,
     s: &FrameSettings,
     state: &mut FrameState,
 ) -> Result<FrameOutputs> {
+    // The scene BVH as the caller updated it for this frame (`SceneRt::update`): GI rays
+    // trace every kept instance, shadow rays all but the lamp shells.
+    let rt_bvh = rt.import(g)?;
     let size = [s.width, s.height];
     let aspect = s.width as f32 / s.height as f32;
 
@@ -248,7 +253,7 @@ pub fn record<'r>(
     if s.settings.ray_traced_gi.enabled {
         let rt_scene = state.rtgi_scene.clone().ok_or_else(|| {
             crate::error::RenderError::Graph(
-                "ray_traced_gi: the scene's BVH is not built (the Renderer builds it)".into(),
+                "ray_traced_gi: the instance table is not built (the Renderer builds it)".into(),
             )
         })?;
         let sky_source = match (sky.enabled, s.settings.sky.sky) {
@@ -272,6 +277,7 @@ pub fn record<'r>(
             lights: scene.lights,
             view: &view,
             params: &params,
+            bvh: rt_bvh.gi,
         };
         let (frame, rays) =
             t.ray_traced_gi
@@ -351,9 +357,16 @@ pub fn record<'r>(
     if area_params.shades_punctual() {
         lighting.skip_punctual();
     }
-    let area_lights = t
-        .area_lights
-        .record(g, area, &gbuffer, brdf, scene, &view, &area_params)?;
+    let area_lights = t.area_lights.record(
+        g,
+        area,
+        &rt_bvh.shadow,
+        &gbuffer,
+        brdf,
+        scene,
+        &view,
+        &area_params,
+    )?;
     let lit_frame = t.direct_lighting.record(
         g,
         &gbuffer,

@@ -17,6 +17,7 @@ pub mod reference;
 pub mod renderer;
 pub mod scene_bvh;
 pub mod scene_gpu;
+pub mod scene_rt;
 pub mod scene_textures;
 pub mod settings;
 pub mod shader;

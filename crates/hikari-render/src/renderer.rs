@@ -8,6 +8,7 @@ use crate::frame::{self, FrameOutputs, FrameSettings, FrameState, Techniques};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
 use crate::raster::RasterQueues;
 use crate::scene_gpu::SceneGpu;
+use crate::scene_rt::{FrameBvhStats, SceneRt};
 use crate::techniques::area_lights::AreaLightScene;
 
 /// A rendered frame: timings, and the images if they were asked for.
@@ -26,9 +27,11 @@ pub struct Renderer {
     pub runtime: GraphRuntime,
     techniques: Techniques,
     scene: SceneGpu,
-    /// The scene's area lights and the BVH of its shadow rays.
+    /// The scene's area lights.
     area_lights: AreaLightScene,
-    /// The scene as given, for the ray tracer's BVH (built on first use).
+    /// The one scene BVH of every ray the frame traces, updated each frame.
+    scene_rt: SceneRt,
+    /// The scene as given, for ray-traced GI's instance table (built on first use).
     scene_source: Scene,
     state: FrameState,
     /// Interactive mode: when the last frame began, for the exposure's adaptation.
@@ -43,9 +46,11 @@ impl Renderer {
     pub fn new(ctx: GpuContext, scene: &Scene) -> Result<Self> {
         let techniques = Techniques::new(&ctx)?;
         let scene_gpu = SceneGpu::upload(&ctx, scene)?;
-        let area_lights = AreaLightScene::new(&ctx, scene, &scene_gpu.textures.color)?;
+        let area_lights = AreaLightScene::new(&ctx, scene)?;
+        let scene_rt = SceneRt::new(&ctx, scene, &scene_gpu.textures.color)?;
         Ok(Self {
             area_lights,
+            scene_rt,
             runtime: GraphRuntime::new(),
             techniques,
             scene: scene_gpu,
@@ -66,9 +71,19 @@ impl Renderer {
         &self.scene
     }
 
-    /// The scene's area lights and shadow-ray BVH.
+    /// The scene's area lights.
     pub fn area_lights(&self) -> &AreaLightScene {
         &self.area_lights
+    }
+
+    /// The frame's scene BVH (its CPU side, `scene_rt.cpu`, is what the GPU traces).
+    pub fn scene_rt(&self) -> &SceneRt {
+        &self.scene_rt
+    }
+
+    /// What the last frame's BVH update cost (`None` before the first frame).
+    pub fn scene_rt_stats(&self) -> Option<FrameBvhStats> {
+        self.scene_rt.last_stats()
     }
 
     /// The rasteriser's queue sizes, which grow by themselves; for tests and tuning.
@@ -166,13 +181,26 @@ impl Renderer {
         }
         if settings.settings.ray_traced_gi.enabled && self.state.rtgi_scene.is_none() {
             self.state.rtgi_scene = Some(std::sync::Arc::new(
-                crate::techniques::ray_traced_gi::RtGiScene::new(
-                    &self.ctx,
-                    &self.scene_source,
-                    &self.scene.textures.color,
-                )?,
+                crate::techniques::ray_traced_gi::RtGiScene::new(&self.ctx, &self.scene_source)?,
             ));
         }
+        // The BVH follows the frame: culled around this camera, deforming meshes at the
+        // frame's time (refits throttled), and the raster's vertices at the same time.
+        let aspect = settings.width as f32 / settings.height as f32;
+        let view_proj = settings.camera.projection(aspect) * settings.camera.view();
+        let rt = &settings.settings.scene_rt;
+        let stats = self
+            .scene_rt
+            .update(&self.ctx, settings.camera.position, &view_proj, rt)?;
+        if self
+            .scene_rt
+            .update_raster(&self.ctx, &self.scene, rt.time_s)
+            > 0
+        {
+            // Cached cascades hold the old pose.
+            self.state.shadow_cache = Default::default();
+        }
+        log::info!("{}", self.scene_rt.last_stats().unwrap_or(stats).summary());
         let binding_limit = self.ctx.limits.max_storage_buffer_binding_size;
         for _ in 0..MAX_QUEUE_RETRIES {
             let mut g = self.runtime.begin_frame(&self.ctx);
@@ -181,6 +209,7 @@ impl Renderer {
                 &self.techniques,
                 &self.scene,
                 &self.area_lights,
+                &self.scene_rt,
                 settings,
                 &mut self.state,
             )?;

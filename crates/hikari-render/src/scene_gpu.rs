@@ -297,6 +297,12 @@ impl SceneCpu {
             };
             let triangles = scene.meshes[inst.mesh].indices.len() as u32 / 3;
             let first = mesh_first_triangle[inst.mesh];
+            let mesh = &scene.meshes[inst.mesh];
+            let reach = Vec3::splat(
+                mesh.deformation
+                    .map_or(0.0, |d| d.max_displacement(mesh))
+                    .max(0.0),
+            );
             let mut t = 0;
             while t < triangles {
                 let count = (triangles - t).min(CHUNK_TRIANGLES);
@@ -307,6 +313,9 @@ impl SceneCpu {
                     .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
                         (lo.min(p), hi.max(p))
                     });
+                // A deforming mesh's vertices leave their rest-pose box by up to its reach
+                // (scene_rt draws them moved): the chunk's box covers every pose.
+                let (lo, hi) = (lo - reach, hi + reach);
                 chunks.push(Chunk {
                     instance: i as u32,
                     first_triangle: first + t,

@@ -203,6 +203,7 @@ register_settings! {
     irradiance_probes: IrradianceProbesSettings,
     ray_traced_gi: RayTracedGiSettings,
     tonemap: TonemapSettings,
+    scene_rt: crate::scene_rt::SceneRtSettings,
 }
 
 impl Settings {

@@ -11,7 +11,7 @@ use hikari_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
 use crate::probe_bake;
-use crate::report::{FrameTimings, ms};
+use crate::report::{BvhUpdates, FrameTimings, ms};
 use crate::scene_source::{self, ResolvedFrame};
 
 #[derive(Args, Debug)]
@@ -34,6 +34,11 @@ pub struct BenchFrameArgs {
     /// cached shadow cascades are redrawn as in a moving view; 0 keeps a still view.
     #[arg(long, default_value_t = 0.0)]
     pub dolly: f32,
+    /// Advance the scene time (`scene_rt.time_s`, from 0 or its configured value) this many
+    /// seconds every frame, so that deforming meshes move and their BLAS are refitted (under
+    /// the refit budget) as in a running game; 0 keeps the time still.
+    #[arg(long, default_value_t = 0.0)]
+    pub time_step: f32,
 }
 
 pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
@@ -42,6 +47,11 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         a.dolly.is_finite() && a.dolly.abs() <= 100.0,
         "--dolly {} is outside -100 to 100 metres a frame",
         a.dolly
+    );
+    anyhow::ensure!(
+        a.time_step.is_finite() && a.time_step.abs() <= 10.0,
+        "--time-step {} is outside -10 to 10 seconds a frame",
+        a.time_step
     );
     let ResolvedFrame {
         scene,
@@ -81,6 +91,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         renderer.render(&settings, false)?;
     }
     let mut timings = FrameTimings::default();
+    let mut bvh = BvhUpdates::default();
     for _ in 0..a.frames {
         if a.dolly != 0.0 {
             let step = settings.camera.forward() * a.dolly;
@@ -88,8 +99,13 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             settings.camera.position += step;
             settings.camera.target += step;
         }
+        if a.time_step != 0.0 {
+            let t = settings.settings.scene_rt.time_s.unwrap_or(0.0);
+            settings.settings.scene_rt.time_s = Some(t + a.time_step);
+        }
         let f = renderer.render(&settings, false)?;
         timings.add(&f.result);
+        bvh.add(renderer.scene_rt_stats());
     }
     let summary = timings.summary();
     let triangles = renderer.scene().triangles;
@@ -104,6 +120,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             "frames": a.frames,
             "warmup": a.warmup,
             "dolly_m": a.dolly,
+            "time_step_s": a.time_step,
             "frame_only": a.frame_only,
             "triangles": triangles,
             "startup_ms": { "instance": ms(startup.instance), "adapter": ms(startup.adapter), "device": ms(startup.device), "total": ms(startup.total()) },
@@ -112,6 +129,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             "passes": summary.passes_json(),
             "frame_gpu_ms": summary.span_ms.map(|s| s.json()),
             "frame_cpu_encode_us": summary.encode_us.json(),
+            "scene_bvh_update": bvh.json(),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
@@ -127,5 +145,6 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         triangles
     );
     summary.print_table();
+    bvh.print();
     Ok(())
 }

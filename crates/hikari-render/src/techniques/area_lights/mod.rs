@@ -8,7 +8,6 @@ pub mod reference;
 pub mod settings;
 
 use bytemuck::{Pod, Zeroable};
-use hikari_bvh::{BuildOptions, Tlas};
 use hikari_scene::Scene;
 use naga_oil::compose::ShaderDefValue;
 
@@ -17,14 +16,13 @@ pub use settings::AreaLightsSettings;
 
 use super::direct_lighting::{LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, RADIANCE_FORMAT};
 use super::gbuffer::GBuffer;
-use crate::bvh_trace::{BvhTrace, TraceConfig};
+use crate::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
-use crate::error::{RenderError, Result};
+use crate::error::Result;
 use crate::graph::{BindingSet, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::scene_bvh::{self, BvhAlpha};
 use crate::scene_gpu::SceneInFrame;
-use crate::shader::{self, ShaderLibrary};
+use crate::shader::ShaderLibrary;
 use crate::view::View;
 
 /// [`AreaLightParams::config`] `.y` bit: shade the polygonal lights.
@@ -98,13 +96,12 @@ pub fn frame_rotation(frame: u64) -> [f32; 4] {
     [rng.next_f32(), rng.next_f32(), 0.0, 0.0]
 }
 
-/// What the pass needs of a scene, built once when it is loaded: its area lights and a BVH
-/// of its instances at their rest pose for the shadow rays. Instances that are the glowing
-/// shell of a point or spot light are left out of the BVH: they stand for that light's own
-/// light passing through them (the village's lanterns).
+/// What the pass needs of a scene, built once when it is loaded: its area lights. The shadow
+/// rays trace the frame's scene BVH (`scene_rt::SceneRt`, its shadow TLAS), from which the
+/// instances that are the glowing shell of a point or spot light ([`shadow_casters`]) are left
+/// out: they stand for that light's own light passing through them (the village's lanterns).
 pub struct AreaLightScene {
     pub lights: PolygonLights,
-    bvh: BvhTrace,
     light_buffer: wgpu::Buffer,
     triangle_buffer: wgpu::Buffer,
 }
@@ -142,25 +139,7 @@ pub fn shadow_casters(scene: &Scene) -> Vec<u32> {
 }
 
 impl AreaLightScene {
-    /// `color_textures`: the scene's sRGB texture array as uploaded (`SceneGpu::textures.color`),
-    /// which the shadow rays' cut-out test samples.
-    pub fn new(ctx: &GpuContext, scene: &Scene, color_textures: &wgpu::Texture) -> Result<Self> {
-        let invalid = |e: hikari_bvh::BvhError| RenderError::Graph(format!("area lights: {e}"));
-        let blases = scene_bvh::blases(scene, &BuildOptions::default()).map_err(invalid)?;
-        let instances = scene_bvh::instances(scene);
-        let tlas = Tlas::build(&instances, &shadow_casters(scene), &blases).map_err(invalid)?;
-        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
-        let mut bvh = BvhTrace::with_config(
-            ctx,
-            &mut lib,
-            TraceConfig {
-                alpha: true,
-                ..TraceConfig::coherent()
-            },
-        )?;
-        bvh.upload_blases(ctx, &blases)?;
-        bvh.upload_tlas(ctx, &tlas)?;
-        bvh.upload_alpha(ctx, &BvhAlpha::for_scene(scene), Some(color_textures))?;
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
         let lights = PolygonLights::for_scene(scene);
         use wgpu::util::DeviceExt;
         let buffer = |name: &str, bytes: &[u8]| {
@@ -179,7 +158,6 @@ impl AreaLightScene {
                 bytemuck::cast_slice(&lights.triangles),
             ),
             lights,
-            bvh,
         })
     }
 
@@ -208,12 +186,14 @@ impl AreaLights {
     /// `area_lights.radiance`: the area lights' light, and the point and spot lights' when
     /// `params` says so, in nits (rgb), and the illuminance in lux they bring to the surface,
     /// shadowed (a: what the deferred lighting's illuminance for the exposure meter lacks);
-    /// zero where the pass is off and on the sky.
+    /// zero where the pass is off and on the sky. `bvh`: the frame's shadow TLAS
+    /// (`SceneRtBuffers::shadow`).
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         area: &'r AreaLightScene,
+        bvh: &BvhBuffers,
         gb: &GBuffer,
         brdf_tables: BindingSet,
         scene: &SceneInFrame,
@@ -225,7 +205,7 @@ impl AreaLights {
             "area_lights.radiance",
             TextureDesc::d2(w, h, RADIANCE_FORMAT),
         )?;
-        let bvh = area.bvh.import(g)?.binding_set(g);
+        let bvh = bvh.binding_set(g);
         let lights = g.import_buffer("area_lights.lights", &area.light_buffer);
         let triangles = g.import_buffer("area_lights.triangles", &area.triangle_buffer);
         g.pass("area_lights.shade")

@@ -23,7 +23,6 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use hikari_bvh::{BuildOptions, InstanceRecord, PackedBlases, Tlas, TriangleRecord, WideNode};
 use hikari_math::sampling::blue_noise::BLUE_NOISE_64X64X64;
 use hikari_scene::{Scene, Sun};
 use naga_oil::compose::ShaderDefValue;
@@ -37,10 +36,9 @@ use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
 use crate::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
-use crate::error::{RenderError, Result};
+use crate::error::Result;
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::scene_bvh::{self, AlphaInstance, AlphaTriangle, BvhAlpha};
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 pub use settings::RayTracedGiSettings;
@@ -185,27 +183,16 @@ impl RtGiParams {
     }
 }
 
-/// The scene's BVH (built once, static: no refit or per-frame culling yet) with its cut-out
-/// data and the per-instance albedo table, on the GPU.
+/// What the technique keeps of a scene besides the frame's BVH (`scene_rt::SceneRt`, which it
+/// traces through [`RtGiInputs::bvh`]): the per-instance albedo table, on the GPU.
 pub struct RtGiScene {
-    blas_nodes: wgpu::Buffer,
-    triangles: wgpu::Buffer,
-    tlas_nodes: wgpu::Buffer,
-    instances: wgpu::Buffer,
-    alpha_instances: wgpu::Buffer,
-    alpha_triangles: wgpu::Buffer,
-    alpha_textures: wgpu::Texture,
     /// [`reference::instance_table`].
     instance_table: wgpu::Buffer,
-    /// Nodes on the longest TLAS root-to-leaf path.
-    pub tlas_depth: u32,
 }
 
 impl std::fmt::Debug for RtGiScene {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RtGiScene")
-            .field("tlas_depth", &self.tlas_depth)
-            .finish_non_exhaustive()
+        f.debug_struct("RtGiScene").finish_non_exhaustive()
     }
 }
 
@@ -218,8 +205,7 @@ fn storage_buffer(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
         })
 }
 
-/// Zero-sized bindings are not allowed: an empty list is uploaded as one zeroed record, which
-/// a zeroed (childless) node never reaches.
+/// Zero-sized bindings are not allowed: an empty list is uploaded as one zeroed record.
 fn non_empty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
     if v.is_empty() {
         vec![T::zeroed()]
@@ -229,54 +215,21 @@ fn non_empty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
 }
 
 impl RtGiScene {
-    /// Builds the BVH of `scene` on the CPU (hikari-bvh) and uploads it, with the cut-out data
-    /// and `color_textures` (`SceneGpu::textures.color`, for the alpha test).
-    pub fn new(ctx: &GpuContext, scene: &Scene, color_textures: &wgpu::Texture) -> Result<Self> {
-        let bvh_error = |e: hikari_bvh::BvhError| RenderError::Pass {
-            pass: "ray_traced_gi".into(),
-            message: format!("building the scene's BVH: {e}"),
-        };
-        let blases = scene_bvh::blases(scene, &BuildOptions::default()).map_err(bvh_error)?;
-        let instances = scene_bvh::instances(scene);
-        let all: Vec<u32> = (0..instances.len() as u32).collect();
-        let tlas = Tlas::build(&instances, &all, &blases).map_err(bvh_error)?;
-        let packed = PackedBlases::new(&blases);
-        let alpha = BvhAlpha::for_scene(scene);
+    /// Uploads the per-instance table of `scene` (albedo, emission).
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
         let table = non_empty(&reference::instance_table(scene));
-        let nodes: Vec<WideNode> = non_empty(&packed.nodes);
-        let tris: Vec<TriangleRecord> = non_empty(&packed.triangles);
-        let tlas_nodes: Vec<WideNode> = non_empty(&tlas.nodes);
-        let records: Vec<InstanceRecord> = non_empty(&tlas.instances);
-        let alpha_inst: Vec<AlphaInstance> = non_empty(&alpha.instances);
-        let alpha_tri: Vec<AlphaTriangle> = non_empty(&alpha.triangles);
-        let b = |name: &str, bytes: &[u8]| storage_buffer(ctx, name, bytes);
         Ok(Self {
-            blas_nodes: b("bvh.blas_nodes", bytemuck::cast_slice(&nodes)),
-            triangles: b("bvh.triangles", bytemuck::cast_slice(&tris)),
-            tlas_nodes: b("bvh.tlas_nodes", bytemuck::cast_slice(&tlas_nodes)),
-            instances: b("bvh.instances", bytemuck::cast_slice(&records)),
-            alpha_instances: b("bvh.alpha_instances", bytemuck::cast_slice(&alpha_inst)),
-            alpha_triangles: b("bvh.alpha_triangles", bytemuck::cast_slice(&alpha_tri)),
-            alpha_textures: color_textures.clone(),
-            instance_table: b("ray_traced_gi.instance_table", bytemuck::cast_slice(&table)),
-            tlas_depth: tlas.stats.depth,
+            instance_table: storage_buffer(
+                ctx,
+                "ray_traced_gi.instance_table",
+                bytemuck::cast_slice(&table),
+            ),
         })
     }
 
-    /// The BVH's buffers in a frame, and the per-instance table (albedo, emission).
-    pub fn import(&self, g: &mut FrameGraph<'_>) -> (BvhBuffers, Buf) {
-        (
-            BvhBuffers {
-                blas_nodes: g.import_buffer("bvh.blas_nodes", &self.blas_nodes),
-                triangles: g.import_buffer("bvh.triangles", &self.triangles),
-                tlas_nodes: g.import_buffer("bvh.tlas_nodes", &self.tlas_nodes),
-                instances: g.import_buffer("bvh.instances", &self.instances),
-                alpha_instances: g.import_buffer("bvh.alpha_instances", &self.alpha_instances),
-                alpha_triangles: g.import_buffer("bvh.alpha_triangles", &self.alpha_triangles),
-                alpha_textures: g.import_texture("bvh.alpha_textures", &self.alpha_textures),
-            },
-            g.import_buffer("ray_traced_gi.instance_table", &self.instance_table),
-        )
+    /// The per-instance table in a frame.
+    pub fn import(&self, g: &mut FrameGraph<'_>) -> Buf {
+        g.import_buffer("ray_traced_gi.instance_table", &self.instance_table)
     }
 }
 
@@ -290,6 +243,8 @@ pub struct RtGiInputs<'a> {
     pub lights: Buf,
     pub view: &'a View,
     pub params: &'a RtGiParams,
+    /// The frame's scene BVH for GI rays (`SceneRtBuffers::gi`).
+    pub bvh: BvhBuffers,
 }
 
 /// The raw (unaccumulated) signal of a frame.
@@ -392,7 +347,7 @@ impl RayTracedGi {
         let hits = g.buffer("ray_traced_gi.hits", pixels * 4)?;
         let hit_instances = g.buffer("ray_traced_gi.hit_instances", pixels * 4)?;
         let queue = g.buffer("ray_traced_gi.queue", (pixels + 1) * 4)?;
-        let (bvh, table) = scene.import(g);
+        let (bvh, table) = (inputs.bvh, scene.import(g));
 
         g.pass("ray_traced_gi.clear")
             .write(queue)
