@@ -3,7 +3,8 @@
 // along the ray: where the hit was visible last frame, last frame's lit image there; on a miss the sky in that direction (no sun or moon disk: direct light is the
 // deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
 // moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light and the point and spot lights, plus the
-// emission of the hit's instance (its material's, textures averaged). The word
+// emission of the hit's instance (its material's, textures averaged) unless it is an area
+// light, whose light the area-light pass gives every surface already. The word
 // carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
 // as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
 
