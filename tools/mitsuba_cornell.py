@@ -7,6 +7,12 @@ with the same camera, light and albedos.
     pip install mitsuba numpy
     python3 tools/mitsuba_cornell.py [--size 64] [--spp 4096] \
         [-o crates/hikari-render/tests/fixtures/mitsuba_cornell_direct_64.pfm]
+    # direct light plus ONE diffuse bounce (path, max_depth 3), for the ray-traced GI:
+    python3 tools/mitsuba_cornell.py --size 128 --spp 4096 --max-depth 3 \
+        -o crates/hikari-render/tests/fixtures/mitsuba_cornell_one_bounce_128.pfm
+    # ray-traced AO with hikari's ao_max_distance_m (50 m), our integrator on Mitsuba's rays:
+    python3 tools/mitsuba_cornell.py --size 128 --spp 1024 --ao-distance 50 \
+        -o crates/hikari-render/tests/fixtures/mitsuba_cornell_ao50_128.pfm
 
 Output: a PFM (portable float map: "PF", width height, -1.0 for little-endian, then RGB f32
 rows from the bottom up), linear Rec.709 radiance in nits (Mitsuba's `rgb` variant with the
@@ -72,20 +78,12 @@ def write_ply(path, quads):
             f.write(f"3 {b} {b + 1} {b + 2}\n3 {b} {b + 2} {b + 3}\n")
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--size", type=int, default=64)
-    ap.add_argument("--spp", type=int, default=4096)
-    ap.add_argument("-o", default="crates/hikari-render/tests/fixtures/mitsuba_cornell_direct_64.pfm")
-    args = ap.parse_args()
-
-    import mitsuba as mi
-
-    mi.set_variant("scalar_rgb")
+def build_scene(mi, size, spp, max_depth):
+    """The Cornell box as a Mitsuba scene dict: `path` integrator with `max_depth` (2: direct
+    light only, 3: direct plus one diffuse bounce), box-filtered film of `size` pixels."""
     centre = np.array([0.278, 0.274, 0.280])
     inward = lambda q: centre - np.mean(np.array(q) * 1e-3, axis=0)
     tmp = tempfile.mkdtemp()
-    meshes = {}
     walls = [quad_facing(q, inward(q)) for q in (FLOOR, CEILING, BACK)]
     blocks = []
     for block in (SHORT_BLOCK, TALL_BLOCK):
@@ -102,7 +100,7 @@ def main():
         "green": ([quad_facing(RIGHT_GREEN, inward(RIGHT_GREEN))], GREEN),
         "blocks": (blocks, WHITE),
     }
-    scene = {"type": "scene", "integrator": {"type": "path", "max_depth": 2}}
+    scene = {"type": "scene", "integrator": {"type": "path", "max_depth": max_depth}}
     for name, (quads, albedo) in parts.items():
         path = os.path.join(tmp, name + ".ply")
         write_ply(path, quads)
@@ -130,23 +128,89 @@ def main():
         "fov_axis": "y",
         "near_clip": 0.01,
         "to_world": mi.ScalarTransform4f().look_at(origin=list(cam), target=list(cam + [0, 0, 1.0]), up=[0, 1.0, 0]),
-        "sampler": {"type": "independent", "sample_count": args.spp},
+        "sampler": {"type": "independent", "sample_count": spp},
         "film": {
             "type": "hdrfilm",
-            "width": args.size,
-            "height": args.size,
+            "width": size,
+            "height": size,
             "rfilter": {"type": "box"},
             "pixel_format": "rgb",
         },
     }
-    img = np.array(mi.render(mi.load_dict(scene)), dtype=np.float32)[:, :, :3]
-    os.makedirs(os.path.dirname(args.o) or ".", exist_ok=True)
-    tmp_out = args.o + ".tmp"
+    return scene
+
+
+def render_ao(mi, scene, size, spp, distance, seed=7):
+    """Ray-traced ambient occlusion, as Mitsuba 3 has no AO integrator: written here on its
+    ray-intersection API (`Sensor.sample_ray`, `Scene.ray_intersect`, `Scene.ray_test`,
+    `Interaction.spawn_ray`, `warp.square_to_cosine_hemisphere`), scalar variant.
+    Each sample is a camera ray through a uniform point of the pixel (a box filter, as the
+    film above); at its first hit, a cosine-distributed direction about the geometric normal
+    turned towards the camera; the sample counts 1 when nothing lies within `distance` metres
+    along it. Camera rays that hit nothing count 1 (hikari writes AO 1 on sky pixels)."""
+    sensor = scene.sensors()[0]
+    rng = np.random.default_rng(seed)
+    ao = np.zeros((size, size), dtype=np.float64)
+    for y in range(size):
+        u = rng.random((size, spp, 4))
+        for x in range(size):
+            acc = 0.0
+            for k in range(spp):
+                film = mi.Point2f((x + u[x, k, 0]) / size, (y + u[x, k, 1]) / size)
+                ray, _ = sensor.sample_ray(0.0, 0.5, film, mi.Point2f(0.5, 0.5))
+                si = scene.ray_intersect(ray)
+                if not si.is_valid():
+                    acc += 1.0
+                    continue
+                nrm = mi.Vector3f(si.n)
+                if float(nrm[0] * ray.d[0] + nrm[1] * ray.d[1] + nrm[2] * ray.d[2]) > 0:
+                    nrm = -nrm
+                local = mi.warp.square_to_cosine_hemisphere(mi.Point2f(u[x, k, 2], u[x, k, 3]))
+                probe = si.spawn_ray(mi.Frame3f(nrm).to_world(local))
+                probe.maxt = distance
+                acc += 0.0 if scene.ray_test(probe) else 1.0
+            ao[y, x] = acc / spp
+    return np.repeat(ao.astype(np.float32)[:, :, None], 3, axis=2)
+
+
+def write_pfm(path, img):
+    """RGB PFM, rows from the bottom, written to a temporary file and renamed."""
+    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+    h, w = img.shape[:2]
+    tmp_out = path + ".tmp"
     with open(tmp_out, "wb") as f:
-        f.write(f"PF\n{args.size} {args.size}\n-1.0\n".encode())
+        f.write(f"PF\n{w} {h}\n-1.0\n".encode())
         f.write(np.ascontiguousarray(img[::-1]).astype("<f4").tobytes())
-    os.replace(tmp_out, args.o)
-    print(f"wrote {args.o}: mean {img.mean(axis=(0, 1))} nits, fov_y {fov:.4f} deg")
+    os.replace(tmp_out, path)
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--size", type=int, default=64)
+    ap.add_argument("--spp", type=int, default=4096)
+    ap.add_argument(
+        "--max-depth", type=int, default=2, help="path length: 2 direct light only, 3 direct plus one diffuse bounce"
+    )
+    ap.add_argument(
+        "--ao-distance",
+        type=float,
+        default=None,
+        help="render ray-traced AO with this maximum distance in metres instead of radiance",
+    )
+    ap.add_argument("--variant", default="scalar_rgb", help="Mitsuba variant (llvm_ad_rgb fails to compile on some AVX-512 hosts)")
+    ap.add_argument("-o", default="crates/hikari-render/tests/fixtures/mitsuba_cornell_direct_64.pfm")
+    args = ap.parse_args()
+
+    import mitsuba as mi
+
+    mi.set_variant(args.variant)
+    scene_dict = build_scene(mi, args.size, args.spp, args.max_depth)
+    if args.ao_distance is not None:
+        img = render_ao(mi, mi.load_dict(scene_dict), args.size, args.spp, args.ao_distance)
+    else:
+        img = np.array(mi.render(mi.load_dict(scene_dict)), dtype=np.float32)[:, :, :3]
+    write_pfm(args.o, img)
+    print(f"wrote {args.o}: mean {img.mean(axis=(0, 1))}")
 
 
 if __name__ == "__main__":

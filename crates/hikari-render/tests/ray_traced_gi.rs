@@ -701,8 +701,11 @@ fn hits_are_lit_like_the_twin() {
         meshes: vec![shapes::plane(400.0)],
         materials: vec![
             Material::diffuse("floor", Vec3::splat(0.5)),
+            // Not an area light: GI carries its emission (an area light's is the area-light
+            // pass's, and GI leaves it out; `gi_validation.rs` checks that on the Cornell box).
             Material {
                 emissive_nits: ceiling_emission,
+                area_light: Some(false),
                 ..Material::diffuse("ceiling", ceiling_albedo)
             },
         ],

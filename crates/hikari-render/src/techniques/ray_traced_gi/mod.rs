@@ -423,6 +423,7 @@ impl RayTracedGi {
             .write(hit_distance)
             .read(lit.prev)
             .read(vz.prev)
+            .read(gb.instance)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)

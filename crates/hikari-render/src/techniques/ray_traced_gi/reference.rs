@@ -182,7 +182,11 @@ pub fn texture_mean(t: &Texture) -> Vec3 {
     )
 }
 
-/// Per-instance data for hits, two records an instance: `[albedo, 0]` and `[emission, 0]`.
+/// Per-instance data for hits, two records an instance: `[albedo, 0]` and
+/// `[emission, area light]`, the last 1 where the instance is one of the area-light pass's
+/// lights (`area_lights::PolygonLights`): that pass lights every surface with it directly, so
+/// GI leaves its emission out (of the computed hit light and of the reused lit image), else
+/// the direct light would be counted twice.
 /// Albedo (the simple version of Metro's table): the material's base colour factor times its
 /// base colour texture's mean, through [`hit_albedo`]; Metro renders each mesh-material pair
 /// from six directions instead (not done). Emission: the material's emitted luminance (nits)
@@ -193,16 +197,22 @@ pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
         r.and_then(|r| means.get(r.texture).copied())
             .unwrap_or(Vec3::ONE)
     };
+    let area = crate::techniques::area_lights::PolygonLights::for_scene(scene);
     scene
         .instances
         .iter()
-        .flat_map(|i| {
+        .enumerate()
+        .flat_map(|(k, i)| {
             let m = &scene.materials[i.material];
             let albedo = hit_albedo(m.base_color * mean_of(m.base_color_texture), m.metalness);
             let emission = m.emissive_nits * mean_of(m.emissive_texture);
+            let is_area_light =
+                emission.max_element() > 0.0 && !area.skipped.iter().any(|(s, _)| *s == k);
             [
                 albedo.extend(0.0).to_array(),
-                emission.extend(0.0).to_array(),
+                emission
+                    .extend(f32::from(u8::from(is_area_light)))
+                    .to_array(),
             ]
         })
         .collect()

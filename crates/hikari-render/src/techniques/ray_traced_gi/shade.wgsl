@@ -3,7 +3,8 @@
 // along the ray: where the hit was visible last frame, last frame's lit image there; on a miss the sky in that direction (no sun or moon disk: direct light is the
 // deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
 // moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light and the point and spot lights, plus the
-// emission of the hit's instance (its material's, textures averaged). The word
+// emission of the hit's instance (its material's, textures averaged) unless it is an area
+// light, whose light the area-light pass gives every surface already. The word
 // carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
 // as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
 
@@ -33,6 +34,8 @@
 // Last frame's lit image (nits) and view depth (`ray_traced_gi.lit`, `.view_depth`).
 @group(0) @binding(11) var prev_lit: texture_2d<f32>;
 @group(0) @binding(12) var prev_view_depth: texture_2d<f32>;
+// This frame's G-buffer instance ids, to check that a reused texel shows the hit's instance.
+@group(0) @binding(13) var gbuffer_instance: texture_2d<u32>;
 
 const MAX_RADIANCE: f32 = 65000.0;
 
@@ -76,8 +79,30 @@ fn sun_visible(x: vec3<f32>, n: vec3<f32>) -> f32 {
 
 // Last frame's lit image where x was visible then (on screen, and its view depth within 1 %
 // of the depth stored there), as radiance towards that camera; w = 0 where it was not.
-fn reused_lit(x: vec3<f32>) -> vec4<f32> {
+// Screen texel of world point x under a view-projection, or none (x < 0).
+fn texel_of(view_proj: mat4x4<f32>, x: vec3<f32>, size: vec2<f32>) -> vec2<f32> {
+    let c = view_proj * vec4<f32>(x, 1.0);
+    if !(c.w > 0.0) {
+        return vec2<f32>(-1.0);
+    }
+    let ndc = c.xy / c.w;
+    let s = vec2<f32>((ndc.x * 0.5 + 0.5) * size.x, (0.5 - ndc.y * 0.5) * size.y);
+    if any(s < vec2<f32>(0.0)) || any(s >= size) {
+        return vec2<f32>(-1.0);
+    }
+    return s;
+}
+
+fn reused_lit(x: vec3<f32>, instance: u32) -> vec4<f32> {
     if (params.config.y & RTGI_REUSE_LIT) == 0u {
+        return vec4<f32>(0.0);
+    }
+    // The depth test below cannot tell surfaces apart that lie closer than 1 % of the view
+    // depth: a hit on the Cornell box's ceiling beside its light (0.5 mm below it) read the
+    // light's texel and brought its 5000 nits back as a firefly. The surface seen there now
+    // must be the hit's instance.
+    let now = texel_of(view.view_proj, x, vec2<f32>(textureDimensions(gbuffer_instance)));
+    if now.x >= 0.0 && textureLoad(gbuffer_instance, vec2<u32>(now), 0).x != instance {
         return vec4<f32>(0.0);
     }
     let c = view.prev_view_proj * vec4<f32>(x, 1.0);
@@ -168,15 +193,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Back along the ray a little, off the surface it hit.
         let x = o + dir * (distance - (1.0e-3 + 1.0e-3 * distance));
         // The talk's "first bounce from all lights": the lit image where the hit was seen.
-        let lit = reused_lit(o + dir * distance);
+        let instance = hit_instances[pixel.y * size.x + pixel.x];
+        let lit = reused_lit(o + dir * distance, instance);
+        var emission = vec4<f32>(0.0);
+        if 2u * instance + 1u < arrayLength(&instance_table) {
+            emission = instance_table[2u * instance + 1u];
+        }
+        // An area light's emission reaches every surface through the area-light pass already
+        // (w = 1 in the table); counted here too, the direct light would be counted twice.
+        let own = emission.rgb * (1.0 - emission.w);
         if lit.w > 0.0 {
-            radiance = lit.rgb;
+            radiance = max(lit.rgb - emission.rgb * emission.w, vec3<f32>(0.0));
         } else {
-            radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir);
-            let instance = hit_instances[pixel.y * size.x + pixel.x];
-            if 2u * instance + 1u < arrayLength(&instance_table) {
-                radiance += instance_table[2u * instance + 1u].rgb;
-            }
+            radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir) + own;
         }
     } else {
         radiance = miss_radiance(dir);
