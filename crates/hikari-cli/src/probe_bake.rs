@@ -1,28 +1,53 @@
 //! The scene's irradiance-probe bake, shared by `hikari bake`, `hikari probes` and `hikari
-//! render`: the scene's content key, the cache under `$XDG_CACHE_HOME/hikari` (default
-//! `~/.cache/hikari`), baking with a progress line, and reading a given file.
+//! render`: the scene's probe volumes, its content key, the cache under `$XDG_CACHE_HOME/hikari`
+//! (default `~/.cache/hikari`), baking with a progress bar (hikari-bake's `bake_to_file`:
+//! grid and tetrahedral meshes, sky and bounced sky visibility, interior flags) that resumes
+//! from `<file>.partial` after an interruption, and reading a given file.
 //!
 //! Bad files: a file given with `--bake` that is missing, truncated, corrupt, of another
 //! version or another scene is an error naming the file and the problem; a bad file in the
 //! cache is baked again with a warning saying why.
 
+use std::cell::RefCell;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
 
-use hikari_bake::{BakeStats, GridBake, GridBakeOptions};
-use hikari_probes::{Bake, BakeSettings, GridTile, ProbeSh, Problem, SceneKey, TILE_PROBE_COUNT};
+use hikari_bake::{BakeError, BakeProgress, ProbeVolume, SceneBakeOptions};
+use hikari_probes::{Bake, Problem, SceneKey};
 use hikari_scene::Scene;
 
-/// Bumped when the baker's output changes for the same scene and options, so that caches made
-/// by an older baker are not reused.
-const BAKER_VERSION: u32 = 1;
+use crate::scene_source::SceneSource;
 
-/// The options `hikari render` and `hikari bake` bake with.
-pub fn options() -> GridBakeOptions {
-    GridBakeOptions::default()
+/// Bumped when the baker's output changes for the same scene and options, so that caches made
+/// by an older baker are not reused. 2: bounced sky visibility, interior flags, meshes.
+const BAKER_VERSION: u32 = 2;
+
+/// Seconds between checkpoints (`<file>.partial`) of a running bake.
+const CHECKPOINT_INTERVAL: Duration = Duration::from_secs(2);
+
+/// The probe volumes (tetrahedral meshes) of a scene: the village's houses, temple and
+/// courtyard for the built-in village, the volumes a glTF file marks in its nodes' `extras`.
+pub fn volumes(source: &SceneSource) -> anyhow::Result<Vec<ProbeVolume>> {
+    Ok(match source {
+        SceneSource::Builtin(name) => hikari_bake::volumes::builtin_volumes(name),
+        SceneSource::Gltf(path) => hikari_bake::volumes::gltf_volumes(path)?,
+    })
+}
+
+/// The options `hikari render`, `hikari probes` and `hikari bake` bake `scene` with: the
+/// default grid and bounce, `source`'s volumes, and the key of all of it
+/// ([`scene_key`]).
+pub fn options(scene: &Scene, source: &SceneSource) -> anyhow::Result<SceneBakeOptions> {
+    let mut o = SceneBakeOptions {
+        volumes: volumes(source)?,
+        ..Default::default()
+    };
+    o.scene_key = scene_key(scene, &o);
+    Ok(o)
 }
 
 /// 64-bit FNV-1a, word by word: fast enough for the village's geometry in a debug build.
@@ -55,21 +80,36 @@ impl Hasher {
 }
 
 /// The key of `scene`'s bake with `options`: a hash of everything the bake reads (geometry,
-/// instances, the materials' colours, alpha and interior values, textures, the options and
-/// the baker's version).
-pub fn scene_key(scene: &Scene, options: &GridBakeOptions) -> SceneKey {
+/// instances, the materials' colours, alpha and interior values, textures), of every option
+/// (grid, rays, bounce rays, volumes, interior classification, jitter) and of the baker's
+/// version. `options.scene_key` itself is not hashed.
+pub fn scene_key(scene: &Scene, options: &SceneBakeOptions) -> SceneKey {
     let mut h = Hasher(0xcbf2_9ce4_8422_2325);
     h.word(BAKER_VERSION);
-    h.word(options.rays_per_probe);
-    h.word(options.probes_per_tile);
-    h.word(options.inside_test_rays);
+    let g = &options.grid;
+    h.word(g.rays_per_probe);
+    h.word(g.probes_per_tile);
+    h.word(g.inside_test_rays);
     h.f32s([
-        options.spacing,
-        options.inside_back_face_fraction,
-        options.lift_step,
-        options.max_lift,
+        g.spacing,
+        g.inside_back_face_fraction,
+        g.lift_step,
+        g.max_lift,
     ]);
-    h.f32s(options.heights);
+    h.f32s(g.heights);
+    h.word(options.bounce_rays);
+    h.f32s([
+        options.enclosure_radius,
+        options.interior_enclosed_fraction,
+        options.volume_jitter,
+    ]);
+    h.word(options.volumes.len() as u32);
+    for v in &options.volumes {
+        h.bytes(v.name.as_bytes());
+        h.word(v.name.len() as u32);
+        h.f32s(v.transform.to_cols_array());
+        h.f32s([v.spacing]);
+    }
     for m in &scene.meshes {
         h.word(m.positions.len() as u32);
         h.f32s(m.positions.iter().flat_map(|p| p.to_array()));
@@ -123,31 +163,75 @@ pub fn cache_path(key: &SceneKey) -> PathBuf {
     cache_dir().join(format!("probes-{key}.hikprobe"))
 }
 
-/// A progress line on stderr (only on a terminal): a bar, the count and the time left.
+/// Set by Ctrl-C while a bake runs: the bake saves its checkpoint and stops.
+static CANCEL: AtomicBool = AtomicBool::new(false);
+
+#[cfg(unix)]
+extern "C" fn on_interrupt(_: libc::c_int) {
+    CANCEL.store(true, Ordering::SeqCst);
+    // A second Ctrl-C ends the process at once.
+    // SAFETY: signal() is async-signal-safe; SIG_DFL is a valid disposition.
+    unsafe {
+        libc::signal(libc::SIGINT, libc::SIG_DFL);
+    }
+}
+
+/// Ctrl-C cancels the bake (after the tile or mesh being baked, with a checkpoint) instead of
+/// killing the process, while the guard lives.
+struct InterruptGuard;
+
+impl InterruptGuard {
+    fn install() -> Self {
+        CANCEL.store(false, Ordering::SeqCst);
+        #[cfg(unix)]
+        // SAFETY: the handler only stores an atomic and resets the disposition, both
+        // async-signal-safe.
+        unsafe {
+            libc::signal(
+                libc::SIGINT,
+                on_interrupt as extern "C" fn(libc::c_int) as libc::sighandler_t,
+            );
+        }
+        Self
+    }
+}
+
+impl Drop for InterruptGuard {
+    fn drop(&mut self) {
+        #[cfg(unix)]
+        // SAFETY: restoring the default disposition.
+        unsafe {
+            libc::signal(libc::SIGINT, libc::SIG_DFL);
+        }
+    }
+}
+
+/// A progress bar on stderr (only on a terminal): probes done, sections, the time left.
 pub struct Progress {
     label: &'static str,
-    start: Instant,
     last: Option<Instant>,
     tty: bool,
+    /// The latest report, for the summary.
+    pub latest: Option<BakeProgress>,
 }
 
 impl Progress {
     pub fn new(label: &'static str) -> Self {
         Self {
             label,
-            start: Instant::now(),
             last: None,
             tty: std::io::stderr().is_terminal(),
+            latest: None,
         }
     }
 
-    /// `done` of `total` units finished.
-    pub fn update(&mut self, done: usize, total: usize) {
-        if !self.tty || total == 0 {
+    pub fn update(&mut self, p: BakeProgress) {
+        self.latest = Some(p);
+        if !self.tty || p.probes_total == 0 {
             return;
         }
         let now = Instant::now();
-        let finished = done >= total;
+        let finished = p.sections_done >= p.sections_total;
         if !finished
             && self
                 .last
@@ -156,20 +240,22 @@ impl Progress {
             return;
         }
         self.last = Some(now);
-        let f = done as f64 / total as f64;
-        let elapsed = self.start.elapsed().as_secs_f64();
-        let eta = if done > 0 {
-            format!("{:.1} s left", elapsed * (1.0 - f) / f)
-        } else {
-            "estimating".into()
+        let f = (p.probes_done as f64 / p.probes_total as f64).min(1.0);
+        let eta = match p.eta() {
+            Some(d) => format!("{:.1} s left", d.as_secs_f64()),
+            None => "estimating".into(),
         };
         let bar: String = (0..30)
             .map(|i| if (i as f64) < f * 30.0 { '#' } else { '.' })
             .collect();
         eprint!(
-            "\r{} [{bar}] {:3.0}% {done}/{total}, {eta}   ",
+            "\r{} [{bar}] {:3.0}% {}/{} probes, {}/{} tiles+meshes, {eta}   ",
             self.label,
-            f * 100.0
+            f * 100.0,
+            p.probes_done,
+            p.probes_total,
+            p.sections_done,
+            p.sections_total,
         );
         if finished {
             eprintln!();
@@ -177,75 +263,85 @@ impl Progress {
     }
 }
 
-/// hikari-bake's grid in the bake file's model. Bounced sky visibility and interior flags are
-/// not baked yet (zero and false); tetrahedral meshes neither.
-pub fn to_probe_bake(grid: &GridBake, key: SceneKey) -> anyhow::Result<Bake> {
-    let o = &grid.options;
-    if o.probes_per_tile as usize * o.probes_per_tile as usize * hikari_bake::LAYERS
-        != TILE_PROBE_COUNT
-    {
-        anyhow::bail!(
-            "the bake file holds tiles of 16x16x3 probes, not {}x{}x3",
-            o.probes_per_tile,
-            o.probes_per_tile
-        );
-    }
-    let mut bake = Bake::new(
-        key,
-        BakeSettings {
-            rays_per_probe: o.rays_per_probe,
-            grid_spacing_m: o.spacing,
-            layer_heights_m: o.heights,
-        },
-    );
-    for t in &grid.tiles {
-        bake.tiles.push(GridTile {
-            tile: [t.index[0] as i32, t.index[1] as i32],
-            origin_xz: t.origin.to_array(),
-            ground_heights_m: t.ground.clone(),
-            probes: t
-                .probes
-                .iter()
-                .map(|p| ProbeSh {
-                    sky_visibility: p.sky_visibility,
-                    bounced_sky_visibility: [[0.0; 3]; 9],
-                })
-                .collect(),
-            interior: vec![false; t.probes.len()],
-        });
-    }
-    bake.complete = true;
-    Ok(bake)
+/// What a bake run did, for `hikari bake`'s summary.
+pub struct BakeRun {
+    pub bake: Bake,
+    /// Tiles and meshes taken from `<file>.partial`.
+    pub resumed_sections: usize,
+    /// Rays traced in this run (probe, bounce, ground and inside-test rays).
+    pub rays: u64,
+    pub seconds: f64,
 }
 
-/// Bakes `scene` on the CPU with a progress line.
-///
-/// The one place the baker is called: when hikari-bake gains bounced visibility, tetrahedral
-/// meshes and its own progress reports, this is what changes.
-pub fn bake_scene(scene: &Scene, key: SceneKey) -> anyhow::Result<(Bake, BakeStats)> {
-    let mut progress = Progress::new("baking probes");
-    let grid = hikari_bake::bake_grid_sky_visibility(scene, &options(), |done, total| {
-        progress.update(done, total)
-    })
-    .context("baking the irradiance probes")?;
-    Ok((to_probe_bake(&grid, key)?, grid.stats))
-}
-
-/// Writes `bake` atomically, making the folder first.
-pub fn write(path: &Path, bake: &Bake) -> anyhow::Result<()> {
+/// Bakes `scene` into `path` with a progress bar: resumes from `<path>.partial`, checkpoints
+/// every few seconds, and Ctrl-C stops it with a checkpoint (the next run resumes it).
+pub fn bake_into(
+    scene: &Scene,
+    options: &SceneBakeOptions,
+    path: &Path,
+) -> anyhow::Result<BakeRun> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("creating the folder {}", dir.display()))?;
     }
-    hikari_probes::write_bake(path, bake)?;
-    Ok(())
+    let progress = RefCell::new(Progress::new("baking probes"));
+    let start = Instant::now();
+    let guard = InterruptGuard::install();
+    let result = hikari_bake::bake_to_file(
+        scene,
+        options,
+        path,
+        &|p| progress.borrow_mut().update(p),
+        &CANCEL,
+        CHECKPOINT_INTERVAL,
+    );
+    drop(guard);
+    let baked = match result {
+        Ok(b) => b,
+        Err(BakeError::Cancelled) => {
+            if progress.borrow().tty {
+                eprintln!();
+            }
+            anyhow::bail!(
+                "the bake of {} was interrupted; its checkpoint {} resumes it on the next run",
+                path.display(),
+                hikari_probes::partial_path(path).display()
+            )
+        }
+        Err(e) => {
+            return Err(anyhow::Error::from(e))
+                .with_context(|| format!("baking the irradiance probes into {}", path.display()));
+        }
+    };
+    if let Some(why) = &baked.discarded_checkpoint {
+        log::warn!("probes: an old checkpoint was not used: {why}");
+    }
+    if baked.resumed_sections > 0 {
+        log::info!(
+            "probes: resumed {} tiles and meshes from {}",
+            baked.resumed_sections,
+            hikari_probes::partial_path(path).display()
+        );
+    }
+    let rays = progress.borrow().latest.map_or(0, |p| p.rays_traced);
+    Ok(BakeRun {
+        bake: baked.bake,
+        resumed_sections: baked.resumed_sections,
+        rays,
+        seconds: start.elapsed().as_secs_f64(),
+    })
 }
 
-/// The bake to render `scene` with: `given` (any problem with it is an error naming the file),
-/// else the cache's, baked and cached on a miss; a bad cache file is baked again with a
-/// warning. A cache that cannot be written is a warning too: the frame still renders.
-pub fn for_render(scene: &Scene, given: Option<&Path>) -> anyhow::Result<Bake> {
-    let key = scene_key(scene, &options());
+/// The bake to render `scene` (from `source`) with: `given` (any problem with it is an error
+/// naming the file), else the cache's, baked into the cache on a miss (resuming an interrupted
+/// one); a bad cache file is baked again with a warning.
+pub fn for_render(
+    scene: &Scene,
+    source: &SceneSource,
+    given: Option<&Path>,
+) -> anyhow::Result<Bake> {
+    let options = options(scene, source)?;
+    let key = options.scene_key;
     if let Some(path) = given {
         return hikari_probes::read_bake(path, &key)
             .map_err(anyhow::Error::from)
@@ -265,16 +361,13 @@ pub fn for_render(scene: &Scene, given: Option<&Path>) -> anyhow::Result<Bake> {
         }
         Err(e) => log::warn!("{e}; baking the probes again"),
     }
-    let (bake, stats) = bake_scene(scene, key)?;
+    let run = bake_into(scene, &options, &path)?;
     log::info!(
         "probes: baked {} probes in {:.1} s",
-        stats.probes,
-        stats.total_seconds
+        run.bake.probe_count(),
+        run.seconds
     );
-    if let Err(e) = write(&path, &bake) {
-        log::warn!("probes: could not cache the bake: {e:#}");
-    }
-    Ok(bake)
+    Ok(run.bake)
 }
 
 /// Gives `renderer` the scene's bake ([`for_render`]) when the frame's settings use the
@@ -282,12 +375,13 @@ pub fn for_render(scene: &Scene, given: Option<&Path>) -> anyhow::Result<Bake> {
 pub fn attach(
     renderer: &mut hikari_render::Renderer,
     scene: &Scene,
+    source: &SceneSource,
     settings: &hikari_render::FrameSettings,
     given: Option<&Path>,
 ) -> anyhow::Result<()> {
     let s = &settings.settings;
     if s.irradiance_probes.enabled && s.sky.enabled && s.sky.sky {
-        let bake = for_render(scene, given)?;
+        let bake = for_render(scene, source, given)?;
         renderer.set_probe_bake(Some(&bake));
     } else if let Some(path) = given {
         log::warn!(

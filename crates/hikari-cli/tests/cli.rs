@@ -375,6 +375,8 @@ fn bake_and_probes_write_and_list_the_bake() {
     assert!(tiles >= 1);
     assert_eq!(summary["grid"]["probes"], tiles * 768);
     assert_eq!(summary["rays_per_probe"], 2048);
+    assert_eq!(summary["bounce_rays_per_hit"], 2);
+    assert!(summary["rays"].as_u64().unwrap() >= 2048 * tiles as u64 * 768 / 2);
     assert!(summary["seconds"].as_f64().unwrap() > 0.0);
 
     let listed = json_of(&hikari_cached(
@@ -392,6 +394,18 @@ fn bake_and_probes_write_and_list_the_bake() {
         assert!(b.iter().all(|c| c.as_array().unwrap().len() == 3));
         assert!(p["grid_tile"].is_array());
     }
+    // The bake is the full one: the ground (albedo 0.3, a 40 m square) bounces sky light to the
+    // low probes above it.
+    let over_ground = |p: &&serde_json::Value| {
+        let at = |k: usize| p["position"][k].as_f64().unwrap().abs();
+        p["index"][2] == 0 && at(0) < 18.0 && at(2) < 18.0
+    };
+    let bounced = |p: &serde_json::Value| p["bounced_sky_visibility"][0][0].as_f64().unwrap();
+    assert!(
+        probes.iter().filter(over_ground).all(|p| bounced(p) > 0.0)
+            && probes.iter().filter(over_ground).count() >= 4,
+        "a probe 1.5 m over the ground has no bounced sky visibility"
+    );
     // The top layer stands 30 m over the ground: nothing of the boxes scene reaches that high.
     let top = probes
         .iter()

@@ -330,6 +330,49 @@ fn relight_of_open_and_closed_probes_in_closed_form() {
 /// The lookup (`hikari::irradiance_probes` through `lookup_check.wgsl`) against
 /// `reference::irradiance_at`, at random points in and around the mesh and over the grid,
 /// with random normals and masks; tolerance 1e-3 of the value (plus 1e-3 lux).
+/// Runs `lookup_check.wgsl` at `queries` (two vec4 per point: position, normal and mask).
+fn gpu_lookup(
+    ctx: &hikari_render::GpuContext,
+    pipeline: &ComputePipeline,
+    data: &ProbeGpuData,
+    lp: &ProbeLookupParams,
+    flat: &[[f32; 4]],
+    queries: &[[f32; 4]],
+) -> Vec<[f32; 4]> {
+    let count = queries.len() / 2;
+    let q = buffer(ctx, "queries", bytemuck::cast_slice(queries));
+    let out = buffer(ctx, "results", &vec![0u8; count * 16]);
+    let irr = buffer(ctx, "irradiance", bytemuck::cast_slice(flat));
+    let pos = buffer(ctx, "positions", bytemuck::cast_slice(&data.positions));
+    let topo = buffer(ctx, "topology", bytemuck::cast_slice(&data.topology));
+    let mut rt = GraphRuntime::new();
+    let mut g = rt.begin_frame(ctx);
+    let (q, out) = (
+        g.import_buffer("queries", &q),
+        g.import_buffer("results", &out),
+    );
+    let irr = g.import_buffer("irradiance", &irr);
+    let pos = g.import_buffer("positions", &pos);
+    let topo = g.import_buffer("topology", &topo);
+    let set = g
+        .binding_set("irradiance_probes")
+        .constants(lp)
+        .read(irr)
+        .read(pos)
+        .read(topo)
+        .finish();
+    g.pass("test.lookup")
+        .read(q)
+        .write(out)
+        .set(set)
+        .dispatch_threads(pipeline, [count as u32, 1, 1])
+        .unwrap();
+    g.readback(out);
+    let r = g.execute().unwrap();
+    let got: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(r.buffer("results").unwrap());
+    got
+}
+
 #[test]
 fn lookup_matches_the_cpu_twin() {
     let Some(ctx) = common::gpu() else {
@@ -386,36 +429,7 @@ fn lookup_matches_the_cpu_twin() {
         if interior_mask {
             lp.grid_size[3] |= PROBES_INTERIOR_MASK;
         }
-        let q = buffer(&ctx, "queries", bytemuck::cast_slice(&queries));
-        let out = buffer(&ctx, "results", &vec![0u8; points.len() * 16]);
-        let irr = buffer(&ctx, "irradiance", bytemuck::cast_slice(&flat));
-        let pos = buffer(&ctx, "positions", bytemuck::cast_slice(&data.positions));
-        let topo = buffer(&ctx, "topology", bytemuck::cast_slice(&data.topology));
-        let mut rt = GraphRuntime::new();
-        let mut g = rt.begin_frame(&ctx);
-        let (q, out) = (
-            g.import_buffer("queries", &q),
-            g.import_buffer("results", &out),
-        );
-        let irr = g.import_buffer("irradiance", &irr);
-        let pos = g.import_buffer("positions", &pos);
-        let topo = g.import_buffer("topology", &topo);
-        let set = g
-            .binding_set("irradiance_probes")
-            .constants(&lp)
-            .read(irr)
-            .read(pos)
-            .read(topo)
-            .finish();
-        g.pass("test.lookup")
-            .read(q)
-            .write(out)
-            .set(set)
-            .dispatch_threads(&pipeline, [points.len() as u32, 1, 1])
-            .unwrap();
-        g.readback(out);
-        let r = g.execute().unwrap();
-        let got: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(r.buffer("results").unwrap());
+        let got = gpu_lookup(&ctx, &pipeline, &data, &lp, &flat, &queries);
         let mut covered = 0;
         for (i, (p, n, mask)) in points.iter().enumerate() {
             let want = reference::irradiance_at(&data, &lp, &irradiance, *p, *n, *mask);
@@ -503,7 +517,7 @@ fn point_location_and_interior_weights_match_brute_force() {
                 let want: f64 = (0..4)
                     .map(|k| weights[k] * f64::from(value(tet[k] as usize)))
                     .sum();
-                let w = reference::lookup_weights(&data, p);
+                let w = reference::mesh_weights(&data, 0, p).unwrap();
                 let w = reference::masked_weights(&w, &data, mask);
                 let got: f32 = w
                     .iter()
@@ -764,4 +778,187 @@ fn grid_weights_reproduce_linear_functions() {
             .sum();
         assert!((got - f(p)).abs() < 2e-3, "{p}: {got} vs {}", f(p));
     }
+}
+
+/// A point on a face of the synthetic mesh's bounds (the cube (40, 2, 50) + [0, 10]³) and
+/// that face's inward normal.
+fn point_on_mesh_face(rng: &mut SmallRng) -> (Vec3, Vec3) {
+    let (lo, hi) = (Vec3::new(40.0, 2.0, 50.0), Vec3::new(50.0, 12.0, 60.0));
+    let axis = rng.random_range(0..3);
+    let upper = rng.random_bool(0.5);
+    let mut p = Vec3::new(
+        rng.random_range(lo.x + 0.5..hi.x - 0.5),
+        rng.random_range(lo.y + 0.5..hi.y - 0.5),
+        rng.random_range(lo.z + 0.5..hi.z - 0.5),
+    );
+    p[axis] = if upper { hi[axis] } else { lo[axis] };
+    let mut inward = Vec3::ZERO;
+    inward[axis] = if upper { -1.0 } else { 1.0 };
+    (p, inward)
+}
+
+/// The mesh blends into the grid at its bounds: on the CPU twin, the interpolated value is
+/// continuous across every face of the mesh's bounds (a jump of the mesh's and the grid's
+/// difference without the blend), is the mesh's alone deeper than the margin, and in the
+/// margin is `a` x mesh + (1 - a) x grid with `a` the depth over the margin (computed here
+/// from the cube's known corners); on the GPU, irradiance in the margin matches the twin and
+/// is continuous across the faces too.
+#[test]
+fn the_mesh_blends_into_the_grid_at_its_bounds() {
+    let data = ProbeGpuData::new(&synthetic_bake(11));
+    let value = |p: u32| (p as f32 * 0.37).sin();
+    // A masked, renormalised mean of `value` over weights `w`.
+    let mean = |w: &[(u32, f32)], mask: f32| -> f32 {
+        let w = reference::masked_weights(w, &data, mask);
+        w.iter().map(|&(k, wk)| wk * value(k)).sum()
+    };
+    let field = |p: Vec3, mask: f32| -> f32 {
+        let w = reference::blended_weights(&data, p, mask);
+        w.iter().map(|&(k, wk)| wk * value(k)).sum()
+    };
+    let mut rng = SmallRng::seed_from_u64(12);
+    let mut largest_mesh_grid_gap = 0.0f32;
+    for i in 0..600 {
+        let mask = [0.0, 1.0, 0.5, 0.3][i % 4];
+        let (on, inward) = point_on_mesh_face(&mut rng);
+        let inside = on + 1e-3 * inward;
+        let outside = on - 1e-3 * inward;
+        let (fi, fo) = (field(inside, mask), field(outside, mask));
+        assert!(
+            (fi - fo).abs() < 5e-3,
+            "{on} mask {mask}: {fi} inside, {fo} outside"
+        );
+        let mesh_only = mean(&reference::mesh_weights(&data, 0, inside).unwrap(), mask);
+        largest_mesh_grid_gap = largest_mesh_grid_gap.max((mesh_only - fo).abs());
+
+        let depth: f32 = rng.random_range(0.0..1.5);
+        let p = on + depth * inward;
+        let grid = mean(&reference::grid_weights(&data, p), mask);
+        let mesh = mean(&reference::mesh_weights(&data, 0, p).unwrap(), mask);
+        // The depth below the nearest face (maybe not the one `p` was pushed in from).
+        let (lo, hi) = (Vec3::new(40.0, 2.0, 50.0), Vec3::new(50.0, 12.0, 60.0));
+        let nearest = (p - lo).min(hi - p).min_element();
+        let a = (nearest / reference::BLEND_MARGIN_M).min(1.0);
+        let want = a * mesh + (1.0 - a) * grid;
+        let got = field(p, mask);
+        assert!(
+            (got - want).abs() < 1e-3,
+            "{p} depth {nearest} mask {mask}: blended {got}, want {want}"
+        );
+    }
+    // Without the blend the faces would show this jump.
+    assert!(
+        largest_mesh_grid_gap > 0.1,
+        "the mesh and the grid agree at the faces ({largest_mesh_grid_gap}): the test shows nothing"
+    );
+
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let pipeline = ComputePipeline::new(
+        &ctx,
+        &mut lib,
+        "irradiance_probes/lookup_check.wgsl",
+        "main",
+        &[],
+    )
+    .unwrap();
+    let sky = synthetic_sky(&mut rng);
+    let params = RelightParams::new(None, &IrradianceProbesSettings::default(), 0);
+    let irradiance = reference::relight_all(&data, &sky, &params);
+    let flat: Vec<[f32; 4]> = irradiance
+        .iter()
+        .flat_map(|sh| sh.coeffs.map(|c| c.extend(0.0).to_array()))
+        .collect();
+    let mut lp: ProbeLookupParams = data.params;
+    lp.grid_size[3] |= PROBES_INTERIOR_MASK;
+    let mut queries = Vec::new();
+    let mut points = Vec::new();
+    for i in 0..256 {
+        let (on, inward) = point_on_mesh_face(&mut rng);
+        let n = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize_or(Vec3::Y);
+        let mask = [0.0, 1.0, 0.5, 0.25][i % 4];
+        // Pairs straddling the face, then a point in the margin.
+        for p in [
+            on + 1e-3 * inward,
+            on - 1e-3 * inward,
+            on + rng.random_range(0.0..1.2) * inward,
+        ] {
+            queries.push(p.extend(0.0).to_array());
+            queries.push(n.extend(mask).to_array());
+            points.push((p, n, mask));
+        }
+    }
+    let got = gpu_lookup(&ctx, &pipeline, &data, &lp, &flat, &queries);
+    for (i, (p, n, mask)) in points.iter().enumerate() {
+        let want = reference::irradiance_at(&data, &lp, &irradiance, *p, *n, *mask)
+            .expect("the synthetic bake covers the mesh's faces");
+        let g = Vec3::from_slice(&got[i][..3]);
+        assert_eq!(got[i][3], 1.0, "{p}: the GPU finds no probe");
+        assert!(
+            (g - want).abs().max_element() <= 1e-3 * want.max_element() + 1e-3,
+            "{p} n {n} mask {mask}: gpu {g} cpu {want}"
+        );
+        if i % 3 == 1 {
+            let inner = Vec3::from_slice(&got[i - 1][..3]);
+            assert!(
+                (g - inner).abs().max_element() <= 5e-3 * g.max_element().max(1.0),
+                "{p}: gpu {inner} inside the face, {g} outside"
+            );
+        }
+    }
+}
+
+/// The walk from the start grid finds every point inside the mesh in fewer steps, on
+/// average, than a walk from the mesh's first tetrahedron (the old start, walked here the
+/// same way: across the face opposite the most negative barycentric coordinate).
+#[test]
+fn the_walk_starts_near_the_point() {
+    let mut rng = SmallRng::seed_from_u64(14);
+    let mut bake = synthetic_bake(13);
+    bake.meshes[0] = kuhn_mesh(&mut rng, Vec3::new(40.0, 2.0, 50.0), 2.5, 4);
+    let data = ProbeGpuData::new(&bake);
+    let slot = data.meshes[0];
+    let adj = data.params.topology[2] as usize;
+    let from_first = |p: Vec3| -> u32 {
+        let mut t = slot.first_tet;
+        for step in 1..=256 {
+            let b = reference::barycentrics(&data, t, p).unwrap();
+            let k = (0..4).min_by(|&i, &j| b[i].total_cmp(&b[j])).unwrap();
+            if b[k] >= -reference::INSIDE_EPSILON {
+                return step;
+            }
+            t = data.topology[adj + 4 * t as usize + k];
+            assert_ne!(
+                t, HULL,
+                "{p}: the walk from the first tetrahedron left the mesh"
+            );
+        }
+        256
+    };
+    let (mut grid_steps, mut first_steps) = (0u32, 0u32);
+    for _ in 0..2000 {
+        let p = Vec3::new(
+            rng.random_range(40.1..49.9),
+            rng.random_range(2.1..11.9),
+            rng.random_range(50.1..59.9),
+        );
+        let (hit, n) = reference::locate_counting(&data, 0, p);
+        assert!(hit.is_some(), "{p}: inside the mesh but not found");
+        grid_steps += n;
+        first_steps += from_first(p);
+    }
+    assert!(
+        2 * grid_steps < first_steps,
+        "{grid_steps} steps from the start grid, {first_steps} from the first tetrahedron"
+    );
+    println!(
+        "walk steps over 2000 points: {grid_steps} from the start grid, {first_steps} from the first tetrahedron"
+    );
 }

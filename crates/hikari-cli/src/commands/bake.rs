@@ -1,6 +1,8 @@
-//! `hikari bake`: bakes a scene's irradiance probes on the CPU and writes the bake file (by
-//! default into the cache `hikari render` reads), with a summary: probes per grid tile and
-//! mesh, rays, time.
+//! `hikari bake`: bakes a scene's irradiance probes on the CPU (grid tiles and the scene's
+//! tetrahedral meshes, sky and bounced sky visibility, interior flags) and writes the bake file
+//! (by default into the cache `hikari render` reads), with a progress bar and the time left; an
+//! interrupted bake (Ctrl-C) resumes from `<file>.partial`. The summary lists probes per grid
+//! tile and mesh, rays and time.
 
 use std::path::PathBuf;
 
@@ -9,7 +11,7 @@ use serde_json::json;
 
 use crate::args::{JsonArgs, SceneArgs};
 use crate::probe_bake;
-use crate::scene_source::{self, DEFAULT_SCENE};
+use crate::scene_source::{DEFAULT_SCENE, SceneSource};
 
 #[derive(Args, Debug)]
 pub struct BakeArgs {
@@ -28,23 +30,36 @@ pub fn run(a: BakeArgs) -> anyhow::Result<()> {
         .scene
         .clone()
         .unwrap_or_else(|| DEFAULT_SCENE.into());
-    let scene = scene_source::load_scene(&name)?;
-    let key = probe_bake::scene_key(&scene, &probe_bake::options());
-    let (bake, stats) = probe_bake::bake_scene(&scene, key)?;
+    let source = SceneSource::parse(&name)?;
+    let scene = source.load()?;
+    let options = probe_bake::options(&scene, &source)?;
+    let key = options.scene_key;
     let path = a.output.unwrap_or_else(|| probe_bake::cache_path(&key));
-    probe_bake::write(&path, &bake)?;
+    let run = probe_bake::bake_into(&scene, &options, &path)?;
+    let bake = &run.bake;
+    let count = |flags: &[bool]| flags.iter().filter(|&&f| f).count();
     let tiles: Vec<_> = bake
         .tiles
         .iter()
-        .map(|t| json!({"tile": t.tile, "probes": t.probes.len()}))
+        .map(|t| json!({"tile": t.tile, "probes": t.probes.len(), "interior": count(&t.interior)}))
         .collect();
     let meshes: Vec<_> = bake
         .meshes
         .iter()
-        .map(|m| json!({"id": m.id, "probes": m.probes.len(), "tetrahedra": m.tets.len()}))
+        .map(|m| {
+            let name = options.volumes.get(m.id as usize).map(|v| v.name.clone());
+            json!({
+                "id": m.id,
+                "name": name,
+                "probes": m.probes.len(),
+                "interior": count(&m.interior),
+                "tetrahedra": m.tets.len(),
+            })
+        })
         .collect();
     let grid_probes: usize = bake.tiles.iter().map(|t| t.probes.len()).sum();
     let mesh_probes: usize = bake.meshes.iter().map(|m| m.probes.len()).sum();
+    let g = &options.grid;
     if a.json.json {
         let out = json!({
             "scene": name,
@@ -54,38 +69,46 @@ pub fn run(a: BakeArgs) -> anyhow::Result<()> {
             "meshes": meshes,
             "mesh_probes": mesh_probes,
             "probes": bake.probe_count(),
-            "lifted": stats.lifted,
-            "dropped": stats.dropped,
-            "rays_per_probe": stats.rays_per_probe,
-            "sky_rays": stats.sky_rays,
-            "placement_rays": stats.placement_rays,
-            "sky_rays_per_second": stats.sky_rays_per_second(),
-            "threads": stats.threads,
-            "seconds": stats.total_seconds,
+            "rays_per_probe": g.rays_per_probe,
+            "bounce_rays_per_hit": options.bounce_rays,
+            "rays": run.rays,
+            "rays_per_second": run.rays as f64 / run.seconds.max(1e-9),
+            "resumed_sections": run.resumed_sections,
+            "threads": rayon_threads(),
+            "seconds": run.seconds,
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
         println!("scene {name} (key {key})");
-        println!(
-            "grid: {} tiles, {grid_probes} probes ({} lifted, {} dropped)",
-            bake.tiles.len(),
-            stats.lifted,
-            stats.dropped
-        );
+        println!("grid: {} tiles, {grid_probes} probes", bake.tiles.len());
         println!(
             "tetrahedral meshes: {}, {mesh_probes} probes",
             bake.meshes.len()
         );
         println!(
-            "rays: {} a probe, {} sky + {} placement, {:.1} Mrays/s on {} threads",
-            stats.rays_per_probe,
-            stats.sky_rays,
-            stats.placement_rays,
-            stats.sky_rays_per_second() / 1e6,
-            stats.threads
+            "rays: {} a probe, {} bounce rays a hit, {} traced in this run ({:.1} Mrays/s)",
+            g.rays_per_probe,
+            options.bounce_rays,
+            run.rays,
+            run.rays as f64 / run.seconds.max(1e-9) / 1e6
         );
-        println!("time: {:.2} s", stats.total_seconds);
+        if run.resumed_sections > 0 {
+            println!(
+                "resumed {} tiles and meshes from the checkpoint",
+                run.resumed_sections
+            );
+        }
+        println!("time: {:.2} s", run.seconds);
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// Threads the baker's pool runs on (`RAYON_NUM_THREADS`, else the cores).
+fn rayon_threads() -> usize {
+    std::env::var("RAYON_NUM_THREADS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }

@@ -80,7 +80,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
     let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);
     let t0 = Instant::now();
     let mut renderer = Renderer::new(ctx, &scene)?;
-    probe_bake::attach(&mut renderer, &scene, &settings, None)?;
+    probe_bake::attach(&mut renderer, &scene, &description.source, &settings, None)?;
     renderer.runtime.set_timestamps(if a.frame_only {
         TimestampMode::Frame
     } else {

@@ -115,7 +115,7 @@ pub fn run(a: ProbesArgs) -> anyhow::Result<()> {
             .map(|s| parse_point(s))
             .collect::<Result<_, _>>()?;
     let frame = scene_source::resolve(&a.frame)?;
-    let bake = probe_bake::for_render(&frame.scene, a.bake.as_deref())?;
+    let bake = probe_bake::for_render(&frame.scene, &frame.description.source, a.bake.as_deref())?;
     if points.is_empty() {
         let probes = list(&bake);
         if a.json.json {
@@ -152,11 +152,10 @@ pub fn run(a: ProbesArgs) -> anyhow::Result<()> {
     };
     let mut out = Vec::new();
     for p in &points {
-        let w = reference::lookup_weights(&data, *p);
+        let w = reference::blended_weights(&data, *p, 0.5);
         let covered = w.iter().map(|x| x.1).sum::<f32>() > 0.0;
         let mut entry = json!({"position": p.to_array(), "covered": covered});
         if covered {
-            let w = reference::masked_weights(&w, &data, 0.5);
             let mut vis = ShL2::zero();
             let mut bounce = ShL2Rgb::zero();
             for &(k, wk) in &w {

@@ -77,7 +77,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
     let mut renderer = Renderer::new(ctx, &scene)?;
-    probe_bake::attach(&mut renderer, &scene, &settings, args.bake.as_deref())?;
+    probe_bake::attach(
+        &mut renderer,
+        &scene,
+        &description.source,
+        &settings,
+        args.bake.as_deref(),
+    )?;
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
     renderer.runtime.set_timestamps(if args.timings {

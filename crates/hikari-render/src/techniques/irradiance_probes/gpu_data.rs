@@ -7,7 +7,10 @@
 //!   bounding rectangle of tiles, or [`NO_TILE`]), then 4 global probe indices per
 //!   tetrahedron, then 4 global neighbour tetrahedra (or [`hikari_probes::HULL`]), then
 //!   [`MESH_WORDS`] per mesh: bounds min xyz, max xyz (f32 bits), first tetrahedron,
-//!   tetrahedra, first probe, probes, 0, 0.
+//!   tetrahedra, first probe, probes, offset in `topology` of its start grid, 0; then each
+//!   mesh's start grid: [`START_CELLS`]³ tetrahedra (x fastest), for each cell of the mesh's
+//!   bounds the tetrahedron whose centroid is nearest the cell's centre, where the lookup's
+//!   walk starts (a few steps instead of crossing the mesh from its first tetrahedron).
 //!
 //! Non-finite numbers in a bake become 0 here (a bake file with them is refused when read,
 //! but a bake made in memory is not checked), so NaN never reaches the frame.
@@ -19,6 +22,8 @@ use hikari_probes::{Bake, HULL, TILE_COLUMNS, TILE_LAYERS, TILE_PROBE_COUNT};
 pub const NO_TILE: u32 = u32::MAX;
 /// Words per mesh record in `topology`.
 pub const MESH_WORDS: usize = 12;
+/// Cells of a mesh's start grid along each axis.
+pub const START_CELLS: usize = 4;
 /// Probes along x (and z) of a tile.
 pub const TILE_SIDE: usize = hikari_probes::model::TILE_PROBES_X;
 
@@ -59,6 +64,8 @@ pub struct MeshSlot {
     pub tets: u32,
     pub lo: [f32; 3],
     pub hi: [f32; 3],
+    /// Offset in `topology` (words) of the mesh's start grid.
+    pub start_grid: u32,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -110,6 +117,42 @@ fn push_probe(
         finite(at[2], replaced),
         if interior { 1.0 } else { 0.0 },
     ]);
+}
+
+/// The start grid of mesh `m` (see the module's documentation): per cell, x fastest, the
+/// tetrahedron (global index) whose centroid is nearest the cell's centre; the mesh's first
+/// one for a mesh without tetrahedra.
+fn start_grid(m: &MeshSlot, tets: &[u32], positions: &[[f32; 4]]) -> Vec<u32> {
+    let n = START_CELLS;
+    let centroid = |t: usize| {
+        let mut c = [0.0f32; 3];
+        for v in &tets[4 * t..4 * t + 4] {
+            for a in 0..3 {
+                c[a] += 0.25 * positions[*v as usize][a];
+            }
+        }
+        c
+    };
+    let range = m.first_tet as usize..(m.first_tet + m.tets) as usize;
+    let centroids: Vec<(u32, [f32; 3])> = range.map(|t| (t as u32, centroid(t))).collect();
+    let mut out = Vec::with_capacity(n * n * n);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                let centre: [f32; 3] = std::array::from_fn(|a| {
+                    let i = [x, y, z][a] as f32;
+                    m.lo[a] + (m.hi[a] - m.lo[a]) * (i + 0.5) / n as f32
+                });
+                let d2 = |c: &[f32; 3]| (0..3).map(|a| (c[a] - centre[a]).powi(2)).sum::<f32>();
+                let best = centroids
+                    .iter()
+                    .min_by(|a, b| d2(&a.1).total_cmp(&d2(&b.1)))
+                    .map_or(m.first_tet, |c| c.0);
+                out.push(best);
+            }
+        }
+    }
+    out
 }
 
 impl ProbeGpuData {
@@ -225,20 +268,36 @@ impl ProbeGpuData {
                 tets: m.tets.len() as u32,
                 lo: mlo,
                 hi: mhi,
+                start_grid: 0,
             });
         }
 
         let tet_offset = tile_map.len();
         let adj_offset = tet_offset + tets.len();
         let mesh_offset = adj_offset + adjacency.len();
+        let cells = START_CELLS * START_CELLS * START_CELLS;
+        let grids_offset = mesh_offset + MESH_WORDS * meshes.len();
+        let mut start_grids = Vec::with_capacity(cells * meshes.len());
+        for (k, m) in meshes.iter_mut().enumerate() {
+            m.start_grid = (grids_offset + k * cells) as u32;
+            start_grids.extend(start_grid(m, &tets, &positions));
+        }
         let mut topology = tile_map;
         topology.extend(tets);
         topology.extend(adjacency);
         for m in &meshes {
             topology.extend(m.lo.map(f32::to_bits));
             topology.extend(m.hi.map(f32::to_bits));
-            topology.extend([m.first_tet, m.tets, m.first_probe, m.probes, 0, 0]);
+            topology.extend([
+                m.first_tet,
+                m.tets,
+                m.first_probe,
+                m.probes,
+                m.start_grid,
+                0,
+            ]);
         }
+        topology.extend(start_grids);
         let mut flags = 0;
         if !positions.is_empty() {
             flags |= PROBES_PRESENT;

@@ -1,8 +1,10 @@
 #define_import_path hikari::irradiance_probes
 
 // Irradiance from the relit probes at a surface point: the tetrahedral mesh that holds the
-// point (found by walking adjacency from the mesh's first tetrahedron), else the grid
-// (bilinear over columns, linear between layers); probe weights scaled by the interior mask
+// point (found by walking adjacency from the tetrahedron of the mesh's start grid nearest the
+// point), blended with the grid over PROBE_BLEND_MARGIN metres inside the mesh's bounds (the
+// mesh's weight falls linearly to 0 at the bounds), else the grid (bilinear over columns,
+// linear between layers); probe weights scaled by the interior mask
 // (w for interior probes, 1 - w for exterior ones) and renormalised, or left as they are when
 // that leaves nothing. Binding set `irradiance_probes` (`ProbesFrame::lookup`); layout of the
 // buffers in gpu_data.rs. CPU twin: reference::irradiance_at.
@@ -31,6 +33,9 @@ const PROBE_TILE_SIDE: u32 = 16u;
 const PROBE_COLUMNS: u32 = 256u;
 const PROBE_MAX_WALK: u32 = 256u;
 const PROBE_INSIDE_EPSILON: f32 = 1e-5;
+// reference::BLEND_MARGIN_M and gpu_data::START_CELLS.
+const PROBE_BLEND_MARGIN: f32 = 1.0;
+const PROBE_START_CELLS: f32 = 4.0;
 
 // Weighted sums of probe irradiance, with and without the interior mask.
 struct ProbeSum {
@@ -63,6 +68,15 @@ fn probe_add(s: ProbeSum, probe: u32, w: f32, n: vec3<f32>, mask: f32) -> ProbeS
     return out;
 }
 
+// The masked, renormalised mean of a sum; the plain one where the mask leaves nothing; 0 for
+// an empty sum.
+fn probe_resolve(s: ProbeSum) -> vec3<f32> {
+    if s.plain_w <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    return select(s.plain / s.plain_w, s.masked / s.masked_w, s.masked_w > 1e-6);
+}
+
 fn probe_position(probe: u32) -> vec3<f32> {
     return probe_positions[probe].xyz;
 }
@@ -85,15 +99,20 @@ fn probe_barycentrics(t: u32, p: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(b0, b1, b2, 1.0 - b0 - b1 - b2);
 }
 
-// Adds mesh m's probes around p to s; false when the mesh does not hold p.
-fn probe_mesh_sum(m: u32, p: vec3<f32>, n: vec3<f32>, mask: f32, s: ptr<function, ProbeSum>) -> bool {
+// Adds mesh m's probes around p to s; returns the mesh's blend weight (1 without a grid), or -1
+// when the mesh does not hold p.
+fn probe_mesh_sum(m: u32, p: vec3<f32>, n: vec3<f32>, mask: f32, has_grid: bool, s: ptr<function, ProbeSum>) -> f32 {
     let mo = probe_params.topology.w + 12u * m;
     let lo = vec3<f32>(bitcast<f32>(probe_topology[mo]), bitcast<f32>(probe_topology[mo + 1u]), bitcast<f32>(probe_topology[mo + 2u]));
     let hi = vec3<f32>(bitcast<f32>(probe_topology[mo + 3u]), bitcast<f32>(probe_topology[mo + 4u]), bitcast<f32>(probe_topology[mo + 5u]));
     if probe_topology[mo + 7u] == 0u || any(p < lo) || any(p > hi) {
-        return false;
+        return -1.0;
     }
-    var t = probe_topology[mo + 6u];
+    let cell = vec3<u32>(clamp((p - lo) / max(hi - lo, vec3<f32>(1e-6)) * PROBE_START_CELLS, vec3<f32>(0.0), vec3<f32>(PROBE_START_CELLS - 1.0)));
+    let cells = u32(PROBE_START_CELLS);
+    var t = probe_topology[probe_topology[mo + 10u] + cell.x + cells * (cell.y + cells * cell.z)];
+    let d = min(p - lo, hi - p);
+    let a = select(1.0, clamp(min(d.x, min(d.y, d.z)) / PROBE_BLEND_MARGIN, 0.0, 1.0), has_grid);
     for (var step = 0u; step < PROBE_MAX_WALK; step++) {
         let b = probe_barycentrics(t, p);
         // The first smallest coordinate, as the twin picks it.
@@ -110,19 +129,20 @@ fn probe_mesh_sum(m: u32, p: vec3<f32>, n: vec3<f32>, mask: f32, s: ptr<function
             acc = probe_add(acc, probe_topology[o + 2u], max(b.z, 0.0), n, mask);
             acc = probe_add(acc, probe_topology[o + 3u], max(b.w, 0.0), n, mask);
             *s = acc;
-            return true;
+            return a;
         }
         let next = probe_topology[probe_params.topology.z + 4u * t + k];
         if next == PROBE_NONE {
-            return false;
+            return -1.0;
         }
         t = next;
     }
-    return false;
+    return -1.0;
 }
 
-fn probe_grid_sum(p: vec3<f32>, n: vec3<f32>, mask: f32) -> ProbeSum {
-    var s = ProbeSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0);
+// Adds the grid's probes around p to s, their weights times `scale`.
+fn probe_grid_sum(p: vec3<f32>, n: vec3<f32>, mask: f32, scale: f32, acc: ptr<function, ProbeSum>) {
+    var s = *acc;
     let cols = vec2<f32>(probe_params.grid_size.xy);
     let g = (p.xz - probe_params.grid.xy) / probe_params.grid.z;
     let gc = clamp(g, vec2<f32>(0.0), cols - 1.0);
@@ -146,10 +166,10 @@ fn probe_grid_sum(p: vec3<f32>, n: vec3<f32>, mask: f32) -> ProbeSum {
         let hb = probe_positions[col + (upper + 1u) * PROBE_COLUMNS].y;
         let t = clamp((p.y - ha) / max(hb - ha, 1e-4), 0.0, 1.0);
         let base = col + upper * PROBE_COLUMNS;
-        s = probe_add(s, base, wx * wz * (1.0 - t), n, mask);
-        s = probe_add(s, base + PROBE_COLUMNS, wx * wz * t, n, mask);
+        s = probe_add(s, base, wx * wz * (1.0 - t) * scale, n, mask);
+        s = probe_add(s, base + PROBE_COLUMNS, wx * wz * t * scale, n, mask);
     }
-    return s;
+    *acc = s;
 }
 
 // Irradiance (lux, rgb) at world position p on a surface with unit normal n and interior mask
@@ -160,17 +180,26 @@ fn probe_irradiance_at(p: vec3<f32>, n: vec3<f32>, interior: f32) -> vec4<f32> {
         return vec4<f32>(0.0);
     }
     let mask = select(0.5, clamp(interior, 0.0, 1.0), (flags & PROBES_INTERIOR_MASK) != 0u);
-    var s = ProbeSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0);
-    var found = false;
-    for (var m = 0u; m < probe_params.topology.x && !found; m++) {
-        found = probe_mesh_sum(m, p, n, mask, &s);
+    // The mesh's and the grid's sums are masked and renormalised each on its own, then
+    // blended: continuous across the mesh's bounds whatever the mask (reference::blended_weights).
+    var ms = ProbeSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0);
+    var gs = ProbeSum(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), 0.0);
+    let has_grid = (flags & PROBES_GRID) != 0u;
+    var a = -1.0;
+    for (var m = 0u; m < probe_params.topology.x && a < 0.0; m++) {
+        a = probe_mesh_sum(m, p, n, mask, has_grid, &ms);
     }
-    if !found && (flags & PROBES_GRID) != 0u {
-        s = probe_grid_sum(p, n, mask);
+    if a < 1.0 && has_grid {
+        probe_grid_sum(p, n, mask, 1.0, &gs);
     }
-    if s.plain_w <= 0.0 {
+    if gs.plain_w <= 0.0 {
+        a = select(a, 1.0, a >= 0.0);
+    }
+    a = max(a, 0.0);
+    let covered = (a > 0.0 && ms.plain_w > 0.0) || (a < 1.0 && gs.plain_w > 0.0);
+    if !covered {
         return vec4<f32>(0.0);
     }
-    let e = select(s.plain / s.plain_w, s.masked / s.masked_w, s.masked_w > 1e-6);
+    let e = a * probe_resolve(ms) + (1.0 - a) * probe_resolve(gs);
     return vec4<f32>(max(e, vec3<f32>(0.0)) * probe_params.grid.w, 1.0);
 }

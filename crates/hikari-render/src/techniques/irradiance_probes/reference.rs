@@ -7,7 +7,8 @@ use hikari_math::sh::product::product_l2_mono;
 use hikari_math::sh::{Sh, ShL2, ShL2Rgb, basis, window, zonal};
 
 use super::gpu_data::{
-    COLUMNS, NO_TILE, PROBES_GRID, PROBES_INTERIOR_MASK, PROBES_PRESENT, ProbeGpuData, TILE_SIDE,
+    COLUMNS, MeshSlot, NO_TILE, PROBES_GRID, PROBES_INTERIOR_MASK, PROBES_PRESENT, ProbeGpuData,
+    START_CELLS, TILE_SIDE,
 };
 use super::{RELIGHT_BOOST, RELIGHT_BOUNCE, RELIGHT_DERING, RELIGHT_SUN_BOUNCE, RelightParams};
 use hikari_probes::HULL;
@@ -21,6 +22,10 @@ pub const MAX_WALK_STEPS: u32 = 256;
 
 /// A point is inside a tetrahedron when no barycentric coordinate is below this.
 pub const INSIDE_EPSILON: f32 = 1e-5;
+
+/// Metres inside a tetrahedral mesh's bounds over which its weight rises from 0 (at the
+/// bounds) to 1; the grid takes the rest ([`mesh_blend_weight`]).
+pub const BLEND_MARGIN_M: f32 = 1.0;
 
 /// Radiance SH of the sun's (or moon's) light bounced by an imaginary ground and an imaginary
 /// wall facing the light, as seen by a probe whose mean bounced visibility (relative to a
@@ -114,17 +119,32 @@ pub fn barycentrics(data: &ProbeGpuData, t: u32, p: Vec3) -> Option<[f32; 4]> {
     Some([b0, b1, b2, 1.0 - b0 - b1 - b2])
 }
 
+/// The start-grid cell of `p` in `mesh` (x fastest), as `lookup.wgsl` computes it.
+pub fn start_cell(mesh: &MeshSlot, p: Vec3) -> usize {
+    let n = START_CELLS as f32;
+    let c: [usize; 3] = std::array::from_fn(|a| {
+        let ext = (mesh.hi[a] - mesh.lo[a]).max(1e-6);
+        ((p[a] - mesh.lo[a]) / ext * n).clamp(0.0, n - 1.0) as usize
+    });
+    c[0] + START_CELLS * (c[1] + START_CELLS * c[2])
+}
+
 /// The tetrahedron of mesh `m` holding `p` and its barycentrics, found by walking from the
-/// mesh's first tetrahedron across the face opposite the most negative coordinate; `None`
-/// when the walk leaves the mesh (or `p` is outside the mesh's bounds).
+/// start grid's tetrahedron of `p`'s cell across the face opposite the most negative
+/// coordinate; `None` when the walk leaves the mesh (or `p` is outside the mesh's bounds).
 pub fn locate(data: &ProbeGpuData, m: usize, p: Vec3) -> Option<(u32, [f32; 4])> {
+    locate_counting(data, m, p).0
+}
+
+/// [`locate`], and the steps its walk took.
+pub fn locate_counting(data: &ProbeGpuData, m: usize, p: Vec3) -> (Option<(u32, [f32; 4])>, u32) {
     let mesh = &data.meshes[m];
     if mesh.tets == 0 || (0..3).any(|a| p[a] < mesh.lo[a] || p[a] > mesh.hi[a]) {
-        return None;
+        return (None, 0);
     }
     let adj = data.params.topology[2] as usize;
-    let mut t = mesh.first_tet;
-    for _ in 0..MAX_WALK_STEPS {
+    let mut t = data.topology[mesh.start_grid as usize + start_cell(mesh, p)];
+    for step in 0..MAX_WALK_STEPS {
         let b = barycentrics(data, t, p).unwrap_or([-1.0, 0.0, 0.0, 0.0]);
         let (k, min) =
             b.iter().enumerate().fold(
@@ -132,15 +152,37 @@ pub fn locate(data: &ProbeGpuData, m: usize, p: Vec3) -> Option<(u32, [f32; 4])>
                 |acc, (k, &x)| if x < acc.1 { (k, x) } else { acc },
             );
         if min >= -INSIDE_EPSILON {
-            return Some((t, b));
+            return (Some((t, b)), step + 1);
         }
         let next = data.topology[adj + 4 * t as usize + k];
         if next == HULL {
-            return None;
+            return (None, step + 1);
         }
         t = next;
     }
-    None
+    (None, MAX_WALK_STEPS)
+}
+
+/// Mesh `m`'s barycentric weights of its probes at `p` (negative ones as 0); `None` where the
+/// mesh does not hold `p`.
+pub fn mesh_weights(data: &ProbeGpuData, m: usize, p: Vec3) -> Option<Vec<(u32, f32)>> {
+    let (t, b) = locate(data, m, p)?;
+    let off = data.params.topology[1] as usize + 4 * t as usize;
+    Some(
+        (0..4)
+            .map(|k| (data.topology[off + k], b[k].max(0.0)))
+            .collect(),
+    )
+}
+
+/// The weight of a mesh's own probes at `p` inside its bounds: the distance to the nearest
+/// face of the bounds over [`BLEND_MARGIN_M`], clamped to 1; the grid gets the rest, so the
+/// light is continuous where the mesh ends.
+pub fn mesh_blend_weight(mesh: &MeshSlot, p: Vec3) -> f32 {
+    let d = (0..3)
+        .map(|a| (p[a] - mesh.lo[a]).min(mesh.hi[a] - p[a]))
+        .fold(f32::MAX, f32::min);
+    (d / BLEND_MARGIN_M).clamp(0.0, 1.0)
 }
 
 /// Probe weights by the interior mask `mask`: each weight times `mask` for interior probes and
@@ -216,18 +258,81 @@ pub fn grid_weights(data: &ProbeGpuData, p: Vec3) -> Vec<(u32, f32)> {
     out
 }
 
-/// The probes and weights that light a point at `p`: the first mesh that holds it, else the
-/// grid; empty where no probe covers it.
-pub fn lookup_weights(data: &ProbeGpuData, p: Vec3) -> Vec<(u32, f32)> {
+/// The parts of the lookup at `p`: the first mesh holding `p` (its barycentric weights, and
+/// its blend weight: [`mesh_blend_weight`], 1 when there is no grid) and the grid's weights
+/// where the mesh leaves the grid a share (or holds nothing).
+pub struct LookupParts {
+    pub mesh: Vec<(u32, f32)>,
+    pub mesh_weight: f32,
+    pub grid: Vec<(u32, f32)>,
+}
+
+pub fn lookup_parts(data: &ProbeGpuData, p: Vec3) -> LookupParts {
+    let has_grid = data.params.grid_size[3] & PROBES_GRID != 0;
     for m in 0..data.meshes.len() {
-        if let Some((t, b)) = locate(data, m, p) {
-            let off = data.params.topology[1] as usize + 4 * t as usize;
-            return (0..4)
-                .map(|k| (data.topology[off + k], b[k].max(0.0)))
-                .collect();
+        if let Some(mesh) = mesh_weights(data, m, p) {
+            let a = if has_grid {
+                mesh_blend_weight(&data.meshes[m], p)
+            } else {
+                1.0
+            };
+            let grid = if a < 1.0 {
+                grid_weights(data, p)
+            } else {
+                Vec::new()
+            };
+            let a = if grid.iter().map(|x| x.1).sum::<f32>() > 0.0 {
+                a
+            } else {
+                1.0
+            };
+            return LookupParts {
+                mesh,
+                mesh_weight: a,
+                grid,
+            };
         }
     }
-    grid_weights(data, p)
+    LookupParts {
+        mesh: Vec::new(),
+        mesh_weight: 0.0,
+        grid: grid_weights(data, p),
+    }
+}
+
+/// The probes and (unmasked, unnormalised) weights that light a point at `p`: the mesh's times
+/// its blend weight and the grid's times the rest; empty where no probe covers it.
+pub fn lookup_weights(data: &ProbeGpuData, p: Vec3) -> Vec<(u32, f32)> {
+    let parts = lookup_parts(data, p);
+    let a = parts.mesh_weight;
+    let mut out: Vec<(u32, f32)> = parts.mesh.into_iter().map(|(k, w)| (k, w * a)).collect();
+    out.extend(parts.grid.into_iter().map(|(k, w)| (k, w * (1.0 - a))));
+    out
+}
+
+/// The weights the lookup uses at `p` with interior mask `mask`: the mesh's and the grid's
+/// each masked and renormalised ([`masked_weights`]) on their own, then blended (so the blend
+/// stays continuous however the mask weighs either side); empty where no probe covers `p`.
+pub fn blended_weights(data: &ProbeGpuData, p: Vec3, mask: f32) -> Vec<(u32, f32)> {
+    let parts = lookup_parts(data, p);
+    let a = parts.mesh_weight;
+    let total = |w: &[(u32, f32)]| w.iter().map(|x| x.1).sum::<f32>();
+    let mut out = Vec::new();
+    if a > 0.0 && total(&parts.mesh) > 0.0 {
+        out.extend(
+            masked_weights(&parts.mesh, data, mask)
+                .into_iter()
+                .map(|(k, w)| (k, w * a)),
+        );
+    }
+    if a < 1.0 && total(&parts.grid) > 0.0 {
+        out.extend(
+            masked_weights(&parts.grid, data, mask)
+                .into_iter()
+                .map(|(k, w)| (k, w * (1.0 - a))),
+        );
+    }
+    out
 }
 
 /// Irradiance at `p` on a surface with normal `n` and interior mask `mask` from the relit
@@ -244,15 +349,15 @@ pub fn irradiance_at(
     if params.grid_size[3] & PROBES_PRESENT == 0 {
         return None;
     }
-    let mut w = lookup_weights(data, p);
+    let mask = if params.grid_size[3] & PROBES_INTERIOR_MASK != 0 {
+        mask
+    } else {
+        0.5
+    };
+    let w = blended_weights(data, p, mask);
     if w.iter().map(|x| x.1).sum::<f32>() <= 0.0 {
         return None;
     }
-    w = if params.grid_size[3] & PROBES_INTERIOR_MASK != 0 {
-        masked_weights(&w, data, mask)
-    } else {
-        masked_weights(&w, data, 0.5)
-    };
     let e: Vec3 = w
         .iter()
         .map(|&(k, wk)| irradiance[k as usize].eval(n) * wk)
