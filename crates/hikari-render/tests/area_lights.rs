@@ -703,3 +703,44 @@ fn gpu_irradiance_of_a_square_light_matches_the_closed_form() {
     }
     println!("worst relative error {worst:e}");
 }
+
+/// The area lights' reach (beyond which the shader culls them per tile and the twin per pixel)
+/// must be where a light's illuminance has fallen below the cut-off, in any direction, and not
+/// far beyond it on the light's axis (the bound L A / (d - r)^2 tends to the far-field law).
+#[test]
+fn an_area_light_brings_less_than_the_cut_off_beyond_its_reach() {
+    let nits = 1000.0f32;
+    for &(side, cutoff) in &[(0.1f32, 0.01f32), (2.0, 0.01), (2.0, 100.0), (0.5, 5.0)] {
+        let s = side as f64 * 0.5;
+        let area = side * side;
+        let params = AreaLightParams {
+            values: [0.0, 0.0, cutoff, 0.0],
+            ..Default::default()
+        };
+        let light = area_lights::AreaLightGpu {
+            centroid_radius: [0.0, 0.0, 0.0, side * std::f32::consts::FRAC_1_SQRT_2],
+            normal_area: [0.0, -1.0, 0.0, area],
+            radiance_flux: [nits, nits, nits, std::f32::consts::PI * nits * area],
+            range: [0; 4],
+        };
+        let reach = reference::area_light_reach(&params, &light) as f64;
+        // On the axis, facing the light: the closed form.
+        let on_axis = nits as f64 * rectangle_closed_form(-s, s, -s, s, reach);
+        assert!(
+            on_axis <= cutoff as f64 && on_axis > 0.5 * cutoff as f64,
+            "side {side} m, cut-off {cutoff} lux: {on_axis} lux on the axis at the reach {reach} m"
+        );
+        // Elsewhere below the light at the same distance, facing its centre.
+        for &(x, z) in &[(0.5, 0.0), (0.7, 0.7), (-0.2, 0.9), (0.99, -0.1)] {
+            let y = -(1.0f64 - x * x - z * z).max(0.0).sqrt();
+            let p = DVec3::new(x, y, z).normalize() * reach;
+            let q = rectangle(-s, s, -s, s, 0.0, p);
+            let e = nits as f64
+                * reference::polygon_vector_irradiance(&q, -p.normalize()).dot(-p.normalize());
+            assert!(
+                e <= cutoff as f64,
+                "side {side} m, cut-off {cutoff} lux: {e} lux at {p} (reach {reach} m)"
+            );
+        }
+    }
+}

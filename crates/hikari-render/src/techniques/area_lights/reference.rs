@@ -196,6 +196,11 @@ pub fn shade_with_lux(
             {
                 continue;
             }
+            // Beyond the distance where its illuminance must be below the cut-off (the
+            // shader culls per tile with the same bound).
+            if to_c.length() >= area_light_reach(p, l) {
+                continue;
+            }
             let s = l.radiance_flux[3] / to_c.length_squared().max(r * r);
             if s > 0.0 {
                 scored.push((s, i));
@@ -243,6 +248,14 @@ pub fn shade_with_lux(
     }
     let lux = if lux >= 0.0 { lux.min(65000.0) } else { 0.0 };
     (clamp(out), lux)
+}
+
+/// Distance (m) from an area light's centroid beyond which it brings less than the frame's
+/// cut-off (lux, `p.values[2]`): no point of it is nearer than d − r, and it brings at most
+/// L A / (d − r)².
+pub fn area_light_reach(p: &AreaLightParams, l: &super::AreaLightGpu) -> f32 {
+    let peak = luminance(v3(l.radiance_flux)) * l.normal_area[3];
+    l.centroid_radius[3] + (peak.max(0.0) / p.values[2]).sqrt()
 }
 
 /// The deferred lighting's point and spot attenuation (`direct_lighting::reference`), with

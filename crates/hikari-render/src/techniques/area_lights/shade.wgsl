@@ -7,6 +7,9 @@
 // points sampled by area on the light, each weighted by its unshadowed integrand. Point and spot
 // lights: as the deferred lighting shades them, the brightest few per pixel times the fraction
 // of shadow rays to a disc of the light's radius that reach it. Rays: hikari::bvh.
+// Lights are culled per 16x16 tile against the bounds of the surfaces it sees (hikari::
+// tile_bounds): a point or spot light beyond its range, an area light beyond the distance where
+// its illuminance must fall below the frame's cut-off or wholly behind its one-sided plane.
 // Output: radiance in nits (rgb) and the illuminance in lux these lights bring to the surface,
 // shadowed (a), for the exposure meter. CPU twin: area_lights::reference.
 
@@ -15,6 +18,7 @@
 #import hikari::brdf::{BrdfMaterial, BrdfView, brdf_view, brdf_light_weights, brdf_apply_weights}
 #import hikari::scene_gpu::LightGpu
 #import hikari::bvh::{Ray, bvh_occluded}
+#import hikari::tile_bounds::{TileBounds, tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 
 struct AreaLightParams {
     // x: area lights; y: AREA_* flags; z: frame index; w: point and spot lights.
@@ -49,6 +53,10 @@ const MAX_PER_PIXEL: u32 = 8u;
 const NONE: u32 = 0xffffffffu;
 const PI: f32 = 3.14159265358979;
 const MAX_RADIANCE: f32 = 65000.0;
+// Lights of each kind listed per tile at most; the rest are left out there (as the deferred
+// lighting's tiles do).
+const TILE_LIGHTS: u32 = 256u;
+const TILE_THREADS: u32 = 256u;
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: AreaLightParams;
@@ -60,6 +68,15 @@ const MAX_RADIANCE: f32 = 65000.0;
 @group(0) @binding(7) var<storage, read> area_triangles: array<AreaTriangleGpu>;
 @group(0) @binding(8) var<storage, read> lights: array<LightGpu>;
 @group(0) @binding(9) var out_radiance: texture_storage_2d<rgba16float, write>;
+
+// The lights that may reach the tile, in index order (so that the per-pixel selection breaks
+// ties and sums as over all lights): chunks of 256 lights are tested one per invocation into
+// bit masks (words 0-7 point and spot, 8-15 area), which 16 invocations then append.
+var<workgroup> chunk_mask: array<atomic<u32>, 16>;
+var<workgroup> tile_punctual: array<u32, TILE_LIGHTS>;
+var<workgroup> tile_area: array<u32, TILE_LIGHTS>;
+// Listed point and spot lights (x) and area lights (y), possibly past TILE_LIGHTS.
+var<workgroup> tile_counts: vec2<u32>;
 
 // The sample pattern: Roberts's R2 sequence, shifted per pixel by interleaved gradient noise
 // (Jimenez 2014) and per frame by one random rotation shared by every pixel.
@@ -135,6 +152,133 @@ fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
         a *= s * s;
     }
     return a;
+}
+
+// Distance (m) from an area light's centroid beyond which its illuminance is below the frame's
+// cut-off (lux): no point of it is nearer than d - r, and each triangle brings at most
+// L A_tri / d_min^2, so E <= L A / (d - r)^2.
+fn area_light_reach(light: AreaLightGpu) -> f32 {
+    let peak = luminance(light.radiance_flux.rgb) * light.normal_area.w;
+    return light.centroid_radius.w + sqrt(max(peak, 0.0) / params.values.z);
+}
+
+// Whether area light `i` can light a surface at `lo..hi` (a point, or a tile's bounds): bright
+// enough to be a light, within its reach, not wholly behind its one-sided plane.
+fn area_light_reaches(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    let light = area_lights[i];
+    if light.radiance_flux.w < params.values.x && (light.range.z & AREA_LIGHT_FORCED) == 0u {
+        return false;
+    }
+    let c = light.centroid_radius.xyz;
+    let reach = area_light_reach(light);
+    if tile_bounds_distance2(TileBounds(lo, hi), c) >= reach * reach {
+        return false;
+    }
+    // The box's corner furthest in front of the plane.
+    let nl = light.normal_area.xyz;
+    let front = select(lo, hi, nl > vec3<f32>(0.0));
+    let r = light.centroid_radius.w;
+    return (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u || length(nl) <= 0.99 || dot(front - c, nl) >= -r;
+}
+
+fn punctual_light_reaches(i: u32, b: TileBounds) -> bool {
+    let range = light_range(lights[i]);
+    return tile_bounds_distance2(b, lights[i].position_range.xyz) < range * range;
+}
+
+// Lists the lights that may reach the tile `b` (see tile_punctual). Every invocation calls it.
+fn cull_lights(lid: u32, b: TileBounds) {
+    if lid == 0u {
+        tile_counts = vec2<u32>(0u);
+    }
+    let flags = params.config.y;
+    let np = select(0u, params.config.w, (flags & AREA_PUNCTUAL) != 0u);
+    let na = select(0u, params.config.x, (flags & AREA_POLYGONS) != 0u);
+    let seen = b.lo.x <= b.hi.x;
+    for (var base = 0u; base < max(np, na); base += TILE_THREADS) {
+        if lid < 16u {
+            atomicStore(&chunk_mask[lid], 0u);
+        }
+        workgroupBarrier();
+        let i = base + lid;
+        let bit = 1u << (lid % 32u);
+        if seen && i < np && punctual_light_reaches(i, b) {
+            atomicOr(&chunk_mask[lid / 32u], bit);
+        }
+        if seen && i < na && area_light_reaches(i, b.lo, b.hi) {
+            atomicOr(&chunk_mask[8u + lid / 32u], bit);
+        }
+        workgroupBarrier();
+        if lid < 16u {
+            let kind = lid / 8u;
+            var at = tile_counts[kind];
+            for (var k = kind * 8u; k < lid; k++) {
+                at += countOneBits(atomicLoad(&chunk_mask[k]));
+            }
+            var bits = atomicLoad(&chunk_mask[lid]);
+            while bits != 0u {
+                let id = base + (lid % 8u) * 32u + firstTrailingBit(bits);
+                bits &= bits - 1u;
+                if at < TILE_LIGHTS {
+                    if kind == 0u {
+                        tile_punctual[at] = id;
+                    } else {
+                        tile_area[at] = id;
+                    }
+                }
+                at++;
+            }
+        }
+        workgroupBarrier();
+        if lid == 0u {
+            var added = vec2<u32>(0u);
+            for (var k = 0u; k < 8u; k++) {
+                added += vec2<u32>(countOneBits(atomicLoad(&chunk_mask[k])), countOneBits(atomicLoad(&chunk_mask[8u + k])));
+            }
+            tile_counts += added;
+        }
+        workgroupBarrier();
+    }
+}
+
+// Inserts light `id` of score `s` into the list of the `keep` best, largest first (ties keep
+// the earlier light). The loops run to the constant MAX_PER_PIXEL so that the compiler unrolls
+// them and keeps the arrays in registers: indexed by a variable, lavapipe puts them in memory.
+fn insert_best(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, score: ptr<function, array<f32, MAX_PER_PIXEL>>, keep: u32, id_in: u32, s_in: f32) {
+    var s = s_in;
+    var id = id_in;
+    for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+        if k < keep && s > (*score)[k] {
+            let ts = (*score)[k];
+            let ti = (*sel)[k];
+            (*score)[k] = s;
+            (*sel)[k] = id;
+            s = ts;
+            id = ti;
+        }
+    }
+}
+
+// Entry `k` of `sel`, through a constant-bound loop (see insert_best).
+fn pick(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, k: u32) -> u32 {
+    var id = NONE;
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            id = (*sel)[j];
+        }
+    }
+    return id;
+}
+
+// The slot of light `i` in `sel` among its first `keep`, or NONE.
+fn slot_of(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, keep: u32, i: u32) -> u32 {
+    var slot = NONE;
+    for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+        if k < keep && (*sel)[k] == i && slot == NONE {
+            slot = k;
+        }
+    }
+    return slot;
 }
 
 fn orthonormal(n: vec3<f32>) -> vec3<f32> {
@@ -330,38 +474,24 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             sel[k] = NONE;
             score[k] = 0.0;
         }
-        for (var i = 0u; i < params.config.x; i++) {
+        let listed = min(tile_counts.y, TILE_LIGHTS);
+        for (var t = 0u; t < listed; t++) {
+            let i = tile_area[t];
             let light = area_lights[i];
-            if light.radiance_flux.w < params.values.x && (light.range.z & AREA_LIGHT_FORCED) == 0u {
-                continue;
-            }
             let to_c = light.centroid_radius.xyz - world;
             let r = light.centroid_radius.w;
-            // Wholly below the horizon, or wholly behind a one-sided light's mean plane.
-            if dot(to_c, n) < -r {
+            // Wholly below the horizon; or out of reach or behind at this very point.
+            if dot(to_c, n) < -r || !area_light_reaches(i, world, world) {
                 continue;
             }
-            if (light.range.z & AREA_LIGHT_DOUBLE_SIDED) == 0u && length(light.normal_area.xyz) > 0.99 && dot(-to_c, light.normal_area.xyz) < -r {
-                continue;
-            }
-            var s = light.radiance_flux.w / max(dot(to_c, to_c), r * r);
-            var id = i;
-            for (var k = 0u; k < keep; k++) {
-                if s > score[k] {
-                    let ts = score[k];
-                    let ti = sel[k];
-                    score[k] = s;
-                    sel[k] = id;
-                    s = ts;
-                    id = ti;
-                }
-            }
+            insert_best(&sel, &score, keep, i, light.radiance_flux.w / max(dot(to_c, to_c), r * r));
         }
         for (var k = 0u; k < keep; k++) {
-            if sel[k] == NONE {
+            let id = pick(&sel, k);
+            if id == NONE {
                 break;
             }
-            shade_area_light(sel[k], k, pixel, world, origin, n, v, brdf);
+            shade_area_light(id, k, pixel, world, origin, n, v, brdf);
         }
     }
 
@@ -373,25 +503,20 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             sel[k] = NONE;
             score[k] = 0.0;
         }
-        for (var i = 0u; i < params.config.w; i++) {
-            let light = lights[i];
-            let to_light = light.position_range.xyz - world;
-            let d2 = dot(to_light, to_light);
-            let l = to_light * inverseSqrt(max(d2, 1e-8));
-            var s = luminance(light.intensity.rgb) * light_attenuation(light, l, d2) * max(dot(n, l), 0.0);
-            var id = i;
-            for (var k = 0u; k < keep; k++) {
-                if s > score[k] {
-                    let ts = score[k];
-                    let ti = sel[k];
-                    score[k] = s;
-                    sel[k] = id;
-                    s = ts;
-                    id = ti;
-                }
+        let listed = min(tile_counts.x, TILE_LIGHTS);
+        if keep > 0u {
+            for (var t = 0u; t < listed; t++) {
+                let i = tile_punctual[t];
+                let light = lights[i];
+                let to_light = light.position_range.xyz - world;
+                let d2 = dot(to_light, to_light);
+                let l = to_light * inverseSqrt(max(d2, 1e-8));
+                let s = luminance(light.intensity.rgb) * light_attenuation(light, l, d2) * max(dot(n, l), 0.0);
+                insert_best(&sel, &score, keep, i, s);
             }
         }
-        for (var i = 0u; i < params.config.w; i++) {
+        for (var t = 0u; t < listed; t++) {
+            let i = tile_punctual[t];
             let light = lights[i];
             let to_light = light.position_range.xyz - world;
             let d2 = dot(to_light, to_light);
@@ -400,11 +525,9 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             if !(luminance(e) > 0.0) {
                 continue;
             }
-            for (var k = 0u; k < keep; k++) {
-                if sel[k] == i {
-                    e *= punctual_visibility(light, k, pixel, origin);
-                    break;
-                }
+            let slot = slot_of(&sel, keep, i);
+            if slot != NONE {
+                e *= punctual_visibility(light, slot, pixel, origin);
             }
             lux += luminance(e) * max(dot(n, l), 0.0);
             add_light(brdf_light_weights(brdf, l), e);
@@ -413,17 +536,40 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
     return brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
 }
 
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+@compute @workgroup_size(16, 16, 1)
+fn main(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
     let size = textureDimensions(out_radiance);
     let pixel = gid.xy;
-    if any(pixel >= size) {
+    let inside = all(pixel < size);
+    // No lights this frame (a uniform branch, before any barrier).
+    if params.config.y == 0u {
+        if inside {
+            textureStore(out_radiance, pixel, vec4<f32>(0.0));
+        }
+        return;
+    }
+    var d = 0.0;
+    var lo = vec3<f32>(TILE_BOUNDS_FAR);
+    var hi = vec3<f32>(-TILE_BOUNDS_FAR);
+    if inside {
+        d = textureLoad(depth, pixel, 0).r;
+        if d > 0.0 {
+            lo = world_from_depth(view, pixel, d);
+            hi = lo;
+        }
+    }
+    cull_lights(lid, tile_bounds(lid, lo, hi));
+    let listed = workgroupUniformLoad(&tile_counts);
+    if !inside {
         return;
     }
     var radiance = vec3<f32>(0.0);
     lux = 0.0;
-    let d = textureLoad(depth, pixel, 0).r;
-    if d > 0.0 && params.config.y != 0u {
+    // Tiles no light reaches (and the sky) skip the shading.
+    if d > 0.0 && listed.x + listed.y > 0u {
         radiance = shade(pixel, d);
     }
     // NaN fails every comparison, so this also turns NaN into 0.

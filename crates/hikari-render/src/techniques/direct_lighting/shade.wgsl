@@ -14,6 +14,7 @@
 #import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_specular}
 #import hikari::irradiance_probes::probe_irradiance_at
 #import hikari::rtgi_resolve::{rtgi_signal, rtgi_resolve_diffuse, rtgi_resolve_specular}
+#import hikari::tile_bounds::{tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 
 struct LightingParams {
     // xyz: unit vector towards the sun; w: illuminance in lux.
@@ -61,13 +62,8 @@ const LIGHTING_RTGI: u32 = 64u;
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
 const MAX_RADIANCE: f32 = 65000.0;
-const TILE: u32 = 16u;
 const MAX_TILE_LIGHTS: u32 = 256u;
 
-// Bounds of the tile's visible surfaces, reduced as a tree (contended shared atomics on six
-// addresses cost more than the lighting itself).
-var<workgroup> bounds_lo: array<vec3<f32>, 256>;
-var<workgroup> bounds_hi: array<vec3<f32>, 256>;
 var<workgroup> tile_count: atomic<u32>;
 // Rec.709 luminance weights, for the illuminance the exposure meters.
 const EXPOSURE_LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
@@ -75,7 +71,6 @@ const EXPOSURE_LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
 var<workgroup> tile_lights: array<u32, MAX_TILE_LIGHTS>;
 // 1 / range^2 of each listed light, found once a tile rather than once a pixel.
 var<workgroup> tile_inv_range2: array<f32, MAX_TILE_LIGHTS>;
-const FAR: f32 = 3.0e38;
 
 fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
     let t = clamp(dir.y, 0.0, 1.0);
@@ -132,8 +127,8 @@ fn main(
     }
     var d = 0.0;
     var world = vec3<f32>(0.0);
-    var lo = vec3<f32>(FAR);
-    var hi = vec3<f32>(-FAR);
+    var lo = vec3<f32>(TILE_BOUNDS_FAR);
+    var hi = vec3<f32>(-TILE_BOUNDS_FAR);
     if inside {
         d = textureLoad(depth, pixel, 0).r;
         if d > 0.0 {
@@ -142,28 +137,14 @@ fn main(
             hi = world;
         }
     }
-    bounds_lo[lid] = lo;
-    bounds_hi[lid] = hi;
-    workgroupBarrier();
-    for (var stride = TILE * TILE / 2u; stride > 0u; stride >>= 1u) {
-        if lid < stride {
-            bounds_lo[lid] = min(bounds_lo[lid], bounds_lo[lid + stride]);
-            bounds_hi[lid] = max(bounds_hi[lid], bounds_hi[lid + stride]);
-        }
-        workgroupBarrier();
-    }
+    let bounds = tile_bounds(lid, lo, hi);
 
     // Cull the lights against the bounds of the tile's visible surfaces.
     let light_count = select(0u, params.config.x, (params.config.y & LIGHTING_PUNCTUAL) != 0u);
-    let tile_lo = bounds_lo[0];
-    let tile_hi = bounds_hi[0];
-    if tile_lo.x <= tile_hi.x {
-        for (var i = lid; i < light_count; i += TILE * TILE) {
-            let lp = lights[i].position_range.xyz;
+    if bounds.lo.x <= bounds.hi.x {
+        for (var i = lid; i < light_count; i += 256u) {
             let range = light_range(lights[i]);
-            let nearest = clamp(lp, tile_lo, tile_hi);
-            let dd = nearest - lp;
-            if dot(dd, dd) < range * range {
+            if tile_bounds_distance2(bounds, lights[i].position_range.xyz) < range * range {
                 let slot = atomicAdd(&tile_count, 1u);
                 if slot < MAX_TILE_LIGHTS {
                     tile_lights[slot] = i;
