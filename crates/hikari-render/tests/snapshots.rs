@@ -121,6 +121,8 @@ impl Shot {
         // Snapshots of the frame without the sky, whose own tests are tests/sky.rs: the sky's
         // table build would dominate these tests' time on the CPU driver.
         settings.sky.enabled = false;
+        // Ray-traced GI is noisy frame to frame and has its own tests.
+        settings.ray_traced_gi.enabled = false;
         // Small maps keep the CPU driver fast; the cascades still cover the view.
         settings.sun_shadows.resolution = 512;
         Self {

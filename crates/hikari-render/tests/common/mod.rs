@@ -81,6 +81,9 @@ pub fn small_frame_settings(
     settings.sun_shadows.max_distance_m = 40.0;
     // The atmosphere has its own tests (tests/sky.rs); here the placeholders light the frame.
     settings.sky.enabled = false;
+    // Ray-traced GI has its own tests (tests/ray_traced_gi.rs, gi_validation.rs): here the
+    // frame's other techniques are checked against their twins, which leave it out.
+    settings.ray_traced_gi.enabled = false;
     hikari_render::FrameSettings {
         width: w,
         height: h,

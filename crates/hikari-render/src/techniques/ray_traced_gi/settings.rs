@@ -54,8 +54,7 @@ pub struct RayTracedGiSettings {
 impl Default for RayTracedGiSettings {
     fn default() -> Self {
         Self {
-            // Off until the deferred lighting resolves it (nothing reads it yet).
-            enabled: false,
+            enabled: true,
             pretrace: true,
             pretrace_step_px: 4.0,
             pretrace_max_steps: 16,
