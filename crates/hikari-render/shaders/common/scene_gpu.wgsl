@@ -45,6 +45,26 @@ struct LightGpu {
     spot: vec4<f32>,
 }
 
+// Where a punctual light's illuminance falls to `cutoff_lux`, or its own range if nearer.
+fn light_range(light: LightGpu, cutoff_lux: f32) -> f32 {
+    let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
+    return max(min(light.position_range.w, sqrt(peak / cutoff_lux)), 1e-3);
+}
+
+// Illuminance factor of a punctual light at 1 / distance^2 `inv_d2`, `x` = distance^2 /
+// range^2: inverse square (held below 1e4, a light 1 cm away), windowed to 0 at the range (the
+// smooth window glTF's KHR_lights_punctual recommends), times the spot cone; `l` is the unit
+// direction from the surface to the light.
+fn light_attenuation(light: LightGpu, l: vec3<f32>, inv_d2: f32, x: f32) -> f32 {
+    let window = clamp(1.0 - x * x, 0.0, 1.0);
+    var a = window * window * min(inv_d2, 1e4);
+    if light.direction_kind.w > 0.5 {
+        let s = clamp(dot(-l, light.direction_kind.xyz) * light.spot.x + light.spot.y, 0.0, 1.0);
+        a *= s * s;
+    }
+    return a;
+}
+
 const CHUNK_TRIANGLES: u32 = 64u;
 const NO_TEXTURE: u32 = 0xffffffffu;
 const INSTANCE_DOUBLE_SIDED: u32 = 1u;

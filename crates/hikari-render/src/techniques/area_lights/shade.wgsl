@@ -16,7 +16,7 @@
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
 #import hikari::brdf::{BrdfMaterial, BrdfView, brdf_view, brdf_light_weights, brdf_apply_weights}
-#import hikari::scene_gpu::LightGpu
+#import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::tile_bounds::{TileBounds, tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 
@@ -135,23 +135,11 @@ fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
-// Where a light's illuminance falls to the frame's cutoff, or its own range if nearer (as the
-// deferred lighting).
-fn light_range(light: LightGpu) -> f32 {
-    let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
-    return max(min(light.position_range.w, sqrt(peak / params.values.z)), 1e-3);
-}
-
-fn light_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
-    let range = light_range(light);
-    let x = d2 / (range * range);
-    let window = clamp(1.0 - x * x, 0.0, 1.0);
-    var a = window * window / max(d2, 1e-4);
-    if light.direction_kind.w > 0.5 {
-        let s = clamp(dot(-l, light.direction_kind.xyz) * light.spot.x + light.spot.y, 0.0, 1.0);
-        a *= s * s;
-    }
-    return a;
+// A punctual light's illuminance factor `d2` metres squared away in unit direction `l`
+// (surface to light), with the frame's cut-off (as the deferred lighting).
+fn punctual_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
+    let range = light_range(light, params.values.z);
+    return light_attenuation(light, l, 1.0 / max(d2, 1e-4), d2 / (range * range));
 }
 
 // Distance (m) from an area light's centroid beyond which its illuminance is below the frame's
@@ -182,7 +170,7 @@ fn area_light_reaches(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
 }
 
 fn punctual_light_reaches(i: u32, b: TileBounds) -> bool {
-    let range = light_range(lights[i]);
+    let range = light_range(lights[i], params.values.z);
     return tile_bounds_distance2(b, lights[i].position_range.xyz) < range * range;
 }
 
@@ -511,7 +499,7 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
                 let to_light = light.position_range.xyz - world;
                 let d2 = dot(to_light, to_light);
                 let l = to_light * inverseSqrt(max(d2, 1e-8));
-                let s = luminance(light.intensity.rgb) * light_attenuation(light, l, d2) * max(dot(n, l), 0.0);
+                let s = luminance(light.intensity.rgb) * punctual_attenuation(light, l, d2) * max(dot(n, l), 0.0);
                 insert_best(&sel, &score, keep, i, s);
             }
         }
@@ -521,7 +509,7 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             let to_light = light.position_range.xyz - world;
             let d2 = dot(to_light, to_light);
             let l = to_light * inverseSqrt(max(d2, 1e-8));
-            var e = light.intensity.rgb * light_attenuation(light, l, d2);
+            var e = light.intensity.rgb * punctual_attenuation(light, l, d2);
             if !(luminance(e) > 0.0) {
                 continue;
             }

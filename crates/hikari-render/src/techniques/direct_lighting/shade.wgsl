@@ -8,7 +8,7 @@
 #import hikari::view::{View, view_ray, world_from_depth}
 #import hikari::octahedral::oct_decode
 #import hikari::brdf::{BrdfMaterial, brdf_view, brdf_light_weights, brdf_apply_weights, brdf_fresnel_schlick, brdf_material_f0}
-#import hikari::scene_gpu::LightGpu
+#import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
 #import hikari::sky::sky_background
 #import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_specular}
@@ -94,26 +94,6 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
     return brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0)) * env;
 }
 
-// Where a light's illuminance falls to the frame's cutoff, or its own range if nearer.
-fn light_range(light: LightGpu) -> f32 {
-    let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
-    return max(min(light.position_range.w, sqrt(peak / params.cutoff.x)), 1e-3);
-}
-
-// Illuminance factor of a punctual light at 1 / distance^2 `inv_d2`, `x` = distance^2 /
-// range^2: inverse square (held below 1e4, a light 1 cm away), windowed to 0 at the range (the
-// smooth window glTF's KHR_lights_punctual recommends), times the spot cone.
-fn light_attenuation(light: LightGpu, l: vec3<f32>, inv_d2: f32, x: f32) -> f32 {
-    let window = max(1.0 - x * x, 0.0);
-    var a = window * window * min(inv_d2, 1e4);
-    if light.direction_kind.w > 0.5 {
-        let cos_angle = dot(-l, light.direction_kind.xyz);
-        let s = clamp(cos_angle * light.spot.x + light.spot.y, 0.0, 1.0);
-        a *= s * s;
-    }
-    return a;
-}
-
 @compute @workgroup_size(16, 16, 1)
 fn main(
     @builtin(global_invocation_id) gid: vec3<u32>,
@@ -143,7 +123,7 @@ fn main(
     let light_count = select(0u, params.config.x, (params.config.y & LIGHTING_PUNCTUAL) != 0u);
     if bounds.lo.x <= bounds.hi.x {
         for (var i = lid; i < light_count; i += 256u) {
-            let range = light_range(lights[i]);
+            let range = light_range(lights[i], params.cutoff.x);
             if tile_bounds_distance2(bounds, lights[i].position_range.xyz) < range * range {
                 let slot = atomicAdd(&tile_count, 1u);
                 if slot < MAX_TILE_LIGHTS {

@@ -10,7 +10,7 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::scene_gpu::LightGpu
+#import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sh::{ShYCoCg, shy_encode}
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::sky::sky_background_no_disks
@@ -148,17 +148,10 @@ fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             let light = lights[i];
             let to_light = light.position_range.xyz - x;
             let d2 = max(dot(to_light, to_light), 1e-8);
-            let peak = max(light.intensity.r, max(light.intensity.g, light.intensity.b));
-            let range = max(min(light.position_range.w, sqrt(peak / params.distances.w)), 1e-3);
-            let r = d2 / (range * range);
-            let window = max(1.0 - r * r, 0.0);
+            let range = light_range(light, params.distances.w);
             let dir = to_light * inverseSqrt(d2);
-            var a = window * window * min(1.0 / d2, 1e4) * max(dot(n, dir), 0.0);
-            if light.direction_kind.w > 0.5 {
-                let s = clamp(dot(-dir, light.direction_kind.xyz) * light.spot.x + light.spot.y, 0.0, 1.0);
-                a *= s * s;
-            }
-            e += light.intensity.rgb * a;
+            let a = light_attenuation(light, dir, 1.0 / d2, d2 / (range * range));
+            e += light.intensity.rgb * (a * max(dot(n, dir), 0.0));
         }
     }
     return e;
