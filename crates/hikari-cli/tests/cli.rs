@@ -3,26 +3,9 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-fn hikari(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hikari"))
-        .args(args)
-        .output()
-        .expect("run hikari")
-}
+mod common;
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hikari-cli-test-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use common::{hikari, text, tmp};
 
 #[test]
 fn render_writes_png_exr_and_dumps() {

@@ -1,29 +1,12 @@
 //! The grading workflow as a user runs it (`render --lut-screenshot`, `lut extract`,
 //! `lut apply`), and the final image's flags refusing bad input before anything is written.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-fn hikari(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hikari"))
-        .args(args)
-        .output()
-        .expect("run hikari")
-}
+mod common;
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hikari-tonemap-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
+use common::{hikari, text, tmp};
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
