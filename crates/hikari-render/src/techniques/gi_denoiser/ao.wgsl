@@ -7,7 +7,7 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -46,28 +46,8 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     p.ao = select(1.0, raw, p.ao_ok);
     let raw_history = textureLoad(history_tex, pixel, 0).x;
     p.keep = combine_weight(select(1.0, raw_history, is_finite_f(raw_history)), params.scales);
-    var sum = 0.0;
-    var sum_sq = 0.0;
-    var count = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
-            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
-                continue;
-            }
-            let v = textureLoad(ao_tex, q, 0).x;
-            if is_finite_f(v) {
-                sum += v;
-                sum_sq += v * v;
-                count += 1.0;
-            }
-        }
-    }
-    p.variance_scale = radius_scale_variance(
-        sum / max(count, 1.0),
-        sum_sq / max(count, 1.0),
-        params.scales
-    );
+    let moments = moments_3x3(ao_tex, pixel, size);
+    p.variance_scale = radius_scale_variance(moments.x, moments.y, params.scales);
     return p;
 }
 

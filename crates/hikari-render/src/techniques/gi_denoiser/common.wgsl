@@ -39,6 +39,29 @@ fn is_finite4(v: vec4<f32>) -> bool {
     return all((bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u)) != vec4<u32>(0x7f800000u));
 }
 
+// E[x] and E[x^2] of the red channel over the 3x3 neighbourhood of `pixel`, finite texels
+// inside the image only (the variance input of F(variance)).
+fn moments_3x3(tex: texture_2d<f32>, pixel: vec2<u32>, size: vec2<u32>) -> vec2<f32> {
+    var sum = 0.0;
+    var sum_sq = 0.0;
+    var count = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
+            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+                continue;
+            }
+            let v = textureLoad(tex, q, 0).x;
+            if is_finite_f(v) {
+                sum += v;
+                sum_sq += v * v;
+                count += 1.0;
+            }
+        }
+    }
+    return vec2<f32>(sum, sum_sq) / max(count, 1.0);
+}
+
 // The helpers take the fields of GiDenoiserParams they need, not the struct: a copy of the
 // struct with its disk array could be spilled to local memory where the disk is indexed.
 

@@ -8,7 +8,7 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -47,25 +47,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
 
     // Variance of the luminance (the SH's c0) over 3x3, finite texels only.
-    var sum = 0.0;
-    var sum_sq = 0.0;
-    var count = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
-            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
-                continue;
-            }
-            let v = textureLoad(in_y, q, 0).x;
-            if is_finite_f(v) {
-                sum += v;
-                sum_sq += v * v;
-                count += 1.0;
-            }
-        }
-    }
-    let mean = sum / max(count, 1.0);
-    let mean_sq = sum_sq / max(count, 1.0);
+    let moments = moments_3x3(in_y, pixel, size);
 
     let raw_ao = textureLoad(ao_tex, pixel, 0).x;
     let ao = select(1.0, clamp(raw_ao, 0.0, 1.0), is_finite_f(raw_ao));
@@ -73,7 +55,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let history = select(1.0, raw_history, is_finite_f(raw_history));
 
     let scale = radius_scale_z(s.view_z, params.rotation.w)
-        * radius_scale_variance(mean, mean_sq, params.scales)
+        * radius_scale_variance(moments.x, moments.y, params.scales)
         * max(ao, params.scales.y);
     let radius = radius_pixels(params.radius.x * scale, s.view_z, params.radius, params.rotation);
     // Small radius, bigger step: fewer taps where the kernel covers fewer pixels.
