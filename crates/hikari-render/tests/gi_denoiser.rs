@@ -282,15 +282,19 @@ fn gi_image(
 
 /// Runs `frames` frames of the denoiser (the disk rotation changes each frame) and reads back
 /// the last one.
-fn run_gpu(
-    gpu: &Gpu,
-    settings: &GiDenoiserSettings,
-    scene: &Scene,
-    signal: &Signal,
-    frames: u64,
-) -> GpuOut {
+/// The denoiser's input textures for `scene` and `signal`.
+struct Inputs {
+    depth: wgpu::Texture,
+    normal: wgpu::Texture,
+    gi_y: wgpu::Texture,
+    gi_cocg: wgpu::Texture,
+    history: wgpu::Texture,
+    ao: wgpu::Texture,
+    hit: wgpu::Texture,
+}
+
+fn inputs(ctx: &GpuContext, scene: &Scene, signal: &Signal) -> Inputs {
     use wgpu::TextureFormat as F;
-    let ctx = &gpu.ctx;
     let (w, h) = (scene.geo.width, scene.geo.height);
     let tex = |format, data: &[u8]| common::texture_with_data(ctx, format, w, h, data);
     let depth = tex(F::R32Float, bytemuck::cast_slice(&scene.geo.depth));
@@ -315,6 +319,35 @@ fn run_gpu(
     let history = tex(F::R16Float, &halves(signal.history.iter().copied()));
     let ao = tex(F::R16Float, &halves(signal.ao.iter().copied()));
     let hit = tex(F::R16Float, &halves(vec![0.0; (w * h) as usize]));
+    Inputs {
+        depth,
+        normal,
+        gi_y,
+        gi_cocg,
+        history,
+        ao,
+        hit,
+    }
+}
+
+fn run_gpu(
+    gpu: &Gpu,
+    settings: &GiDenoiserSettings,
+    scene: &Scene,
+    signal: &Signal,
+    frames: u64,
+) -> GpuOut {
+    let ctx = &gpu.ctx;
+    let (w, h) = (scene.geo.width, scene.geo.height);
+    let Inputs {
+        depth,
+        normal,
+        gi_y,
+        gi_cocg,
+        history,
+        ao,
+        hit,
+    } = inputs(ctx, scene, signal);
 
     let mut rt = GraphRuntime::new();
     let mut dumps = Vec::new();
@@ -756,35 +789,20 @@ fn constant_input_comes_out_unchanged() {
 #[ignore = "a measurement, not a check: run by hand on the GPU it is for"]
 fn timing_at_2560x1440() {
     use hikari_render::graph::TimestampMode;
-    use wgpu::TextureFormat as F;
     let gpu = gpu();
     let (w, h) = (2560u32, 1440u32);
     let scene = mixed_scene_sized([w, h]);
     let signal = noisy_signal(&scene, 11, |rng| rng.random_range(1..=32) as f32);
     let ctx = &gpu.ctx;
-    let tex = |format, data: &[u8]| common::texture_with_data(ctx, format, w, h, data);
-    let depth = tex(F::R32Float, bytemuck::cast_slice(&scene.geo.depth));
-    let normal = tex(
-        F::Rgba16Float,
-        &halves(
-            scene
-                .geo
-                .normal_oct
-                .iter()
-                .flat_map(|o| [o.x, o.y, 0.0, 0.0]),
-        ),
-    );
-    let gi_y = tex(
-        F::Rgba16Float,
-        &halves(signal.gi.y.iter().flat_map(|v| v.to_array())),
-    );
-    let gi_cocg = tex(
-        F::Rg16Float,
-        &halves(signal.gi.cocg.iter().flat_map(|v| v.to_array())),
-    );
-    let history = tex(F::R16Float, &halves(signal.history.iter().copied()));
-    let ao = tex(F::R16Float, &halves(signal.ao.iter().copied()));
-    let hit = tex(F::R16Float, &halves(vec![0.0; (w * h) as usize]));
+    let Inputs {
+        depth,
+        normal,
+        gi_y,
+        gi_cocg,
+        history,
+        ao,
+        hit,
+    } = inputs(ctx, &scene, &signal);
     let mut rt = GraphRuntime::new();
     rt.set_timestamps(TimestampMode::Pass);
     let settings = GiDenoiserSettings::default();
