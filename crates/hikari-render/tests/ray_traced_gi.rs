@@ -684,14 +684,18 @@ fn pretrace_hits_agree_with_the_bvh() {
     }
 }
 
-/// A floor under a glowing ceiling 2 m up, lit only by a point light between them and the
-/// ceiling's emission (no sun, no sky):
-/// every GI ray from the floor hits the ceiling through the BVH. One frame without
+/// A floor under a glowing ceiling 2 m up, lit only by a point light between them, two
+/// coloured area lights lying on the floor facing up, and the ceiling's emission (no sun, no
+/// sky): every GI ray from the floor hits the ceiling through the BVH. One frame without
 /// accumulation, each pixel against the twin: the same ray from the G-buffer's depth and
 /// normal, the ceiling's hit found analytically, the hit word's quantisation, the light as the
-/// shade pass applies it to a hit lit facing the ray, the ceiling's emission, the encoding. Tolerance: the outputs
-/// are f16 (2^-11 relative) and the lighting a few f32 roundings, so 2^-9 of the pixel's
-/// luminance scale; the distance to an f16 ulp, AO exactly.
+/// shade pass applies it to a hit lit facing the ray (the area lights' polygon integration in
+/// f64, one of them picked by the same random number; nothing stands between the ceiling and
+/// the lights, so their shadow rays all pass), the ceiling's emission, the encoding.
+/// Tolerance: the outputs are f16 (2^-11 relative) and the lighting a few f32 roundings, so
+/// 2^-9 of the pixel's luminance scale; the distance to an f16 ulp, AO exactly. Up to 0.5 % of
+/// the pixels may differ beyond it: where the random number falls within rounding of the
+/// boundary between the two lights, GPU and twin may pick different ones.
 #[test]
 fn hits_are_lit_like_the_twin() {
     use hikari_scene::{Light, LightKind};
@@ -708,6 +712,16 @@ fn hits_are_lit_like_the_twin() {
                 area_light: Some(false),
                 ..Material::diffuse("ceiling", ceiling_albedo)
             },
+            Material {
+                emissive_nits: Vec3::new(40.0, 8.0, 4.0),
+                area_light: Some(true),
+                ..Material::diffuse("red lamp", Vec3::splat(0.5))
+            },
+            Material {
+                emissive_nits: Vec3::new(3.0, 6.0, 30.0),
+                area_light: Some(true),
+                ..Material::diffuse("blue lamp", Vec3::splat(0.5))
+            },
         ],
         instances: vec![
             Instance {
@@ -720,6 +734,20 @@ fn hits_are_lit_like_the_twin() {
                 material: 1,
                 transform: Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0))
                     * Mat4::from_rotation_x(std::f32::consts::PI),
+            },
+            // 2 mm above the floor, under the rays' origins (pushed 2.5 mm off the floor), so
+            // that no GI ray hits them.
+            Instance {
+                mesh: 0,
+                material: 2,
+                transform: Mat4::from_translation(Vec3::new(-0.5, 0.002, 0.1))
+                    * Mat4::from_scale(Vec3::splat(0.4 / 400.0)),
+            },
+            Instance {
+                mesh: 0,
+                material: 3,
+                transform: Mat4::from_translation(Vec3::new(0.6, 0.002, -0.3))
+                    * Mat4::from_scale(Vec3::new(0.3 / 400.0, 1.0, 0.6 / 400.0)),
             },
         ],
         lights: vec![Light {
@@ -747,6 +775,9 @@ fn hits_are_lit_like_the_twin() {
     s.settings.ray_traced_gi.accumulate = false;
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let light = renderer.scene().cpu.lights[0];
+    let area = renderer.area_lights().lights.clone();
+    assert_eq!(area.lights.len(), 2, "both lamps are area lights");
+    let min_flux = s.settings.area_lights.min_flux_lm;
     let mut picked = None;
     let mut r = renderer
         .render_reading(&s, |o| {
@@ -773,6 +804,7 @@ fn hits_are_lit_like_the_twin() {
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
     let cutoff = (s.metered_lux() * 1e-4).max(0.01);
     let mut lit = 0;
+    let mut off = 0;
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
@@ -794,7 +826,16 @@ fn hits_are_lit_like_the_twin() {
                         distance
                     };
                     let p = o + dir * (used - (1e-3 + 1e-3 * used));
-                    let e = reference::punctual_irradiance(p, -dir, &light, cutoff);
+                    let hn = -dir;
+                    let mut e = reference::punctual_irradiance(p, hn, &light, cutoff);
+                    let each = (0..area.lights.len()).map(|k| {
+                        reference::area_light_irradiance(&area, k, p, hn, min_flux, cutoff)
+                    });
+                    if let Some((_, ek, total)) =
+                        reference::pick_light(each, reference::random([x, y], 0, 0))
+                    {
+                        e += ek * (total / ek.dot(Vec3::new(0.2126, 0.7152, 0.0722)));
+                    }
                     (
                         albedo / std::f32::consts::PI * e + ceiling_emission,
                         distance,
@@ -813,13 +854,11 @@ fn hits_are_lit_like_the_twin() {
                 gc.rgba[i][1],
             ];
             let scale = (want[0].abs() / C0 as f32).max(1e-6);
-            for k in 0..6 {
-                assert!(
-                    (got[k] - want[k]).abs() <= scale * 2f32.powi(-9),
-                    "pixel ({x}, {y}) value {k}: GPU {}, twin {} (t {t})",
-                    got[k],
-                    want[k]
-                );
+            if (0..6).any(|k| (got[k] - want[k]).abs() > scale * 2f32.powi(-9)) {
+                off += 1;
+                if off <= 5 {
+                    eprintln!("pixel ({x}, {y}): GPU {got:?}, twin {want:?} (t {t})");
+                }
             }
             // The BVH's t and the analytic one may round to neighbouring f16 values.
             assert!(
@@ -834,6 +873,10 @@ fn hits_are_lit_like_the_twin() {
         }
     }
     assert!(lit > 3000, "only {lit} pixels' rays were lit");
+    assert!(
+        off <= (w * h) as usize / 200,
+        "{off} pixels differ from the twin"
+    );
 }
 
 /// `hikari::rtgi_resolve` against its twin on seeded random signals (each the mean of 2 to 8

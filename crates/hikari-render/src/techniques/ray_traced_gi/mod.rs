@@ -28,6 +28,7 @@ use hikari_scene::{Scene, Sun};
 use naga_oil::compose::ShaderDefValue;
 use wgpu::util::DeviceExt;
 
+use super::area_lights::AreaLightScene;
 use super::direct_lighting::{
     LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH,
 };
@@ -85,6 +86,10 @@ pub const FLAG_SKY_AMBIENT: u32 = 256;
 pub const FLAG_SHADOW_MAPS: u32 = 512;
 /// Hits visible last frame take last frame's lit image there.
 pub const FLAG_REUSE_LIT: u32 = 1024;
+/// Hits are lit by the area lights (shadowed by one ray to one light).
+pub const FLAG_AREA: u32 = 2048;
+/// The point and spot lights' light at hits is shadowed (one ray to one light).
+pub const FLAG_PUNCTUAL_SHADOWS: u32 = 4096;
 
 /// Uniform of every ray-traced GI pass (`RtGiParams` in `rtgi.wgsl`).
 #[repr(C)]
@@ -103,6 +108,8 @@ pub struct RtGiParams {
     /// Placeholder sky radiance in nits at the zenith and the horizon.
     pub sky_zenith: [f32; 4],
     pub sky_horizon: [f32; 4],
+    /// Lights at hits: the area lights (a count), their minimum flux (lm), 0, 0.
+    pub area: [f32; 4],
 }
 
 /// Where the sky for misses and ambient light comes from.
@@ -167,7 +174,25 @@ impl RtGiParams {
             sun_color: color.extend(1.0).to_array(),
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky_scale).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
+            area: [0.0; 4],
         }
+    }
+
+    /// The frame's area lights and shadows at hits, as the area-light pass has them: its
+    /// `area_lights` lights of at least `min_flux_lm` (or flagged) light hits when the pass is
+    /// `enabled`, and the point and spot lights' light at hits is shadowed when it shadows
+    /// them (`punctual_shadows`).
+    pub fn with_hit_lights(
+        mut self,
+        enabled: bool,
+        area_lights: u32,
+        min_flux_lm: f32,
+        punctual_shadows: bool,
+    ) -> Self {
+        self.set_flag(FLAG_AREA, enabled && area_lights > 0);
+        self.set_flag(FLAG_PUNCTUAL_SHADOWS, enabled && punctual_shadows);
+        self.area = [area_lights as f32, min_flux_lm, 0.0, 0.0];
+        self
     }
 
     pub fn flags(&self) -> u32 {
@@ -245,6 +270,11 @@ pub struct RtGiInputs<'a> {
     pub params: &'a RtGiParams,
     /// The frame's scene BVH for GI rays (`SceneRtBuffers::gi`).
     pub bvh: BvhBuffers,
+    /// The BVH that the shadow rays of hits trace (`SceneRtBuffers::shadow`: without the
+    /// lamps' glowing shells, which stand for their point light's light passing through).
+    pub shadow_bvh: BvhBuffers,
+    /// The area lights that light hits (`RtGiParams::with_hit_lights`).
+    pub area: &'a AreaLightScene,
 }
 
 /// The raw (unaccumulated) signal of a frame.
@@ -408,7 +438,8 @@ impl RayTracedGi {
         }
         let params = &params;
         let noise = self.noise_set(g);
-        let bvh_set = bvh.binding_set(g);
+        let bvh_set = inputs.shadow_bvh.binding_set(g);
+        let (area_lights, area_triangles) = inputs.area.import(g);
         g.pass("ray_traced_gi.shade")
             .constants(view)
             .constants(params)
@@ -424,6 +455,8 @@ impl RayTracedGi {
             .read(lit.prev)
             .read(vz.prev)
             .read(gb.instance)
+            .read(area_lights)
+            .read(area_triangles)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)
