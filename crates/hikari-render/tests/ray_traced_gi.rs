@@ -492,6 +492,7 @@ struct Read {
     distance: ImageRgba32,
     hits: Vec<u32>,
     instances: Vec<u32>,
+    normals: Vec<u32>,
     queue: Vec<u32>,
 }
 
@@ -510,6 +511,7 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
                 f.hit_distance.into(),
                 rays.hits.into(),
                 rays.hit_instances.into(),
+                rays.hit_normals.into(),
                 rays.queue.into(),
             ]
         })
@@ -519,6 +521,7 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
     let hits = words("ray_traced_gi.hits");
     let queue = words("ray_traced_gi.queue");
     let instances = words("ray_traced_gi.hit_instances");
+    let normals = words("ray_traced_gi.hit_normals");
     Read {
         y: r.take_image_of(f.gi_y).unwrap(),
         cocg: r.take_image_of(f.gi_cocg).unwrap(),
@@ -527,6 +530,7 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
         distance: r.take_image_of(f.hit_distance).unwrap(),
         hits,
         instances,
+        normals,
         queue,
     }
 }
@@ -642,7 +646,8 @@ fn pretrace_hits_agree_with_the_bvh() {
         .iter()
         .filter(|&&w| w != reference::HIT_NOT_TRACED)
         .count();
-    let (mut resolved, mut agree) = (0, 0);
+    let (mut resolved, mut agree, mut normals_agree) = (0, 0, 0);
+    let normal_of = |w: u32| reference::unpack_normal(w).map(reference::oct_decode);
     for i in 0..n {
         if a.hits[i] == reference::HIT_NOT_TRACED || in_queue.contains(&(i as u32)) {
             continue;
@@ -663,10 +668,18 @@ fn pretrace_hits_agree_with_the_bvh() {
             && a.instances[i] == b.instances[i]
         {
             agree += 1;
+            // The pre-trace's normal is the G-buffer's (towards the camera), the BVH's the
+            // triangle's as wound: either side.
+            if let (Some(n1), Some(n2)) = (normal_of(a.normals[i]), normal_of(b.normals[i]))
+                && n1.dot(n2).abs() > 0.99
+            {
+                normals_agree += 1;
+            }
         }
     }
     eprintln!(
-        "pre-trace resolved {resolved} of {traced} rays ({:.1} %); {agree} agree with the BVH",
+        "pre-trace resolved {resolved} of {traced} rays ({:.1} %); {agree} agree with the BVH, \
+         {normals_agree} of them in the normal too",
         100.0 * resolved as f32 / traced.max(1) as f32
     );
     assert_eq!(
@@ -678,6 +691,10 @@ fn pretrace_hits_agree_with_the_bvh() {
         agree as f32 >= 0.9 * resolved as f32,
         "{agree} of {resolved} agree"
     );
+    assert!(
+        normals_agree as f32 >= 0.9 * agree as f32,
+        "the normals of only {normals_agree} of {agree} agreeing hits agree"
+    );
     // Nothing non-finite anywhere.
     for img in [&a.y, &a.cocg, &a.ao, &a.length, &a.distance] {
         assert!(img.rgba.iter().all(|p| p.iter().all(|v| v.is_finite())));
@@ -688,8 +705,9 @@ fn pretrace_hits_agree_with_the_bvh() {
 /// coloured area lights lying on the floor facing up, and the ceiling's emission (no sun, no
 /// sky): every GI ray from the floor hits the ceiling through the BVH. One frame without
 /// accumulation, each pixel against the twin: the same ray from the G-buffer's depth and
-/// normal, the ceiling's hit found analytically, the hit word's quantisation, the light as the
-/// shade pass applies it to a hit lit facing the ray (the area lights' polygon integration in
+/// normal, the ceiling's hit found analytically, the hit word's quantisation, the hit's normal
+/// (the ceiling's, from the normal tables; checked in the hit normals' buffer), the light as
+/// the shade pass applies it to the hit (the area lights' polygon integration in
 /// f64, one of them picked by the same random number; nothing stands between the ceiling and
 /// the lights, so their shadow rays all pass), the ceiling's emission, the encoding.
 /// Tolerance: the outputs are f16 (2^-11 relative) and the lighting a few f32 roundings, so
@@ -778,6 +796,18 @@ fn hits_are_lit_like_the_twin() {
     let area = renderer.area_lights().lights.clone();
     assert_eq!(area.lights.len(), 2, "both lamps are area lights");
     let min_flux = s.settings.area_lights.min_flux_lm;
+    // The ceiling's normal as the BVH trace gives it: its triangle's in object space through
+    // the normal tables, turned into world space, packed.
+    let (inst_n, tri_n) = reference::normal_tables(&scene);
+    let ceiling_normal = {
+        let row = |k: usize| Vec3::from_slice(&inst_n[3 + k][..3]);
+        let first = inst_n[3][3].to_bits() as usize;
+        let no = reference::oct_decode(reference::unpack_normal(tri_n[first]).unwrap());
+        let nw = Vec3::new(row(0).dot(no), row(1).dot(no), row(2).dot(no)).normalize();
+        let w = reference::pack_normal(reference::oct_encode(nw));
+        reference::oct_decode(reference::unpack_normal(w).unwrap())
+    };
+    assert!(ceiling_normal.dot(Vec3::NEG_Y) > 0.9999, "{ceiling_normal}");
     let mut picked = None;
     let mut r = renderer
         .render_reading(&s, |o| {
@@ -790,6 +820,7 @@ fn hits_are_lit_like_the_twin() {
                 f.hit_distance.into(),
                 o.gbuffer.depth.into(),
                 o.gbuffer.normal.into(),
+                o.ray_traced_gi_rays.unwrap().hit_normals.into(),
             ]
         })
         .unwrap();
@@ -800,6 +831,8 @@ fn hits_are_lit_like_the_twin() {
     let gd = r.take_image_of(f.hit_distance).unwrap();
     let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
     let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
+    let hit_normals: Vec<u32> =
+        bytemuck::pod_collect_to_vec(r.buffer("ray_traced_gi.hit_normals").unwrap());
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
     let cutoff = (s.metered_lux() * 1e-4).max(0.01);
@@ -825,8 +858,20 @@ fn hits_are_lit_like_the_twin() {
                     } else {
                         distance
                     };
-                    let p = o + dir * (used - (1e-3 + 1e-3 * used));
-                    let hn = -dir;
+                    let eps = 1e-3 + 1e-3 * used;
+                    let hn = if ceiling_normal.dot(dir) > 0.0 {
+                        -ceiling_normal
+                    } else {
+                        ceiling_normal
+                    };
+                    let got = reference::oct_decode(
+                        reference::unpack_normal(hit_normals[i]).expect("a BVH hit has a normal"),
+                    );
+                    assert!(
+                        got.dot(ceiling_normal) > 1.0 - 1e-6,
+                        "pixel ({x}, {y}): hit normal {got}, the ceiling's {ceiling_normal}"
+                    );
+                    let p = o + dir * (used - eps) + hn * eps;
                     let mut e = reference::punctual_irradiance(p, hn, &light, cutoff);
                     let each = (0..area.lights.len()).map(|k| {
                         reference::area_light_irradiance(&area, k, p, hn, min_flux, cutoff)

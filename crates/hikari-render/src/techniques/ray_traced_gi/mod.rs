@@ -66,6 +66,8 @@ pub struct RtGiFrame {
 pub struct RtGiRays {
     pub hits: Buf,
     pub hit_instances: Buf,
+    /// Each hit's normal ([`reference::pack_normal`]; 0: none).
+    pub hit_normals: Buf,
     pub queue: Buf,
 }
 
@@ -213,6 +215,9 @@ impl RtGiParams {
 pub struct RtGiScene {
     /// [`reference::instance_table`].
     instance_table: wgpu::Buffer,
+    /// [`reference::normal_tables`]: per instance, then per mesh triangle.
+    instance_normals: wgpu::Buffer,
+    triangle_normals: wgpu::Buffer,
 }
 
 impl std::fmt::Debug for RtGiScene {
@@ -243,13 +248,32 @@ impl RtGiScene {
     /// Uploads the per-instance table of `scene` (albedo, emission).
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
         let table = non_empty(&reference::instance_table(scene));
+        let (instance_normals, triangle_normals) = reference::normal_tables(scene);
         Ok(Self {
             instance_table: storage_buffer(
                 ctx,
                 "ray_traced_gi.instance_table",
                 bytemuck::cast_slice(&table),
             ),
+            instance_normals: storage_buffer(
+                ctx,
+                "ray_traced_gi.instance_normals",
+                bytemuck::cast_slice(&non_empty(&instance_normals)),
+            ),
+            triangle_normals: storage_buffer(
+                ctx,
+                "ray_traced_gi.triangle_normals",
+                bytemuck::cast_slice(&non_empty(&triangle_normals)),
+            ),
         })
+    }
+
+    /// The normal tables in a frame (instances, triangles).
+    fn import_normals(&self, g: &mut FrameGraph<'_>) -> (Buf, Buf) {
+        (
+            g.import_buffer("ray_traced_gi.instance_normals", &self.instance_normals),
+            g.import_buffer("ray_traced_gi.triangle_normals", &self.triangle_normals),
+        )
     }
 
     /// The per-instance table in a frame.
@@ -376,6 +400,7 @@ impl RayTracedGi {
         let params = inputs.params;
         let hits = g.buffer("ray_traced_gi.hits", pixels * 4)?;
         let hit_instances = g.buffer("ray_traced_gi.hit_instances", pixels * 4)?;
+        let hit_normals = g.buffer("ray_traced_gi.hit_normals", pixels * 4)?;
         let queue = g.buffer("ray_traced_gi.queue", (pixels + 1) * 4)?;
         let (bvh, table) = (inputs.bvh, scene.import(g));
 
@@ -396,6 +421,7 @@ impl RayTracedGi {
             .write(hits)
             .write(hit_instances)
             .write(queue)
+            .write(hit_normals)
             .set(noise)
             .dispatch_threads(&self.pretrace, [w, h, 1])?;
 
@@ -406,6 +432,7 @@ impl RayTracedGi {
             let max = g.ctx().limits.max_compute_workgroups_per_dimension.max(1) as u64;
             let gy = total.div_ceil(max);
             let gx = total.div_ceil(gy);
+            let (instance_normals, triangle_normals) = scene.import_normals(g);
             g.pass("ray_traced_gi.trace")
                 .constants(view)
                 .constants(params)
@@ -415,6 +442,9 @@ impl RayTracedGi {
                 .write(hits)
                 .write(hit_instances)
                 .read(table)
+                .write(hit_normals)
+                .read(instance_normals)
+                .read(triangle_normals)
                 .set(noise)
                 .set(bvh_set)
                 .dispatch(&self.trace, [gx as u32, gy as u32, 1])?;
@@ -457,6 +487,7 @@ impl RayTracedGi {
             .read(gb.instance)
             .read(area_lights)
             .read(area_triangles)
+            .read(hit_normals)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)
@@ -470,6 +501,7 @@ impl RayTracedGi {
             rays: RtGiRays {
                 hits,
                 hit_instances,
+                hit_normals,
                 queue,
             },
         })

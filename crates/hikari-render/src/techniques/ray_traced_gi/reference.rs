@@ -228,6 +228,75 @@ pub fn oct_decode(e: Vec2) -> Vec3 {
     v.normalize()
 }
 
+/// `hikari::octahedral`'s `oct_encode`: unit vector to [-1, 1]².
+pub fn oct_encode(n: Vec3) -> Vec2 {
+    let p = Vec2::new(n.x, n.y) / (n.x.abs() + n.y.abs() + n.z.abs());
+    if n.z >= 0.0 {
+        return p;
+    }
+    let s = |x: f32| if x >= 0.0 { 1.0 } else { -1.0 };
+    Vec2::new((1.0 - p.y.abs()) * s(p.x), (1.0 - p.x.abs()) * s(p.y))
+}
+
+/// A hit's normal word: the octahedral encoding `e` as two 16-bit numbers
+/// `round(32767 e) + 32768` (steps of 3e-5; 0 cannot come out and means none).
+pub fn pack_normal(e: Vec2) -> u32 {
+    let q = |v: f32| ((v.clamp(-1.0, 1.0) * 32767.0).round() + 32768.0) as u32;
+    q(e.x) | (q(e.y) << 16)
+}
+
+/// The octahedral encoding of a normal word, `None` for 0 (no normal).
+pub fn unpack_normal(w: u32) -> Option<Vec2> {
+    (w != 0).then(|| {
+        Vec2::new(
+            ((w & 0xffff) as f32 - 32768.0) / 32767.0,
+            ((w >> 16) as f32 - 32768.0) / 32767.0,
+        )
+    })
+}
+
+/// The tables from which the BVH trace gives its hits their normal: per scene instance three
+/// `[f32; 4]`, the rows of its normal matrix (the inverse transpose of its transform's 3 x 3)
+/// with the bits of its mesh's first entry in the second table and of its triangle count in
+/// the first two `w`; per mesh triangle, in mesh order (the BVH's primitive index), its
+/// geometric normal `(p1 - p0) x (p2 - p0)` in object space as a [`pack_normal`] word (0 for
+/// a degenerate one). The rest pose: a deforming mesh's hits keep its rest normals.
+pub fn normal_tables(scene: &Scene) -> (Vec<[f32; 4]>, Vec<u32>) {
+    let mut triangles = Vec::new();
+    let mut first = Vec::with_capacity(scene.meshes.len());
+    for m in &scene.meshes {
+        first.push(triangles.len() as u32);
+        triangles.extend(m.indices.chunks_exact(3).map(|t| {
+            let p = |k: usize| {
+                m.positions
+                    .get(t[k] as usize)
+                    .copied()
+                    .unwrap_or(Vec3::ZERO)
+            };
+            let n = (p(1) - p(0)).cross(p(2) - p(0));
+            if n.is_finite() && n.length_squared() > 0.0 {
+                pack_normal(oct_encode(n.normalize()))
+            } else {
+                0
+            }
+        }));
+    }
+    let instances = scene
+        .instances
+        .iter()
+        .flat_map(|i| {
+            let m = glam::Mat3::from_mat4(i.transform).inverse().transpose();
+            let count = scene.meshes[i.mesh].indices.len() as u32 / 3;
+            [
+                m.row(0).extend(f32::from_bits(first[i.mesh])).to_array(),
+                m.row(1).extend(f32::from_bits(count)).to_array(),
+                m.row(2).extend(0.0).to_array(),
+            ]
+        })
+        .collect();
+    (instances, triangles)
+}
+
 /// Irradiance (lux) from one point or spot light at `x` on a surface facing `n`, as the
 /// shade pass lights hits: inverse square held below 1e4, windowed to 0 at the light's range
 /// (its own, or where it falls below `cutoff_lux`), the spot cone, Lambert's cosine; no shadow.

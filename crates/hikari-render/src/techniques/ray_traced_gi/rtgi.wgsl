@@ -151,6 +151,19 @@ const RTGI_RESET: u32 = 128u;
 const RTGI_SKY_AMBIENT: u32 = 256u;
 const RTGI_SHADOW_MAPS: u32 = 512u;
 const RTGI_REUSE_LIT: u32 = 1024u;
+// A hit's normal, oct-encoded (hikari::octahedral) as two 16-bit numbers round(32767 e) +
+// 32768, e in [-1, 1]: 0 cannot be produced and means "none". CPU twin: reference::pack_normal.
+const RTGI_NO_NORMAL: u32 = 0u;
+
+fn rtgi_pack_normal(e: vec2<f32>) -> u32 {
+    let q = vec2<u32>(round(clamp(e, vec2<f32>(-1.0), vec2<f32>(1.0)) * 32767.0) + 32768.0);
+    return q.x | (q.y << 16u);
+}
+
+fn rtgi_unpack_normal(w: u32) -> vec2<f32> {
+    return (vec2<f32>(f32(w & 0xffffu), f32(w >> 16u)) - 32768.0) / 32767.0;
+}
+
 const RTGI_AREA: u32 = 2048u;
 const RTGI_PUNCTUAL_SHADOWS: u32 = 4096u;
 

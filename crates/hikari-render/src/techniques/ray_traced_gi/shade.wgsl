@@ -6,7 +6,9 @@
 // lights (in closed form, shadowed by one ray to one light), plus the emission of the hit's
 // instance (its material's, textures averaged) unless it is an area light, whose light the
 // area-light pass gives every surface already (its light on the hit is counted). The word
-// carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
+// hit is lit with its normal (`hit_normals`: the triangle's for BVH hits, the G-buffer's for
+// the pre-trace's), turned to face the ray; without one (tables missing) as if it faced the
+// ray. Output: the raw sample, encoded
 // as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
 
 #import hikari::view::{View, world_from_depth}
@@ -18,7 +20,7 @@
 #import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
 #import hikari::area_polygon::area_triangle_vector_irradiance
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -41,6 +43,7 @@
 // The area lights' tables (`area_lights::AreaLightScene`; layouts in area_lights/shade.wgsl).
 @group(0) @binding(14) var<storage, read> area_lights: array<AreaLightGpu>;
 @group(0) @binding(15) var<storage, read> area_triangles: array<AreaTriangleGpu>;
+@group(0) @binding(16) var<storage, read> hit_normals: array<u32>;
 
 // Mirrors of area_lights/shade.wgsl's records (`area_lights::lights`).
 struct AreaLightGpu {
@@ -316,8 +319,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if rtgi_is_hit(word) {
         distance = rtgi_hit_distance(word);
         ao = select(1.0, 0.0, distance < params.distances.y);
+        // The hit's normal, facing the ray.
+        var hn = -dir;
+        let packed_normal = hit_normals[pixel.y * size.x + pixel.x];
+        if packed_normal != RTGI_NO_NORMAL {
+            let m = oct_decode(rtgi_unpack_normal(packed_normal));
+            hn = select(m, -m, dot(m, dir) > 0.0);
+        }
         // Back along the ray a little, off the surface it hit.
-        let x = o + dir * (distance - (1.0e-3 + 1.0e-3 * distance));
+        let eps = 1.0e-3 + 1.0e-3 * distance;
+        let x = o + dir * (distance - eps) + hn * eps;
         // The talk's "first bounce from all lights": the lit image where the hit was seen.
         let instance = hit_instances[pixel.y * size.x + pixel.x];
         let lit = reused_lit(o + dir * distance, instance);
@@ -331,7 +342,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if lit.w > 0.0 {
             radiance = max(lit.rgb - emission.rgb * emission.w, vec3<f32>(0.0));
         } else {
-            let hn = -dir;
             let e = irradiance(x, hn) + area_irradiance(pixel, x, hn);
             radiance = rtgi_hit_albedo_of(word) / RTGI_PI * e + own;
         }
