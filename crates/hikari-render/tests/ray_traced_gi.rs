@@ -1004,6 +1004,211 @@ fn resolve_helpers_match_the_cpu_twin() {
     assert!(nonzero > 500, "only {nonzero} cases with visible specular");
 }
 
+/// Shadows of point lights at hits: a floor under a ceiling 2 m up, two point lights between
+/// them and a small board right above one of them, so that it shades a patch of the ceiling
+/// (no sun, sky or area lights). One frame, the pre-trace off, each pixel against the twin: the
+/// GI ray's hit found analytically (the ceiling or the board's underside), lit by the light that the same random
+/// number picks in proportion to its unshadowed irradiance, times the sum's luminance over
+/// its own, and 0 where the segment from the hit to that light crosses the board (found
+/// analytically). Tolerances as `hits_are_lit_like_the_twin`, with up to 0.5 % of the pixels
+/// beyond them (a light picked differently within rounding, a segment grazing the board's
+/// edge). At least 5 % of the hits must be shadowed from the light picked.
+#[test]
+fn point_lights_at_hits_cast_shadows_like_the_twin() {
+    use hikari_scene::{Light, LightKind};
+    let (board_y, board_half) = (1.3f32, 0.2f32);
+    let board_at = Vec3::new(0.3, board_y, 0.2);
+    let (ceiling_albedo, board_albedo) = (Vec3::new(0.8, 0.7, 0.6), Vec3::new(0.3, 0.6, 0.3));
+    let light = |name: &str, position: Vec3, intensity_cd: f32, color: Vec3| Light {
+        name: name.into(),
+        kind: LightKind::Point,
+        position,
+        direction: Vec3::NEG_Y,
+        intensity_cd,
+        color,
+        range: None,
+    };
+    let scene = Scene {
+        meshes: vec![shapes::plane(400.0)],
+        materials: vec![
+            Material::diffuse("floor", Vec3::splat(0.5)),
+            Material::diffuse("ceiling", ceiling_albedo),
+            Material::diffuse("board", board_albedo),
+        ],
+        instances: vec![
+            Instance {
+                mesh: 0,
+                material: 0,
+                transform: Mat4::IDENTITY,
+            },
+            Instance {
+                mesh: 0,
+                material: 1,
+                transform: Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0))
+                    * Mat4::from_rotation_x(std::f32::consts::PI),
+            },
+            Instance {
+                mesh: 0,
+                material: 2,
+                transform: Mat4::from_translation(board_at)
+                    * Mat4::from_scale(Vec3::new(
+                        2.0 * board_half / 400.0,
+                        1.0,
+                        2.0 * board_half / 400.0,
+                    )),
+            },
+        ],
+        lights: vec![
+            light("under the board", Vec3::new(0.3, 0.9, 0.2), 60.0, Vec3::ONE),
+            light(
+                "aside",
+                Vec3::new(-0.6, 0.8, -0.4),
+                20.0,
+                Vec3::new(1.0, 0.5, 0.2),
+            ),
+        ],
+        cameras: vec![Camera {
+            name: "down".into(),
+            position: Vec3::new(0.0, 1.9, 0.0),
+            target: Vec3::ZERO,
+            up: Vec3::Z,
+            ..Camera::default()
+        }],
+        sun: None,
+        ..Default::default()
+    };
+    let (w, h) = (64u32, 64u32);
+    let mut s = rtgi_settings(&scene, w, h);
+    s.sun = None;
+    s.settings.ray_traced_gi.accumulate = false;
+    // Every ray through the BVH: the pre-trace's screen-space hits near the board's edges are
+    // its own approximation (`pretrace_hits_agree_with_the_bvh`).
+    s.settings.ray_traced_gi.pretrace = false;
+    assert!(s.settings.area_lights.enabled && s.settings.area_lights.punctual_shadows);
+    let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let lights = renderer.scene().cpu.lights.clone();
+    let mut picked = None;
+    let mut r = renderer
+        .render_reading(&s, |o| {
+            let f = o.ray_traced_gi.unwrap();
+            picked = Some(f);
+            vec![
+                f.gi_y.into(),
+                f.gi_cocg.into(),
+                f.hit_distance.into(),
+                o.gbuffer.depth.into(),
+                o.gbuffer.normal.into(),
+            ]
+        })
+        .unwrap();
+    let f = picked.unwrap();
+    let gy = r.take_image_of(f.gi_y).unwrap();
+    let gc = r.take_image_of(f.gi_cocg).unwrap();
+    let gd = r.take_image_of(f.hit_distance).unwrap();
+    let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
+    let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
+
+    let view = View::new(&s.camera, w, h);
+    let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
+    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let in_board =
+        |q: Vec3| (q.x - board_at.x).abs() < board_half && (q.z - board_at.z).abs() < board_half;
+    // The hits' normal face the rays, which all go up here.
+    let down = reference::oct_decode(
+        reference::unpack_normal(reference::pack_normal(reference::oct_encode(Vec3::NEG_Y)))
+            .unwrap(),
+    );
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let (mut off, mut shadowed, mut hits) = (0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let d = depth[i][0];
+            assert!(d > 0.0, "pixel ({x}, {y}) sees a surface");
+            let n = reference::oct_decode(Vec2::new(normal[i][0], normal[i][1]));
+            let world = reference::world_from_depth(inv_vp, [w, h], [x, y], d);
+            let o = reference::ray_origin(world, n, s.camera.position);
+            let (dir, weight) = reference::ray([x, y], 0, n);
+            assert!(dir.y > 0.0);
+            let mut t = (2.0 - o.y) / dir.y;
+            let mut albedo = ceiling_albedo;
+            let tb = (board_y - o.y) / dir.y;
+            if o.y < board_y && in_board(o + dir * tb) {
+                (t, albedo) = (tb, board_albedo);
+            }
+            let mut dbg_pick = None;
+            let (radiance, unshadowed) = match unpack_hit(pack_hit(Some(t), albedo)) {
+                HitWord::Hit { distance, albedo } if t < 250.0 => {
+                    hits += 1;
+                    let gpu_t = gd.rgba[i][0];
+                    let used = if (gpu_t - distance).abs() <= distance * 2f32.powi(-10) * 1.001 {
+                        gpu_t
+                    } else {
+                        distance
+                    };
+                    let eps = 1e-3 + 1e-3 * used;
+                    let p = o + dir * (used - eps) + down * eps;
+                    let each: Vec<Vec3> = lights
+                        .iter()
+                        .map(|l| reference::punctual_irradiance(p, down, l, cutoff))
+                        .collect();
+                    let mut e = Vec3::ZERO;
+                    if let Some((k, ek, total)) =
+                        reference::pick_light(each.iter().copied(), reference::random([x, y], 0, 3))
+                    {
+                        let at = Vec3::from_slice(&lights[k].position_range[..3]);
+                        let sb = (board_y - p.y) / (at.y - p.y);
+                        let blocked =
+                            (p.y - board_y) * (at.y - board_y) < 0.0 && in_board(p + (at - p) * sb);
+                        if blocked {
+                            shadowed += 1;
+                        } else {
+                            e = ek * (total / lum(ek));
+                        }
+                        dbg_pick = Some((k, blocked, p));
+                    }
+                    let k = albedo / std::f32::consts::PI;
+                    (k * e, k * each.iter().sum::<Vec3>())
+                }
+                _ => (Vec3::ZERO, Vec3::ZERO),
+            };
+            let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
+            let plain = reference::to_floats(&reference::encode_sample(unshadowed, dir, weight));
+            let got = [
+                gy.rgba[i][0],
+                gy.rgba[i][1],
+                gy.rgba[i][2],
+                gy.rgba[i][3],
+                gc.rgba[i][0],
+                gc.rgba[i][1],
+            ];
+            let scale = (want[0].abs() / C0 as f32)
+                .max(plain[0].abs() / C0 as f32)
+                .max(1e-6);
+            let tol = scale * 2f32.powi(-9);
+            if (0..6).any(|k| (got[k] - want[k]).abs() > tol) {
+                off += 1;
+                if off <= 5 {
+                    eprintln!(
+                        "pixel ({x}, {y}): GPU {got:?} (t {}), twin {want:?} (t {t}; light, blocked, hit: {dbg_pick:?})",
+                        gd.rgba[i][0]
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("{hits} hits, {off} pixels off the twin, {shadowed} shadowed");
+    assert!(hits > 4000, "only {hits} hits");
+    assert!(
+        off <= (w * h) as usize / 200,
+        "{off} pixels differ from the twin"
+    );
+    assert!(
+        shadowed >= (w * h) as usize / 20,
+        "only {shadowed} pixels' hits are shadowed"
+    );
+}
+
 /// The sun's shadow at hits from the shadow maps (inside a cascade) against shadow rays
 /// through the BVH, two independent methods, on `boxes` by day: the same rays (frame 0, no
 /// accumulation). The maps filter (PCF) and are coarse here (256 texels over 40 m), so pixels

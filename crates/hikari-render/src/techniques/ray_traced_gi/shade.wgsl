@@ -2,8 +2,8 @@
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
 // along the ray: where the hit was visible last frame, last frame's lit image there; on a miss the sky in that direction (no sun or moon disk: direct light is the
 // deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
-// moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light, the point and spot lights and the area
-// lights (in closed form, shadowed by one ray to one light), plus the emission of the hit's
+// moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light, the point and spot lights (shadowed by one
+// ray to one light) and the area lights (in closed form, shadowed by one ray to one light), plus the emission of the hit's
 // instance (its material's, textures averaged) unless it is an area light, whose light the
 // area-light pass gives every surface already (its light on the hit is counted). The word
 // hit is lit with its normal (`hit_normals`: the triangle's for BVH hits, the G-buffer's for
@@ -20,7 +20,7 @@
 #import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
 #import hikari::area_polygon::area_triangle_vector_irradiance
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -262,8 +262,7 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return chosen_e * (total / luminance(chosen_e) * area_light_visible(chosen, x, n, uv));
 }
 
-// Irradiance (lux) at x on a surface facing n from the sun or moon, the sky and the point and
-// spot lights.
+// Irradiance (lux) at x on a surface facing n from the sun or moon and the sky.
 fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let flags = params.config.y;
     var e = vec3<f32>(0.0);
@@ -279,18 +278,69 @@ fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             e += RTGI_PI * 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb) * 0.5 * (1.0 + n.y);
         }
     }
-    if (flags & RTGI_PUNCTUAL) != 0u {
-        for (var i = 0u; i < min(params.config.w, arrayLength(&lights)); i++) {
-            let light = lights[i];
-            let to_light = light.position_range.xyz - x;
-            let d2 = max(dot(to_light, to_light), 1e-8);
-            let range = light_range(light, params.distances.w);
-            let dir = to_light * inverseSqrt(d2);
-            let a = light_attenuation(light, dir, 1.0 / d2, d2 / (range * range));
-            e += light.intensity.rgb * (a * max(dot(n, dir), 0.0));
-        }
-    }
     return e;
+}
+
+// Unshadowed irradiance (lux) of point or spot light `i` at x on a surface facing n: inverse
+// square, the deferred lighting's window and cut-off, the spot cone, Lambert's cosine.
+fn punctual_light_irradiance(i: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let light = lights[i];
+    let to_light = light.position_range.xyz - x;
+    let d2 = max(dot(to_light, to_light), 1e-8);
+    let range = light_range(light, params.distances.w);
+    let dir = to_light * inverseSqrt(d2);
+    let a = light_attenuation(light, dir, 1.0 / d2, d2 / (range * range));
+    return light.intensity.rgb * (a * max(dot(n, dir), 0.0));
+}
+
+// Irradiance (lux) at x on a surface facing n from the point and spot lights. Shadowed
+// (RTGI_PUNCTUAL_SHADOWS, when the frame shadows them): one light picked in proportion to the
+// luminance of its unshadowed irradiance, as for the area lights, and one shadow ray to its
+// centre; its light times the sum's luminance over its own if the ray passes, else 0, which
+// is unbiased for the lights' shadowed sum with point lights. Else the unshadowed sum.
+fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let flags = params.config.y;
+    if (flags & RTGI_PUNCTUAL) == 0u {
+        return vec3<f32>(0.0);
+    }
+    let count = min(params.config.w, arrayLength(&lights));
+    if (flags & RTGI_PUNCTUAL_SHADOWS) == 0u {
+        var e = vec3<f32>(0.0);
+        for (var i = 0u; i < count; i++) {
+            e += punctual_light_irradiance(i, x, n);
+        }
+        return e;
+    }
+    var u = rtgi_random(pixel, params.config.x, 3u);
+    var total = 0.0;
+    var chosen = NO_LIGHT;
+    var chosen_e = vec3<f32>(0.0);
+    for (var i = 0u; i < count; i++) {
+        let e = punctual_light_irradiance(i, x, n);
+        let s = luminance(e);
+        if !(s > 0.0) {
+            continue;
+        }
+        total += s;
+        let p = s / total;
+        if u < p {
+            chosen = i;
+            chosen_e = e;
+            u = u / p;
+        } else {
+            u = (u - p) / max(1.0 - p, 1e-7);
+        }
+        u = min(u, 0.99999994);
+    }
+    if chosen == NO_LIGHT {
+        return vec3<f32>(0.0);
+    }
+    let to_light = lights[chosen].position_range.xyz - x;
+    let dist = length(to_light);
+    if bvh_occluded(Ray(x, 0.0, to_light / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
+        return vec3<f32>(0.0);
+    }
+    return chosen_e * (total / luminance(chosen_e));
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -342,7 +392,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if lit.w > 0.0 {
             radiance = max(lit.rgb - emission.rgb * emission.w, vec3<f32>(0.0));
         } else {
-            let e = irradiance(x, hn) + area_irradiance(pixel, x, hn);
+            let e = irradiance(x, hn) + punctual_irradiance(pixel, x, hn) + area_irradiance(pixel, x, hn);
             radiance = rtgi_hit_albedo_of(word) / RTGI_PI * e + own;
         }
     } else {
