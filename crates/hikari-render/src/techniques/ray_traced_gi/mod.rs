@@ -7,13 +7,14 @@
 //! | pass | does | writes |
 //! |---|---|---|
 //! | `ray_traced_gi.clear` | empties the BVH queue | `ray_traced_gi.queue` |
-//! | `ray_traced_gi.pretrace` | screen-space march | `ray_traced_gi.hits` (one word a pixel), the queue |
-//! | `ray_traced_gi.trace` | BVH closest hit of the queued rays | `ray_traced_gi.hits` |
-//! | `ray_traced_gi.shade` | lights hits, sky for misses, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
+//! | `ray_traced_gi.pretrace` | screen-space march | `ray_traced_gi.hits` (one word a pixel), `.hit_instances`, `.hit_normals`, the queue |
+//! | `ray_traced_gi.trace` | BVH closest hit of the queued rays | the same three |
+//! | `ray_traced_gi.shade` | lights hits (sun, sky, point, spot and area lights, shadowed), sky for misses, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
 //! | `ray_traced_gi.accumulate` | temporal accumulation | `ray_traced_gi.gi_y`, `.gi_cocg`, `.ao`, `.history_length`, `.view_depth` |
 //!
 //! Every texture above can be dumped by that name. The hit word packs the distance (f16, bits
 //! 0-15) and the hit's albedo (√albedo as R5G6B5, bits 16-31); see [`reference::pack_hit`].
+//! The hit's normal is a word of its own ([`reference::pack_normal`]).
 //! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
 
 pub mod reference;

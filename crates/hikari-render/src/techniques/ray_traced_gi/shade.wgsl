@@ -1,15 +1,18 @@
 // Lights the GI rays' hits (Metro Exodus's "deferred lighting of hits"): regenerates each
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
-// along the ray: where the hit was visible last frame, last frame's lit image there; on a miss the sky in that direction (no sun or moon disk: direct light is the
-// deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
-// moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light, the point and spot lights (shadowed by one
-// ray to one light) and the area lights (in closed form, shadowed by one ray to one light), plus the emission of the hit's
-// instance (its material's, textures averaged) unless it is an area light, whose light the
-// area-light pass gives every surface already (its light on the hit is counted). The word
-// hit is lit with its normal (`hit_normals`: the triangle's for BVH hits, the G-buffer's for
-// the pre-trace's), turned to face the ray; without one (tables missing) as if it faced the
-// ray. Output: the raw sample, encoded
-// as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// along the ray. Where the hit was visible last frame: last frame's lit image there. On a
+// miss: the sky in that direction (no sun or moon disk: direct light is the deferred pass's).
+// On a hit: the hit's albedo / π times the irradiance there, on a surface facing the hit's
+// normal (`hit_normals`: the triangle's for BVH hits, the G-buffer's for the pre-trace's,
+// turned to face the ray; -dir without one), from the sun or moon (its shadow maps inside a
+// cascade, else a shadow ray), the sky's ambient light, the point and spot lights and the area
+// lights (in closed form), each kind shadowed by one ray to one light picked by its
+// unshadowed light; plus the emission of the hit's instance (its material's, textures
+// averaged) unless it is an area light, whose direct light the area-light pass gives every
+// surface already (its light on the hit is counted here). Output: the raw sample, encoded as
+// luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// CPU twins: ray_traced_gi::reference (punctual_irradiance, area_light_irradiance,
+// pick_light, area_light_point, random).
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
