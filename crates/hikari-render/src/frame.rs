@@ -269,6 +269,12 @@ pub fn record<'r>(
             scene.light_count,
             s.metered_lux_with_sky(sky.sky_lux),
             sky_source,
+        )
+        .with_hit_lights(
+            s.settings.area_lights.enabled,
+            area.light_count(),
+            s.settings.area_lights.min_flux_lm,
+            s.settings.area_lights.punctual_shadows,
         );
         let inputs = RtGiInputs {
             gbuffer: &gbuffer,
@@ -278,6 +284,8 @@ pub fn record<'r>(
             view: &view,
             params: &params,
             bvh: rt_bvh.gi,
+            shadow_bvh: rt_bvh.shadow,
+            area,
         };
         let (frame, rays) =
             t.ray_traced_gi

@@ -164,6 +164,15 @@ impl AreaLightScene {
     pub fn light_count(&self) -> u32 {
         self.lights.lights.len() as u32
     }
+
+    /// The light and triangle tables in a frame (`area_lights.lights`, `.triangles`), also
+    /// read by the lighting of GI hits.
+    pub fn import(&self, g: &mut FrameGraph<'_>) -> (crate::graph::Buf, crate::graph::Buf) {
+        (
+            g.import_buffer("area_lights.lights", &self.light_buffer),
+            g.import_buffer("area_lights.triangles", &self.triangle_buffer),
+        )
+    }
 }
 
 pub struct AreaLights {
@@ -206,8 +215,7 @@ impl AreaLights {
             TextureDesc::d2(w, h, RADIANCE_FORMAT),
         )?;
         let bvh = bvh.binding_set(g);
-        let lights = g.import_buffer("area_lights.lights", &area.light_buffer);
-        let triangles = g.import_buffer("area_lights.triangles", &area.triangle_buffer);
+        let (lights, triangles) = area.import(g);
         g.pass("area_lights.shade")
             .constants(view)
             .constants(params)

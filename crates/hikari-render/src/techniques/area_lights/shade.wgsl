@@ -1,8 +1,8 @@
 // Polygonal area lights and shadowed point and spot lights (docs/area-lights.md).
 //
-// Area lights: the unshadowed light of each polygon in closed form (Lambert's vector
-// irradiance of each front-facing triangle clipped to the surface's horizon: exact for the
-// diffuse lobe), the specular lobe at a representative point with Karis's widening, both times
+// Area lights: the unshadowed light of each polygon in closed form (hikari::area_polygon,
+// Lambert's vector irradiance of each front-facing triangle clipped to the surface's horizon:
+// exact for the diffuse lobe), the specular lobe at a representative point with Karis's widening, both times
 // a shadow factor: the ratio estimator of stochastic shadows (Heitz et al. 2018), shadow rays to
 // points sampled by area on the light, each weighted by its unshadowed integrand. Point and spot
 // lights: as the deferred lighting shades them, the brightest few per pixel times the fraction
@@ -19,6 +19,7 @@
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::tile_bounds::{TileBounds, tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
+#import hikari::area_polygon::area_triangle_vector_irradiance
 
 struct AreaLightParams {
     // x: area lights; y: AREA_* flags; z: frame index; w: point and spot lights.
@@ -86,49 +87,6 @@ fn sample_2d(pixel: vec2<u32>, i: u32) -> vec2<f32> {
     let ign2 = fract(52.9829189 * fract(0.06711056 * (p.x + 5.0) + 0.00583715 * (p.y + 7.0)));
     let r2 = fract(f32(i) * vec2<f32>(0.7548776662, 0.5698402910));
     return fract(r2 + vec2<f32>(ign, ign2) + params.rotation.xy);
-}
-
-// Half the angle-weighted edge normal of edge a -> b (unit vectors from the point), oriented
-// for a polygon whose front faces the point: Lambert's vector irradiance is the sum over edges.
-fn edge_vector(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
-    let c = cross(b, a);
-    let s = length(c);
-    let cos_t = dot(a, b);
-    let theta = atan2(s, cos_t);
-    let k = select(theta / s, 1.0, s < 1e-7);
-    return 0.5 * k * c;
-}
-
-// Vector irradiance per unit radiance of triangle q0 q1 q2 (relative to the point, front face
-// towards it), clipped to the upper hemisphere of n.
-fn triangle_vector_irradiance(q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    var q = array<vec3<f32>, 3>(q0, q1, q2);
-    var out: array<vec3<f32>, 4>;
-    var count = 0u;
-    for (var i = 0u; i < 3u; i++) {
-        let a = q[i];
-        let b = q[(i + 1u) % 3u];
-        let da = dot(a, n);
-        let db = dot(b, n);
-        if da >= 0.0 {
-            out[count] = a;
-            count++;
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            out[count] = a + (b - a) * (da / (da - db));
-            count++;
-        }
-    }
-    var f = vec3<f32>(0.0);
-    if count < 3u {
-        return f;
-    }
-    for (var i = 0u; i < count; i++) {
-        let a = normalize(out[i]);
-        let b = normalize(out[(i + 1u) % count]);
-        f += edge_vector(a, b);
-    }
-    return f;
 }
 
 fn luminance(c: vec3<f32>) -> f32 {
@@ -345,19 +303,7 @@ fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origi
     var f = vec3<f32>(0.0);
     for (var j = light.range.x; j < light.range.x + light.range.y; j++) {
         let tri = area_triangles[j];
-        let q0 = tri.p0_cdf.xyz - world;
-        var q1 = tri.p1.xyz - world;
-        var q2 = tri.p2.xyz - world;
-        let side = -dot(q0, cross(q1 - q0, q2 - q0));
-        if side <= 0.0 {
-            if !double_sided {
-                continue;
-            }
-            let t = q1;
-            q1 = q2;
-            q2 = t;
-        }
-        f += triangle_vector_irradiance(q0, q1, q2, n);
+        f += area_triangle_vector_irradiance(tri.p0_cdf.xyz, tri.p1.xyz, tri.p2.xyz, world, n, double_sided);
     }
     // Irradiance per unit radiance (sr): the light's projected solid angle.
     let e = dot(f, n);

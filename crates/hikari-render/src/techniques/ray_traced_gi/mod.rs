@@ -7,13 +7,14 @@
 //! | pass | does | writes |
 //! |---|---|---|
 //! | `ray_traced_gi.clear` | empties the BVH queue | `ray_traced_gi.queue` |
-//! | `ray_traced_gi.pretrace` | screen-space march | `ray_traced_gi.hits` (one word a pixel), the queue |
-//! | `ray_traced_gi.trace` | BVH closest hit of the queued rays | `ray_traced_gi.hits` |
-//! | `ray_traced_gi.shade` | lights hits, sky for misses, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
+//! | `ray_traced_gi.pretrace` | screen-space march | `ray_traced_gi.hits` (one word a pixel), `.hit_instances`, `.hit_normals`, the queue |
+//! | `ray_traced_gi.trace` | BVH closest hit of the queued rays | the same three |
+//! | `ray_traced_gi.shade` | lights hits (sun, sky, point, spot and area lights, shadowed), sky for misses, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
 //! | `ray_traced_gi.accumulate` | temporal accumulation | `ray_traced_gi.gi_y`, `.gi_cocg`, `.ao`, `.history_length`, `.view_depth` |
 //!
 //! Every texture above can be dumped by that name. The hit word packs the distance (f16, bits
 //! 0-15) and the hit's albedo (√albedo as R5G6B5, bits 16-31); see [`reference::pack_hit`].
+//! The hit's normal is a word of its own ([`reference::pack_normal`]).
 //! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
 
 pub mod reference;
@@ -28,6 +29,7 @@ use hikari_scene::{Scene, Sun};
 use naga_oil::compose::ShaderDefValue;
 use wgpu::util::DeviceExt;
 
+use super::area_lights::AreaLightScene;
 use super::direct_lighting::{
     LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH,
 };
@@ -65,6 +67,8 @@ pub struct RtGiFrame {
 pub struct RtGiRays {
     pub hits: Buf,
     pub hit_instances: Buf,
+    /// Each hit's normal ([`reference::pack_normal`]; 0: none).
+    pub hit_normals: Buf,
     pub queue: Buf,
 }
 
@@ -85,6 +89,10 @@ pub const FLAG_SKY_AMBIENT: u32 = 256;
 pub const FLAG_SHADOW_MAPS: u32 = 512;
 /// Hits visible last frame take last frame's lit image there.
 pub const FLAG_REUSE_LIT: u32 = 1024;
+/// Hits are lit by the area lights (shadowed by one ray to one light).
+pub const FLAG_AREA: u32 = 2048;
+/// The point and spot lights' light at hits is shadowed (one ray to one light).
+pub const FLAG_PUNCTUAL_SHADOWS: u32 = 4096;
 
 /// Uniform of every ray-traced GI pass (`RtGiParams` in `rtgi.wgsl`).
 #[repr(C)]
@@ -103,6 +111,8 @@ pub struct RtGiParams {
     /// Placeholder sky radiance in nits at the zenith and the horizon.
     pub sky_zenith: [f32; 4],
     pub sky_horizon: [f32; 4],
+    /// Lights at hits: the area lights (a count), their minimum flux (lm), 0, 0.
+    pub area: [f32; 4],
 }
 
 /// Where the sky for misses and ambient light comes from.
@@ -167,7 +177,25 @@ impl RtGiParams {
             sun_color: color.extend(1.0).to_array(),
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky_scale).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
+            area: [0.0; 4],
         }
+    }
+
+    /// The frame's area lights and shadows at hits, as the area-light pass has them: its
+    /// `area_lights` lights of at least `min_flux_lm` (or flagged) light hits when the pass is
+    /// `enabled`, and the point and spot lights' light at hits is shadowed when it shadows
+    /// them (`punctual_shadows`).
+    pub fn with_hit_lights(
+        mut self,
+        enabled: bool,
+        area_lights: u32,
+        min_flux_lm: f32,
+        punctual_shadows: bool,
+    ) -> Self {
+        self.set_flag(FLAG_AREA, enabled && area_lights > 0);
+        self.set_flag(FLAG_PUNCTUAL_SHADOWS, enabled && punctual_shadows);
+        self.area = [area_lights as f32, min_flux_lm, 0.0, 0.0];
+        self
     }
 
     pub fn flags(&self) -> u32 {
@@ -188,6 +216,9 @@ impl RtGiParams {
 pub struct RtGiScene {
     /// [`reference::instance_table`].
     instance_table: wgpu::Buffer,
+    /// [`reference::normal_tables`]: per instance, then per mesh triangle.
+    instance_normals: wgpu::Buffer,
+    triangle_normals: wgpu::Buffer,
 }
 
 impl std::fmt::Debug for RtGiScene {
@@ -218,13 +249,32 @@ impl RtGiScene {
     /// Uploads the per-instance table of `scene` (albedo, emission).
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
         let table = non_empty(&reference::instance_table(scene));
+        let (instance_normals, triangle_normals) = reference::normal_tables(scene);
         Ok(Self {
             instance_table: storage_buffer(
                 ctx,
                 "ray_traced_gi.instance_table",
                 bytemuck::cast_slice(&table),
             ),
+            instance_normals: storage_buffer(
+                ctx,
+                "ray_traced_gi.instance_normals",
+                bytemuck::cast_slice(&non_empty(&instance_normals)),
+            ),
+            triangle_normals: storage_buffer(
+                ctx,
+                "ray_traced_gi.triangle_normals",
+                bytemuck::cast_slice(&non_empty(&triangle_normals)),
+            ),
         })
+    }
+
+    /// The normal tables in a frame (instances, triangles).
+    fn import_normals(&self, g: &mut FrameGraph<'_>) -> (Buf, Buf) {
+        (
+            g.import_buffer("ray_traced_gi.instance_normals", &self.instance_normals),
+            g.import_buffer("ray_traced_gi.triangle_normals", &self.triangle_normals),
+        )
     }
 
     /// The per-instance table in a frame.
@@ -245,6 +295,11 @@ pub struct RtGiInputs<'a> {
     pub params: &'a RtGiParams,
     /// The frame's scene BVH for GI rays (`SceneRtBuffers::gi`).
     pub bvh: BvhBuffers,
+    /// The BVH that the shadow rays of hits trace (`SceneRtBuffers::shadow`: without the
+    /// lamps' glowing shells, which stand for their point light's light passing through).
+    pub shadow_bvh: BvhBuffers,
+    /// The area lights that light hits (`RtGiParams::with_hit_lights`).
+    pub area: &'a AreaLightScene,
 }
 
 /// The raw (unaccumulated) signal of a frame.
@@ -346,6 +401,7 @@ impl RayTracedGi {
         let params = inputs.params;
         let hits = g.buffer("ray_traced_gi.hits", pixels * 4)?;
         let hit_instances = g.buffer("ray_traced_gi.hit_instances", pixels * 4)?;
+        let hit_normals = g.buffer("ray_traced_gi.hit_normals", pixels * 4)?;
         let queue = g.buffer("ray_traced_gi.queue", (pixels + 1) * 4)?;
         let (bvh, table) = (inputs.bvh, scene.import(g));
 
@@ -366,6 +422,7 @@ impl RayTracedGi {
             .write(hits)
             .write(hit_instances)
             .write(queue)
+            .write(hit_normals)
             .set(noise)
             .dispatch_threads(&self.pretrace, [w, h, 1])?;
 
@@ -376,6 +433,7 @@ impl RayTracedGi {
             let max = g.ctx().limits.max_compute_workgroups_per_dimension.max(1) as u64;
             let gy = total.div_ceil(max);
             let gx = total.div_ceil(gy);
+            let (instance_normals, triangle_normals) = scene.import_normals(g);
             g.pass("ray_traced_gi.trace")
                 .constants(view)
                 .constants(params)
@@ -385,6 +443,9 @@ impl RayTracedGi {
                 .write(hits)
                 .write(hit_instances)
                 .read(table)
+                .write(hit_normals)
+                .read(instance_normals)
+                .read(triangle_normals)
                 .set(noise)
                 .set(bvh_set)
                 .dispatch(&self.trace, [gx as u32, gy as u32, 1])?;
@@ -408,7 +469,8 @@ impl RayTracedGi {
         }
         let params = &params;
         let noise = self.noise_set(g);
-        let bvh_set = bvh.binding_set(g);
+        let bvh_set = inputs.shadow_bvh.binding_set(g);
+        let (area_lights, area_triangles) = inputs.area.import(g);
         g.pass("ray_traced_gi.shade")
             .constants(view)
             .constants(params)
@@ -424,6 +486,9 @@ impl RayTracedGi {
             .read(lit.prev)
             .read(vz.prev)
             .read(gb.instance)
+            .read(area_lights)
+            .read(area_triangles)
+            .read(hit_normals)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)
@@ -437,6 +502,7 @@ impl RayTracedGi {
             rays: RtGiRays {
                 hits,
                 hit_instances,
+                hit_normals,
                 queue,
             },
         })

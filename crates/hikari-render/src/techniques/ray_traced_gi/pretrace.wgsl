@@ -7,7 +7,7 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_PRETRACE, RTGI_BVH, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray_direction, rtgi_ray_origin, rtgi_pack_hit, rtgi_pack_miss, rtgi_hit_albedo}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_PRETRACE, RTGI_BVH, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray_direction, rtgi_ray_origin, rtgi_pack_hit, rtgi_pack_miss, rtgi_hit_albedo, rtgi_pack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -22,6 +22,8 @@
 @group(0) @binding(9) var<storage, read_write> hit_instances: array<u32>;
 // Word 0: count; then pixel indices.
 @group(0) @binding(10) var<storage, read_write> queue: array<atomic<u32>>;
+// Each hit's normal (rtgi_pack_normal): the G-buffer's at the texel the ray crossed.
+@group(0) @binding(11) var<storage, read_write> hit_normals: array<u32>;
 
 const NO_INSTANCE: u32 = 0xffffffffu;
 // The pixel the pre-trace hit, if any.
@@ -118,6 +120,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if !(d > 0.0 && d <= 1.0) || !all(n == n) || !(dot(n, n) > 0.5) {
         hits[i] = RTGI_HIT_NOT_TRACED;
         hit_instances[i] = NO_INSTANCE;
+        hit_normals[i] = RTGI_NO_NORMAL;
         return;
     }
     let world = world_from_depth(view, pixel, d);
@@ -129,10 +132,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         word = march(o, dir);
     }
     var instance = NO_INSTANCE;
+    var normal = RTGI_NO_NORMAL;
     if word != RTGI_HIT_UNRESOLVED {
         instance = textureLoad(gbuffer_instance, hit_pixel, 0).x;
+        normal = rtgi_pack_normal(textureLoad(gbuffer_normal, hit_pixel, 0).xy);
     }
     hit_instances[i] = instance;
+    hit_normals[i] = normal;
     if word == RTGI_HIT_UNRESOLVED {
         if (flags & RTGI_BVH) != 0u {
             let slot = atomicAdd(&queue[0], 1u);

@@ -228,6 +228,75 @@ pub fn oct_decode(e: Vec2) -> Vec3 {
     v.normalize()
 }
 
+/// `hikari::octahedral`'s `oct_encode`: unit vector to [-1, 1]².
+pub fn oct_encode(n: Vec3) -> Vec2 {
+    let p = Vec2::new(n.x, n.y) / (n.x.abs() + n.y.abs() + n.z.abs());
+    if n.z >= 0.0 {
+        return p;
+    }
+    let s = |x: f32| if x >= 0.0 { 1.0 } else { -1.0 };
+    Vec2::new((1.0 - p.y.abs()) * s(p.x), (1.0 - p.x.abs()) * s(p.y))
+}
+
+/// A hit's normal word: the octahedral encoding `e` as two 16-bit numbers
+/// `round(32767 e) + 32768` (steps of 3e-5; 0 cannot come out and means none).
+pub fn pack_normal(e: Vec2) -> u32 {
+    let q = |v: f32| ((v.clamp(-1.0, 1.0) * 32767.0).round() + 32768.0) as u32;
+    q(e.x) | (q(e.y) << 16)
+}
+
+/// The octahedral encoding of a normal word, `None` for 0 (no normal).
+pub fn unpack_normal(w: u32) -> Option<Vec2> {
+    (w != 0).then(|| {
+        Vec2::new(
+            ((w & 0xffff) as f32 - 32768.0) / 32767.0,
+            ((w >> 16) as f32 - 32768.0) / 32767.0,
+        )
+    })
+}
+
+/// The tables from which the BVH trace gives its hits their normal: per scene instance three
+/// `[f32; 4]`, the rows of its normal matrix (the inverse transpose of its transform's 3 x 3)
+/// with the bits of its mesh's first entry in the second table and of its triangle count in
+/// the first two `w`; per mesh triangle, in mesh order (the BVH's primitive index), its
+/// geometric normal `(p1 - p0) x (p2 - p0)` in object space as a [`pack_normal`] word (0 for
+/// a degenerate one). The rest pose: a deforming mesh's hits keep its rest normals.
+pub fn normal_tables(scene: &Scene) -> (Vec<[f32; 4]>, Vec<u32>) {
+    let mut triangles = Vec::new();
+    let mut first = Vec::with_capacity(scene.meshes.len());
+    for m in &scene.meshes {
+        first.push(triangles.len() as u32);
+        triangles.extend(m.indices.chunks_exact(3).map(|t| {
+            let p = |k: usize| {
+                m.positions
+                    .get(t[k] as usize)
+                    .copied()
+                    .unwrap_or(Vec3::ZERO)
+            };
+            let n = (p(1) - p(0)).cross(p(2) - p(0));
+            if n.is_finite() && n.length_squared() > 0.0 {
+                pack_normal(oct_encode(n.normalize()))
+            } else {
+                0
+            }
+        }));
+    }
+    let instances = scene
+        .instances
+        .iter()
+        .flat_map(|i| {
+            let m = glam::Mat3::from_mat4(i.transform).inverse().transpose();
+            let count = scene.meshes[i.mesh].indices.len() as u32 / 3;
+            [
+                m.row(0).extend(f32::from_bits(first[i.mesh])).to_array(),
+                m.row(1).extend(f32::from_bits(count)).to_array(),
+                m.row(2).extend(0.0).to_array(),
+            ]
+        })
+        .collect();
+    (instances, triangles)
+}
+
 /// Irradiance (lux) from one point or spot light at `x` on a surface facing `n`, as the
 /// shade pass lights hits: inverse square held below 1e4, windowed to 0 at the light's range
 /// (its own, or where it falls below `cutoff_lux`), the spot cone, Lambert's cosine; no shadow.
@@ -255,6 +324,107 @@ pub fn punctual_irradiance(
         a *= s * s;
     }
     intensity * a
+}
+
+/// `hikari::ray_traced_gi`'s PCG hash (Jarzynski and Olano 2020).
+pub fn hash(v: u32) -> u32 {
+    let s = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let w = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277_803_737);
+    (w >> 22) ^ w
+}
+
+/// Number `k` in [0, 1) of `pixel` in `frame` for the light samples of its hit (white noise).
+pub fn random(pixel: [u32; 2], frame: u32, k: u32) -> f32 {
+    let h = hash(pixel[0] ^ hash(pixel[1] ^ hash(frame.wrapping_mul(8).wrapping_add(k))));
+    (h >> 8) as f32 / 16_777_216.0
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// The light a hit's shadow ray goes to, as the shade pass picks it: each light's
+/// unshadowed irradiance `e` (lux) in order, one chosen in proportion to its luminance by a
+/// running choice on the one number `u` (rescaled after each light). Returns the chosen index,
+/// its irradiance and the luminance of the sum; `None` when nothing lights the point.
+pub fn pick_light(e: impl IntoIterator<Item = Vec3>, u: f32) -> Option<(usize, Vec3, f32)> {
+    let (mut u, mut total, mut chosen) = (u, 0.0f32, None);
+    for (i, e) in e.into_iter().enumerate() {
+        let s = luminance(e);
+        if s.is_nan() || s <= 0.0 {
+            continue;
+        }
+        total += s;
+        let p = s / total;
+        if u < p {
+            chosen = Some((i, e));
+            u /= p;
+        } else {
+            u = (u - p) / (1.0 - p).max(1e-7);
+        }
+        u = u.min(0.999_999_94);
+    }
+    chosen.map(|(i, e)| (i, e, total))
+}
+
+/// Unshadowed irradiance (lux) of area light `i` at `x` on a surface facing `n`, as the shade
+/// pass lights hits: nothing from a light under `min_flux_lm` (unless flagged), beyond where
+/// it falls below `cutoff_lux`, wholly behind its one-sided plane or below the horizon; else
+/// the light's radiance times the polygon integration (`area_lights::reference`).
+pub fn area_light_irradiance(
+    lights: &crate::techniques::area_lights::PolygonLights,
+    i: usize,
+    x: Vec3,
+    n: Vec3,
+    min_flux_lm: f32,
+    cutoff_lux: f32,
+) -> Vec3 {
+    use crate::techniques::area_lights::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED};
+    let l = &lights.lights[i];
+    let forced = l.range[2] & AREA_LIGHT_FORCED != 0;
+    let double_sided = l.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
+    if l.radiance_flux[3] < min_flux_lm && !forced {
+        return Vec3::ZERO;
+    }
+    let radiance = Vec3::from_slice(&l.radiance_flux[..3]);
+    let c = Vec3::from_slice(&l.centroid_radius[..3]);
+    let r = l.centroid_radius[3];
+    let reach = r + ((luminance(radiance) * l.normal_area[3]).max(0.0) / cutoff_lux).sqrt();
+    let nl = Vec3::from_slice(&l.normal_area[..3]);
+    if (c - x).length_squared() >= reach * reach
+        || (c - x).dot(n) < -r
+        || (!double_sided && nl.length() > 0.99 && (x - c).dot(nl) < -r)
+    {
+        return Vec3::ZERO;
+    }
+    let f = crate::techniques::area_lights::reference::light_vector_irradiance(
+        lights.triangles_of(i),
+        double_sided,
+        x.as_dvec3(),
+        n.as_dvec3(),
+    );
+    radiance * (f.dot(n.as_dvec3()).max(0.0) as f32)
+}
+
+/// The point of area light `i` that the hit's shadow ray goes to, from two numbers in [0, 1):
+/// a triangle by area (the first number, rescaled within it), then uniform on it.
+pub fn area_light_point(
+    lights: &crate::techniques::area_lights::PolygonLights,
+    i: usize,
+    u: Vec2,
+) -> Vec3 {
+    let tris = lights.triangles_of(i);
+    let (mut k, mut lo) = (0, 0.0);
+    while u.x > tris[k].p0_cdf[3] && k + 1 < tris.len() {
+        lo = tris[k].p0_cdf[3];
+        k += 1;
+    }
+    let t = &tris[k];
+    let ux = ((u.x - lo) / (t.p0_cdf[3] - lo).max(1e-12)).clamp(0.0, 1.0);
+    let su = ux.sqrt();
+    Vec3::from_slice(&t.p0_cdf[..3]) * (1.0 - su)
+        + Vec3::from_slice(&t.p1[..3]) * (su * (1.0 - u.y))
+        + Vec3::from_slice(&t.p2[..3]) * (su * u.y)
 }
 
 /// The encoded sample of one ray: radiance `l` arriving along `dir` with weight `weight`

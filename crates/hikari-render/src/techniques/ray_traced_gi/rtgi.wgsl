@@ -136,6 +136,8 @@ struct RtGiParams {
     // Placeholder sky radiance (nits) at the zenith and the horizon (atmosphere off).
     sky_zenith: vec4<f32>,
     sky_horizon: vec4<f32>,
+    // Lights at hits: x area lights (a count, exact in f32), y their minimum flux (lm), z, w 0.
+    area: vec4<f32>,
 }
 
 const RTGI_PRETRACE: u32 = 1u;
@@ -149,3 +151,33 @@ const RTGI_RESET: u32 = 128u;
 const RTGI_SKY_AMBIENT: u32 = 256u;
 const RTGI_SHADOW_MAPS: u32 = 512u;
 const RTGI_REUSE_LIT: u32 = 1024u;
+// A hit's normal, oct-encoded (hikari::octahedral) as two 16-bit numbers round(32767 e) +
+// 32768, e in [-1, 1]: 0 cannot be produced and means "none". CPU twin: reference::pack_normal.
+const RTGI_NO_NORMAL: u32 = 0u;
+
+fn rtgi_pack_normal(e: vec2<f32>) -> u32 {
+    let q = vec2<u32>(round(clamp(e, vec2<f32>(-1.0), vec2<f32>(1.0)) * 32767.0) + 32768.0);
+    return q.x | (q.y << 16u);
+}
+
+fn rtgi_unpack_normal(w: u32) -> vec2<f32> {
+    return (vec2<f32>(f32(w & 0xffffu), f32(w >> 16u)) - 32768.0) / 32767.0;
+}
+
+const RTGI_AREA: u32 = 2048u;
+const RTGI_PUNCTUAL_SHADOWS: u32 = 4096u;
+
+// PCG hash (Jarzynski and Olano 2020, "Hash Functions for GPU Rendering").
+fn rtgi_hash(v: u32) -> u32 {
+    let s = v * 747796405u + 2891336453u;
+    let w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return (w >> 22u) ^ w;
+}
+
+// Number `k` in [0, 1) of a pixel and frame, for the light samples of its hit: white noise, as
+// the ray's blue-noise pair already sets its direction and has no third dimension. CPU twin:
+// reference::random.
+fn rtgi_random(pixel: vec2<u32>, frame: u32, k: u32) -> f32 {
+    let h = rtgi_hash(pixel.x ^ rtgi_hash(pixel.y ^ rtgi_hash(frame * 8u + k)));
+    return f32(h >> 8u) / 16777216.0;
+}

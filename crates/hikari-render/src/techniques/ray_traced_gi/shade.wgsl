@@ -1,12 +1,18 @@
 // Lights the GI rays' hits (Metro Exodus's "deferred lighting of hits"): regenerates each
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
-// along the ray: where the hit was visible last frame, last frame's lit image there; on a miss the sky in that direction (no sun or moon disk: direct light is the
-// deferred pass's), on a hit the hit's albedo / π times the irradiance there from the sun or
-// moon (its shadow maps inside a cascade, else a shadow ray), the sky's ambient light and the point and spot lights, plus the
-// emission of the hit's instance (its material's, textures averaged) unless it is an area
-// light, whose light the area-light pass gives every surface already. The word
-// carries no normal, so a hit is lit as if it faced the ray. Output: the raw sample, encoded
-// as luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// along the ray. Where the hit was visible last frame: last frame's lit image there. On a
+// miss: the sky in that direction (no sun or moon disk: direct light is the deferred pass's).
+// On a hit: the hit's albedo / π times the irradiance there, on a surface facing the hit's
+// normal (`hit_normals`: the triangle's for BVH hits, the G-buffer's for the pre-trace's,
+// turned to face the ray; -dir without one), from the sun or moon (its shadow maps inside a
+// cascade, else a shadow ray), the sky's ambient light, the point and spot lights and the area
+// lights (in closed form), each kind shadowed by one ray to one light picked by its
+// unshadowed light; plus the emission of the hit's instance (its material's, textures
+// averaged) unless it is an area light, whose direct light the area-light pass gives every
+// surface already (its light on the hit is counted here). Output: the raw sample, encoded as
+// luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// CPU twins: ray_traced_gi::reference (punctual_irradiance, area_light_irradiance,
+// pick_light, area_light_point, random).
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
@@ -16,7 +22,8 @@
 #import hikari::sky::sky_background_no_disks
 #import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of}
+#import hikari::area_polygon::area_triangle_vector_irradiance
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -36,6 +43,28 @@
 @group(0) @binding(12) var prev_view_depth: texture_2d<f32>;
 // This frame's G-buffer instance ids, to check that a reused texel shows the hit's instance.
 @group(0) @binding(13) var gbuffer_instance: texture_2d<u32>;
+// The area lights' tables (`area_lights::AreaLightScene`; layouts in area_lights/shade.wgsl).
+@group(0) @binding(14) var<storage, read> area_lights: array<AreaLightGpu>;
+@group(0) @binding(15) var<storage, read> area_triangles: array<AreaTriangleGpu>;
+@group(0) @binding(16) var<storage, read> hit_normals: array<u32>;
+
+// Mirrors of area_lights/shade.wgsl's records (`area_lights::lights`).
+struct AreaLightGpu {
+    centroid_radius: vec4<f32>,
+    normal_area: vec4<f32>,
+    radiance_flux: vec4<f32>,
+    range: vec4<u32>,
+}
+
+struct AreaTriangleGpu {
+    p0_cdf: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+}
+
+const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
+const AREA_LIGHT_FORCED: u32 = 2u;
+const NO_LIGHT: u32 = 0xffffffffu;
 
 const MAX_RADIANCE: f32 = 65000.0;
 
@@ -127,7 +156,116 @@ fn reused_lit(x: vec3<f32>, instance: u32) -> vec4<f32> {
     return vec4<f32>(l, 1.0);
 }
 
-// Irradiance (lux) at x on a surface facing n.
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// Unshadowed irradiance (lux) of area light `i` at x on a surface facing n: nothing from a
+// light dimmer than the area-light pass's minimum flux (unless flagged), beyond the distance
+// where it must fall below the frame's cut-off, wholly behind its one-sided plane or below
+// the surface's horizon (the area-light pass's culling); else the polygon integration.
+fn area_light_irradiance(i: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let light = area_lights[i];
+    let forced = (light.range.z & AREA_LIGHT_FORCED) != 0u;
+    let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
+    if light.radiance_flux.w < params.area.y && !forced {
+        return vec3<f32>(0.0);
+    }
+    let c = light.centroid_radius.xyz;
+    let r = light.centroid_radius.w;
+    let reach = r + sqrt(max(luminance(light.radiance_flux.rgb) * light.normal_area.w, 0.0) / params.distances.w);
+    let to_c = c - x;
+    let nl = light.normal_area.xyz;
+    if dot(to_c, to_c) >= reach * reach || dot(to_c, n) < -r
+        || (!double_sided && length(nl) > 0.99 && dot(x - c, nl) < -r) {
+        return vec3<f32>(0.0);
+    }
+    var f = vec3<f32>(0.0);
+    for (var j = light.range.x; j < light.range.x + light.range.y; j++) {
+        let tri = area_triangles[j];
+        f += area_triangle_vector_irradiance(tri.p0_cdf.xyz, tri.p1.xyz, tri.p2.xyz, x, n, double_sided);
+    }
+    return light.radiance_flux.rgb * max(dot(f, n), 0.0);
+}
+
+// One shadow ray from x to a point of area light `i` sampled by area (u: two numbers in
+// [0, 1)): 1 if it reaches it, 0 if blocked. A point the surface or the light turns away from
+// carries no weight in the area-light pass's ratio estimator, which with one ray gives 1.
+fn area_light_visible(i: u32, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>) -> f32 {
+    let light = area_lights[i];
+    let first = light.range.x;
+    let last = first + light.range.y - 1u;
+    var j = first;
+    var lo = 0.0;
+    loop {
+        let cdf = area_triangles[j].p0_cdf.w;
+        if u.x <= cdf || j >= last {
+            break;
+        }
+        lo = cdf;
+        j++;
+    }
+    let tri = area_triangles[j];
+    let ux = clamp((u.x - lo) / max(tri.p0_cdf.w - lo, 1e-12), 0.0, 1.0);
+    let su = sqrt(ux);
+    let p = tri.p0_cdf.xyz * (1.0 - su) + tri.p1.xyz * (su * (1.0 - u.y)) + tri.p2.xyz * (su * u.y);
+    let to_p = p - x;
+    let dist = length(to_p);
+    if !(dist > 1e-6) {
+        return 1.0;
+    }
+    let dir = to_p / dist;
+    let ng = cross(tri.p1.xyz - tri.p0_cdf.xyz, tri.p2.xyz - tri.p0_cdf.xyz);
+    var cos_l = -dot(dir, ng);
+    if (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u {
+        cos_l = abs(cos_l);
+    }
+    if !(dot(dir, n) > 0.0 && cos_l > 0.0) {
+        return 1.0;
+    }
+    return select(1.0, 0.0, bvh_occluded(Ray(x, 0.0, dir, dist * (1.0 - 1e-3))));
+}
+
+// Irradiance (lux) at x on a surface facing n from the area lights, shadowed with one ray:
+// one light is picked in proportion to the luminance of its unshadowed irradiance (one pass,
+// a running choice on one random number, rescaled after each light), and its light times the
+// sum's luminance over its own, times its visibility, is the estimate. Without shadows it is
+// the exact sum; the shadow is the ratio estimator's with one ray (Heitz et al. 2018).
+fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    if (params.config.y & RTGI_AREA) == 0u {
+        return vec3<f32>(0.0);
+    }
+    let frame = params.config.x;
+    var u = rtgi_random(pixel, frame, 0u);
+    var total = 0.0;
+    var chosen = NO_LIGHT;
+    var chosen_e = vec3<f32>(0.0);
+    let count = min(u32(params.area.x), arrayLength(&area_lights));
+    for (var i = 0u; i < count; i++) {
+        let e = area_light_irradiance(i, x, n);
+        let s = luminance(e);
+        if !(s > 0.0) {
+            continue;
+        }
+        total += s;
+        let p = s / total;
+        if u < p {
+            chosen = i;
+            chosen_e = e;
+            u = u / p;
+        } else {
+            u = (u - p) / max(1.0 - p, 1e-7);
+        }
+        u = min(u, 0.99999994);
+    }
+    if chosen == NO_LIGHT {
+        return vec3<f32>(0.0);
+    }
+    let uv = vec2<f32>(rtgi_random(pixel, frame, 1u), rtgi_random(pixel, frame, 2u));
+    return chosen_e * (total / luminance(chosen_e) * area_light_visible(chosen, x, n, uv));
+}
+
+// Irradiance (lux) at x on a surface facing n from the sun or moon and the sky.
 fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let flags = params.config.y;
     var e = vec3<f32>(0.0);
@@ -143,18 +281,69 @@ fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             e += RTGI_PI * 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb) * 0.5 * (1.0 + n.y);
         }
     }
-    if (flags & RTGI_PUNCTUAL) != 0u {
-        for (var i = 0u; i < min(params.config.w, arrayLength(&lights)); i++) {
-            let light = lights[i];
-            let to_light = light.position_range.xyz - x;
-            let d2 = max(dot(to_light, to_light), 1e-8);
-            let range = light_range(light, params.distances.w);
-            let dir = to_light * inverseSqrt(d2);
-            let a = light_attenuation(light, dir, 1.0 / d2, d2 / (range * range));
-            e += light.intensity.rgb * (a * max(dot(n, dir), 0.0));
-        }
-    }
     return e;
+}
+
+// Unshadowed irradiance (lux) of point or spot light `i` at x on a surface facing n: inverse
+// square, the deferred lighting's window and cut-off, the spot cone, Lambert's cosine.
+fn punctual_light_irradiance(i: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let light = lights[i];
+    let to_light = light.position_range.xyz - x;
+    let d2 = max(dot(to_light, to_light), 1e-8);
+    let range = light_range(light, params.distances.w);
+    let dir = to_light * inverseSqrt(d2);
+    let a = light_attenuation(light, dir, 1.0 / d2, d2 / (range * range));
+    return light.intensity.rgb * (a * max(dot(n, dir), 0.0));
+}
+
+// Irradiance (lux) at x on a surface facing n from the point and spot lights. Shadowed
+// (RTGI_PUNCTUAL_SHADOWS, when the frame shadows them): one light picked in proportion to the
+// luminance of its unshadowed irradiance, as for the area lights, and one shadow ray to its
+// centre; its light times the sum's luminance over its own if the ray passes, else 0, which
+// is unbiased for the lights' shadowed sum with point lights. Else the unshadowed sum.
+fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let flags = params.config.y;
+    if (flags & RTGI_PUNCTUAL) == 0u {
+        return vec3<f32>(0.0);
+    }
+    let count = min(params.config.w, arrayLength(&lights));
+    if (flags & RTGI_PUNCTUAL_SHADOWS) == 0u {
+        var e = vec3<f32>(0.0);
+        for (var i = 0u; i < count; i++) {
+            e += punctual_light_irradiance(i, x, n);
+        }
+        return e;
+    }
+    var u = rtgi_random(pixel, params.config.x, 3u);
+    var total = 0.0;
+    var chosen = NO_LIGHT;
+    var chosen_e = vec3<f32>(0.0);
+    for (var i = 0u; i < count; i++) {
+        let e = punctual_light_irradiance(i, x, n);
+        let s = luminance(e);
+        if !(s > 0.0) {
+            continue;
+        }
+        total += s;
+        let p = s / total;
+        if u < p {
+            chosen = i;
+            chosen_e = e;
+            u = u / p;
+        } else {
+            u = (u - p) / max(1.0 - p, 1e-7);
+        }
+        u = min(u, 0.99999994);
+    }
+    if chosen == NO_LIGHT {
+        return vec3<f32>(0.0);
+    }
+    let to_light = lights[chosen].position_range.xyz - x;
+    let dist = length(to_light);
+    if bvh_occluded(Ray(x, 0.0, to_light / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
+        return vec3<f32>(0.0);
+    }
+    return chosen_e * (total / luminance(chosen_e));
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -183,8 +372,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if rtgi_is_hit(word) {
         distance = rtgi_hit_distance(word);
         ao = select(1.0, 0.0, distance < params.distances.y);
+        // The hit's normal, facing the ray.
+        var hn = -dir;
+        let packed_normal = hit_normals[pixel.y * size.x + pixel.x];
+        if packed_normal != RTGI_NO_NORMAL {
+            let m = oct_decode(rtgi_unpack_normal(packed_normal));
+            hn = select(m, -m, dot(m, dir) > 0.0);
+        }
         // Back along the ray a little, off the surface it hit.
-        let x = o + dir * (distance - (1.0e-3 + 1.0e-3 * distance));
+        let eps = 1.0e-3 + 1.0e-3 * distance;
+        let x = o + dir * (distance - eps) + hn * eps;
         // The talk's "first bounce from all lights": the lit image where the hit was seen.
         let instance = hit_instances[pixel.y * size.x + pixel.x];
         let lit = reused_lit(o + dir * distance, instance);
@@ -198,7 +395,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if lit.w > 0.0 {
             radiance = max(lit.rgb - emission.rgb * emission.w, vec3<f32>(0.0));
         } else {
-            radiance = rtgi_hit_albedo_of(word) / RTGI_PI * irradiance(x, -dir) + own;
+            let e = irradiance(x, hn) + punctual_irradiance(pixel, x, hn) + area_irradiance(pixel, x, hn);
+            radiance = rtgi_hit_albedo_of(word) / RTGI_PI * e + own;
         }
     } else {
         radiance = miss_radiance(dir);

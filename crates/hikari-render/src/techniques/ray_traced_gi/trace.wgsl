@@ -1,11 +1,13 @@
 // The rays the pre-trace left (the queue), traced through the scene's BVH with cut-outs, up
-// to the near field's length; a hit takes its instance's albedo and records the instance. Output: their hit words.
+// to the near field's length; a hit takes its instance's albedo and records the instance and
+// its triangle's geometric normal (the mesh's rest pose, turned into world space by the
+// instance's normal matrix). Output: their hit words.
 // Invocations past the queue's count return at once; the queue keeps the live ones together.
 
 #import hikari::view::{View, world_from_depth}
-#import hikari::octahedral::oct_decode
+#import hikari::octahedral::{oct_decode, oct_encode}
 #import hikari::bvh::{Ray, bvh_closest_hit, bvh_is_hit}
-#import hikari::ray_traced_gi::{RtGiParams, rtgi_ray_direction, rtgi_ray_origin, rtgi_pack_hit, rtgi_pack_miss}
+#import hikari::ray_traced_gi::{RtGiParams, rtgi_ray_direction, rtgi_ray_origin, rtgi_pack_hit, rtgi_pack_miss, rtgi_pack_normal, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -16,6 +18,38 @@
 @group(0) @binding(6) var<storage, read_write> hit_instances: array<u32>;
 // Per scene instance: albedo for hits, then emission (reference::instance_table).
 @group(0) @binding(7) var<storage, read> instance_table: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read_write> hit_normals: array<u32>;
+// Per scene instance, three vec4: the rows of its normal matrix (xyz); w of the first the
+// index of its mesh's first triangle in `triangle_normals`, of the second its triangle count
+// (bitcast). Per mesh triangle: its geometric normal in object space (rtgi_pack_normal).
+// `RtGiScene::normal_tables`.
+@group(0) @binding(9) var<storage, read> instance_normals: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read> triangle_normals: array<u32>;
+
+// World-space geometric normal of triangle `primitive` of scene instance `instance` (unit, as
+// wound in the mesh), packed; RTGI_NO_NORMAL where the tables do not hold it.
+fn hit_normal(instance: u32, primitive: u32) -> u32 {
+    if 3u * instance + 2u >= arrayLength(&instance_normals) {
+        return RTGI_NO_NORMAL;
+    }
+    let r0 = instance_normals[3u * instance];
+    let r1 = instance_normals[3u * instance + 1u];
+    let r2 = instance_normals[3u * instance + 2u];
+    let first = bitcast<u32>(r0.w);
+    if primitive >= bitcast<u32>(r1.w) || first + primitive >= arrayLength(&triangle_normals) {
+        return RTGI_NO_NORMAL;
+    }
+    let w = triangle_normals[first + primitive];
+    if w == RTGI_NO_NORMAL {
+        return RTGI_NO_NORMAL;
+    }
+    let no = oct_decode(rtgi_unpack_normal(w));
+    let nw = vec3<f32>(dot(r0.xyz, no), dot(r1.xyz, no), dot(r2.xyz, no));
+    if !(dot(nw, nw) > 0.0) {
+        return RTGI_NO_NORMAL;
+    }
+    return rtgi_pack_normal(oct_encode(normalize(nw)));
+}
 
 @compute @workgroup_size(64, 1, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -34,7 +68,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let hit = bvh_closest_hit(Ray(o, 0.0, dir, params.distances.x));
     var word = rtgi_pack_miss();
     var instance = 0xffffffffu;
+    var normal = RTGI_NO_NORMAL;
     if bvh_is_hit(hit) {
+        normal = hit_normal(hit.instance, hit.primitive);
         var albedo = vec3<f32>(0.5);
         if 2u * hit.instance < arrayLength(&instance_table) {
             albedo = instance_table[2u * hit.instance].rgb;
@@ -44,4 +80,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     hits[i] = word;
     hit_instances[i] = instance;
+    hit_normals[i] = normal;
 }
