@@ -873,13 +873,14 @@ fn hits_are_lit_like_the_twin() {
                     );
                     let p = o + dir * (used - eps) + hn * eps;
                     let mut e = reference::punctual_irradiance(p, hn, &light, cutoff);
-                    let each = (0..area.lights.len()).map(|k| {
-                        reference::area_light_irradiance(&area, k, p, hn, min_flux, cutoff)
-                    });
-                    if let Some((_, ek, total)) =
-                        reference::pick_light(each, reference::random([x, y], 0, 0))
+                    let scores = (0..area.lights.len())
+                        .map(|k| reference::area_light_score(&area, k, p, hn, min_flux, cutoff));
+                    if let Some((k, sk, total)) =
+                        reference::pick_weighted(scores, reference::random([x, y], 0, 0))
                     {
-                        e += ek * (total / ek.dot(Vec3::new(0.2126, 0.7152, 0.0722)));
+                        let ek =
+                            reference::area_light_irradiance(&area, k, p, hn, min_flux, cutoff);
+                        e += ek * (total / sk);
                     }
                     (
                         albedo / std::f32::consts::PI * e + ceiling_emission,

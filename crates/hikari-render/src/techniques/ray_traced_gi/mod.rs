@@ -429,7 +429,8 @@ impl RayTracedGi {
         if params.flags() & FLAG_BVH != 0 {
             let noise = self.noise_set(g);
             let bvh_set = bvh.binding_set(g);
-            let total = pixels.div_ceil(64).max(1);
+            // 64 invocations of 8 rays each a workgroup (trace.wgsl).
+            let total = pixels.div_ceil(64 * 8).max(1);
             let max = g.ctx().limits.max_compute_workgroups_per_dimension.max(1) as u64;
             let gy = total.div_ceil(max);
             let gx = total.div_ceil(gy);

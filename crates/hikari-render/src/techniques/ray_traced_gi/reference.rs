@@ -343,34 +343,87 @@ fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
-/// The light a hit's shadow ray goes to, as the shade pass picks it: each light's
-/// unshadowed irradiance `e` (lux) in order, one chosen in proportion to its luminance by a
-/// running choice on the one number `u` (rescaled after each light). Returns the chosen index,
-/// its irradiance and the luminance of the sum; `None` when nothing lights the point.
-pub fn pick_light(e: impl IntoIterator<Item = Vec3>, u: f32) -> Option<(usize, Vec3, f32)> {
+/// One of `scores` picked in proportion to its value, as the shade pass picks lights: in order,
+/// by a running choice on the one number `u` (rescaled after each). Returns the chosen index,
+/// its score and the scores' sum; `None` when none is above 0.
+pub fn pick_weighted(scores: impl IntoIterator<Item = f32>, u: f32) -> Option<(usize, f32, f32)> {
     let (mut u, mut total, mut chosen) = (u, 0.0f32, None);
-    for (i, e) in e.into_iter().enumerate() {
-        let s = luminance(e);
+    for (i, s) in scores.into_iter().enumerate() {
         if s.is_nan() || s <= 0.0 {
             continue;
         }
         total += s;
         let p = s / total;
         if u < p {
-            chosen = Some((i, e));
+            chosen = Some((i, s));
             u /= p;
         } else {
             u = (u - p) / (1.0 - p).max(1e-7);
         }
         u = u.min(0.999_999_94);
     }
-    chosen.map(|(i, e)| (i, e, total))
+    chosen.map(|(i, s)| (i, s, total))
+}
+
+/// The point or spot light a hit's shadow ray goes to, as the shade pass picks it: each
+/// light's unshadowed irradiance `e` (lux), one chosen in proportion to its luminance
+/// ([`pick_weighted`]). Returns the chosen index, its irradiance and the luminance of the sum;
+/// `None` when nothing lights the point.
+pub fn pick_light(e: impl IntoIterator<Item = Vec3>, u: f32) -> Option<(usize, Vec3, f32)> {
+    let e: Vec<Vec3> = e.into_iter().collect();
+    pick_weighted(e.iter().map(|&e| luminance(e)), u).map(|(i, _, total)| (i, e[i], total))
+}
+
+/// Whether area light `i` may light `x` on a surface facing `n`, as the shade pass culls: not a
+/// light under `min_flux_lm` (unless flagged), not beyond where it falls below `cutoff_lux`,
+/// not wholly behind its one-sided plane or below the horizon.
+pub fn area_light_reaches(
+    lights: &crate::techniques::area_lights::PolygonLights,
+    i: usize,
+    x: Vec3,
+    n: Vec3,
+    min_flux_lm: f32,
+    cutoff_lux: f32,
+) -> bool {
+    use crate::techniques::area_lights::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED};
+    let l = &lights.lights[i];
+    let forced = l.range[2] & AREA_LIGHT_FORCED != 0;
+    let double_sided = l.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
+    if l.radiance_flux[3] < min_flux_lm && !forced {
+        return false;
+    }
+    let radiance = Vec3::from_slice(&l.radiance_flux[..3]);
+    let c = Vec3::from_slice(&l.centroid_radius[..3]);
+    let r = l.centroid_radius[3];
+    let reach = r + ((luminance(radiance) * l.normal_area[3]).max(0.0) / cutoff_lux).sqrt();
+    let nl = Vec3::from_slice(&l.normal_area[..3]);
+    !((c - x).length_squared() >= reach * reach
+        || (c - x).dot(n) < -r
+        || (!double_sided && nl.length() > 0.99 && (x - c).dot(nl) < -r))
+}
+
+/// What a hit picks area light `i` by, as the shade pass: its flux over the squared distance
+/// to its centroid, 0 where it cannot reach `x` ([`area_light_reaches`]).
+pub fn area_light_score(
+    lights: &crate::techniques::area_lights::PolygonLights,
+    i: usize,
+    x: Vec3,
+    n: Vec3,
+    min_flux_lm: f32,
+    cutoff_lux: f32,
+) -> f32 {
+    if !area_light_reaches(lights, i, x, n, min_flux_lm, cutoff_lux) {
+        return 0.0;
+    }
+    let l = &lights.lights[i];
+    let c = Vec3::from_slice(&l.centroid_radius[..3]);
+    let r = l.centroid_radius[3];
+    l.radiance_flux[3] / (c - x).length_squared().max((r * r).max(1e-6))
 }
 
 /// Unshadowed irradiance (lux) of area light `i` at `x` on a surface facing `n`, as the shade
-/// pass lights hits: nothing from a light under `min_flux_lm` (unless flagged), beyond where
-/// it falls below `cutoff_lux`, wholly behind its one-sided plane or below the horizon; else
-/// the light's radiance times the polygon integration (`area_lights::reference`).
+/// pass lights hits: 0 where it cannot reach `x` ([`area_light_reaches`]), else the light's
+/// radiance times the polygon integration (`area_lights::reference`).
 pub fn area_light_irradiance(
     lights: &crate::techniques::area_lights::PolygonLights,
     i: usize,
@@ -379,24 +432,13 @@ pub fn area_light_irradiance(
     min_flux_lm: f32,
     cutoff_lux: f32,
 ) -> Vec3 {
-    use crate::techniques::area_lights::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED};
+    use crate::techniques::area_lights::lights::AREA_LIGHT_DOUBLE_SIDED;
+    if !area_light_reaches(lights, i, x, n, min_flux_lm, cutoff_lux) {
+        return Vec3::ZERO;
+    }
     let l = &lights.lights[i];
-    let forced = l.range[2] & AREA_LIGHT_FORCED != 0;
     let double_sided = l.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
-    if l.radiance_flux[3] < min_flux_lm && !forced {
-        return Vec3::ZERO;
-    }
     let radiance = Vec3::from_slice(&l.radiance_flux[..3]);
-    let c = Vec3::from_slice(&l.centroid_radius[..3]);
-    let r = l.centroid_radius[3];
-    let reach = r + ((luminance(radiance) * l.normal_area[3]).max(0.0) / cutoff_lux).sqrt();
-    let nl = Vec3::from_slice(&l.normal_area[..3]);
-    if (c - x).length_squared() >= reach * reach
-        || (c - x).dot(n) < -r
-        || (!double_sided && nl.length() > 0.99 && (x - c).dot(nl) < -r)
-    {
-        return Vec3::ZERO;
-    }
     let f = crate::techniques::area_lights::reference::light_vector_irradiance(
         lights.triangles_of(i),
         double_sided,
@@ -576,4 +618,33 @@ pub fn resolve_specular(s: &ShL1YCoCg, n: Vec3, v: Vec3, f0: Vec3, material_alph
     let spec = ggx::ggx_ndf(n.dot(h) as f64, alpha) * smith::visibility(n_v, n_l, alpha);
     let f = fresnel::fresnel_schlick(f0.as_dvec3(), v.dot(h).max(0.0) as f64);
     (f * spec * e * n_l).as_vec3()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pick_weighted;
+
+    /// The hit's one-light estimate `v_k * total / s_k`, averaged over the random number,
+    /// is the sum of every light's value whatever the scores (all above 0 where a value is):
+    /// the selection is unbiased. A score of 0 drops its light.
+    #[test]
+    fn picking_by_score_is_unbiased() {
+        let scores = [3.0f32, 0.0, 0.5, 10.0, 0.2];
+        let values = [2.0f32, 0.0, 7.0, 0.25, 40.0];
+        let n = 200_000;
+        let mean = (0..n)
+            .map(|k| {
+                let u = (k as f32 + 0.5) / n as f32;
+                let (i, s, total) = pick_weighted(scores, u).expect("some score is above 0");
+                (values[i] * total / s) as f64
+            })
+            .sum::<f64>()
+            / n as f64;
+        let want: f32 = values.iter().sum();
+        assert!(
+            (mean - want as f64).abs() < 2e-3 * want as f64,
+            "mean {mean}, sum {want}"
+        );
+        assert_eq!(pick_weighted([0.0, f32::NAN], 0.5), None);
+    }
 }

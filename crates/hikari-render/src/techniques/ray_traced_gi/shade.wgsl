@@ -160,26 +160,47 @@ fn luminance(c: vec3<f32>) -> f32 {
     return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
 }
 
-// Unshadowed irradiance (lux) of area light `i` at x on a surface facing n: nothing from a
-// light dimmer than the area-light pass's minimum flux (unless flagged), beyond the distance
-// where it must fall below the frame's cut-off, wholly behind its one-sided plane or below
-// the surface's horizon (the area-light pass's culling); else the polygon integration.
-fn area_light_irradiance(i: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// Whether area light `i` may light x on a surface facing n, by the area-light pass's culling:
+// not a light dimmer than its minimum flux (unless flagged), not beyond the distance where it
+// must fall below the frame's cut-off, not wholly behind its one-sided plane or below the
+// surface's horizon.
+fn area_light_reaches(i: u32, x: vec3<f32>, n: vec3<f32>) -> bool {
     let light = area_lights[i];
     let forced = (light.range.z & AREA_LIGHT_FORCED) != 0u;
     let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
     if light.radiance_flux.w < params.area.y && !forced {
-        return vec3<f32>(0.0);
+        return false;
     }
     let c = light.centroid_radius.xyz;
     let r = light.centroid_radius.w;
     let reach = r + sqrt(max(luminance(light.radiance_flux.rgb) * light.normal_area.w, 0.0) / params.distances.w);
     let to_c = c - x;
     let nl = light.normal_area.xyz;
-    if dot(to_c, to_c) >= reach * reach || dot(to_c, n) < -r
-        || (!double_sided && length(nl) > 0.99 && dot(x - c, nl) < -r) {
+    return !(dot(to_c, to_c) >= reach * reach || dot(to_c, n) < -r
+        || (!double_sided && length(nl) > 0.99 && dot(x - c, nl) < -r));
+}
+
+// What a hit picks area light `i` by: its flux over the squared distance to its centroid
+// (the area-light pass's ranking), 0 where it cannot reach x. Cheap, so that a hit in reach of
+// hundreds of lit windows integrates one polygon, not hundreds.
+fn area_light_score(i: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
+    if !area_light_reaches(i, x, n) {
+        return 0.0;
+    }
+    let light = area_lights[i];
+    let to_c = light.centroid_radius.xyz - x;
+    let r = light.centroid_radius.w;
+    return light.radiance_flux.w / max(dot(to_c, to_c), max(r * r, 1e-6));
+}
+
+// Unshadowed irradiance (lux) of area light `i` at x on a surface facing n: 0 where it cannot
+// reach x, else the polygon integration.
+fn area_light_irradiance(i: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    if !area_light_reaches(i, x, n) {
         return vec3<f32>(0.0);
     }
+    let light = area_lights[i];
+    let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
     var f = vec3<f32>(0.0);
     for (var j = light.range.x; j < light.range.x + light.range.y; j++) {
         let tri = area_triangles[j];
@@ -226,11 +247,12 @@ fn area_light_visible(i: u32, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>) -> f32 {
     return select(1.0, 0.0, bvh_occluded(Ray(x, 0.0, dir, dist * (1.0 - 1e-3))));
 }
 
-// Irradiance (lux) at x on a surface facing n from the area lights, shadowed with one ray:
-// one light is picked in proportion to the luminance of its unshadowed irradiance (one pass,
-// a running choice on one random number, rescaled after each light), and its light times the
-// sum's luminance over its own, times its visibility, is the estimate. Without shadows it is
-// the exact sum; the shadow is the ratio estimator's with one ray (Heitz et al. 2018).
+// Irradiance (lux) at x on a surface facing n from the area lights, with one polygon
+// integration and one shadow ray: one light is picked in proportion to its score (one pass, a
+// running choice on one random number, rescaled after each light), and its unshadowed light
+// times the scores' sum over its own score, times its visibility, is the estimate: unbiased,
+// since every light that can light x has a score above 0. The shadow is the ratio
+// estimator's with one ray (Heitz et al. 2018).
 fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     if (params.config.y & RTGI_AREA) == 0u {
         return vec3<f32>(0.0);
@@ -239,11 +261,10 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     var u = rtgi_random(pixel, frame, 0u);
     var total = 0.0;
     var chosen = NO_LIGHT;
-    var chosen_e = vec3<f32>(0.0);
+    var chosen_s = 0.0;
     let count = min(u32(params.area.x), arrayLength(&area_lights));
     for (var i = 0u; i < count; i++) {
-        let e = area_light_irradiance(i, x, n);
-        let s = luminance(e);
+        let s = area_light_score(i, x, n);
         if !(s > 0.0) {
             continue;
         }
@@ -251,7 +272,7 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         let p = s / total;
         if u < p {
             chosen = i;
-            chosen_e = e;
+            chosen_s = s;
             u = u / p;
         } else {
             u = (u - p) / max(1.0 - p, 1e-7);
@@ -261,8 +282,12 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     if chosen == NO_LIGHT {
         return vec3<f32>(0.0);
     }
+    let e = area_light_irradiance(chosen, x, n);
+    if !(luminance(e) > 0.0) {
+        return vec3<f32>(0.0);
+    }
     let uv = vec2<f32>(rtgi_random(pixel, frame, 1u), rtgi_random(pixel, frame, 2u));
-    return chosen_e * (total / luminance(chosen_e) * area_light_visible(chosen, x, n, uv));
+    return e * (total / chosen_s * area_light_visible(chosen, x, n, uv));
 }
 
 // Irradiance (lux) at x on a surface facing n from the sun or moon and the sky.

@@ -2,11 +2,10 @@
 // to the near field's length; a hit takes its instance's albedo and records the instance and
 // its triangle's geometric normal (the mesh's rest pose, turned into world space by the
 // instance's normal matrix). Output: their hit words.
-// Invocations past the queue's count return at once; the queue keeps the live ones together.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::{oct_decode, oct_encode}
-#import hikari::bvh::{Ray, bvh_closest_hit, bvh_is_hit}
+#import hikari::bvh::{Ray, Hit, bvh_begin, bvh_step, bvh_result, bvh_is_hit}
 #import hikari::ray_traced_gi::{RtGiParams, rtgi_ray_direction, rtgi_ray_origin, rtgi_pack_hit, rtgi_pack_miss, rtgi_pack_normal, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
@@ -51,12 +50,18 @@ fn hit_normal(instance: u32, primitive: u32) -> u32 {
     return rtgi_pack_normal(oct_encode(normalize(nw)));
 }
 
-@compute @workgroup_size(64, 1, 1)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let k = gid.x + gid.y * nwg.x * 64u;
-    if k >= queue[0] || k + 1u >= arrayLength(&queue) {
-        return;
-    }
+// Rays an invocation traces, one after the other (persistent threads, Aila and Laine 2009):
+// each workgroup owns a chunk of RAYS_PER_THREAD * 64 queue slots, and an invocation whose ray
+// is done takes the chunk's next one instead of idling until the slowest ray of its warp ends
+// (incoherent rays differ in length by orders of magnitude). hikari-bvh's trace kernel
+// measured this as the fastest way to trace incoherent rays (BENCHMARKS.md).
+const RAYS_PER_THREAD: u32 = 8u;
+const WORKGROUP: u32 = 64u;
+
+var<workgroup> next_slot: atomic<u32>;
+
+// Starts queue slot k's ray; returns its pixel index.
+fn begin_ray(k: u32) -> u32 {
     let i = queue[k + 1u];
     let size = textureDimensions(depth);
     let pixel = vec2<u32>(i % size.x, i / size.x);
@@ -65,7 +70,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let world = world_from_depth(view, pixel, d);
     let o = rtgi_ray_origin(world, n, view.position.xyz);
     let dir = rtgi_ray_direction(pixel, params.config.x, n).xyz;
-    let hit = bvh_closest_hit(Ray(o, 0.0, dir, params.distances.x));
+    bvh_begin(Ray(o, 0.0, dir, params.distances.x));
+    return i;
+}
+
+fn finish_ray(i: u32, hit: Hit) {
     var word = rtgi_pack_miss();
     var instance = 0xffffffffu;
     var normal = RTGI_NO_NORMAL;
@@ -81,4 +90,34 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     hits[i] = word;
     hit_instances[i] = instance;
     hit_normals[i] = normal;
+}
+
+@compute @workgroup_size(64, 1, 1)
+fn main(
+    @builtin(workgroup_id) wid: vec3<u32>,
+    @builtin(num_workgroups) nwg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
+    let chunk = WORKGROUP * RAYS_PER_THREAD;
+    let start = (wid.y * nwg.x + wid.x) * chunk;
+    let end = min(start + chunk, min(queue[0], arrayLength(&queue) - 1u));
+    if lid == 0u {
+        atomicStore(&next_slot, WORKGROUP);
+    }
+    workgroupBarrier();
+    var k = start + lid;
+    if k >= end {
+        return;
+    }
+    var i = begin_ray(k);
+    loop {
+        if bvh_step(false) {
+            finish_ray(i, bvh_result());
+            k = start + atomicAdd(&next_slot, 1u);
+            if k >= end {
+                break;
+            }
+            i = begin_ray(k);
+        }
+    }
 }
