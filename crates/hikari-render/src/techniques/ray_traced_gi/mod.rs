@@ -103,6 +103,9 @@ pub struct RtGiParams {
     /// Placeholder sky radiance in nits at the zenith and the horizon.
     pub sky_zenith: [f32; 4],
     pub sky_horizon: [f32; 4],
+    /// The accumulation's firefly clamp ([`reference::FireflyClamp`]): k (0: off), the floor
+    /// (SH c0 units), the history length from which it applies; w unused.
+    pub firefly: [f32; 4],
 }
 
 /// Where the sky for misses and ambient light comes from.
@@ -167,6 +170,7 @@ impl RtGiParams {
             sun_color: color.extend(1.0).to_array(),
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky_scale).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
+            firefly: reference::FireflyClamp::new(s.firefly_clamp, metered_lux).to_array(),
         }
     }
 

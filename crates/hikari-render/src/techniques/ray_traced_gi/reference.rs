@@ -298,11 +298,68 @@ pub struct AccumulateInput {
     pub raw_ao: f32,
 }
 
+/// The accumulation's firefly clamp. A sample whose luminance (SH c0) exceeds
+/// `k · max(history c0, 0) + floor` is scaled down to that, whole (Y SH and CoCg alike, so its
+/// chroma and direction stay those of the sample), once the history holds at least
+/// `min_history` frames (younger pixels must still converge from their first samples).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FireflyClamp {
+    /// Times the history's c0 a sample may reach (0: off). Unitless.
+    pub k: f32,
+    /// Added to the limit, in SH c0 units (luminance × `C0`): what a dark history may still
+    /// take in one frame.
+    pub floor: f32,
+    /// History length (frames) from which the clamp applies.
+    pub min_history: f32,
+}
+
+/// History length from which the firefly clamp applies: below it a pixel's history is too
+/// young to say what is too bright.
+pub const FIREFLY_MIN_HISTORY: f32 = 4.0;
+
+impl FireflyClamp {
+    /// The clamp of setting `k` in a frame metered at `metered_lux` (lux): the floor is the c0
+    /// of a sample of luminance `metered_lux / π`, a white Lambertian surface under the metered
+    /// illuminance, so the clamp scales with the scene's light and not with the camera's
+    /// exposure settings. A non-finite or non-positive `k` or a non-finite meter turns it off.
+    pub fn new(k: f32, metered_lux: f32) -> Self {
+        if !(k.is_finite() && k > 0.0 && metered_lux.is_finite()) {
+            return Self::default();
+        }
+        Self {
+            k,
+            floor: hikari_math::sh::basis::C0 as f32 * metered_lux.max(0.0) / std::f32::consts::PI,
+            min_history: FIREFLY_MIN_HISTORY,
+        }
+    }
+
+    /// As `RtGiParams::firefly`.
+    pub fn to_array(self) -> [f32; 4] {
+        [self.k, self.floor, self.min_history, 0.0]
+    }
+
+    /// `sample` limited against `history` of `history_length` frames.
+    pub fn apply(&self, sample: ShL1YCoCg, history: &ShL1YCoCg, history_length: f32) -> ShL1YCoCg {
+        let on = self.k > 0.0 && history_length >= self.min_history;
+        if !on {
+            return sample;
+        }
+        let limit = self.k * history.y.coeffs[0].max(0.0) + self.floor;
+        let c0 = sample.y.coeffs[0];
+        if c0 > limit {
+            sample.scale(limit / c0)
+        } else {
+            sample
+        }
+    }
+}
+
 /// Temporal accumulation of one pixel: reprojects by the motion vector to the nearest texel
 /// of the history, accepts it if inside the image, finite, with history, and its view depth
 /// within `depth_tolerance` (relative) of where this surface point was seen last frame
 /// (`prev_view_proj · world`, w); then blends with speed 1 / length, length growing to
-/// `max_history`. Non-finite raw values count as a zero sample (AO: open).
+/// `max_history`, the raw sample held by `firefly` against the history it joins. Non-finite
+/// raw values count as a zero sample (AO: open).
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_pixel(
     pixel: [u32; 2],
@@ -314,6 +371,7 @@ pub fn accumulate_pixel(
     history_valid: bool,
     max_history: f32,
     depth_tolerance: f32,
+    firefly: &FireflyClamp,
 ) -> Accumulated {
     if input.depth.is_nan() || input.depth <= 0.0 {
         return Accumulated {
@@ -358,6 +416,7 @@ pub fn accumulate_pixel(
     {
         return fresh;
     }
+    let raw = firefly.apply(raw, &h.gi, h.length);
     let length = (h.length + 1.0).min(max_history);
     let speed = 1.0 / length;
     Accumulated {

@@ -136,6 +136,9 @@ struct RtGiParams {
     // Placeholder sky radiance (nits) at the zenith and the horizon (atmosphere off).
     sky_zenith: vec4<f32>,
     sky_horizon: vec4<f32>,
+    // The accumulation's firefly clamp: x: k (0: off), y: the floor (SH c0), z: the history
+    // length from which it applies.
+    firefly: vec4<f32>,
 }
 
 const RTGI_PRETRACE: u32 = 1u;
