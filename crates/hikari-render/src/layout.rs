@@ -132,7 +132,8 @@ pub fn all() -> Vec<StructLayout> {
                 sun,
                 sun_color,
                 sky_zenith,
-                sky_horizon
+                sky_horizon,
+                firefly
             ]
         ),
         gpu_layout!(

@@ -252,8 +252,18 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
         max_history: 3,
         ..RayTracedGiSettings::default()
     };
-    let base = RtGiParams::new(&settings, 0, None, 0, 1000.0, SkySource::None);
+    let mut base = RtGiParams::new(&settings, 0, None, 0, 1000.0, SkySource::None);
     assert_ne!(base.flags() & FLAG_ACCUMULATE, 0);
+    // A firefly clamp tight enough to act on these random samples from 2 frames of history
+    // on, so that its 3x3 scale is compared too (reprojected, at the image's edges, beside
+    // rejected and non-finite history).
+    let firefly = FireflyClamp {
+        k: 1.5,
+        floor: 0.25,
+        min_history: 2.0,
+    };
+    base.firefly = firefly.to_array();
+    let mut clamped = 0;
     let mut rng = SmallRng::seed_from_u64(7);
     let mut rt = GraphRuntime::new();
     let mut history: Vec<Accumulated> = vec![Accumulated::default(); (w * h) as usize];
@@ -394,8 +404,23 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
                     history_valid && !reset,
                     settings.max_history as f32,
                     settings.depth_tolerance,
-                    &FireflyClamp::new(settings.firefly_clamp, 1000.0),
+                    &firefly,
                 );
+                let unclamped = accumulate_pixel(
+                    [xx, yy],
+                    [w, h],
+                    &input,
+                    worlds[i],
+                    prev_vp,
+                    &look,
+                    history_valid && !reset,
+                    settings.max_history as f32,
+                    settings.depth_tolerance,
+                    &FireflyClamp::default(),
+                );
+                if unclamped.gi != a.gi {
+                    clamped += 1;
+                }
                 let fl = reference::to_floats(&a.gi).map(f16);
                 let a = Accumulated {
                     gi: reference::from_floats(fl),
@@ -432,7 +457,9 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
                 }
             }
         }
-        eprintln!("frame {frame}: {fresh} fresh, {accumulated} accumulated");
+        eprintln!(
+            "frame {frame}: {fresh} fresh, {accumulated} accumulated, {clamped} clamped so far"
+        );
         if frame == 0 || reset {
             assert_eq!(
                 accumulated, 0,
@@ -457,6 +484,10 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
         }
         history_valid = true;
     }
+    assert!(
+        clamped > 200,
+        "the firefly clamp acted in {clamped} pixels only"
+    );
 }
 
 fn floor_scene() -> Scene {
@@ -1063,9 +1094,10 @@ fn the_lighting_resolves_gi_near_and_the_far_field_beyond() {
 /// ((k - 1) · h + floor) / L (k = 8, h = 50, floor = C0 · 1000 lux / π, L = 8: 55, where the
 /// unclamped sample moves it by 1244), and the whole sample is scaled alike, so Y SH and CoCg
 /// follow c0. Checked against the analytic value of S + (F · limit / c0(F) - S) / L and the CPU
-/// twin; pixels without the firefly keep S; a firefly while the history is 2 frames long
-/// (below `FIREFLY_MIN_HISTORY`) is not clamped; with `firefly_clamp = 0` the same firefly
-/// breaks the bound (the control). Tolerance: f16 storage, 2^-9 · max(|v|, 1).
+/// twin; pixels without the firefly keep S; a pixel whose own samples were all 0 takes the
+/// limit of its neighbours' scale (F · limit / c0(F) / L); a firefly while the history is 2
+/// frames long (below `FIREFLY_MIN_HISTORY`) is not clamped; with `firefly_clamp = 0` the same
+/// firefly breaks the bound (the control). Tolerance: f16 storage, 2^-9 · max(|v|, 1).
 #[test]
 fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
     let ctx = common::gpu_context();
@@ -1087,6 +1119,7 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
     let firefly = 200.0f32;
     let late = [(3u32, 4u32), (9, 9), (12, 2)];
     let young = (6u32, 13u32);
+    let dark = (13u32, 12u32);
     let close = |g: f32, e: f32| (g - e).abs() <= e.abs().max(1.0) * 2f32.powi(-9);
     for k in [8.0f32, 0.0] {
         let settings = RayTracedGiSettings {
@@ -1129,6 +1162,11 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
             let mut hot: Vec<(u32, u32)> = Vec::new();
             if frame == 10 {
                 hot.extend(late);
+                hot.push(dark);
+            } else {
+                let i = (dark.1 * w + dark.0) as usize;
+                raw_y[i] = [0.0; 4];
+                raw_c[i] = [0.0, 0.0, 0.5, 0.0];
             }
             if frame == 2 {
                 hot.push(young);
@@ -1202,16 +1240,23 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
             let bound =
                 ((k - 1.0) * s_y[0] + C0 as f32 * metered_lux / std::f32::consts::PI) / length;
             let clamp = FireflyClamp::new(k, metered_lux);
-            for &(x, y) in &late {
+            let want_dark = s6.map(|v| v * firefly * scale / length);
+            for &(x, y) in late.iter().chain([&dark]) {
                 let i = (y * w + x) as usize;
                 assert_eq!(rgba(&gl)[i][0], length);
                 let g = got(x, y);
-                // The twin, from a converged history of S at full length.
-                let history = Accumulated {
-                    gi: reference::from_floats(s6),
+                let (want, s_hist) = if (x, y) == dark {
+                    (want_dark, [0.0; 6])
+                } else {
+                    (want, s6)
+                };
+                // The twin, from a converged history of S at full length (0 at the dark
+                // pixel).
+                let history = |p: [u32; 2]| Accumulated {
+                    gi: reference::from_floats(if (p[0], p[1]) == (x, y) { s_hist } else { s6 }),
                     ao: 0.5,
                     length,
-                    view_depth: motion[i][2],
+                    view_depth: motion[(p[1] * w + p[0]) as usize][2],
                 };
                 let input = AccumulateInput {
                     depth: depth[i],
@@ -1225,7 +1270,7 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
                     &input,
                     worlds[i],
                     prev_vp,
-                    &|_| history,
+                    &history,
                     true,
                     length,
                     settings.depth_tolerance,
@@ -1241,6 +1286,9 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
                         want[c]
                     );
                 }
+                if (x, y) == dark {
+                    continue;
+                }
                 let moved = g[0] - s_y[0];
                 eprintln!("k {k}: the firefly moved c0 by {moved} (bound {bound})");
                 if k > 0.0 {
@@ -1254,7 +1302,7 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
             }
             for y in 0..h {
                 for x in 0..w {
-                    if late.contains(&(x, y)) || (x, y) == young {
+                    if late.contains(&(x, y)) || (x, y) == young || (x, y) == dark {
                         continue;
                     }
                     for (g, e) in got(x, y).into_iter().zip(s6) {

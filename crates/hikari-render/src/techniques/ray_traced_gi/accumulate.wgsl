@@ -82,11 +82,24 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     // Firefly clamp: the whole sample scaled so that its c0 stays within k times the
-    // history's plus the floor; chroma and direction are the sample's still.
+    // history's local scale (the brightest c0 of its 3x3: a pixel whose few samples all came
+    // out dark must not cut what its neighbours see) plus the floor; chroma and direction
+    // stay the sample's.
     var cocg = cocg_ao.xy;
     let ff = params.firefly;
     if ff.x > 0.0 && hl >= ff.z {
-        let limit = ff.x * max(hy.x, 0.0) + ff.y;
+        var scale = max(hy.x, 0.0);
+        let qi = vec2<i32>(q);
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let t = clamp(qi + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(size) - 1);
+                let c = textureLoad(prev_y, t, 0).x;
+                if c == c && c <= 3.0e38 {
+                    scale = max(scale, c);
+                }
+            }
+        }
+        let limit = ff.x * scale + ff.y;
         if y.x > limit {
             let s = limit / y.x;
             y *= s;

@@ -299,9 +299,10 @@ pub struct AccumulateInput {
 }
 
 /// The accumulation's firefly clamp. A sample whose luminance (SH c0) exceeds
-/// `k · max(history c0, 0) + floor` is scaled down to that, whole (Y SH and CoCg alike, so its
-/// chroma and direction stay those of the sample), once the history holds at least
-/// `min_history` frames (younger pixels must still converge from their first samples).
+/// `k · scale + floor`, where `scale` is the history's local scale ([`firefly_scale`]), is
+/// scaled down to that, whole (Y SH and CoCg alike, so its chroma and direction stay those of
+/// the sample), once the history holds at least `min_history` frames (younger pixels must
+/// still converge from their first samples).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FireflyClamp {
     /// Times the history's c0 a sample may reach (0: off). Unitless.
@@ -338,13 +339,14 @@ impl FireflyClamp {
         [self.k, self.floor, self.min_history, 0.0]
     }
 
-    /// `sample` limited against `history` of `history_length` frames.
-    pub fn apply(&self, sample: ShL1YCoCg, history: &ShL1YCoCg, history_length: f32) -> ShL1YCoCg {
+    /// `sample` limited against a history of `history_length` frames whose local scale is
+    /// `scale` ([`firefly_scale`]).
+    pub fn apply(&self, sample: ShL1YCoCg, scale: f32, history_length: f32) -> ShL1YCoCg {
         let on = self.k > 0.0 && history_length >= self.min_history;
         if !on {
             return sample;
         }
-        let limit = self.k * history.y.coeffs[0].max(0.0) + self.floor;
+        let limit = self.k * scale.max(0.0) + self.floor;
         let c0 = sample.y.coeffs[0];
         if c0 > limit {
             sample.scale(limit / c0)
@@ -352,6 +354,29 @@ impl FireflyClamp {
             sample
         }
     }
+}
+
+/// The history's local scale for the firefly clamp, in SH c0: the largest finite c0 of the
+/// 3x3 history texels around `q` (clamped to the image), at least 0. The neighbours keep a
+/// pixel whose few samples all came out dark (or that a light just reached) from cutting what
+/// the surface around it sees.
+pub fn firefly_scale(
+    history: &dyn Fn([u32; 2]) -> Accumulated,
+    q: [u32; 2],
+    size: [u32; 2],
+) -> f32 {
+    let mut scale = 0f32;
+    for dy in -1i64..=1 {
+        for dx in -1i64..=1 {
+            let x = (q[0] as i64 + dx).clamp(0, size[0] as i64 - 1) as u32;
+            let y = (q[1] as i64 + dy).clamp(0, size[1] as i64 - 1) as u32;
+            let c = history([x, y]).gi.y.coeffs[0];
+            if c.is_finite() {
+                scale = scale.max(c);
+            }
+        }
+    }
+    scale
 }
 
 /// Temporal accumulation of one pixel: reprojects by the motion vector to the nearest texel
@@ -408,7 +433,8 @@ pub fn accumulate_pixel(
     if prev.x < 0.0 || prev.y < 0.0 || prev.x >= size[0] as f32 || prev.y >= size[1] as f32 {
         return fresh;
     }
-    let h = history([prev.x as u32, prev.y as u32]);
+    let q = [prev.x as u32, prev.y as u32];
+    let h = history(q);
     let expected = (prev_view_proj * world.extend(1.0)).w;
     if !h.finite()
         || h.length < 1.0
@@ -416,7 +442,11 @@ pub fn accumulate_pixel(
     {
         return fresh;
     }
-    let raw = firefly.apply(raw, &h.gi, h.length);
+    let raw = if firefly.k > 0.0 && h.length >= firefly.min_history {
+        firefly.apply(raw, firefly_scale(history, q, size), h.length)
+    } else {
+        raw
+    };
     let length = (h.length + 1.0).min(max_history);
     let speed = 1.0 / length;
     Accumulated {

@@ -45,8 +45,8 @@ pub struct RayTracedGiSettings {
     /// than this fraction.
     pub depth_tolerance: f32,
     /// Firefly clamp of the temporal accumulation: a new sample's luminance (SH c0) is held
-    /// to this many times the history's plus the metered floor (`reference::FireflyClamp`),
-    /// the whole sample scaled with it; 0 turns it off. Unitless.
+    /// to this many times the history's local scale (its 3x3 maximum) plus the metered floor
+    /// (`reference::FireflyClamp`), the whole sample scaled with it; 0 turns it off. Unitless.
     pub firefly_clamp: f32,
     /// The deferred lighting takes its ambient light from the GI within this distance of the
     /// camera (metres) and from the probes or the sky beyond.
