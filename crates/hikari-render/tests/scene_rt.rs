@@ -460,7 +460,8 @@ fn to_pixel(view_proj: Mat4, world: Vec3, w: u32, h: u32) -> Vec2 {
 /// the GPU and the CPU see the same depth (silhouettes excluded). A control checks that the
 /// sway moves the tree's reference by more than half a pixel from the camera-only motion in
 /// many pixels (the motion before this change), so the test can fail. A third frame at t1
-/// from the same camera has no motion anywhere: the previous positions caught up.
+/// from the same camera has no motion anywhere: the previous positions caught up. The
+/// G-buffer's CPU twin, given the vertices at both times, agrees on every surface pixel.
 #[test]
 fn motion_vectors_follow_deforming_vertices() {
     let mut scene = Scene {
@@ -507,9 +508,14 @@ fn motion_vectors_follow_deforming_vertices() {
         let mut r = renderer
             .render_reading(s, |o| {
                 texs = Some((o.gbuffer.motion, o.gbuffer.depth));
-                vec![o.gbuffer.motion.into(), o.gbuffer.depth.into()]
+                vec![
+                    o.gbuffer.motion.into(),
+                    o.gbuffer.depth.into(),
+                    o.gbuffer.visibility.into(),
+                ]
             })
             .unwrap();
+        let vis: Vec<u32> = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap()).to_vec();
         let (m, d) = texs.unwrap();
         let motion = r.take_image_of(m).unwrap();
         let depth = r.take_image_of(d).unwrap();
@@ -520,6 +526,7 @@ fn motion_vectors_follow_deforming_vertices() {
                 .map(|p| Vec2::new(p[0], p[1]))
                 .collect::<Vec<_>>(),
             depth.rgba.iter().map(|p| p[0]).collect::<Vec<_>>(),
+            vis,
         )
     };
     let cam_a = scene.cameras[0].clone();
@@ -534,7 +541,7 @@ fn motion_vectors_follow_deforming_vertices() {
     s.settings.scene_rt.time_s = Some(t1);
     s.camera = cam_b.clone();
     s.prev_camera = Some(cam_a.clone());
-    let (motion, depth) = read(&mut renderer, &s);
+    let (motion, depth, vis) = read(&mut renderer, &s);
 
     let instances = scene_bvh::instances(&scene);
     let mut meshes = scene_bvh::meshes(&scene);
@@ -600,9 +607,54 @@ fn motion_vectors_follow_deforming_vertices() {
         &bad[..bad.len().min(8)]
     );
 
+    // The G-buffer's twin (`gbuffer::reference::resolve_deformed`) on the GPU's visibility
+    // ids, its vertices at t1 and last frame's at t0: every surface pixel within the G-buffer
+    // test's motion tolerance (0.02 px + 2e-3 relative).
+    let base: usize = scene.meshes[..2].iter().map(|m| m.positions.len()).sum();
+    let mut now = renderer.scene().cpu.clone();
+    let mut then = now.positions.clone();
+    for (k, (p1, p0)) in meshes[2].positions.iter().zip(&before).enumerate() {
+        now.positions[base + k] = p1.extend(1.0).to_array();
+        then[base + k] = p0.extend(1.0).to_array();
+    }
+    let view = hikari_render::view::View::with_previous(&cam_b, &cam_a, w, h);
+    let (mut twin_tree, mut twin_bad) = (0, Vec::new());
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            if vis[2 * i + 1] == 0 {
+                continue;
+            }
+            let want = hikari_render::techniques::gbuffer::reference::resolve_deformed(
+                &scene,
+                &now,
+                &view,
+                [x, y],
+                vis[2 * i],
+                &then,
+            )
+            .unwrap();
+            if want.instance == tree_instance {
+                twin_tree += 1;
+            }
+            let close = |g: f32, e: f32| (g - e).abs() <= 0.02 + 2e-3 * e.abs();
+            if !(close(motion[i].x, want.motion.x) && close(motion[i].y, want.motion.y)) {
+                twin_bad.push(((x, y), motion[i], want.motion));
+            }
+        }
+    }
+    eprintln!("twin: {twin_tree} tree pixels, {} beyond", twin_bad.len());
+    assert!(twin_tree > 100, "{twin_tree}");
+    assert!(
+        twin_bad.is_empty(),
+        "first of {}: {:?}",
+        twin_bad.len(),
+        &twin_bad[..twin_bad.len().min(8)]
+    );
+
     // The same time and camera again: last frame's pose is this frame's, nothing moves.
     s.prev_camera = Some(cam_b.clone());
-    let (motion, _) = read(&mut renderer, &s);
+    let (motion, _, _) = read(&mut renderer, &s);
     let worst = motion.iter().map(|m| m.length()).fold(0f32, f32::max);
     assert!(worst <= 1e-3, "a still frame has motion {worst} px");
 }
