@@ -132,7 +132,9 @@ pub fn all() -> Vec<StructLayout> {
                 sun,
                 sun_color,
                 sky_zenith,
-                sky_horizon
+                sky_horizon,
+                area,
+                firefly
             ]
         ),
         gpu_layout!(

@@ -136,6 +136,9 @@ pub struct Chunk {
 
 pub struct SceneGpu {
     pub positions: wgpu::Buffer,
+    /// What `positions` held the frame before: the same but for deforming meshes, whose
+    /// last frame's pose gives the G-buffer's motion (`scene_rt::SceneRt::update_raster`).
+    pub prev_positions: wgpu::Buffer,
     pub attributes: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub instances: wgpu::Buffer,
@@ -399,6 +402,7 @@ impl SceneCpu {
 #[derive(Clone, Copy, Debug)]
 pub struct SceneInFrame {
     pub positions: Buf,
+    pub prev_positions: Buf,
     pub attributes: Buf,
     pub indices: Buf,
     pub instances: Buf,
@@ -418,6 +422,7 @@ impl SceneGpu {
     pub fn import(&self, g: &mut FrameGraph<'_>) -> SceneInFrame {
         SceneInFrame {
             positions: g.import_buffer("scene.positions", &self.positions),
+            prev_positions: g.import_buffer("scene.prev_positions", &self.prev_positions),
             attributes: g.import_buffer("scene.attributes", &self.attributes),
             indices: g.import_buffer("scene.indices", &self.indices),
             instances: g.import_buffer("scene.instances", &self.instances),
@@ -488,6 +493,7 @@ impl SceneGpu {
             });
         Ok(Self {
             positions: buffer("positions", bytemuck::cast_slice(&cpu.positions))?,
+            prev_positions: buffer("previous positions", bytemuck::cast_slice(&cpu.positions))?,
             attributes: buffer("vertex attributes", bytemuck::cast_slice(&cpu.attributes))?,
             indices: buffer("indices", bytemuck::cast_slice(&cpu.indices))?,
             instances: buffer("instances", bytemuck::cast_slice(&cpu.instances))?,

@@ -10,7 +10,8 @@ use hikari_render::graph::{GraphRuntime, ImageRgba32};
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::direct_lighting::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use hikari_render::techniques::ray_traced_gi::reference::{
-    self, AccumulateInput, Accumulated, HitWord, accumulate_pixel, pack_hit, unpack_hit,
+    self, AccumulateInput, Accumulated, FireflyClamp, HitWord, accumulate_pixel, pack_hit,
+    unpack_hit,
 };
 use hikari_render::techniques::ray_traced_gi::{
     FLAG_ACCUMULATE, FLAG_RESET, RayTracedGi, RayTracedGiSettings, RtGiParams, SkySource,
@@ -251,8 +252,18 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
         max_history: 3,
         ..RayTracedGiSettings::default()
     };
-    let base = RtGiParams::new(&settings, 0, None, 0, 1000.0, SkySource::None);
+    let mut base = RtGiParams::new(&settings, 0, None, 0, 1000.0, SkySource::None);
     assert_ne!(base.flags() & FLAG_ACCUMULATE, 0);
+    // A firefly clamp tight enough to act on these random samples from 2 frames of history
+    // on, so that its 3x3 scale is compared too (reprojected, at the image's edges, beside
+    // rejected and non-finite history).
+    let firefly = FireflyClamp {
+        k: 1.5,
+        floor: 0.25,
+        min_history: 2.0,
+    };
+    base.firefly = firefly.to_array();
+    let mut clamped = 0;
     let mut rng = SmallRng::seed_from_u64(7);
     let mut rt = GraphRuntime::new();
     let mut history: Vec<Accumulated> = vec![Accumulated::default(); (w * h) as usize];
@@ -393,7 +404,23 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
                     history_valid && !reset,
                     settings.max_history as f32,
                     settings.depth_tolerance,
+                    &firefly,
                 );
+                let unclamped = accumulate_pixel(
+                    [xx, yy],
+                    [w, h],
+                    &input,
+                    worlds[i],
+                    prev_vp,
+                    &look,
+                    history_valid && !reset,
+                    settings.max_history as f32,
+                    settings.depth_tolerance,
+                    &FireflyClamp::default(),
+                );
+                if unclamped.gi != a.gi {
+                    clamped += 1;
+                }
                 let fl = reference::to_floats(&a.gi).map(f16);
                 let a = Accumulated {
                     gi: reference::from_floats(fl),
@@ -430,7 +457,9 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
                 }
             }
         }
-        eprintln!("frame {frame}: {fresh} fresh, {accumulated} accumulated");
+        eprintln!(
+            "frame {frame}: {fresh} fresh, {accumulated} accumulated, {clamped} clamped so far"
+        );
         if frame == 0 || reset {
             assert_eq!(
                 accumulated, 0,
@@ -455,6 +484,10 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
         }
         history_valid = true;
     }
+    assert!(
+        clamped > 200,
+        "the firefly clamp acted in {clamped} pixels only"
+    );
 }
 
 fn floor_scene() -> Scene {
@@ -1347,4 +1380,230 @@ fn the_lighting_resolves_gi_near_and_the_far_field_beyond() {
         lum(far) / lum(near) > 1.08,
         "the two fields differ: {near} vs {far}"
     );
+}
+
+/// The firefly clamp (`ray_traced_gi.firefly_clamp`): a still 16 x 16 plane takes one constant
+/// sample S (c0 = 50) for 10 frames (history capped at 8), then a firefly F = 200 S at a few
+/// pixels. Stated bound: a firefly moves a converged history's c0 by at most
+/// ((k - 1) · h + floor) / L (k = 8, h = 50, floor = C0 · 1000 lux / π, L = 8: 55, where the
+/// unclamped sample moves it by 1244), and the whole sample is scaled alike, so Y SH and CoCg
+/// follow c0. Checked against the analytic value of S + (F · limit / c0(F) - S) / L and the CPU
+/// twin; pixels without the firefly keep S; a pixel whose own samples were all 0 takes the
+/// limit of its neighbours' scale (F · limit / c0(F) / L); a firefly while the history is 2
+/// frames long (below `FIREFLY_MIN_HISTORY`) is not clamped; with `firefly_clamp = 0` the same
+/// firefly breaks the bound (the control). Tolerance: f16 storage, 2^-9 · max(|v|, 1).
+#[test]
+fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
+    let ctx = common::gpu_context();
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let rtgi = RayTracedGi::new(&ctx, &mut lib).unwrap();
+    let (w, h) = (16u32, 16u32);
+    let n = (w * h) as usize;
+    let camera = Camera {
+        position: Vec3::new(0.0, 3.0, 6.0),
+        target: Vec3::ZERO,
+        ..Camera::default()
+    };
+    let view = View::new(&camera, w, h);
+    let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
+    let prev_vp = Mat4::from_cols_array_2d(&view.prev_view_proj);
+    let metered_lux = 1000.0;
+    let s_y = [50.0f32, 10.0, -5.0, 3.0];
+    let s_c = [4.0f32, -2.0];
+    let firefly = 200.0f32;
+    let late = [(3u32, 4u32), (9, 9), (12, 2)];
+    let young = (6u32, 13u32);
+    let dark = (13u32, 12u32);
+    let close = |g: f32, e: f32| (g - e).abs() <= e.abs().max(1.0) * 2f32.powi(-9);
+    for k in [8.0f32, 0.0] {
+        let settings = RayTracedGiSettings {
+            max_history: 8,
+            firefly_clamp: k,
+            ..RayTracedGiSettings::default()
+        };
+        let base = RtGiParams::new(&settings, 0, None, 0, metered_lux, SkySource::None);
+        let mut rt = GraphRuntime::new();
+        let mut depth = vec![0f32; n];
+        let mut motion = vec![[0f32; 4]; n];
+        let mut worlds = vec![Vec3::ZERO; n];
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                depth[i] = 0.02 + 0.001 * x as f32 + 0.0005 * y as f32;
+                worlds[i] = reference::world_from_depth(inv_vp, [w, h], [x, y], depth[i]);
+                let vz = (worlds[i] - camera.position).dot(camera.forward());
+                motion[i] = [0.0, 0.0, f16(vz), 0.0];
+            }
+        }
+        let depth_tex = texture(
+            &ctx,
+            wgpu::TextureFormat::R32Float,
+            w,
+            h,
+            bytemuck::cast_slice(&depth),
+        );
+        let motion_tex = texture(
+            &ctx,
+            wgpu::TextureFormat::Rgba16Float,
+            w,
+            h,
+            &halves(&motion),
+        );
+        let dist_tex = texture(&ctx, wgpu::TextureFormat::R16Float, w, h, &vec![0u8; n * 2]);
+        for frame in 0..=10u32 {
+            let mut raw_y = vec![s_y; n];
+            let mut raw_c = vec![[s_c[0], s_c[1], 0.5, 0.0]; n];
+            let mut hot: Vec<(u32, u32)> = Vec::new();
+            if frame == 10 {
+                hot.extend(late);
+                hot.push(dark);
+            } else {
+                let i = (dark.1 * w + dark.0) as usize;
+                raw_y[i] = [0.0; 4];
+                raw_c[i] = [0.0, 0.0, 0.5, 0.0];
+            }
+            if frame == 2 {
+                hot.push(young);
+            }
+            for &(x, y) in &hot {
+                let i = (y * w + x) as usize;
+                raw_y[i] = s_y.map(|v| v * firefly);
+                raw_c[i][0] = s_c[0] * firefly;
+                raw_c[i][1] = s_c[1] * firefly;
+            }
+            let y_tex = texture(
+                &ctx,
+                wgpu::TextureFormat::Rgba16Float,
+                w,
+                h,
+                &halves(&raw_y),
+            );
+            let c_tex = texture(
+                &ctx,
+                wgpu::TextureFormat::Rgba16Float,
+                w,
+                h,
+                &halves(&raw_c),
+            );
+            let mut params = base;
+            params.config[0] = frame;
+            let mut g = rt.begin_frame(&ctx);
+            let [d, m, y, c, dist] = [
+                g.import_texture("test.depth", &depth_tex),
+                g.import_texture("test.motion", &motion_tex),
+                g.import_texture("test.raw_y", &y_tex),
+                g.import_texture("test.raw_cocg_ao", &c_tex),
+                g.import_texture("test.hit_distance", &dist_tex),
+            ];
+            let out = rtgi
+                .record_accumulate(&mut g, &view, &params, d, m, y, c, dist)
+                .unwrap();
+            for t in [out.gi_y, out.gi_cocg, out.history_length] {
+                g.readback(t);
+            }
+            let mut r = g.execute().unwrap();
+            let gy = r.take_image_of(out.gi_y).unwrap();
+            let gc = r.take_image_of(out.gi_cocg).unwrap();
+            let gl = r.take_image_of(out.history_length).unwrap();
+            let got = |x: u32, y: u32| {
+                let i = (y * w + x) as usize;
+                let (a, b) = (rgba(&gy)[i], rgba(&gc)[i]);
+                [a[0], a[1], a[2], a[3], b[0], b[1]]
+            };
+            let s6 = [s_y[0], s_y[1], s_y[2], s_y[3], s_c[0], s_c[1]];
+            if frame == 2 {
+                // History of 2 frames: the firefly enters unclamped at speed 1/3.
+                let (x, y) = young;
+                let want = s6.map(|v| v + (v * firefly - v) / 3.0);
+                for (g, e) in got(x, y).into_iter().zip(want) {
+                    assert!(close(g, e), "k {k}: young pixel got {g}, want {e}");
+                }
+            }
+            if frame < 10 {
+                continue;
+            }
+            let length = 8.0f32;
+            // Analytic: the limit on c0 and the whole sample scaled to it.
+            let limit = k * s_y[0] + C0 as f32 * metered_lux / std::f32::consts::PI;
+            let scale = if k > 0.0 {
+                (limit / (s_y[0] * firefly)).min(1.0)
+            } else {
+                1.0
+            };
+            let want = s6.map(|v| v + (v * firefly * scale - v) / length);
+            let bound =
+                ((k - 1.0) * s_y[0] + C0 as f32 * metered_lux / std::f32::consts::PI) / length;
+            let clamp = FireflyClamp::new(k, metered_lux);
+            let want_dark = s6.map(|v| v * firefly * scale / length);
+            for &(x, y) in late.iter().chain([&dark]) {
+                let i = (y * w + x) as usize;
+                assert_eq!(rgba(&gl)[i][0], length);
+                let g = got(x, y);
+                let (want, s_hist) = if (x, y) == dark {
+                    (want_dark, [0.0; 6])
+                } else {
+                    (want, s6)
+                };
+                // The twin, from a converged history of S at full length (0 at the dark
+                // pixel).
+                let history = |p: [u32; 2]| Accumulated {
+                    gi: reference::from_floats(if (p[0], p[1]) == (x, y) { s_hist } else { s6 }),
+                    ao: 0.5,
+                    length,
+                    view_depth: motion[(p[1] * w + p[0]) as usize][2],
+                };
+                let input = AccumulateInput {
+                    depth: depth[i],
+                    motion: Vec3::new(0.0, 0.0, motion[i][2]),
+                    raw: reference::from_floats(s6.map(|v| v * firefly)),
+                    raw_ao: 0.5,
+                };
+                let twin = accumulate_pixel(
+                    [x, y],
+                    [w, h],
+                    &input,
+                    worlds[i],
+                    prev_vp,
+                    &history,
+                    true,
+                    length,
+                    settings.depth_tolerance,
+                    &clamp,
+                );
+                let twin = reference::to_floats(&twin.gi);
+                for c in 0..6 {
+                    assert!(
+                        close(g[c], want[c]) && close(twin[c], want[c]),
+                        "k {k} pixel ({x}, {y}) value {c}: GPU {}, twin {}, analytic {}",
+                        g[c],
+                        twin[c],
+                        want[c]
+                    );
+                }
+                if (x, y) == dark {
+                    continue;
+                }
+                let moved = g[0] - s_y[0];
+                eprintln!("k {k}: the firefly moved c0 by {moved} (bound {bound})");
+                if k > 0.0 {
+                    assert!(moved <= bound * (1.0 + 2f32.powi(-9)), "{moved} > {bound}");
+                } else {
+                    assert!(
+                        moved > 10.0 * (7.0 * s_y[0] + 100.0) / length,
+                        "the control must break the bound: {moved}"
+                    );
+                }
+            }
+            for y in 0..h {
+                for x in 0..w {
+                    if late.contains(&(x, y)) || (x, y) == young || (x, y) == dark {
+                        continue;
+                    }
+                    for (g, e) in got(x, y).into_iter().zip(s6) {
+                        assert!(close(g, e), "k {k} pixel ({x}, {y}): {g} against S {e}");
+                    }
+                }
+            }
+        }
+    }
 }

@@ -430,3 +430,231 @@ fn the_raster_and_the_bvh_draw_the_deformed_tree() {
     let back = depth(&mut renderer, &s);
     assert!(differ(&back, &want_rest) <= allowed);
 }
+
+/// Barycentrics of `p` (on the triangle's plane) in the triangle `a b c`, from sub-triangle
+/// areas.
+fn barycentrics(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let n = (b - a).cross(c - a);
+    let area = |x: Vec3, y: Vec3, z: Vec3| (y - x).cross(z - x).dot(n);
+    let total = area(a, b, c);
+    Vec3::new(area(p, b, c), area(a, p, c), area(a, b, p)) / total
+}
+
+/// Where `world` projects through `view_proj` (unjittered), in pixels (y down).
+fn to_pixel(view_proj: Mat4, world: Vec3, w: u32, h: u32) -> Vec2 {
+    let c = view_proj * world.extend(1.0);
+    let ndc = Vec2::new(c.x, c.y) / c.w;
+    Vec2::new(
+        (ndc.x * 0.5 + 0.5) * w as f32,
+        (0.5 - ndc.y * 0.5) * h as f32,
+    )
+}
+
+/// Motion vectors of a deforming mesh. A tree swaying 2 m (with a still cube and the floor)
+/// is drawn at t0 = 0.1 s, then at t1 = 0.6 s from a camera moved 0.3 m sideways. The
+/// reference casts each pixel's centre ray on the CPU against the meshes at t1 (brute force),
+/// takes the hit's barycentrics in its triangle, and projects the point of the same
+/// barycentrics on the t0 triangle through last frame's view-projection (the still meshes:
+/// the hit point itself). The G-buffer's motion (previous minus current position) must match
+/// within 0.03 px + 2^-10 of its length (f16 storage; the GPU's barycentrics are f32) where
+/// the GPU and the CPU see the same depth (silhouettes excluded). A control checks that the
+/// sway moves the tree's reference by more than half a pixel from the camera-only motion in
+/// many pixels (the motion before this change), so the test can fail. A third frame at t1
+/// from the same camera has no motion anywhere: the previous positions caught up. The
+/// G-buffer's CPU twin, given the vertices at both times, agrees on every surface pixel.
+#[test]
+fn motion_vectors_follow_deforming_vertices() {
+    let mut scene = Scene {
+        materials: vec![Material::diffuse("grey", Vec3::splat(0.5))],
+        meshes: vec![shapes::plane(40.0), shapes::cube()],
+        instances: vec![
+            Instance {
+                mesh: 0,
+                material: 0,
+                transform: Mat4::IDENTITY,
+            },
+            Instance {
+                mesh: 1,
+                material: 0,
+                transform: Mat4::from_translation(Vec3::new(-4.0, 1.0, 0.0)),
+            },
+        ],
+        cameras: vec![hikari_scene::Camera {
+            position: Vec3::new(0.0, 3.0, 12.0),
+            target: Vec3::new(0.0, 3.0, 0.0),
+            ..Default::default()
+        }],
+        sun: Some(hikari_scene::Sun::default()),
+        ..Default::default()
+    };
+    let mut t = tree(6.0, 0.0);
+    if let Some(Deformation::Sway { amplitude_m, .. }) = &mut t.deformation {
+        *amplitude_m = 2.0;
+    }
+    scene.meshes.push(t);
+    scene.instances.push(Instance {
+        mesh: 2,
+        material: 0,
+        transform: Mat4::IDENTITY,
+    });
+    let tree_instance = 2u32;
+    let (w, h) = (64u32, 48u32);
+    let (t0, t1) = (0.1f32, 0.6f32);
+    let mut s = common::small_frame_settings(&scene, w, h);
+    s.settings.taa.enabled = false;
+    let mut renderer = hikari_render::Renderer::new(common::gpu_context(), &scene).unwrap();
+    let read = |renderer: &mut hikari_render::Renderer, s: &hikari_render::FrameSettings| {
+        let mut texs = None;
+        let mut r = renderer
+            .render_reading(s, |o| {
+                texs = Some((o.gbuffer.motion, o.gbuffer.depth));
+                vec![
+                    o.gbuffer.motion.into(),
+                    o.gbuffer.depth.into(),
+                    o.gbuffer.visibility.into(),
+                ]
+            })
+            .unwrap();
+        let vis: Vec<u32> = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap()).to_vec();
+        let (m, d) = texs.unwrap();
+        let motion = r.take_image_of(m).unwrap();
+        let depth = r.take_image_of(d).unwrap();
+        (
+            motion
+                .rgba
+                .iter()
+                .map(|p| Vec2::new(p[0], p[1]))
+                .collect::<Vec<_>>(),
+            depth.rgba.iter().map(|p| p[0]).collect::<Vec<_>>(),
+            vis,
+        )
+    };
+    let cam_a = scene.cameras[0].clone();
+    let mut cam_b = cam_a.clone();
+    cam_b.position.x += 0.3;
+    cam_b.target.x += 0.3;
+    let aspect = w as f32 / h as f32;
+    let vp_a = cam_a.projection(aspect) * cam_a.view();
+
+    s.settings.scene_rt.time_s = Some(t0);
+    read(&mut renderer, &s);
+    s.settings.scene_rt.time_s = Some(t1);
+    s.camera = cam_b.clone();
+    s.prev_camera = Some(cam_a.clone());
+    let (motion, depth, vis) = read(&mut renderer, &s);
+
+    let instances = scene_bvh::instances(&scene);
+    let mut meshes = scene_bvh::meshes(&scene);
+    meshes[2].positions = scene.meshes[2].deformed(t1).0;
+    let before = scene.meshes[2].deformed(t0).0;
+    let want_depth = cpu_depth(&cam_b, w, h, &meshes, &instances);
+    let inv = (cam_b.projection(aspect) * cam_b.view()).inverse();
+    let (mut tree_px, mut compared, mut swayed) = (0, 0, 0);
+    let mut bad = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let (d, e) = (depth[i], want_depth[i]);
+            if e == 0.0 || (d - e).abs() > 1e-3 * e {
+                continue;
+            }
+            let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let ndc = Vec2::new(
+                centre.x / w as f32 * 2.0 - 1.0,
+                1.0 - centre.y / h as f32 * 2.0,
+            );
+            let dir = (inv.project_point3(ndc.extend(0.5)) - cam_b.position).normalize();
+            let ray = Ray::new(cam_b.position, dir, 0.0, f32::INFINITY);
+            let Some(hit) = closest_hit_instances(&meshes, &instances, None, &ray) else {
+                continue;
+            };
+            let p = cam_b.position + dir * hit.t;
+            let camera_only = to_pixel(vp_a, p, w, h) - centre;
+            let want = if hit.instance == tree_instance {
+                tree_px += 1;
+                let [a, b, c] = meshes[2].indices[hit.primitive as usize].map(|v| v as usize);
+                let pos = &meshes[2].positions;
+                let bary = barycentrics(p, pos[a], pos[b], pos[c]);
+                let q = before[a] * bary.x + before[b] * bary.y + before[c] * bary.z;
+                let m = to_pixel(vp_a, q, w, h) - centre;
+                if (m - camera_only).length() > 0.5 {
+                    swayed += 1;
+                }
+                m
+            } else {
+                camera_only
+            };
+            compared += 1;
+            let err = (motion[i] - want).length();
+            if err > 0.03 + want.length() / 1024.0 {
+                bad.push(((x, y), hit.instance, motion[i], want));
+            }
+        }
+    }
+    eprintln!(
+        "{compared} pixels compared, {tree_px} on the tree, {swayed} swayed; {} beyond tolerance",
+        bad.len()
+    );
+    assert!(
+        swayed > 60,
+        "the sway must move the tree's motion for this test to mean anything: {swayed}"
+    );
+    assert!(compared > (w * h) as usize / 3, "{compared}");
+    assert!(
+        bad.is_empty(),
+        "first of {}: {:?}",
+        bad.len(),
+        &bad[..bad.len().min(8)]
+    );
+
+    // The G-buffer's twin (`gbuffer::reference::resolve_deformed`) on the GPU's visibility
+    // ids, its vertices at t1 and last frame's at t0: every surface pixel within the G-buffer
+    // test's motion tolerance (0.02 px + 2e-3 relative).
+    let base: usize = scene.meshes[..2].iter().map(|m| m.positions.len()).sum();
+    let mut now = renderer.scene().cpu.clone();
+    let mut then = now.positions.clone();
+    for (k, (p1, p0)) in meshes[2].positions.iter().zip(&before).enumerate() {
+        now.positions[base + k] = p1.extend(1.0).to_array();
+        then[base + k] = p0.extend(1.0).to_array();
+    }
+    let view = hikari_render::view::View::with_previous(&cam_b, &cam_a, w, h);
+    let (mut twin_tree, mut twin_bad) = (0, Vec::new());
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            if vis[2 * i + 1] == 0 {
+                continue;
+            }
+            let want = hikari_render::techniques::gbuffer::reference::resolve_deformed(
+                &scene,
+                &now,
+                &view,
+                [x, y],
+                vis[2 * i],
+                &then,
+            )
+            .unwrap();
+            if want.instance == tree_instance {
+                twin_tree += 1;
+            }
+            let close = |g: f32, e: f32| (g - e).abs() <= 0.02 + 2e-3 * e.abs();
+            if !(close(motion[i].x, want.motion.x) && close(motion[i].y, want.motion.y)) {
+                twin_bad.push(((x, y), motion[i], want.motion));
+            }
+        }
+    }
+    eprintln!("twin: {twin_tree} tree pixels, {} beyond", twin_bad.len());
+    assert!(twin_tree > 100, "{twin_tree}");
+    assert!(
+        twin_bad.is_empty(),
+        "first of {}: {:?}",
+        twin_bad.len(),
+        &twin_bad[..twin_bad.len().min(8)]
+    );
+
+    // The same time and camera again: last frame's pose is this frame's, nothing moves.
+    s.prev_camera = Some(cam_b.clone());
+    let (motion, _, _) = read(&mut renderer, &s);
+    let worst = motion.iter().map(|m| m.length()).fold(0f32, f32::max);
+    assert!(worst <= 1e-3, "a still frame has motion {worst} px");
+}

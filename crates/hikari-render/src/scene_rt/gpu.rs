@@ -100,6 +100,11 @@ pub struct SceneRt {
     vertex_base: Vec<u64>,
     /// The time the raster's vertices show (`None`: the rest pose).
     raster_time: Option<f32>,
+    /// The time `SceneGpu::prev_positions` shows: last frame's `raster_time`.
+    prev_raster_time: Option<f32>,
+    /// Per deforming scene mesh, the positions the raster shows when not the rest pose
+    /// (what goes to `prev_positions` next frame).
+    shown_positions: std::collections::HashMap<usize, Vec<[f32; 4]>>,
 }
 
 fn init_buffer<T: Pod + Zeroable>(
@@ -181,6 +186,8 @@ impl SceneRt {
                 })
                 .collect(),
             raster_time: None,
+            prev_raster_time: None,
+            shown_positions: Default::default(),
             cpu,
         };
         rt.upload(ctx, &first)?;
@@ -242,25 +249,45 @@ impl SceneRt {
 
     /// Rewrites the rasteriser's positions and normals of every deforming mesh for `time`
     /// (all of them, unthrottled: the picture is exact, only the BVH may lag) when it differs
-    /// from what they show. Returns the bytes written (0: nothing changed, cached shadow
-    /// cascades stay valid). Tangents keep their rest pose.
+    /// from what they show, and `SceneGpu::prev_positions` of those meshes with what they
+    /// showed until now, so that the G-buffer's motion sees the deformation. Call it once a
+    /// frame: a frame at the same time as the last still copies the last pose over (the
+    /// motion of a mesh that stopped is 0). Returns the bytes of positions and normals
+    /// written (0: the raster draws what it drew, cached shadow cascades stay valid); the
+    /// frame's stats count both. Tangents keep their rest pose.
     pub fn update_raster(&mut self, ctx: &GpuContext, scene: &SceneGpu, time: Option<f32>) -> u64 {
-        if time == self.raster_time {
+        let moved = time != self.raster_time;
+        if !moved && self.prev_raster_time == self.raster_time {
             return 0;
         }
         let start = std::time::Instant::now();
         let mut bytes = 0;
+        let mut prev_bytes = 0u64;
         let meshes: Vec<usize> = self.cpu.animated_meshes().collect();
         for m in meshes {
+            let base = self.vertex_base[m] as usize;
+            // What the raster shows now becomes last frame's pose.
+            let end = self
+                .vertex_base
+                .get(m + 1)
+                .map_or(scene.cpu.positions.len(), |&e| e as usize);
+            let shown: &[[f32; 4]] = match self.shown_positions.get(&m) {
+                Some(p) => p,
+                None => scene.cpu.positions.get(base..end).unwrap_or(&[]),
+            };
+            ctx.queue.write_buffer(
+                &scene.prev_positions,
+                base as u64 * 16,
+                bytemuck::cast_slice(shown),
+            );
+            prev_bytes += shown.len() as u64 * 16;
+            if !moved {
+                continue;
+            }
             let Some((positions, normals)) = self.cpu.pose_at(m, time) else {
                 continue;
             };
-            let base = self.vertex_base[m];
-            let Some(rest) = scene
-                .cpu
-                .attributes
-                .get(base as usize..base as usize + positions.len())
-            else {
+            let Some(rest) = scene.cpu.attributes.get(base..base + positions.len()) else {
                 continue;
             };
             let p4: Vec<[f32; 4]> = positions.iter().map(|p| p.extend(1.0).to_array()).collect();
@@ -272,19 +299,24 @@ impl SceneRt {
                     ..*a
                 })
                 .collect();
-            ctx.queue
-                .write_buffer(&scene.positions, base * 16, bytemuck::cast_slice(&p4));
+            ctx.queue.write_buffer(
+                &scene.positions,
+                base as u64 * 16,
+                bytemuck::cast_slice(&p4),
+            );
             let attr_size = std::mem::size_of::<VertexAttr>() as u64;
             ctx.queue.write_buffer(
                 &scene.attributes,
-                base * attr_size,
+                base as u64 * attr_size,
                 bytemuck::cast_slice(&attrs),
             );
             bytes += (p4.len() * 16) as u64 + attrs.len() as u64 * attr_size;
+            self.shown_positions.insert(m, p4);
         }
+        self.prev_raster_time = self.raster_time;
         self.raster_time = time;
         if let Some(s) = &mut self.last {
-            s.upload_bytes += bytes;
+            s.upload_bytes += bytes + prev_bytes;
             s.raster_ms += start.elapsed().as_secs_f64() * 1e3;
         }
         bytes

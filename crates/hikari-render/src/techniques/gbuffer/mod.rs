@@ -93,6 +93,7 @@ impl GBufferPass {
             .constants(view)
             .read(gb.visibility)
             .read(scene.positions)
+            .read(scene.prev_positions)
             .read(scene.attributes)
             .read(scene.indices)
             .read(scene.instances)

@@ -114,6 +114,20 @@ pub fn resolve(
     pixel: [u32; 2],
     id: u32,
 ) -> Option<ResolvedTexel> {
+    resolve_deformed(scene, cpu, view, pixel, id, &cpu.positions)
+}
+
+/// [`resolve`] where the vertices stood at `prev_positions` last frame (`SceneGpu::
+/// prev_positions`, object space): the motion follows the point of the same barycentrics on
+/// last frame's triangle.
+pub fn resolve_deformed(
+    scene: &hikari_scene::Scene,
+    cpu: &SceneCpu,
+    view: &crate::view::View,
+    pixel: [u32; 2],
+    id: u32,
+    prev_positions: &[[f32; 4]],
+) -> Option<ResolvedTexel> {
     use glam::{DMat4, DVec2, DVec3, DVec4};
     let chunk = cpu.chunks.get((id / CHUNK_TRIANGLES) as usize)?;
     let lane = id % CHUNK_TRIANGLES;
@@ -200,7 +214,15 @@ pub fn resolve(
         Some(i) => i as f64,
         None => lerp3(&|a| DVec3::splat((a.extra & 0xffff) as f64 / 65535.0)).x,
     };
-    let q = object[0] * w.x + object[1] * w.y + object[2] * w.z;
+    let prev_object = idx
+        .iter()
+        .map(|&i| {
+            prev_positions
+                .get(i as usize)
+                .map(|p| Vec4::from_array(*p).truncate().as_dvec3())
+        })
+        .collect::<Option<Vec<DVec3>>>()?;
+    let q = prev_object[0] * w.x + prev_object[1] * w.y + prev_object[2] * w.z;
     let prev_vp = DMat4::from_cols_array_2d(&view.prev_view_proj.map(|c| c.map(|x| x as f64)));
     let c = prev_vp * model.transform_point3(q).extend(1.0);
     let ndc = c.truncate().truncate() / c.w;

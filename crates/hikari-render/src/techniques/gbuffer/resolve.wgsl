@@ -10,21 +10,23 @@
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<storage, read> visibility: array<vec2<u32>>;
 @group(0) @binding(2) var<storage, read> positions: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> attributes: array<VertexAttr>;
-@group(0) @binding(4) var<storage, read> indices: array<u32>;
-@group(0) @binding(5) var<storage, read> instances: array<InstanceGpu>;
-@group(0) @binding(6) var<storage, read> materials: array<MaterialGpu>;
-@group(0) @binding(7) var<storage, read> chunks: array<Chunk>;
-@group(0) @binding(8) var color_textures: texture_2d_array<f32>;
-@group(0) @binding(9) var data_textures: texture_2d_array<f32>;
-@group(0) @binding(10) var texture_sampler: sampler;
-@group(0) @binding(11) var out_depth: texture_storage_2d<r32float, write>;
-@group(0) @binding(12) var out_normal: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(13) var out_albedo: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(14) var out_material: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(15) var out_motion: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(16) var out_emissive: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(17) var out_instance: texture_storage_2d<r32uint, write>;
+// Last frame's `positions`: they differ only where a mesh deforms.
+@group(0) @binding(3) var<storage, read> prev_positions: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> attributes: array<VertexAttr>;
+@group(0) @binding(5) var<storage, read> indices: array<u32>;
+@group(0) @binding(6) var<storage, read> instances: array<InstanceGpu>;
+@group(0) @binding(7) var<storage, read> materials: array<MaterialGpu>;
+@group(0) @binding(8) var<storage, read> chunks: array<Chunk>;
+@group(0) @binding(9) var color_textures: texture_2d_array<f32>;
+@group(0) @binding(10) var data_textures: texture_2d_array<f32>;
+@group(0) @binding(11) var texture_sampler: sampler;
+@group(0) @binding(12) var out_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(13) var out_normal: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(14) var out_albedo: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(15) var out_material: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(16) var out_motion: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(17) var out_emissive: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(18) var out_instance: texture_storage_2d<r32uint, write>;
 
 const NO_INSTANCE: u32 = 0xffffffffu;
 // Largest finite f16 is 65504.
@@ -233,11 +235,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
     // Motion: where this surface point was last frame, minus where it is now, in pixels. Now is
     // the pixel centre less this frame's jitter: `prev_view_proj` is unjittered.
-    let q = q0 * w.x + q1 * w.y + q2 * w.z;
+    // A deforming mesh's vertices were elsewhere last frame: the same barycentrics on last
+    // frame's triangle. Still meshes (the same vertices) keep the exact point of the ray.
     let world = p0 + e1 * b.x + e2 * b.y;
+    let r0 = prev_positions[i.x].xyz;
+    let r1 = prev_positions[i.y].xyz;
+    let r2 = prev_positions[i.z].xyz;
+    let deformed = any(r0 != q0) || any(r1 != q1) || any(r2 != q2);
+    let q = select(q0 * w.x + q1 * w.y + q2 * w.z, r0 * w.x + r1 * w.y + r2 * w.z, deformed);
     var prev_world = vec4<f32>(world, 1.0);
     if (inst_flags & INSTANCE_MOVED) != 0u {
         prev_world = instances[ci].prev_model * vec4<f32>(q, 1.0);
+    } else if deformed {
+        prev_world = model * vec4<f32>(q, 1.0);
     }
     let prev = project_to_pixel(view.prev_view_proj, prev_world);
     let view_depth = dot(world - o, view.forward_near.xyz);

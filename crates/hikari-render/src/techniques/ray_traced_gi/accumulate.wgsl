@@ -2,7 +2,9 @@
 // the G-buffer's motion vector (nearest texel), rejected off screen, where not finite, or
 // where its view depth differs from where this point was seen last frame by more than the
 // tolerance; the speed is 1 / length, the length growing while the history stays valid, up to
-// a cap. Non-finite input is replaced where it enters. CPU twin: reference::accumulate_pixel.
+// a cap. A sample far brighter than the history it joins is scaled down first (the firefly
+// clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
+// reference::accumulate_pixel.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_ACCUMULATE, RTGI_RESET}
@@ -79,7 +81,32 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;
     }
+    // Firefly clamp: the whole sample scaled so that its c0 stays within k times the
+    // history's local scale (the brightest c0 of its 3x3: a pixel whose few samples all came
+    // out dark must not cut what its neighbours see) plus the floor; chroma and direction
+    // stay the sample's.
+    var cocg = cocg_ao.xy;
+    let ff = params.firefly;
+    if ff.x > 0.0 && hl >= ff.z {
+        var scale = max(hy.x, 0.0);
+        let qi = vec2<i32>(q);
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let t = clamp(qi + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(size) - 1);
+                let c = textureLoad(prev_y, t, 0).x;
+                if c == c && c <= 3.0e38 {
+                    scale = max(scale, c);
+                }
+            }
+        }
+        let limit = ff.x * scale + ff.y;
+        if y.x > limit {
+            let s = limit / y.x;
+            y *= s;
+            cocg *= s;
+        }
+    }
     let len = min(hl + 1.0, f32(params.config.z));
     let speed = 1.0 / len;
-    store(pixel, mix(hy, y, speed), mix(hc, cocg_ao.xy, speed), mix(ha, ao, speed), len, z);
+    store(pixel, mix(hy, y, speed), mix(hc, cocg, speed), mix(ha, ao, speed), len, z);
 }

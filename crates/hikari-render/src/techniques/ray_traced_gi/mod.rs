@@ -113,6 +113,9 @@ pub struct RtGiParams {
     pub sky_horizon: [f32; 4],
     /// Lights at hits: the area lights (a count), their minimum flux (lm), 0, 0.
     pub area: [f32; 4],
+    /// The accumulation's firefly clamp ([`reference::FireflyClamp`]): k (0: off), the floor
+    /// (SH c0 units), the history length from which it applies; w unused.
+    pub firefly: [f32; 4],
 }
 
 /// Where the sky for misses and ambient light comes from.
@@ -178,6 +181,7 @@ impl RtGiParams {
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky_scale).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
             area: [0.0; 4],
+            firefly: reference::FireflyClamp::new(s.firefly_clamp, metered_lux).to_array(),
         }
     }
 

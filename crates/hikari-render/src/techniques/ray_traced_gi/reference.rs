@@ -510,11 +510,93 @@ pub struct AccumulateInput {
     pub raw_ao: f32,
 }
 
+/// The accumulation's firefly clamp. A sample whose luminance (SH c0) exceeds
+/// `k · scale + floor`, where `scale` is the history's local scale ([`firefly_scale`]), is
+/// scaled down to that, whole (Y SH and CoCg alike, so its chroma and direction stay those of
+/// the sample), once the history holds at least `min_history` frames (younger pixels must
+/// still converge from their first samples).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FireflyClamp {
+    /// Times the history's c0 a sample may reach (0: off). Unitless.
+    pub k: f32,
+    /// Added to the limit, in SH c0 units (luminance × `C0`): what a dark history may still
+    /// take in one frame.
+    pub floor: f32,
+    /// History length (frames) from which the clamp applies.
+    pub min_history: f32,
+}
+
+/// History length from which the firefly clamp applies: below it a pixel's history is too
+/// young to say what is too bright.
+pub const FIREFLY_MIN_HISTORY: f32 = 4.0;
+
+impl FireflyClamp {
+    /// The clamp of setting `k` in a frame metered at `metered_lux` (lux): the floor is the c0
+    /// of a sample of luminance `metered_lux / π`, a white Lambertian surface under the metered
+    /// illuminance, so the clamp scales with the scene's light and not with the camera's
+    /// exposure settings. A non-finite or non-positive `k` or a non-finite meter turns it off.
+    pub fn new(k: f32, metered_lux: f32) -> Self {
+        if !(k.is_finite() && k > 0.0 && metered_lux.is_finite()) {
+            return Self::default();
+        }
+        Self {
+            k,
+            floor: hikari_math::sh::basis::C0 as f32 * metered_lux.max(0.0) / std::f32::consts::PI,
+            min_history: FIREFLY_MIN_HISTORY,
+        }
+    }
+
+    /// As `RtGiParams::firefly`.
+    pub fn to_array(self) -> [f32; 4] {
+        [self.k, self.floor, self.min_history, 0.0]
+    }
+
+    /// `sample` limited against a history of `history_length` frames whose local scale is
+    /// `scale` ([`firefly_scale`]).
+    pub fn apply(&self, sample: ShL1YCoCg, scale: f32, history_length: f32) -> ShL1YCoCg {
+        let on = self.k > 0.0 && history_length >= self.min_history;
+        if !on {
+            return sample;
+        }
+        let limit = self.k * scale.max(0.0) + self.floor;
+        let c0 = sample.y.coeffs[0];
+        if c0 > limit {
+            sample.scale(limit / c0)
+        } else {
+            sample
+        }
+    }
+}
+
+/// The history's local scale for the firefly clamp, in SH c0: the largest finite c0 of the
+/// 3x3 history texels around `q` (clamped to the image), at least 0. The neighbours keep a
+/// pixel whose few samples all came out dark (or that a light just reached) from cutting what
+/// the surface around it sees.
+pub fn firefly_scale(
+    history: &dyn Fn([u32; 2]) -> Accumulated,
+    q: [u32; 2],
+    size: [u32; 2],
+) -> f32 {
+    let mut scale = 0f32;
+    for dy in -1i64..=1 {
+        for dx in -1i64..=1 {
+            let x = (q[0] as i64 + dx).clamp(0, size[0] as i64 - 1) as u32;
+            let y = (q[1] as i64 + dy).clamp(0, size[1] as i64 - 1) as u32;
+            let c = history([x, y]).gi.y.coeffs[0];
+            if c.is_finite() {
+                scale = scale.max(c);
+            }
+        }
+    }
+    scale
+}
+
 /// Temporal accumulation of one pixel: reprojects by the motion vector to the nearest texel
 /// of the history, accepts it if inside the image, finite, with history, and its view depth
 /// within `depth_tolerance` (relative) of where this surface point was seen last frame
 /// (`prev_view_proj · world`, w); then blends with speed 1 / length, length growing to
-/// `max_history`. Non-finite raw values count as a zero sample (AO: open).
+/// `max_history`, the raw sample held by `firefly` against the history it joins. Non-finite
+/// raw values count as a zero sample (AO: open).
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_pixel(
     pixel: [u32; 2],
@@ -526,6 +608,7 @@ pub fn accumulate_pixel(
     history_valid: bool,
     max_history: f32,
     depth_tolerance: f32,
+    firefly: &FireflyClamp,
 ) -> Accumulated {
     if input.depth.is_nan() || input.depth <= 0.0 {
         return Accumulated {
@@ -562,7 +645,8 @@ pub fn accumulate_pixel(
     if prev.x < 0.0 || prev.y < 0.0 || prev.x >= size[0] as f32 || prev.y >= size[1] as f32 {
         return fresh;
     }
-    let h = history([prev.x as u32, prev.y as u32]);
+    let q = [prev.x as u32, prev.y as u32];
+    let h = history(q);
     let expected = (prev_view_proj * world.extend(1.0)).w;
     if !h.finite()
         || h.length < 1.0
@@ -570,6 +654,11 @@ pub fn accumulate_pixel(
     {
         return fresh;
     }
+    let raw = if firefly.k > 0.0 && h.length >= firefly.min_history {
+        firefly.apply(raw, firefly_scale(history, q, size), h.length)
+    } else {
+        raw
+    };
     let length = (h.length + 1.0).min(max_history);
     let speed = 1.0 / length;
     Accumulated {

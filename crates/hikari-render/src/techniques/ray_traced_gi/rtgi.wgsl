@@ -138,6 +138,9 @@ struct RtGiParams {
     sky_horizon: vec4<f32>,
     // Lights at hits: x area lights (a count, exact in f32), y their minimum flux (lm), z, w 0.
     area: vec4<f32>,
+    // The accumulation's firefly clamp: x: k (0: off), y: the floor (SH c0), z: the history
+    // length from which it applies.
+    firefly: vec4<f32>,
 }
 
 const RTGI_PRETRACE: u32 = 1u;

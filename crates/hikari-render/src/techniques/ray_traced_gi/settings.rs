@@ -44,6 +44,10 @@ pub struct RayTracedGiSettings {
     /// History is rejected where its view depth differs from the reprojected point's by more
     /// than this fraction.
     pub depth_tolerance: f32,
+    /// Firefly clamp of the temporal accumulation: a new sample's luminance (SH c0) is held
+    /// to this many times the history's local scale (its 3x3 maximum) plus the metered floor
+    /// (`reference::FireflyClamp`), the whole sample scaled with it; 0 turns it off. Unitless.
+    pub firefly_clamp: f32,
     /// The deferred lighting takes its ambient light from the GI within this distance of the
     /// camera (metres) and from the probes or the sky beyond.
     pub near_field_m: f32,
@@ -71,6 +75,7 @@ impl Default for RayTracedGiSettings {
             accumulate: true,
             max_history: 32,
             depth_tolerance: 0.05,
+            firefly_clamp: 8.0,
             near_field_m: 250.0,
             near_field_blend: 0.2,
         }
@@ -131,6 +136,13 @@ impl TechniqueSettings for RayTracedGiSettings {
             Field {
                 key: "depth_tolerance",
                 range: Range::Float { lo: 0.0, hi: 10.0 },
+            },
+            Field {
+                key: "firefly_clamp",
+                range: Range::Float {
+                    lo: 0.0,
+                    hi: 10_000.0,
+                },
             },
         ];
         F
