@@ -26,8 +26,8 @@ pub struct TransportTables {
     /// ([`DOUBLE_SIDED`]) and 0.
     pub instances: Vec<[u32; 4]>,
     /// Three rows (object-space `a`, `b`, `c`, `w` = 0) per triangle of each mesh with a
-    /// BVH instance, then three rows (RGB of `a`, `b`, `c`) per triangle of each such mesh
-    /// with vertex colours.
+    /// BVH instance, then three rows (RGB of `a`, `b`, `c`, `w` = 1, or all 0 for a corner
+    /// without a colour) per triangle of each such mesh with vertex colours.
     pub triangles: Vec<[f32; 4]>,
 }
 
@@ -71,9 +71,11 @@ impl TransportTables {
             for t in indices.chunks_exact(3) {
                 for &v in t {
                     // A corner without a colour makes the CPU fall back to white for the
-                    // whole triangle; NaN marks it so the kernel does the same.
-                    let c = colors.get(v as usize).copied().unwrap_or(Vec3::NAN);
-                    triangles.push([c.x, c.y, c.z, 0.0]);
+                    // whole triangle; w = 0 marks it so the kernel does the same.
+                    triangles.push(match colors.get(v as usize) {
+                        Some(c) => [c.x, c.y, c.z, 1.0],
+                        None => [0.0; 4],
+                    });
                 }
             }
         }
