@@ -386,8 +386,9 @@ pub fn bake_scene_resume_with(
                 .collect();
             let mut probes = Vec::with_capacity(probes_per_tile);
             let mut interior = Vec::with_capacity(probes_per_tile);
-            for batch in (0..probes_per_tile).step_by(grid.progress_batch.min(256)) {
-                let end = (batch + grid.progress_batch.min(256)).min(probes_per_tile);
+            let batch_size = grid.progress_batch.min(transport.batch_size()).max(1);
+            for batch in (0..probes_per_tile).step_by(batch_size) {
+                let end = (batch + batch_size).min(probes_per_tile);
                 let placed: Vec<Option<Vec3>> = (batch..end)
                     .into_par_iter()
                     .map_init(TraversalStacks::default, |stacks, k| {
@@ -446,7 +447,7 @@ pub fn bake_scene_resume_with(
         this_run += dropped;
         let mut probes = Vec::with_capacity(positions.len());
         let mut interior = Vec::with_capacity(positions.len());
-        let batch_size = grid.progress_batch.min(256);
+        let batch_size = grid.progress_batch.min(transport.batch_size()).max(1);
         for batch in (0..positions.len()).step_by(batch_size) {
             let end = (batch + batch_size).min(positions.len());
             let placed: Vec<Option<Vec3>> =

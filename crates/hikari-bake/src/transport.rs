@@ -94,6 +94,11 @@ pub trait TransportTracer {
     fn scene_rays(&self) -> Option<&SceneRays> {
         None
     }
+    /// Probes per call the tracer works best with; the bake takes the smaller of this and
+    /// its progress batch. 256 keeps the CPU's progress reports frequent.
+    fn batch_size(&self) -> usize {
+        256
+    }
     /// Each probe's transport, in the order of `probes`.
     fn trace(&self, probes: &[ProbeRequest]) -> Result<Vec<ProbeTransport>, BakeError>;
 }

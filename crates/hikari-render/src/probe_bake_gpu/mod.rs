@@ -46,20 +46,22 @@ const OUT_STRIDE: usize = 40;
 /// Invocations per workgroup of the bake's kernels.
 const WORKGROUP: u32 = 64;
 
-/// Uniform of the bake's kernels (`hikari::probe_bake::BakeParams`).
+/// Uniform of the bake's kernels (`hikari::probe_bake::BakeParams`; field meanings there).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-struct BakeParams {
-    probes: u32,
-    rays_per_probe: u32,
-    bounce_rays: u32,
-    row_width: u32,
-    enclosure_radius: f32,
-    t_min: f32,
-    surface_offset: f32,
-    offset_per_metre: f32,
-    far: f32,
-    pad: [u32; 3],
+pub(crate) struct BakeParams {
+    pub(crate) probes: u32,
+    pub(crate) rays_per_probe: u32,
+    pub(crate) bounce_rays: u32,
+    pub(crate) row_width: u32,
+    pub(crate) enclosure_radius: f32,
+    pub(crate) t_min: f32,
+    pub(crate) surface_offset: f32,
+    pub(crate) offset_per_metre: f32,
+    pub(crate) far: f32,
+    pub(crate) pad_a: u32,
+    pub(crate) pad_b: u32,
+    pub(crate) pad_c: u32,
 }
 
 /// Whether a bake should trace on the GPU: a real one (integrated, discrete or virtual), not a
@@ -271,7 +273,7 @@ impl<'a> GpuTransport<'a> {
             surface_offset: SURFACE_OFFSET,
             offset_per_metre: SURFACE_OFFSET_PER_METRE,
             far: f32::INFINITY,
-            pad: [0; 3],
+            ..Default::default()
         };
         let mut rt = self.runtime.borrow_mut();
         let mut g = rt.begin_frame(ctx);
@@ -377,6 +379,11 @@ impl TransportTracer for GpuTransport<'_> {
 
     fn scene_rays(&self) -> Option<&SceneRays> {
         Some(&self.rays)
+    }
+
+    /// A whole grid tile (768 probes) a frame: fewer, fuller frames.
+    fn batch_size(&self) -> usize {
+        1024
     }
 
     fn trace(
