@@ -57,6 +57,15 @@ pub fn bounce_shift(seed: u64, k: usize) -> Vec2 {
     )
 }
 
+/// [`bounce_shift`] of every ray of every probe, probe-major (`n` rays a probe), on all
+/// cores: what a GPU twin uploads, having no 64-bit integers to hash with.
+pub fn bounce_shifts(probes: &[ProbeRequest], n: usize) -> Vec<[f32; 2]> {
+    probes
+        .par_iter()
+        .flat_map_iter(|r| (0..n).map(move |k| bounce_shift(r.seed, k).to_array()))
+        .collect()
+}
+
 /// Secondary sample `j` of `m` in the unit square, rotated by `shift`: a Cranley–Patterson
 /// rotation of a stratified pattern, strata along the disk's radius (cosine-weighted
 /// elevation), a golden-ratio sequence in azimuth. The GPU twin (hikari-render's

@@ -10,7 +10,8 @@
 //! 3. `probe_bake.bounce_rays` (`bounce_rays.wgsl`): per hit, the surface's albedo from
 //!    [`TransportTables`] (materials' colours, averaged textures and vertex colours, as the CPU
 //!    reads them) and its `m` cosine-distributed secondary rays, rotated by the CPU's hash
-//!    ([`bounce_shift`], computed here: WGSL has no 64-bit integers);
+//!    ([`hikari_bake::transport::bounce_shift`], computed on the CPU's cores and uploaded:
+//!    WGSL has no 64-bit integers);
 //! 4. `bvh_trace.any`: whether each secondary ray escapes;
 //! 5. `probe_bake.accumulate` (`accumulate.wgsl`): one workgroup per probe sums the L2 SH of
 //!    sky and bounced visibility with the CPU's per-ray weights, in f32, reduced in workgroup
@@ -27,7 +28,7 @@ use glam::Vec3;
 use hikari_bake::scene_rays::SceneRays;
 use hikari_bake::surfaces::SurfaceAlbedo;
 use hikari_bake::transport::{
-    ProbeTransport, SURFACE_OFFSET, SURFACE_OFFSET_PER_METRE, bounce_shift,
+    ProbeTransport, SURFACE_OFFSET, SURFACE_OFFSET_PER_METRE, bounce_shifts,
 };
 use hikari_bake::transport_tables::TransportTables;
 use hikari_bake::{BakeError, ProbeRequest, TransportSettings, TransportTracer};
@@ -248,11 +249,8 @@ impl<'a> GpuTransport<'a> {
             .iter()
             .map(|r| [r.position.x, r.position.y, r.position.z, 0.0])
             .collect();
-        let shifts: Vec<[f32; 2]> = if m > 0 {
-            probes
-                .iter()
-                .flat_map(|r| (0..n as usize).map(move |k| bounce_shift(r.seed, k).to_array()))
-                .collect()
+        let shifts = if m > 0 {
+            bounce_shifts(probes, n as usize)
         } else {
             Vec::new()
         };
