@@ -301,6 +301,27 @@ pub fn bake_scene_resume_with(
             "the bake to resume was made for another scene key or other settings".into(),
         ));
     }
+    if let Some(t) = transport {
+        let s = t.settings();
+        if s.sphere.len() != options.grid.rays_per_probe.max(1) as usize
+            || s.bounce_rays != options.bounce_rays
+            || s.enclosure_radius != options.enclosure_radius
+        {
+            return Err(BakeError::Tracer {
+                tracer: t.name().into(),
+                message: format!(
+                    "it was built for {} rays a probe, {} bounce rays and a {} m enclosure \
+                     radius, but the bake asks for {}, {} and {} m",
+                    s.sphere.len(),
+                    s.bounce_rays,
+                    s.enclosure_radius,
+                    options.grid.rays_per_probe,
+                    options.bounce_rays,
+                    options.enclosure_radius
+                ),
+            });
+        }
+    }
     let start = Instant::now();
     let built;
     let rays = match transport.and_then(|t| t.scene_rays()) {

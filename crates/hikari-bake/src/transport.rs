@@ -99,6 +99,8 @@ pub struct TransportSettings {
 pub trait TransportTracer {
     /// "cpu" or "gpu", for reports.
     fn name(&self) -> &str;
+    /// The rays it traces; the bake refuses a tracer built for other options.
+    fn settings(&self) -> &TransportSettings;
     /// The scene's BVH, when the tracer built one the bake may reuse for probe placement.
     fn scene_rays(&self) -> Option<&SceneRays> {
         None
@@ -122,6 +124,10 @@ pub struct CpuTransport<'a> {
 impl TransportTracer for CpuTransport<'_> {
     fn name(&self) -> &str {
         "cpu"
+    }
+
+    fn settings(&self) -> &TransportSettings {
+        self.settings
     }
 
     fn scene_rays(&self) -> Option<&SceneRays> {

@@ -72,7 +72,10 @@ pub fn gpu_tracer<'a>(
 ) -> anyhow::Result<Option<GpuTransport<'a>>> {
     let Some(ctx) = ctx.filter(|c| choice.uses_gpu(c)) else {
         if choice == TracerChoice::Gpu {
-            anyhow::bail!("--tracer gpu: there is no GPU adapter to bake on");
+            anyhow::bail!(
+                "the GPU tracer was asked for (--tracer gpu or HIKARI_BAKE_TRACER=gpu), but \
+                 this command has no GPU adapter to bake on"
+            );
         }
         return Ok(None);
     };

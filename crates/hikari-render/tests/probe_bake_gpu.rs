@@ -391,4 +391,21 @@ fn gpu_bake_of_a_scene_matches_the_cpu_bake() {
     let g: Vec<_> = g.iter().map(as_transport).collect();
     assert!(c.len() >= 768);
     assert_twins("boxes bake", 64, 1, &c, &g);
+
+    // A tracer built for other rays is refused, naming both.
+    let other = GpuTransport::new(&ctx, &scene, settings(128, 1)).unwrap();
+    let e = bake_scene_resume_with(
+        &scene,
+        &options,
+        fresh(),
+        Some(&other),
+        &|_| {},
+        &mut |_| std::ops::ControlFlow::Continue(()),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("gpu") && e.contains("128") && e.contains("64"),
+        "{e}"
+    );
 }

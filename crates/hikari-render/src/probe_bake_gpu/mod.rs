@@ -375,6 +375,10 @@ impl TransportTracer for GpuTransport<'_> {
         "gpu"
     }
 
+    fn settings(&self) -> &TransportSettings {
+        &self.settings
+    }
+
     fn scene_rays(&self) -> Option<&SceneRays> {
         Some(&self.rays)
     }
