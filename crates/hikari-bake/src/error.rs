@@ -26,6 +26,9 @@ pub enum BakeError {
         volume: String,
         source: crate::delaunay::DelaunayError,
     },
+    /// The transport tracer (the GPU's) failed; the message says what and where.
+    #[error("the {tracer} tracer failed: {message}")]
+    Tracer { tracer: String, message: String },
     #[error("the bake was cancelled")]
     Cancelled,
     /// Reading or writing the bake file or its checkpoint (the message names the file).

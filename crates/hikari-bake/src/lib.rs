@@ -4,7 +4,9 @@
 //! global pool; `RAYON_NUM_THREADS` sets its size). [`bake_scene`] (and [`bake_scene_resume`],
 //! [`bake_to_file`]) bakes the grid and the tetrahedral meshes of [`volumes`] into a
 //! `hikari_probes::Bake`: sky visibility, bounced sky visibility ([`transport`]) and interior
-//! flags ([`scene_bake`]); docs/irradiance-probes.md describes it all. Below, the grid and
+//! flags ([`scene_bake`]); docs/irradiance-probes.md describes it all. The transport's rays go
+//! through a [`TransportTracer`]: [`CpuTransport`] here, or hikari-render's GPU twin
+//! (`probe_bake_gpu`), given to [`bake_scene_resume_with`] or [`bake_to_file_with`]. Below, the grid and
 //! [`bake_grid_sky_visibility`], the first, grid-only entry point (kept).
 //!
 //! ```
@@ -47,6 +49,7 @@ pub mod scene_rays;
 pub mod sky_visibility;
 pub mod surfaces;
 pub mod transport;
+pub mod transport_tables;
 pub mod volumes;
 
 use std::time::Instant;
@@ -59,10 +62,11 @@ use rayon::prelude::*;
 pub use error::BakeError;
 pub use scene_bake::{
     BakeProgress, BakedFile, DEFAULT_BOUNCE_RAYS, SceneBakeOptions, bake_scene, bake_scene_resume,
-    bake_to_file,
+    bake_scene_resume_with, bake_to_file, bake_to_file_with, transport_settings,
 };
 pub use scene_rays::SceneRays;
 pub use sky_visibility::SphereRays;
+pub use transport::{CpuTransport, ProbeRequest, TransportSettings, TransportTracer};
 pub use volumes::ProbeVolume;
 
 /// Layers of a grid tile (1.5 m, 10 m, 30 m above the ground by default).

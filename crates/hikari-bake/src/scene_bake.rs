@@ -31,7 +31,9 @@ use crate::error::BakeError;
 use crate::scene_rays::SceneRays;
 use crate::sky_visibility::SphereRays;
 use crate::surfaces::SurfaceAlbedo;
-use crate::transport::{ProbeTransport, probe_transport};
+use crate::transport::{
+    CpuTransport, ProbeRequest, ProbeTransport, TransportSettings, TransportTracer,
+};
 use crate::volumes::ProbeVolume;
 use crate::{GridBakeOptions, GridLayout, LAYERS, place_probe, placement};
 
@@ -157,32 +159,67 @@ fn check(options: &SceneBakeOptions) -> Result<(), BakeError> {
     Ok(())
 }
 
+/// What the transport tracers are given: the probe rays, bounce rays and enclosure radius of
+/// `options`.
+pub fn transport_settings(options: &SceneBakeOptions) -> TransportSettings {
+    TransportSettings {
+        sphere: SphereRays::fibonacci(options.grid.rays_per_probe),
+        bounce_rays: options.bounce_rays,
+        enclosure_radius: options.enclosure_radius,
+    }
+}
+
 struct Tracer<'a> {
     rays: &'a SceneRays,
-    albedo: &'a SurfaceAlbedo,
-    sphere: &'a SphereRays,
     inside: &'a SphereRays,
     options: &'a SceneBakeOptions,
     /// Rays traced so far, by all threads.
     traced: AtomicU64,
 }
 
-impl Tracer<'_> {
-    fn transport(&self, at: Vec3, seed: u64, stacks: &mut TraversalStacks) -> ProbeTransport {
-        let t = probe_transport(
-            self.rays,
-            self.albedo,
-            self.sphere,
-            self.options.bounce_rays,
-            at,
-            seed,
-            self.options.enclosure_radius,
-            stacks,
-        );
-        self.traced.fetch_add(t.rays, Ordering::Relaxed);
-        t
+/// Traces the probes of `placed` that have a position (in order, `seed(i)` for the `i`-th of
+/// `placed`) through `transport`; those without one get zero transport and stay exterior.
+fn trace_batch(
+    tracer: &Tracer<'_>,
+    transport: &dyn TransportTracer,
+    placed: &[Option<Vec3>],
+    seed: impl Fn(usize) -> u64,
+) -> Result<Vec<(ProbeSh, bool)>, BakeError> {
+    let requests: Vec<ProbeRequest> = placed
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            p.map(|position| ProbeRequest {
+                position,
+                seed: seed(i),
+            })
+        })
+        .collect();
+    let traced = transport.trace(&requests)?;
+    if traced.len() != requests.len() {
+        return Err(BakeError::Tracer {
+            tracer: transport.name().into(),
+            message: format!(
+                "{} probes asked for, {} transports returned",
+                requests.len(),
+                traced.len()
+            ),
+        });
     }
+    let mut traced = traced.into_iter();
+    Ok(placed
+        .iter()
+        .map(|p| match p.and_then(|_| traced.next()) {
+            Some(t) => {
+                tracer.count(t.rays);
+                tracer.probe(&t)
+            }
+            None => (ProbeSh::default(), false),
+        })
+        .collect())
+}
 
+impl Tracer<'_> {
     fn count(&self, rays: u64) {
         self.traced.fetch_add(rays, Ordering::Relaxed);
     }
@@ -233,12 +270,28 @@ impl Tracer<'_> {
     }
 }
 
-/// Bakes what `bake` (a fresh or resumed bake of the same scene key and settings) lacks.
-/// `checkpoint` is called after every finished section with the bake so far.
+/// Bakes what `bake` (a fresh or resumed bake of the same scene key and settings) lacks,
+/// tracing the transport on the CPU. `checkpoint` is called after every finished section with
+/// the bake so far.
 pub fn bake_scene_resume(
     scene: &Scene,
     options: &SceneBakeOptions,
+    bake: Bake,
+    progress: &dyn Fn(BakeProgress),
+    checkpoint: &mut dyn FnMut(&Bake) -> ControlFlow<()>,
+) -> Result<Bake, BakeError> {
+    bake_scene_resume_with(scene, options, bake, None, progress, checkpoint)
+}
+
+/// [`bake_scene_resume`] with the transport's rays traced by `transport` (built for this
+/// scene and [`transport_settings`] of `options`); `None` traces them on the CPU. Probe
+/// placement (ground, inside tests) runs on the CPU either way, through the tracer's BVH when
+/// it offers one.
+pub fn bake_scene_resume_with(
+    scene: &Scene,
+    options: &SceneBakeOptions,
     mut bake: Bake,
+    transport: Option<&dyn TransportTracer>,
     progress: &dyn Fn(BakeProgress),
     checkpoint: &mut dyn FnMut(&Bake) -> ControlFlow<()>,
 ) -> Result<Bake, BakeError> {
@@ -248,15 +301,53 @@ pub fn bake_scene_resume(
             "the bake to resume was made for another scene key or other settings".into(),
         ));
     }
+    if let Some(t) = transport {
+        let s = t.settings();
+        if s.sphere.len() != options.grid.rays_per_probe.max(1) as usize
+            || s.bounce_rays != options.bounce_rays
+            || s.enclosure_radius != options.enclosure_radius
+        {
+            return Err(BakeError::Tracer {
+                tracer: t.name().into(),
+                message: format!(
+                    "it was built for {} rays a probe, {} bounce rays and a {} m enclosure \
+                     radius, but the bake asks for {}, {} and {} m",
+                    s.sphere.len(),
+                    s.bounce_rays,
+                    s.enclosure_radius,
+                    options.grid.rays_per_probe,
+                    options.bounce_rays,
+                    options.enclosure_radius
+                ),
+            });
+        }
+    }
     let start = Instant::now();
-    let rays = SceneRays::build(scene)?;
-    let albedo = SurfaceAlbedo::new(scene);
-    let sphere = SphereRays::fibonacci(options.grid.rays_per_probe);
+    let built;
+    let rays = match transport.and_then(|t| t.scene_rays()) {
+        Some(r) => r,
+        None => {
+            built = SceneRays::build(scene)?;
+            &built
+        }
+    };
+    // The CPU tracer's tables cost a pass over the textures; only built when it is used.
+    let cpu_parts = transport
+        .is_none()
+        .then(|| (SurfaceAlbedo::new(scene), transport_settings(options)));
+    let cpu = cpu_parts.as_ref().map(|(albedo, settings)| CpuTransport {
+        scene: rays,
+        albedo,
+        settings,
+    });
+    let transport: &dyn TransportTracer = match (transport, &cpu) {
+        (Some(t), _) => t,
+        (None, Some(c)) => c,
+        (None, None) => unreachable!("the CPU tracer is built when none is given"),
+    };
     let inside = SphereRays::fibonacci(options.grid.inside_test_rays);
     let tracer = Tracer {
-        rays: &rays,
-        albedo: &albedo,
-        sphere: &sphere,
+        rays,
         inside: &inside,
         options,
         traced: AtomicU64::new(0),
@@ -309,33 +400,30 @@ pub fn bake_scene_resume(
                 .into_par_iter()
                 .map_init(TraversalStacks::default, |stacks, c| {
                     let xz = column_xz(c);
-                    let (y, traced) =
-                        placement::ground_height(&rays, xz.x, xz.y, top, lo.y, stacks);
+                    let (y, traced) = placement::ground_height(rays, xz.x, xz.y, top, lo.y, stacks);
                     tracer.count(traced);
                     y
                 })
                 .collect();
             let mut probes = Vec::with_capacity(probes_per_tile);
             let mut interior = Vec::with_capacity(probes_per_tile);
-            for batch in (0..probes_per_tile).step_by(grid.progress_batch.min(256)) {
-                let end = (batch + grid.progress_batch.min(256)).min(probes_per_tile);
-                let out: Vec<(ProbeSh, bool)> = (batch..end)
+            let batch_size = grid.progress_batch.min(transport.batch_size()).max(1);
+            for batch in (0..probes_per_tile).step_by(batch_size) {
+                let end = (batch + batch_size).min(probes_per_tile);
+                let placed: Vec<Option<Vec3>> = (batch..end)
                     .into_par_iter()
                     .map_init(TraversalStacks::default, |stacks, k| {
                         let (layer, c) = (k / (n * n), k % (n * n));
                         let xz = column_xz(c);
                         let planned = Vec3::new(xz.x, ground[c] + grid.heights[layer], xz.y);
-                        let (placed, traced) = place_probe(&rays, &inside, planned, grid, stacks);
+                        let (placed, traced) = place_probe(rays, &inside, planned, grid, stacks);
                         tracer.count(traced);
-                        match placed {
-                            Some((at, _)) => {
-                                let seed = ((t as u64) << 32) | k as u64;
-                                tracer.probe(&tracer.transport(at, seed, stacks))
-                            }
-                            None => (ProbeSh::default(), false),
-                        }
+                        placed.map(|(at, _)| at)
                     })
                     .collect();
+                let out = trace_batch(&tracer, transport, &placed, |i| {
+                    ((t as u64) << 32) | (batch + i) as u64
+                })?;
                 for (p, i) in out {
                     probes.push(p);
                     interior.push(i);
@@ -380,17 +468,14 @@ pub fn bake_scene_resume(
         this_run += dropped;
         let mut probes = Vec::with_capacity(positions.len());
         let mut interior = Vec::with_capacity(positions.len());
-        let batch_size = grid.progress_batch.min(256);
+        let batch_size = grid.progress_batch.min(transport.batch_size()).max(1);
         for batch in (0..positions.len()).step_by(batch_size) {
             let end = (batch + batch_size).min(positions.len());
-            let out: Vec<(ProbeSh, bool)> = positions[batch..end]
-                .par_iter()
-                .enumerate()
-                .map_init(TraversalStacks::default, |stacks, (k, &at)| {
-                    let seed = (u64::from(id) | 1 << 31) << 32 | (batch + k) as u64;
-                    tracer.probe(&tracer.transport(at, seed, stacks))
-                })
-                .collect();
+            let placed: Vec<Option<Vec3>> =
+                positions[batch..end].iter().copied().map(Some).collect();
+            let out = trace_batch(&tracer, transport, &placed, |k| {
+                (u64::from(id) | 1 << 31) << 32 | (batch + k) as u64
+            })?;
             for (p, i) in out {
                 probes.push(p);
                 interior.push(i);
@@ -454,25 +539,55 @@ pub fn bake_to_file(
     cancel: &AtomicBool,
     checkpoint_interval: Duration,
 ) -> Result<BakedFile, BakeError> {
+    bake_to_file_with(
+        scene,
+        options,
+        path,
+        None,
+        progress,
+        cancel,
+        checkpoint_interval,
+    )
+}
+
+/// [`bake_to_file`] with the transport traced by `transport` (`None`: the CPU). The file does
+/// not record which tracer made it: their results agree within rounding, so a checkpoint of
+/// one may be finished by the other.
+pub fn bake_to_file_with(
+    scene: &Scene,
+    options: &SceneBakeOptions,
+    path: &Path,
+    transport: Option<&dyn TransportTracer>,
+    progress: &dyn Fn(BakeProgress),
+    cancel: &AtomicBool,
+    checkpoint_interval: Duration,
+) -> Result<BakedFile, BakeError> {
     let resumed = hikari_probes::resume(path, options.scene_key, bake_settings(options));
     let resumed_sections = resumed.bake.tiles.len() + resumed.bake.meshes.len();
     let mut last_save = Instant::now();
     let mut save_error = None;
-    let result = bake_scene_resume(scene, options, resumed.bake, progress, &mut |bake| {
-        let stop = cancel.load(Ordering::Relaxed);
-        if stop || last_save.elapsed() >= checkpoint_interval {
-            if let Err(e) = hikari_probes::save_checkpoint(path, bake) {
-                save_error = Some(e.to_string());
-                return ControlFlow::Break(());
+    let result = bake_scene_resume_with(
+        scene,
+        options,
+        resumed.bake,
+        transport,
+        progress,
+        &mut |bake| {
+            let stop = cancel.load(Ordering::Relaxed);
+            if stop || last_save.elapsed() >= checkpoint_interval {
+                if let Err(e) = hikari_probes::save_checkpoint(path, bake) {
+                    save_error = Some(e.to_string());
+                    return ControlFlow::Break(());
+                }
+                last_save = Instant::now();
             }
-            last_save = Instant::now();
-        }
-        if stop {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        }
-    });
+            if stop {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    );
     if let Some(e) = save_error {
         return Err(BakeError::File(e));
     }

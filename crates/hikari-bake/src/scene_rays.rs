@@ -32,13 +32,13 @@ pub struct SceneRays {
     blases: Vec<Blas>,
     tlas: Tlas,
     /// Per TLAS instance index: the scene instance it stands for.
-    scene_instance: Vec<usize>,
+    pub(crate) scene_instance: Vec<usize>,
     /// Per scene mesh: its triangles, for normals of hits.
-    triangles: Vec<Vec<[u32; 3]>>,
-    positions: Vec<Vec<Vec3>>,
+    pub(crate) triangles: Vec<Vec<[u32; 3]>>,
+    pub(crate) positions: Vec<Vec<Vec3>>,
     /// Per scene instance: its transform and mesh.
-    transforms: Vec<Affine3A>,
-    instance_mesh: Vec<usize>,
+    pub(crate) transforms: Vec<Affine3A>,
+    pub(crate) instance_mesh: Vec<usize>,
 }
 
 impl SceneRays {
@@ -98,6 +98,22 @@ impl SceneRays {
                 .collect(),
             instance_mesh: scene.instances.iter().map(|i| i.mesh).collect(),
         })
+    }
+
+    /// The BLASes the TLAS's instance records point at (for a GPU copy of the same BVH).
+    pub fn blases(&self) -> &[Blas] {
+        &self.blases
+    }
+
+    /// The TLAS; hits report its instance records' `instance_index`, an index into
+    /// [`SceneRays::scene_instances`].
+    pub fn tlas(&self) -> &Tlas {
+        &self.tlas
+    }
+
+    /// Per TLAS instance: the scene instance it stands for.
+    pub fn scene_instances(&self) -> &[usize] {
+        &self.scene_instance
     }
 
     /// Whether anything lies along `dir` from `origin` (any hit, `t` in `t_min..infinity`).

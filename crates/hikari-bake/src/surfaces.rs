@@ -17,12 +17,12 @@ use crate::scene_rays::SurfaceHit;
 /// reflect.
 pub struct SurfaceAlbedo {
     /// Per scene material: base colour x texture average x (1 - metalness).
-    material_albedo: Vec<Vec3>,
-    material_double_sided: Vec<bool>,
+    pub(crate) material_albedo: Vec<Vec3>,
+    pub(crate) material_double_sided: Vec<bool>,
     /// Per scene instance: (mesh, material).
-    instance_parts: Vec<(usize, usize)>,
+    pub(crate) instance_parts: Vec<(usize, usize)>,
     /// Per scene mesh: triangle vertex indices and vertex colours (RGB), when it has colours.
-    mesh_colors: Vec<Option<(Vec<u32>, Vec<Vec3>)>>,
+    pub(crate) mesh_colors: Vec<Option<(Vec<u32>, Vec<Vec3>)>>,
 }
 
 /// Mean linear RGB of an sRGB-encoded RGBA8 texture; white for an empty or short one.

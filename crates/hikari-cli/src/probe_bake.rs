@@ -16,8 +16,10 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 
-use hikari_bake::{BakeError, BakeProgress, ProbeVolume, SceneBakeOptions};
+use hikari_bake::{BakeError, BakeProgress, ProbeVolume, SceneBakeOptions, TransportTracer};
 use hikari_probes::{Bake, Problem, SceneKey};
+use hikari_render::GpuContext;
+use hikari_render::probe_bake_gpu::{GpuTransport, is_real_gpu};
 use hikari_scene::Scene;
 
 use crate::scene_source::SceneSource;
@@ -25,6 +27,63 @@ use crate::scene_source::SceneSource;
 /// Bumped when the baker's output changes for the same scene and options, so that caches made
 /// by an older baker are not reused. 2: bounced sky visibility, interior flags, meshes.
 const BAKER_VERSION: u32 = 2;
+
+/// Which tracer traces a bake's transport rays (probe placement is on the CPU either way).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum TracerChoice {
+    /// The GPU when the adapter is a real one (not a CPU driver such as lavapipe), else the
+    /// CPU on all cores.
+    #[default]
+    Auto,
+    /// The GPU adapter wgpu picks, whatever it is (lavapipe included): an error without one.
+    Gpu,
+    /// hikari-bvh's CPU traversal on all cores.
+    Cpu,
+}
+
+impl TracerChoice {
+    /// `HIKARI_BAKE_TRACER` (auto, gpu or cpu), for the bake `hikari render` makes on a cache
+    /// miss; auto when unset.
+    pub fn from_env() -> anyhow::Result<Self> {
+        match std::env::var("HIKARI_BAKE_TRACER") {
+            Err(_) => Ok(Self::Auto),
+            Ok(v) => <Self as clap::ValueEnum>::from_str(&v, true).map_err(|_| {
+                anyhow::anyhow!("HIKARI_BAKE_TRACER is `{v}`; it must be auto, gpu or cpu")
+            }),
+        }
+    }
+
+    /// Whether to bake on `ctx`'s adapter.
+    pub fn uses_gpu(self, ctx: &GpuContext) -> bool {
+        match self {
+            Self::Auto => is_real_gpu(ctx),
+            Self::Gpu => true,
+            Self::Cpu => false,
+        }
+    }
+}
+
+/// The GPU tracer for `scene` on `ctx` when `choice` picks the GPU there; `None` for the CPU.
+pub fn gpu_tracer<'a>(
+    choice: TracerChoice,
+    ctx: Option<&'a GpuContext>,
+    scene: &Scene,
+    options: &SceneBakeOptions,
+) -> anyhow::Result<Option<GpuTransport<'a>>> {
+    let Some(ctx) = ctx.filter(|c| choice.uses_gpu(c)) else {
+        if choice == TracerChoice::Gpu {
+            anyhow::bail!(
+                "the GPU tracer was asked for (--tracer gpu or HIKARI_BAKE_TRACER=gpu), but \
+                 this command has no GPU adapter to bake on"
+            );
+        }
+        return Ok(None);
+    };
+    let t = GpuTransport::new(ctx, scene, hikari_bake::transport_settings(options))
+        .with_context(|| format!("preparing the GPU probe bake on {}", ctx.describe()))?;
+    log::info!("probes: tracing the bake on {}", ctx.describe());
+    Ok(Some(t))
+}
 
 /// Seconds between checkpoints (`<file>.partial`) of a running bake.
 const CHECKPOINT_INTERVAL: Duration = Duration::from_secs(2);
@@ -271,14 +330,18 @@ pub struct BakeRun {
     /// Rays traced in this run (probe, bounce, ground and inside-test rays).
     pub rays: u64,
     pub seconds: f64,
+    /// "gpu" or "cpu": what traced the transport.
+    pub tracer: String,
 }
 
 /// Bakes `scene` into `path` with a progress bar: resumes from `<path>.partial`, checkpoints
 /// every few seconds, and Ctrl-C stops it with a checkpoint (the next run resumes it).
+/// `tracer` traces the transport (`None`: the CPU).
 pub fn bake_into(
     scene: &Scene,
     options: &SceneBakeOptions,
     path: &Path,
+    tracer: Option<&dyn TransportTracer>,
 ) -> anyhow::Result<BakeRun> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir)
@@ -287,10 +350,11 @@ pub fn bake_into(
     let progress = RefCell::new(Progress::new("baking probes"));
     let start = Instant::now();
     let guard = InterruptGuard::install();
-    let result = hikari_bake::bake_to_file(
+    let result = hikari_bake::bake_to_file_with(
         scene,
         options,
         path,
+        tracer,
         &|p| progress.borrow_mut().update(p),
         &CANCEL,
         CHECKPOINT_INTERVAL,
@@ -329,16 +393,19 @@ pub fn bake_into(
         resumed_sections: baked.resumed_sections,
         rays,
         seconds: start.elapsed().as_secs_f64(),
+        tracer: tracer.map_or("cpu", |t| t.name()).into(),
     })
 }
 
 /// The bake to render `scene` (from `source`) with: `given` (any problem with it is an error
 /// naming the file), else the cache's, baked into the cache on a miss (resuming an interrupted
-/// one); a bad cache file is baked again with a warning.
+/// one) on `ctx`'s GPU when `HIKARI_BAKE_TRACER` (default auto) picks it; a bad cache file is
+/// baked again with a warning.
 pub fn for_render(
     scene: &Scene,
     source: &SceneSource,
     given: Option<&Path>,
+    ctx: Option<&GpuContext>,
 ) -> anyhow::Result<Bake> {
     let options = options(scene, source)?;
     let key = options.scene_key;
@@ -361,11 +428,18 @@ pub fn for_render(
         }
         Err(e) => log::warn!("{e}; baking the probes again"),
     }
-    let run = bake_into(scene, &options, &path)?;
+    let gpu = gpu_tracer(TracerChoice::from_env()?, ctx, scene, &options)?;
+    let run = bake_into(
+        scene,
+        &options,
+        &path,
+        gpu.as_ref().map(|t| t as &dyn TransportTracer),
+    )?;
     log::info!(
-        "probes: baked {} probes in {:.1} s",
+        "probes: baked {} probes in {:.1} s ({})",
         run.bake.probe_count(),
-        run.seconds
+        run.seconds,
+        run.tracer
     );
     Ok(run.bake)
 }
@@ -381,7 +455,7 @@ pub fn attach(
 ) -> anyhow::Result<()> {
     let s = &settings.settings;
     if s.irradiance_probes.enabled && s.sky.enabled && s.sky.sky {
-        let bake = for_render(scene, source, given)?;
+        let bake = for_render(scene, source, given, Some(&renderer.ctx))?;
         renderer.set_probe_bake(Some(&bake));
     } else if let Some(path) = given {
         log::warn!(

@@ -216,6 +216,24 @@ pub fn all() -> Vec<StructLayout> {
             [count, image_width, pad0, pad1]
         ),
         gpu_layout!(
+            crate::probe_bake_gpu::BakeParams,
+            "probe_bake_gpu/bounce_rays.wgsl",
+            [
+                probes,
+                rays_per_probe,
+                bounce_rays,
+                row_width,
+                enclosure_radius,
+                t_min,
+                surface_offset,
+                offset_per_metre,
+                far,
+                pad_a,
+                pad_b,
+                pad_c
+            ]
+        ),
+        gpu_layout!(
             hikari_bvh::Ray,
             "bvh/trace.wgsl",
             [origin, t_min, dir, t_max]

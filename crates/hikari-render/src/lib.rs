@@ -12,6 +12,7 @@ pub mod graph;
 pub mod layout;
 pub mod output;
 pub mod pipeline;
+pub mod probe_bake_gpu;
 pub mod raster;
 pub mod reference;
 pub mod renderer;

@@ -1,5 +1,6 @@
-//! `hikari bake`: bakes a scene's irradiance probes on the CPU (grid tiles and the scene's
-//! tetrahedral meshes, sky and bounced sky visibility, interior flags) and writes the bake file
+//! `hikari bake`: bakes a scene's irradiance probes (grid tiles and the scene's tetrahedral
+//! meshes, sky and bounced sky visibility, interior flags; the rays on the GPU when there is a
+//! real one, else on all CPU cores, `--tracer`) and writes the bake file
 //! (by default into the cache `hikari render` reads), with a progress bar and the time left; an
 //! interrupted bake (Ctrl-C) resumes from `<file>.partial`. The summary lists probes per grid
 //! tile and mesh, rays and time.
@@ -10,8 +11,10 @@ use clap::Args;
 use serde_json::json;
 
 use crate::args::{JsonArgs, SceneArgs};
-use crate::probe_bake;
+use crate::probe_bake::{self, TracerChoice};
 use crate::scene_source::{DEFAULT_SCENE, SceneSource};
+use hikari_bake::TransportTracer;
+use hikari_render::{ContextOptions, GpuContext};
 
 #[derive(Args, Debug)]
 pub struct BakeArgs {
@@ -20,6 +23,10 @@ pub struct BakeArgs {
     /// Bake file to write [default: the cache, $XDG_CACHE_HOME/hikari/probes-KEY.hikprobe].
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// What traces the rays: the GPU when the adapter is a real one (auto), or either forced.
+    /// The results agree within rounding, so the cache does not depend on it.
+    #[arg(long, value_enum, default_value_t = TracerChoice::Auto)]
+    pub tracer: TracerChoice,
     #[command(flatten)]
     pub json: JsonArgs,
 }
@@ -35,7 +42,28 @@ pub fn run(a: BakeArgs) -> anyhow::Result<()> {
     let options = probe_bake::options(&scene, &source)?;
     let key = options.scene_key;
     let path = a.output.unwrap_or_else(|| probe_bake::cache_path(&key));
-    let run = probe_bake::bake_into(&scene, &options, &path)?;
+    // The GPU tracer's set-up (BVH build, upload, kernels) counts in the bake's time.
+    let start = std::time::Instant::now();
+    let ctx = match a.tracer {
+        TracerChoice::Cpu => None,
+        TracerChoice::Gpu => Some(GpuContext::new(&ContextOptions::from_env())?),
+        TracerChoice::Auto => match GpuContext::new(&ContextOptions::from_env()) {
+            Ok(c) => Some(c),
+            Err(e) => {
+                log::info!("probes: no GPU adapter ({e}); baking on the CPU");
+                None
+            }
+        },
+    };
+    let gpu = probe_bake::gpu_tracer(a.tracer, ctx.as_ref(), &scene, &options)?;
+    let adapter = gpu.as_ref().map(|g| g.adapter());
+    let setup_seconds = start.elapsed().as_secs_f64();
+    let run = probe_bake::bake_into(
+        &scene,
+        &options,
+        &path,
+        gpu.as_ref().map(|t| t as &dyn TransportTracer),
+    )?;
     let bake = &run.bake;
     let count = |flags: &[bool]| flags.iter().filter(|&&f| f).count();
     let tiles: Vec<_> = bake
@@ -73,9 +101,12 @@ pub fn run(a: BakeArgs) -> anyhow::Result<()> {
             "bounce_rays_per_hit": options.bounce_rays,
             "rays": run.rays,
             "rays_per_second": run.rays as f64 / run.seconds.max(1e-9),
+            "tracer": run.tracer,
+            "adapter": adapter,
             "resumed_sections": run.resumed_sections,
             "threads": rayon_threads(),
-            "seconds": run.seconds,
+            "seconds": setup_seconds + run.seconds,
+            "tracer_setup_seconds": setup_seconds,
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
     } else {
@@ -98,7 +129,15 @@ pub fn run(a: BakeArgs) -> anyhow::Result<()> {
                 run.resumed_sections
             );
         }
-        println!("time: {:.2} s", run.seconds);
+        println!(
+            "tracer: {}{}",
+            run.tracer,
+            adapter.map_or(String::new(), |a| format!(" ({a})"))
+        );
+        println!(
+            "time: {:.2} s ({setup_seconds:.2} s preparing the tracer)",
+            setup_seconds + run.seconds
+        );
         println!("wrote {}", path.display());
     }
     Ok(())

@@ -115,7 +115,12 @@ pub fn run(a: ProbesArgs) -> anyhow::Result<()> {
             .map(|s| parse_point(s))
             .collect::<Result<_, _>>()?;
     let frame = scene_source::resolve(&a.frame)?;
-    let bake = probe_bake::for_render(&frame.scene, &frame.description.source, a.bake.as_deref())?;
+    let bake = probe_bake::for_render(
+        &frame.scene,
+        &frame.description.source,
+        a.bake.as_deref(),
+        None,
+    )?;
     if points.is_empty() {
         let probes = list(&bake);
         if a.json.json {
