@@ -33,7 +33,7 @@ enum Command {
     /// Write the sky of a date, time, place and weather as an equirectangular EXR (nits) and
     /// print its L2 SH and the sun and moon.
     Sky(sky::SkyCommandArgs),
-    /// Bake a scene's irradiance probes (CPU) into a bake file, by default the render cache.
+    /// Bake a scene's irradiance probes (on the GPU when there is one, else the CPU) into a bake file, by default the render cache.
     Bake(bake::BakeArgs),
     /// Print a scene's baked probes, or their values interpolated (and relit) at points, as JSON.
     Probes(probes::ProbesArgs),
