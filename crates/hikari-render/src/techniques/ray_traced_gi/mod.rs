@@ -16,6 +16,7 @@
 //! 0-15) and the hit's albedo (√albedo as R5G6B5, bits 16-31); see [`reference::pack_hit`].
 //! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
 
+pub mod instance_albedo;
 pub mod reference;
 pub mod settings;
 
