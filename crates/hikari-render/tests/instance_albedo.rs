@@ -5,7 +5,7 @@
 //! override wins and is what `reference::instance_table` uploads.
 
 use glam::{Mat4, Vec2, Vec3};
-use hikari_render::techniques::ray_traced_gi::instance_albedo::InstanceAlbedo;
+use hikari_render::techniques::ray_traced_gi::instance_albedo::{InstanceAlbedo, VIEW_RESOLUTION};
 use hikari_render::techniques::ray_traced_gi::reference::instance_table;
 use hikari_scene::{AlphaMode, Instance, Material, Mesh, Scene, Texture, TextureRef, Wrap};
 
@@ -28,10 +28,7 @@ fn mesh_of(name: &str, quads: &[Quad]) -> Mesh {
         m.positions.extend(q.corners);
         m.normals.extend([q.normal; 4]);
         m.uvs.extend(q.uvs);
-        m.colors
-            .as_mut()
-            .unwrap()
-            .extend([q.color.extend(1.0); 4]);
+        m.colors.as_mut().unwrap().extend([q.color.extend(1.0); 4]);
         m.indices
             .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
     }
@@ -58,7 +55,12 @@ fn box_faces(size: Vec3, color: impl Fn(usize, f32) -> Vec3) -> Vec<Quad> {
                 p[v] = b * size[v];
                 p
             };
-            let mut corners = [corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)];
+            let mut corners = [
+                corner(0.0, 0.0),
+                corner(1.0, 0.0),
+                corner(1.0, 1.0),
+                corner(0.0, 1.0),
+            ];
             if sign < 0.0 {
                 corners.reverse();
             }
@@ -114,10 +116,14 @@ fn srgb_decode(e: u8) -> f64 {
 fn a_single_colour_mesh_gives_that_colour() {
     // Two boxes, one partly hiding the other: occlusion changes nothing when all is one colour.
     let mut quads = box_faces(Vec3::new(1.0, 2.0, 3.0), |_, _| Vec3::ONE);
-    quads.extend(box_faces(Vec3::splat(0.5), |_, _| Vec3::ONE).into_iter().map(|mut q| {
-        q.corners = q.corners.map(|c| c + Vec3::new(0.8, 0.2, 0.2));
-        q
-    }));
+    quads.extend(
+        box_faces(Vec3::splat(0.5), |_, _| Vec3::ONE)
+            .into_iter()
+            .map(|mut q| {
+                q.corners = q.corners.map(|c| c + Vec3::new(0.8, 0.2, 0.2));
+                q
+            }),
+    );
     let colour = Vec3::new(0.3, 0.6, 0.2);
     let scene = scene_of(
         vec![mesh_of("boxes", &quads)],
@@ -291,6 +297,11 @@ fn cut_out_texels_are_seen_through() {
     scene.validate().unwrap();
     let a = InstanceAlbedo::for_scene(&scene);
     close(a.per_instance[0], (red + blue * 3.0) / 4.0, 1e-6);
+    // The frame BVH's BLASes, marked the same way, give the same table.
+    let blases =
+        hikari_render::scene_bvh::blases(&scene, &hikari_bvh::BuildOptions::default()).unwrap();
+    let b = InstanceAlbedo::with_blases(&scene, &blases, VIEW_RESOLUTION);
+    assert_eq!(a.per_instance, b.per_instance);
 }
 
 #[test]
@@ -340,4 +351,34 @@ fn a_mesh_that_shows_nothing_falls_back_to_its_material() {
     let a = InstanceAlbedo::for_scene(&scene);
     assert_eq!(a.cost.hits, 0);
     close(a.per_instance[0], colour, 1e-6);
+}
+
+/// The village's cost, for docs/ray-traced-gi.md: `cargo test [--release] -p hikari-render
+/// --test instance_albedo -- --ignored --nocapture village_cost`.
+#[test]
+#[ignore = "a measurement, not a check"]
+fn village_cost() {
+    let scene = hikari_scene::builtin::village();
+    let t = std::time::Instant::now();
+    let a = InstanceAlbedo::for_scene(&scene);
+    let total = t.elapsed();
+    let triangles: usize = scene.meshes.iter().map(|m| m.indices.len() / 3).sum();
+    println!(
+        "village: {} instances, {} meshes ({triangles} triangles), {:?}; total {:.0} ms",
+        scene.instances.len(),
+        scene.meshes.len(),
+        a.cost,
+        total.as_secs_f64() * 1e3
+    );
+    assert!(a.per_instance.iter().all(|v| v.is_finite()));
+    // With the frame BVH's BLASes (what the renderer could pass): the trace alone.
+    let blases =
+        hikari_render::scene_bvh::blases(&scene, &hikari_bvh::BuildOptions::default()).unwrap();
+    let t = std::time::Instant::now();
+    let b = InstanceAlbedo::with_blases(&scene, &blases, VIEW_RESOLUTION);
+    println!(
+        "village through the frame's BLASes: {:.0} ms",
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    assert_eq!(a.per_instance, b.per_instance);
 }

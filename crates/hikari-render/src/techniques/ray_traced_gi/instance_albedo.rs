@@ -51,8 +51,6 @@ pub struct AlbedoCost {
     pub pairs: usize,
     /// Pairs measured (the others had an override).
     pub rendered: usize,
-    /// BLASes built (one per mesh of a rendered pair).
-    pub blases: usize,
     /// Rays traced.
     pub rays: u64,
     /// Rays that hit the mesh and were shaded.
@@ -79,25 +77,9 @@ impl InstanceAlbedo {
 
     /// [`InstanceAlbedo::for_scene`] with `resolution`² rays per view (at least 1).
     pub fn with_resolution(scene: &Scene, resolution: u32) -> Self {
-        let resolution = resolution.max(1);
-        // Each pair once, represented by its first instance (the alpha filter is asked by
-        // instance; every instance of a pair has the same cut-out).
-        let mut first_instance: HashMap<(usize, usize), usize> = HashMap::new();
-        for (k, inst) in scene.instances.iter().enumerate() {
-            first_instance.entry((inst.mesh, inst.material)).or_insert(k);
-        }
-        let mut pairs: Vec<((usize, usize), usize)> = first_instance.into_iter().collect();
-        pairs.sort_unstable();
-        let rendered: Vec<((usize, usize), usize)> = pairs
-            .iter()
-            .copied()
-            .filter(|((mesh, mat), _)| {
-                scene.materials[*mat].gi_albedo.is_none() && *mesh < scene.meshes.len()
-            })
-            .collect();
-
+        let pairs = Pairs::of(scene);
         let t_build = Instant::now();
-        let mut needed: Vec<usize> = rendered.iter().map(|((mesh, _), _)| *mesh).collect();
+        let mut needed: Vec<usize> = pairs.rendered.iter().map(|((mesh, _), _)| *mesh).collect();
         needed.sort_unstable();
         needed.dedup();
         let blases: HashMap<usize, Blas> = needed
@@ -105,19 +87,70 @@ impl InstanceAlbedo {
             .filter_map(|&m| match mesh_blas(scene, m) {
                 Ok(b) => Some((m, b)),
                 Err(e) => {
-                    log::debug!("GI albedo: mesh `{}` has no BLAS: {e}", scene.meshes[m].name);
+                    log::debug!(
+                        "GI albedo: mesh `{}` has no BLAS: {e}",
+                        scene.meshes[m].name
+                    );
                     None
                 }
             })
             .collect();
         let build = t_build.elapsed();
+        pairs.measure(scene, resolution, |m| blases.get(&m), build)
+    }
 
+    /// [`InstanceAlbedo::for_scene`] through BLASes already built: `blases[m]` of scene mesh
+    /// `m`, as `crate::scene_bvh::blases` builds them for the frame's BVH (same triangles,
+    /// cut-out meshes marked non-opaque), which saves building them twice at scene load.
+    pub fn with_blases(scene: &Scene, blases: &[Blas], resolution: u32) -> Self {
+        Pairs::of(scene).measure(scene, resolution, |m| blases.get(m), Duration::ZERO)
+    }
+}
+
+/// The (mesh, material) pairs of a scene's instances, each with its first instance (the alpha
+/// filter is asked by instance; every instance of a pair has the same cut-out).
+struct Pairs {
+    all: Vec<((usize, usize), usize)>,
+    /// Those without an override, to be rendered.
+    rendered: Vec<((usize, usize), usize)>,
+}
+
+impl Pairs {
+    fn of(scene: &Scene) -> Self {
+        let mut first_instance: HashMap<(usize, usize), usize> = HashMap::new();
+        for (k, inst) in scene.instances.iter().enumerate() {
+            first_instance
+                .entry((inst.mesh, inst.material))
+                .or_insert(k);
+        }
+        let mut all: Vec<((usize, usize), usize)> = first_instance.into_iter().collect();
+        all.sort_unstable();
+        let rendered = all
+            .iter()
+            .copied()
+            .filter(|((mesh, mat), _)| {
+                scene.materials[*mat].gi_albedo.is_none() && *mesh < scene.meshes.len()
+            })
+            .collect();
+        Self { all, rendered }
+    }
+
+    /// Renders the pairs through `blas_of(mesh)` and makes the per-instance table.
+    fn measure<'b>(
+        &self,
+        scene: &Scene,
+        resolution: u32,
+        blas_of: impl Fn(usize) -> Option<&'b Blas> + Sync,
+        build: Duration,
+    ) -> InstanceAlbedo {
+        let resolution = resolution.max(1);
         let t_trace = Instant::now();
         let filter = SceneAlphaFilter::new(scene);
-        let measured: Vec<((usize, usize), Option<Vec3>, u64, u64)> = rendered
+        let measured: Vec<((usize, usize), Option<Vec3>, u64, u64)> = self
+            .rendered
             .par_iter()
             .map(|&(pair, instance)| {
-                let Some(blas) = blases.get(&pair.0) else {
+                let Some(blas) = blas_of(pair.0) else {
                     return (pair, None, 0, 0);
                 };
                 let view = MeshView {
@@ -136,9 +169,8 @@ impl InstanceAlbedo {
 
         let mut table: HashMap<(usize, usize), Vec3> = HashMap::new();
         let mut cost = AlbedoCost {
-            pairs: pairs.len(),
-            rendered: rendered.len(),
-            blases: blases.len(),
+            pairs: self.all.len(),
+            rendered: self.rendered.len(),
             build,
             trace,
             ..Default::default()
@@ -168,17 +200,16 @@ impl InstanceAlbedo {
             })
             .collect();
         log::info!(
-            "GI albedo: {} mesh-material pairs ({} rendered), {} BLASes in {:.1} ms, {} rays \
+            "GI albedo: {} mesh-material pairs ({} rendered), BLASes in {:.1} ms, {} rays \
              ({} hits) in {:.1} ms",
             cost.pairs,
             cost.rendered,
-            cost.blases,
             cost.build.as_secs_f64() * 1e3,
             cost.rays,
             cost.hits,
             cost.trace.as_secs_f64() * 1e3,
         );
-        Self { per_instance, cost }
+        InstanceAlbedo { per_instance, cost }
     }
 }
 
@@ -285,14 +316,21 @@ impl MeshView<'_> {
     /// The albedo at the closest hit of `ray`, cut-outs rejected.
     fn trace(&self, ray: &Ray, stack: &mut Stack) -> Option<Vec3> {
         let instance = self.instance as u32;
-        let hit = hikari_bvh::traverse::closest_hit_blas_filtered(
-            &self.blas.nodes,
-            &self.blas.triangles,
-            ray,
-            instance,
-            stack,
-            |_, p, u, v| self.filter.accept(instance, p, u, v),
-        )?;
+        // The unfiltered traversal is compiled once in hikari-bvh (optimised even in debug
+        // builds); the filtered one is generic over the filter and built here.
+        let opaque = alpha_cutoff(&self.scene.materials[self.material]) <= 0.0;
+        let hit = if opaque {
+            self.blas.intersect_with(ray, stack)
+        } else {
+            hikari_bvh::traverse::closest_hit_blas_filtered(
+                &self.blas.nodes,
+                &self.blas.triangles,
+                ray,
+                instance,
+                stack,
+                |_, p, u, v| self.filter.accept(instance, p, u, v),
+            )
+        }?;
         Some(self.albedo_at(hit.primitive as usize, hit.u, hit.v))
     }
 
@@ -312,7 +350,13 @@ impl MeshView<'_> {
                 .and_then(|c| c.get(i as usize))
                 .map_or(Vec3::ONE, |c| c.truncate());
             color += c * w[k];
-            uv += mesh.uvs.get(i as usize).copied().unwrap_or_default().as_dvec2() * w[k] as f64;
+            uv += mesh
+                .uvs
+                .get(i as usize)
+                .copied()
+                .unwrap_or_default()
+                .as_dvec2()
+                * w[k] as f64;
         }
         let textures = TwinTextures { scene: self.scene };
         let sample = |r: Option<hikari_scene::TextureRef>, srgb: bool| {
