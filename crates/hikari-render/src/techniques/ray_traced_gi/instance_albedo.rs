@@ -331,16 +331,17 @@ impl MeshView<'_> {
                 |_, p, u, v| self.filter.accept(instance, p, u, v),
             )
         }?;
-        Some(self.albedo_at(hit.primitive as usize, hit.u, hit.v))
+        self.albedo_at(hit.primitive as usize, hit.u, hit.v)
     }
 
     /// The albedo a hit on triangle `primitive` at weights `u` (second vertex), `v` (third)
-    /// reflects with, from the material as the G-buffer reads it.
-    fn albedo_at(&self, primitive: usize, u: f32, v: f32) -> Vec3 {
+    /// reflects with, from the material as the G-buffer reads it; `None` for a triangle the
+    /// mesh does not have (a BLAS of another mesh given to [`InstanceAlbedo::with_blases`]).
+    fn albedo_at(&self, primitive: usize, u: f32, v: f32) -> Option<Vec3> {
         let mesh = &self.scene.meshes[self.mesh];
         let mat = &self.scene.materials[self.material];
         let w = [1.0 - u - v, u, v];
-        let tri = &mesh.indices[primitive * 3..primitive * 3 + 3];
+        let tri = mesh.indices.get(primitive * 3..primitive * 3 + 3)?;
         let mut color = Vec3::ZERO;
         let mut uv = DVec2::ZERO;
         for (k, &i) in tri.iter().enumerate() {
@@ -372,6 +373,6 @@ impl MeshView<'_> {
         let base = (mat.base_color * color * sample(mat.base_color_texture, true).truncate())
             .clamp(Vec3::ZERO, Vec3::ONE);
         let metalness = mat.metalness * sample(mat.metallic_roughness_texture, false).z;
-        hit_albedo(base, metalness)
+        Some(hit_albedo(base, metalness))
     }
 }
