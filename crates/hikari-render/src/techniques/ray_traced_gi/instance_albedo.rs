@@ -146,12 +146,17 @@ impl Pairs {
         let resolution = resolution.max(1);
         let t_trace = Instant::now();
         let filter = SceneAlphaFilter::new(scene);
-        let measured: Vec<((usize, usize), Option<Vec3>, u64, u64)> = self
+        let measured: Vec<Measured> = self
             .rendered
             .par_iter()
             .map(|&(pair, instance)| {
                 let Some(blas) = blas_of(pair.0) else {
-                    return (pair, None, 0, 0);
+                    return Measured {
+                        pair,
+                        albedo: None,
+                        rays: 0,
+                        hits: 0,
+                    };
                 };
                 let view = MeshView {
                     scene,
@@ -162,7 +167,12 @@ impl Pairs {
                     material: pair.1,
                 };
                 let (albedo, rays, hits) = view.mean_albedo(resolution);
-                (pair, albedo, rays, hits)
+                Measured {
+                    pair,
+                    albedo,
+                    rays,
+                    hits,
+                }
             })
             .collect();
         let trace = t_trace.elapsed();
@@ -175,11 +185,11 @@ impl Pairs {
             trace,
             ..Default::default()
         };
-        for (pair, albedo, rays, hits) in measured {
-            cost.rays += rays;
-            cost.hits += hits;
-            if let Some(a) = albedo {
-                table.insert(pair, a);
+        for m in measured {
+            cost.rays += m.rays;
+            cost.hits += m.hits;
+            if let Some(a) = m.albedo {
+                table.insert(m.pair, a);
             }
         }
         let per_instance = scene
@@ -240,17 +250,24 @@ fn mesh_blas(scene: &Scene, m: usize) -> Result<Blas, hikari_bvh::BvhError> {
         .instances
         .iter()
         .any(|i| i.mesh == m && alpha_cutoff(&scene.materials[i.material]) > 0.0);
-    // One thread a build: the meshes are built in parallel already.
-    let options = BuildOptions {
-        threads: 1,
-        ..Default::default()
-    };
+    // The current rayon pool: small meshes build side by side, a large one (the terrain)
+    // spreads over the threads the others leave.
+    let options = BuildOptions::default();
     if cut {
         let marks = vec![true; indices.len()];
         Blas::build_with_opacity(&mesh.name, &mesh.positions, &indices, &marks, &options)
     } else {
         Blas::build(&mesh.name, &mesh.positions, &indices, &options)
     }
+}
+
+/// What rendering one (mesh, material) pair gave: its mean albedo (`None`: nothing seen), the
+/// rays traced and the hits.
+struct Measured {
+    pair: (usize, usize),
+    albedo: Option<Vec3>,
+    rays: u64,
+    hits: u64,
 }
 
 /// One (mesh, material) pair being rendered.
