@@ -743,6 +743,8 @@ impl<'o> Loader<'o> {
                     .clamp(0.0, 1.0),
                 area_light: area_light_flag(m.extras())
                     .map_err(|e| format!("material `{name}`: {e}"))?,
+                gi_albedo: gi_albedo_override(m.extras())
+                    .map_err(|e| format!("material `{name}`: {e}"))?,
                 name,
                 ..Default::default()
             };
@@ -1086,6 +1088,27 @@ fn area_light_flag(extras: &gltf::json::Extras) -> Res<Option<bool>> {
             "extras hikari.area_light must be true or false, not {other}"
         )),
     }
+}
+
+/// The material `extras` override `{"hikari": {"gi_albedo": [r, g, b]}}`
+/// ([`Material::gi_albedo`]); `None` when absent. Anything but three numbers is an error; the
+/// range is checked with the rest of the material by `Scene::validate`.
+fn gi_albedo_override(extras: &gltf::json::Extras) -> Res<Option<Vec3>> {
+    let Some(raw) = extras else {
+        return Ok(None);
+    };
+    let value: gltf::json::Value = gltf::json::deserialize::from_str(raw.get())
+        .map_err(|e| format!("extras are not JSON: {e}"))?;
+    let Some(v) = value.get("hikari").and_then(|h| h.get("gi_albedo")) else {
+        return Ok(None);
+    };
+    let bad = || format!("extras hikari.gi_albedo must be three numbers [r, g, b], not {v}");
+    let items = v.as_array().filter(|a| a.len() == 3).ok_or_else(bad)?;
+    let mut rgb = [0.0f32; 3];
+    for (c, item) in rgb.iter_mut().zip(items) {
+        *c = item.as_f64().ok_or_else(bad)? as f32;
+    }
+    Ok(Some(Vec3::from(rgb)))
 }
 
 fn to_rgba8(d: &gltf::image::Data) -> Option<(u32, u32, Vec<u8>)> {

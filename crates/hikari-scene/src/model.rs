@@ -196,6 +196,11 @@ pub struct Material {
     /// never are (`Some(false)`), or follow the renderer's size and power rule (`None`);
     /// glTF material `extras` `{"hikari": {"area_light": true}}`. docs/area-lights.md.
     pub area_light: Option<bool>,
+    /// Albedo (linear Rec.709, each channel in [0, 1]) that ray-traced GI gives hits on this
+    /// material instead of the one it measures by rendering each mesh drawn with it from six
+    /// directions; `None`: measured. glTF material `extras`
+    /// `{"hikari": {"gi_albedo": [r, g, b]}}`. docs/ray-traced-gi.md, "Per-instance albedo".
+    pub gi_albedo: Option<Vec3>,
 }
 
 impl Default for Material {
@@ -219,6 +224,7 @@ impl Default for Material {
             anisotropy: None,
             interior: None,
             area_light: None,
+            gi_albedo: None,
         }
     }
 }
@@ -579,6 +585,13 @@ impl Scene {
                 if !(0.0..=1.0).contains(&v) {
                     return Err(err(format!("{what} {v} is outside [0, 1]")));
                 }
+            }
+            if let Some(a) = m.gi_albedo
+                && !(a.is_finite() && a.min_element() >= 0.0 && a.max_element() <= 1.0)
+            {
+                return Err(err(format!(
+                    "GI albedo override {a} must be finite with each channel in [0, 1]"
+                )));
             }
             if let AlphaMode::Mask { cutoff } = m.alpha_mode
                 && !(0.0..=1.0).contains(&cutoff)

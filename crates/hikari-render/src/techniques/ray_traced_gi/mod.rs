@@ -17,6 +17,7 @@
 //! The hit's normal is a word of its own ([`reference::pack_normal`]).
 //! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
 
+pub mod instance_albedo;
 pub mod reference;
 pub mod settings;
 

@@ -187,11 +187,11 @@ pub fn texture_mean(t: &Texture) -> Vec3 {
 /// lights (`area_lights::PolygonLights`): that pass lights every surface with it directly, so
 /// GI leaves its emission out (of the computed hit light and of the reused lit image), else
 /// the direct light would be counted twice.
-/// Albedo (the simple version of Metro's table): the material's base colour factor times its
-/// base colour texture's mean, through [`hit_albedo`]; Metro renders each mesh-material pair
-/// from six directions instead (not done). Emission: the material's emitted luminance (nits)
-/// times its emissive texture's mean.
+/// Albedo: the average visible albedo of the instance's mesh-material pair, rendered from six
+/// directions, or the material's override ([`super::instance_albedo`]). Emission: the
+/// material's emitted luminance (nits) times its emissive texture's mean.
 pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
+    let albedo = super::instance_albedo::InstanceAlbedo::for_scene(scene).per_instance;
     let means: Vec<Vec3> = scene.textures.iter().map(texture_mean).collect();
     let mean_of = |r: Option<hikari_scene::TextureRef>| {
         r.and_then(|r| means.get(r.texture).copied())
@@ -204,7 +204,7 @@ pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
         .enumerate()
         .flat_map(|(k, i)| {
             let m = &scene.materials[i.material];
-            let albedo = hit_albedo(m.base_color * mean_of(m.base_color_texture), m.metalness);
+            let albedo = albedo[k];
             let emission = m.emissive_nits * mean_of(m.emissive_texture);
             let is_area_light =
                 emission.max_element() > 0.0 && !area.skipped.iter().any(|(s, _)| *s == k);
