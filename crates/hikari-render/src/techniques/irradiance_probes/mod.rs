@@ -316,14 +316,16 @@ impl IrradianceProbes {
     }
 
     /// Records the dispatches of `bench` (one pass each, named by its workloads), relit from
-    /// its sky and `light` (the frame's sun or moon) with the switches of `s`.
+    /// its sky and `light` (the frame's sun or moon) with the switches of `s`; returns their
+    /// output, `irradiance_probes.bench_irradiance` (9 `vec4` a probe, the workloads' probes
+    /// one after the other).
     pub fn record_relight_bench<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         bench: &'r RelightBench,
         light: Option<&Sun>,
         s: &IrradianceProbesSettings,
-    ) -> Result<()> {
+    ) -> Result<Buf> {
         let sky = g.import_buffer("irradiance_probes.bench_sky_sh", &bench.sky_sh);
         let gaunt = g.import_buffer("irradiance_probes.gaunt", &self.gaunt);
         let probes = g.import_buffer("irradiance_probes.bench_probes", &bench.probe_data);
@@ -339,7 +341,7 @@ impl IrradianceProbes {
                 .write(irradiance)
                 .dispatch(&self.relight, [w.chunk_count, 1, 1])?;
         }
-        Ok(())
+        Ok(irradiance)
     }
 
     /// The probes' irradiance at every pixel's surface ([`PIXELS_DUMP`], Rgba16Float: lux,
