@@ -12,7 +12,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    bake, bench_frame, bench_overhead, bench_rays, constants, info, lut, probes, render, sky,
+    bake, bench_frame, bench_overhead, bench_probes, bench_rays, constants, info, lut, probes,
+    render, sky,
 };
 
 #[derive(Parser)]
@@ -58,6 +59,9 @@ enum BenchCommand {
     Overhead(bench_overhead::OverheadArgs),
     /// BVH build times and GPU ray throughput (Grays/s) for closest and any hit.
     Rays(bench_rays::RaysArgs),
+    /// The irradiance probes' relight (73 grid tiles, a 5000-probe mesh) and lookup (every
+    /// pixel), each timed on its own.
+    Probes(Box<bench_probes::BenchProbesArgs>),
 }
 
 /// Mesa's drivers complain on every start when XDG_RUNTIME_DIR is unset (containers, CI);
@@ -85,6 +89,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Frame(args)) => bench_frame::run(*args),
         Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
+        Command::Bench(BenchCommand::Probes(args)) => bench_probes::run(*args),
         Command::Constants(args) => constants::run(args),
         Command::Info => info::run(),
         Command::Lut(command) => lut::run(command),

@@ -67,6 +67,12 @@ impl Renderer {
         self.techniques.irradiance_probes.set_bake(&self.ctx, bake);
     }
 
+    /// The irradiance probes (the uploaded bake's layout, the lookup pass's switch, the
+    /// relight's timed dispatches), for `hikari bench probes`.
+    pub fn irradiance_probes(&self) -> &crate::techniques::irradiance_probes::IrradianceProbes {
+        &self.techniques.irradiance_probes
+    }
+
     pub fn scene(&self) -> &SceneGpu {
         &self.scene
     }

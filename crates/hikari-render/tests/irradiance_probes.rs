@@ -962,3 +962,101 @@ fn the_walk_starts_near_the_point() {
         "walk steps over 2000 points: {grid_steps} from the start grid, {first_steps} from the first tetrahedron"
     );
 }
+
+/// `hikari bench probes`'s relight dispatches (`relight_bench`) relight what they say: every
+/// probe they write equals the CPU twin's relight of the bake probe it was copied from (the
+/// grid dispatch from the grid's probes in turn, the mesh dispatch from the meshes', the scene
+/// mesh as it is), with the counts the bench prints. Deringing off: its strength choice is
+/// checked in `relight_matches_the_cpu_twin`; here a wrong copy or chunk would differ by the
+/// whole value. An empty bake and an empty workload are errors naming them.
+#[test]
+fn the_bench_dispatches_relight_copies_of_the_bake() {
+    use hikari_render::techniques::irradiance_probes::IrradianceProbes;
+    use hikari_render::techniques::irradiance_probes::relight_bench::{
+        GRID_PASS, MESH_PASS, RelightBench, RelightBenchSpec, SCENE_MESH_PASS,
+    };
+    let Some(ctx) = common::gpu() else {
+        return;
+    };
+    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let technique = IrradianceProbes::new(&ctx, &mut lib).unwrap();
+    let data = ProbeGpuData::new(&synthetic_bake(23));
+    let mut rng = SmallRng::seed_from_u64(0xBE7C);
+    let sky = synthetic_sky(&mut rng);
+    let spec = RelightBenchSpec {
+        grid_tiles: 3,
+        mesh_probes: 100,
+    };
+    let bench = RelightBench::new(&ctx, &data, &spec, &sky.coeffs).unwrap();
+    let plan: Vec<_> = bench
+        .workloads
+        .iter()
+        .map(|w| (w.pass, w.probes, w.tiles, w.chunk_count))
+        .collect();
+    let mesh = data.meshes[0];
+    assert_eq!(
+        plan,
+        vec![
+            (GRID_PASS, 3 * 768, 3, 36),
+            (MESH_PASS, 100, 0, 2),
+            (SCENE_MESH_PASS, mesh.probes, 0, mesh.probes.div_ceil(64)),
+        ]
+    );
+
+    let sun = hikari_scene::Sun {
+        direction: Vec3::new(-0.4, 0.7, 0.2).normalize(),
+        illuminance_lux: 80_000.0,
+        color: Vec3::new(1.0, 0.9, 0.8),
+    };
+    let s = settings_with(|s| s.dering = false);
+    let mut rt = GraphRuntime::new();
+    let mut g = rt.begin_frame(&ctx);
+    let out = technique
+        .record_relight_bench(&mut g, &bench, Some(&sun), &s)
+        .unwrap();
+    g.readback(out);
+    let r = g.execute().unwrap();
+    let gpu: Vec<[f32; 4]> =
+        bytemuck::pod_collect_to_vec(r.buffer("irradiance_probes.bench_irradiance").unwrap());
+
+    let grid = data.tiles.len() * TILE_PROBE_COUNT;
+    let total = data.probe_count();
+    let mut sources: Vec<usize> = (0..3 * 768).map(|k| k % grid).collect();
+    sources.extend((0..100).map(|k| grid + k % (total - grid)));
+    sources.extend((0..mesh.probes as usize).map(|k| mesh.first_probe as usize + k));
+    assert_eq!(gpu.len(), sources.len() * 9);
+    let params = RelightParams::new(Some(&sun), &s, 0);
+    for (o, &p) in sources.iter().enumerate() {
+        let (v, b) = data.probe_sh(p);
+        let want = reference::relight_probe(&sky, &v, &b, &params);
+        let got = sh_of(&gpu[o * 9..o * 9 + 9]);
+        let scale = want.coeffs[0].abs().max_element().max(1.0);
+        let err = (0..9)
+            .map(|k| (got.coeffs[k] - want.coeffs[k]).abs().max_element())
+            .fold(0.0f32, f32::max)
+            / scale;
+        assert!(
+            err < 2e-3,
+            "output probe {o} (bake probe {p}): relative error {err}: gpu {got:?} cpu {want:?}"
+        );
+    }
+
+    let empty = ProbeGpuData::new(&Bake::new(
+        SceneKey::from_u64(1),
+        BakeSettings::with_rays(1),
+    ));
+    let e = RelightBench::new(&ctx, &empty, &spec, &sky.coeffs)
+        .err()
+        .expect("an empty bake is refused")
+        .to_string();
+    assert!(e.contains("no probes"), "{e}");
+    let none = RelightBenchSpec {
+        grid_tiles: 0,
+        mesh_probes: 5,
+    };
+    let e = RelightBench::new(&ctx, &data, &none, &sky.coeffs)
+        .err()
+        .expect("no grid tiles is refused")
+        .to_string();
+    assert!(e.contains("grid tiles"), "{e}");
+}

@@ -5,6 +5,7 @@
 pub mod bake;
 pub mod bench_frame;
 pub mod bench_overhead;
+pub mod bench_probes;
 pub mod bench_rays;
 pub mod constants;
 pub mod info;

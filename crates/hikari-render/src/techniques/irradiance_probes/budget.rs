@@ -62,21 +62,24 @@ pub fn frame_work(
 /// The work as chunks of at most [`CHUNK`] consecutive probes: `(first probe, count)`.
 pub fn chunks(data: &ProbeGpuData, work: &FrameWork) -> Vec<[u32; 2]> {
     let mut out = Vec::new();
-    let mut add = |first: u32, count: u32| {
-        let mut at = 0;
-        while at < count {
-            out.push([first + at, (count - at).min(CHUNK)]);
-            at += CHUNK;
-        }
-    };
     for &t in &work.tiles {
-        add(
+        push_chunks(
+            &mut out,
             data.tiles[t].first_probe,
             hikari_probes::TILE_PROBE_COUNT as u32,
         );
     }
     for &m in &work.meshes {
-        add(data.meshes[m].first_probe, data.meshes[m].probes);
+        push_chunks(&mut out, data.meshes[m].first_probe, data.meshes[m].probes);
     }
     out
+}
+
+/// Appends the `count` consecutive probes from `first` as chunks of at most [`CHUNK`].
+pub fn push_chunks(out: &mut Vec<[u32; 2]>, first: u32, count: u32) {
+    let mut at = 0;
+    while at < count {
+        out.push([first + at, (count - at).min(CHUNK)]);
+        at += CHUNK;
+    }
 }

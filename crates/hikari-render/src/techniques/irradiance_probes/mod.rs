@@ -9,14 +9,20 @@
 //!   irradiance coefficients a probe, `vec4` each; `--dump` names it).
 //! * `hikari::irradiance_probes` (`lookup.wgsl`, binding set `irradiance_probes`):
 //!   irradiance at a position, normal and interior mask.
+//! * `irradiance_probes.lookup` (`pixels.wgsl`): that lookup alone at every pixel, writing the
+//!   dump `irradiance_probes.pixels`; recorded for `--dump` and for `hikari bench probes`
+//!   ([`IrradianceProbes::set_lookup_pass`]).
+//! * [`relight_bench`]: the relight's steady-state work as separate timed dispatches.
 //!
 //! CPU twins: [`reference`].
 
 pub mod budget;
 pub mod gpu_data;
 pub mod reference;
+pub mod relight_bench;
 pub mod settings;
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use bytemuck::{Pod, Zeroable};
@@ -35,6 +41,7 @@ use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 use gpu_data::{PROBES_INTERIOR_MASK, ProbeGpuData, ProbeLookupParams};
+use relight_bench::RelightBench;
 use settings::IrradianceProbesSettings;
 
 pub const RELIGHT_BOUNCE: u32 = 1;
@@ -121,6 +128,8 @@ struct State {
 
 /// The dump of the probes' irradiance at every pixel (`pixels.wgsl`).
 pub const PIXELS_DUMP: &str = "irradiance_probes.pixels";
+/// The pass that writes it: the probes' lookup alone at every pixel.
+pub const LOOKUP_PASS: &str = "irradiance_probes.lookup";
 
 pub struct IrradianceProbes {
     relight: ComputePipeline,
@@ -129,6 +138,8 @@ pub struct IrradianceProbes {
     /// Bound when there is no bake: one zero element each.
     empty: Arc<Uploaded>,
     state: Mutex<State>,
+    /// Record [`LOOKUP_PASS`] every frame, not only for `--dump` (to time it).
+    lookup_pass: AtomicBool,
 }
 
 fn storage(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
@@ -204,6 +215,7 @@ impl IrradianceProbes {
                 uploaded: None,
                 updates: 0,
             }),
+            lookup_pass: AtomicBool::new(false),
         })
     }
 
@@ -296,8 +308,45 @@ impl IrradianceProbes {
         })
     }
 
+    /// Whether every frame records [`LOOKUP_PASS`] (else only a frame whose `--dump` names
+    /// [`PIXELS_DUMP`]): the lookup's cost on its own, as `hikari bench probes` times it. The
+    /// deferred lighting's own lookup is unchanged.
+    pub fn set_lookup_pass(&self, on: bool) {
+        self.lookup_pass.store(on, Ordering::Relaxed);
+    }
+
+    /// Records the dispatches of `bench` (one pass each, named by its workloads), relit from
+    /// its sky and `light` (the frame's sun or moon) with the switches of `s`; returns their
+    /// output, `irradiance_probes.bench_irradiance` (9 `vec4` a probe, the workloads' probes
+    /// one after the other).
+    pub fn record_relight_bench<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        bench: &'r RelightBench,
+        light: Option<&Sun>,
+        s: &IrradianceProbesSettings,
+    ) -> Result<Buf> {
+        let sky = g.import_buffer("irradiance_probes.bench_sky_sh", &bench.sky_sh);
+        let gaunt = g.import_buffer("irradiance_probes.gaunt", &self.gaunt);
+        let probes = g.import_buffer("irradiance_probes.bench_probes", &bench.probe_data);
+        let irradiance = g.import_buffer("irradiance_probes.bench_irradiance", &bench.irradiance);
+        for w in &bench.workloads {
+            let chunks = g.import_buffer(w.pass, &w.chunks);
+            g.pass(w.pass)
+                .constants(&RelightParams::new(light, s, w.chunk_count))
+                .read(sky)
+                .read(gaunt)
+                .read(chunks)
+                .read(probes)
+                .write(irradiance)
+                .dispatch(&self.relight, [w.chunk_count, 1, 1])?;
+        }
+        Ok(irradiance)
+    }
+
     /// The probes' irradiance at every pixel's surface ([`PIXELS_DUMP`], Rgba16Float: lux,
-    /// alpha 1 where probes cover it), recorded only when `--dump` asks for it.
+    /// alpha 1 where probes cover it) by the pass [`LOOKUP_PASS`], recorded only when `--dump`
+    /// asks for it or [`IrradianceProbes::set_lookup_pass`] is on.
     pub fn record_pixels_dump<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
@@ -305,7 +354,8 @@ impl IrradianceProbes {
         gb: &GBuffer,
         view: &View,
     ) -> Result<Option<Tex>> {
-        if !g.rt.dumps.iter().any(|d| d == PIXELS_DUMP) {
+        if !self.lookup_pass.load(Ordering::Relaxed) && !g.rt.dumps.iter().any(|d| d == PIXELS_DUMP)
+        {
             return Ok(None);
         }
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
@@ -313,7 +363,7 @@ impl IrradianceProbes {
             PIXELS_DUMP,
             TextureDesc::d2(w, h, wgpu::TextureFormat::Rgba16Float),
         )?;
-        g.pass(PIXELS_DUMP)
+        g.pass(LOOKUP_PASS)
             .constants(view)
             .read(gb.depth)
             .read(gb.normal)
