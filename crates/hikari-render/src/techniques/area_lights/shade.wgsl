@@ -2,11 +2,13 @@
 //
 // Area lights: the unshadowed light of each polygon in closed form (Lambert's vector
 // irradiance of each front-facing triangle clipped to the surface's horizon: exact for the
-// diffuse lobe), the specular lobe at a representative point with Karis's widening, both times
-// a shadow factor: the ratio estimator of stochastic shadows (Heitz et al. 2018), shadow rays to
-// points sampled by area on the light, each weighted by its unshadowed integrand. Point and spot
-// lights: as the deferred lighting shades them, the brightest few per pixel times the fraction
-// of shadow rays to a disc of the light's radius that reach it. Rays: hikari::bvh.
+// diffuse lobe), the specular lobe at a representative point with Karis's widening. Point and
+// spot lights: as the deferred lighting shades them. Shadows within a budget of rays per pixel:
+// a few lights picked at random in proportion to their unshadowed radiance (weighted
+// reservoirs, one per pick), each pick's light over its chance times its visibility, the ratio
+// estimator of stochastic shadows (Heitz et al. 2018) over the rays that went to that light
+// (points sampled by area, or on a disc of a point light's radius, weighted by their
+// unshadowed integrand). Rays: hikari::bvh.
 // Lights are culled per 16x16 tile against the bounds of the surfaces it sees (hikari::
 // tile_bounds): a point or spot light beyond its range, an area light beyond the distance where
 // its illuminance must fall below the frame's cut-off or wholly behind its one-sided plane.
@@ -23,8 +25,8 @@
 struct AreaLightParams {
     // x: area lights; y: AREA_* flags; z: frame index; w: point and spot lights.
     config: vec4<u32>,
-    // x: shadow rays per area light; y: area lights per pixel; z: shadowed point and spot
-    // lights per pixel; w: shadow rays per point or spot light.
+    // x: shadow rays per pixel (the budget); y: area lights per pixel; z: lights picked for
+    // those rays per pixel (at most MAX_PER_PIXEL); w: 0.
     counts: vec4<u32>,
     // x: min flux (lm); y: point and spot radius (m); z: point and spot cut-off (lux); w: 0.
     values: vec4<f32>,
@@ -51,6 +53,8 @@ const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
 const AREA_LIGHT_FORCED: u32 = 2u;
 const MAX_PER_PIXEL: u32 = 8u;
 const NONE: u32 = 0xffffffffu;
+// A pick's key: the light's index, with this bit for a point or spot light.
+const PUNCTUAL_KEY: u32 = 0x80000000u;
 const PI: f32 = 3.14159265358979;
 const MAX_RADIANCE: f32 = 65000.0;
 // Lights of each kind listed per tile at most; the rest are left out there (as the deferred
@@ -258,17 +262,6 @@ fn pick(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, k: u32) -> u32 {
     return id;
 }
 
-// The slot of light `i` in `sel` among its first `keep`, or NONE.
-fn slot_of(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, keep: u32, i: u32) -> u32 {
-    var slot = NONE;
-    for (var k = 0u; k < MAX_PER_PIXEL; k++) {
-        if k < keep && (*sel)[k] == i && slot == NONE {
-            slot = k;
-        }
-    }
-    return slot;
-}
-
 fn orthonormal(n: vec3<f32>) -> vec3<f32> {
     let a = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
     return normalize(cross(n, a));
@@ -292,54 +285,109 @@ fn add_light(w: vec4<f32>, e: vec3<f32>) {
     sums.d += e * w.w;
 }
 
-// Fraction of the light of area light `i` that reaches `origin` unblocked (ratio estimator).
-fn area_visibility(i: u32, slot: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> f32 {
-    let light = area_lights[i];
+// PCG's output permutation (O'Neill 2014) as a hash.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// Uniform in [0, 1) for pick `s` of light `key` at `pixel` this frame (new every frame, so the
+// temporal passes average the picks; frame 0 repeats).
+fn pick_random(pixel: vec2<u32>, key: u32, s: u32) -> f32 {
+    let h = pcg(pcg(pcg(pcg(key) ^ (s * 0x9e3779b9u) ^ params.config.z) ^ pixel.x) ^ (pixel.y * 0x85ebca6bu));
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// Offers a light of unshadowed radiance `c` (nits) and illuminance `e_lux` to each pick's
+// weighted reservoir: pick `s` ends holding light j with probability w_j / W, w = luminance(c),
+// W the pixel's sum; it keeps (c, e_lux) / w_j, which times W is the light over its chance.
+// A light is offered even when it is the only one: every pick then holds it.
+// Constant-bound loop (see insert_best).
+fn offer(keys: ptr<function, array<u32, MAX_PER_PIXEL>>, ratios: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, total: ptr<function, f32>, pixel: vec2<u32>, key: u32, c: vec3<f32>, e_lux: f32) {
+    let w = luminance(c);
+    if !(w > 0.0) {
+        return;
+    }
+    *total += w;
+    let picks = params.counts.z;
+    for (var s = 0u; s < MAX_PER_PIXEL; s++) {
+        if s < picks && ((*keys)[s] == NONE || pick_random(pixel, key, s) * *total < w) {
+            (*keys)[s] = key;
+            (*ratios)[s] = vec4<f32>(c, e_lux) / w;
+        }
+    }
+}
+
+// Shadow ray `r` of the pixel towards the light of `key`: (its weight if unblocked, its
+// weight), the ratio estimator's terms. Area lights: a point by area (a triangle by its share,
+// the square-root warp), weighted by the unshadowed integrand cos cos / d^2; point and spot
+// lights: a point on a disc of the light's radius facing the surface, weight 1.
+fn shadow_ray(key: u32, r: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> vec2<f32> {
+    if (key & PUNCTUAL_KEY) != 0u {
+        let light = lights[key & ~PUNCTUAL_KEY];
+        let axis = normalize(light.position_range.xyz - origin);
+        let t = orthonormal(axis);
+        let b = cross(axis, t);
+        let u = sample_2d(pixel, 64u + r);
+        let rho = params.values.y * sqrt(u.x);
+        let phi = 2.0 * PI * u.y;
+        let p = light.position_range.xyz + rho * (cos(phi) * t + sin(phi) * b);
+        let to_p = p - origin;
+        let dist = length(to_p);
+        let blocked = bvh_occluded(Ray(origin, 0.0, to_p / max(dist, 1e-6), dist * (1.0 - 1e-3)));
+        return vec2<f32>(select(1.0, 0.0, blocked), 1.0);
+    }
+    let light = area_lights[key];
     let first = light.range.x;
     let last = first + light.range.y - 1u;
     let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
-    let rays = params.counts.x;
-    var num = 0.0;
-    var den = 0.0;
-    for (var s = 0u; s < rays; s++) {
-        let u = sample_2d(pixel, slot * rays + s);
-        var j = first;
-        var lo = 0.0;
-        loop {
-            let cdf = area_triangles[j].p0_cdf.w;
-            if u.x <= cdf || j >= last {
-                break;
-            }
-            lo = cdf;
-            j++;
+    let u = sample_2d(pixel, r);
+    var j = first;
+    var lo = 0.0;
+    loop {
+        let cdf = area_triangles[j].p0_cdf.w;
+        if u.x <= cdf || j >= last {
+            break;
         }
-        let tri = area_triangles[j];
-        let hi = tri.p0_cdf.w;
-        let ux = clamp((u.x - lo) / max(hi - lo, 1e-12), 0.0, 1.0);
-        let su = sqrt(ux);
-        let p = tri.p0_cdf.xyz * (1.0 - su) + tri.p1.xyz * (su * (1.0 - u.y)) + tri.p2.xyz * (su * u.y);
-        let to_p = p - origin;
-        let dist = length(to_p);
-        if !(dist > 1e-6) {
-            continue;
-        }
-        let dir = to_p / dist;
-        let ng = normalize(cross(tri.p1.xyz - tri.p0_cdf.xyz, tri.p2.xyz - tri.p0_cdf.xyz));
-        var cos_l = -dot(dir, ng);
-        if double_sided {
-            cos_l = abs(cos_l);
-        }
-        let w = max(dot(dir, n), 0.0) * max(cos_l, 0.0) / (dist * dist);
-        if w > 0.0 {
-            let blocked = bvh_occluded(Ray(origin, 0.0, dir, dist * (1.0 - 1e-3)));
-            num += select(w, 0.0, blocked);
-            den += w;
-        }
+        lo = cdf;
+        j++;
     }
-    return select(1.0, num / den, den > 0.0);
+    let tri = area_triangles[j];
+    let hi = tri.p0_cdf.w;
+    let ux = clamp((u.x - lo) / max(hi - lo, 1e-12), 0.0, 1.0);
+    let su = sqrt(ux);
+    let p = tri.p0_cdf.xyz * (1.0 - su) + tri.p1.xyz * (su * (1.0 - u.y)) + tri.p2.xyz * (su * u.y);
+    let to_p = p - origin;
+    let dist = length(to_p);
+    if !(dist > 1e-6) {
+        return vec2<f32>(0.0);
+    }
+    let dir = to_p / dist;
+    let ng = normalize(cross(tri.p1.xyz - tri.p0_cdf.xyz, tri.p2.xyz - tri.p0_cdf.xyz));
+    var cos_l = -dot(dir, ng);
+    if double_sided {
+        cos_l = abs(cos_l);
+    }
+    let w = max(dot(dir, n), 0.0) * max(cos_l, 0.0) / (dist * dist);
+    if !(w > 0.0) {
+        return vec2<f32>(0.0);
+    }
+    let blocked = bvh_occluded(Ray(origin, 0.0, dir, dist * (1.0 - 1e-3)));
+    return vec2<f32>(select(w, 0.0, blocked), w);
 }
 
-fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origin: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView) {
+// Stores `v` at entry `k` of `a` through a constant-bound loop (see insert_best).
+fn put(a: ptr<function, array<f32, MAX_PER_PIXEL>>, k: u32, v: f32) {
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            (*a)[j] = v;
+        }
+    }
+}
+
+// Adds area light `i`'s unshadowed light to the sums and offers it to the picks.
+fn shade_area_light(i: u32, pixel: vec2<u32>, world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView, keys: ptr<function, array<u32, MAX_PER_PIXEL>>, ratios: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, total: ptr<function, f32>) {
     let light = area_lights[i];
     let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
     var f = vec3<f32>(0.0);
@@ -364,12 +412,9 @@ fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origi
     if !(e > 0.0) {
         return;
     }
-    var vis = 1.0;
-    if params.counts.x > 0u {
-        vis = area_visibility(i, slot, pixel, origin, n);
-    }
-    let radiance = light.radiance_flux.rgb * (e * vis);
-    lux += luminance(radiance);
+    let radiance = light.radiance_flux.rgb * e;
+    let e_lux = luminance(radiance);
+    lux += e_lux;
     // Diffuse lobes from the direction of the vector irradiance.
     let l_d = normalize(f);
     let w_d = brdf_light_weights(brdf, l_d) / max(dot(n, l_d), 1e-4);
@@ -405,32 +450,10 @@ fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origi
     let widened = min(alpha + 0.5 * size, 1.0);
     let norm = (alpha / widened) * (alpha / widened);
     let w_s = brdf_light_weights(brdf, l_s) * (norm / max(dot(n, l_s), 1e-4));
-    add_light(vec4<f32>(w_s.x, w_s.y, w_d.z, w_d.w), radiance);
-}
-
-// Fraction of shadow rays from `origin` to a disc of the light's radius facing it that pass.
-fn punctual_visibility(light: LightGpu, slot: u32, pixel: vec2<u32>, origin: vec3<f32>) -> f32 {
-    let rays = params.counts.w;
-    if rays == 0u {
-        return 1.0;
-    }
-    let to_light = light.position_range.xyz - origin;
-    let axis = normalize(to_light);
-    let t = orthonormal(axis);
-    let b = cross(axis, t);
-    var passed = 0u;
-    for (var s = 0u; s < rays; s++) {
-        let u = sample_2d(pixel, 64u + slot * rays + s);
-        let rho = params.values.y * sqrt(u.x);
-        let phi = 2.0 * PI * u.y;
-        let p = light.position_range.xyz + rho * (cos(phi) * t + sin(phi) * b);
-        let to_p = p - origin;
-        let dist = length(to_p);
-        if !bvh_occluded(Ray(origin, 0.0, to_p / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
-            passed++;
-        }
-    }
-    return f32(passed) / f32(rays);
+    let w = vec4<f32>(w_s.x, w_s.y, w_d.z, w_d.w);
+    add_light(w, radiance);
+    let unshadowed = brdf_apply_weights(brdf, radiance * w.x, radiance * w.y, radiance * w.z, radiance * w.w);
+    offer(keys, ratios, total, pixel, i, unshadowed, e_lux);
 }
 
 fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
@@ -452,6 +475,14 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
     sums = Sums(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     lux = 0.0;
     let flags = params.config.y;
+    // The picks for the shadow rays (see offer) and the sum of their weights.
+    var keys: array<u32, MAX_PER_PIXEL>;
+    var ratios: array<vec4<f32>, MAX_PER_PIXEL>;
+    var total = 0.0;
+    for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+        keys[k] = NONE;
+        ratios[k] = vec4<f32>(0.0);
+    }
 
     if (flags & AREA_POLYGONS) != 0u {
         // The lights of largest flux / distance^2 here, at most counts.y, largest first.
@@ -479,49 +510,82 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             if id == NONE {
                 break;
             }
-            shade_area_light(id, k, pixel, world, origin, n, v, brdf);
+            shade_area_light(id, pixel, world, n, v, brdf, &keys, &ratios, &total);
         }
     }
 
     if (flags & AREA_PUNCTUAL) != 0u {
-        var sel: array<u32, MAX_PER_PIXEL>;
-        var score: array<f32, MAX_PER_PIXEL>;
-        let keep = min(params.counts.z, MAX_PER_PIXEL);
-        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
-            sel[k] = NONE;
-            score[k] = 0.0;
-        }
         let listed = min(tile_counts.x, TILE_LIGHTS);
-        if keep > 0u {
-            for (var t = 0u; t < listed; t++) {
-                let i = tile_punctual[t];
-                let light = lights[i];
-                let to_light = light.position_range.xyz - world;
-                let d2 = dot(to_light, to_light);
-                let l = to_light * inverseSqrt(max(d2, 1e-8));
-                let s = luminance(light.intensity.rgb) * punctual_attenuation(light, l, d2) * max(dot(n, l), 0.0);
-                insert_best(&sel, &score, keep, i, s);
-            }
-        }
         for (var t = 0u; t < listed; t++) {
             let i = tile_punctual[t];
             let light = lights[i];
             let to_light = light.position_range.xyz - world;
             let d2 = dot(to_light, to_light);
             let l = to_light * inverseSqrt(max(d2, 1e-8));
-            var e = light.intensity.rgb * punctual_attenuation(light, l, d2);
+            let e = light.intensity.rgb * punctual_attenuation(light, l, d2);
             if !(luminance(e) > 0.0) {
                 continue;
             }
-            let slot = slot_of(&sel, keep, i);
-            if slot != NONE {
-                e *= punctual_visibility(light, slot, pixel, origin);
-            }
-            lux += luminance(e) * max(dot(n, l), 0.0);
-            add_light(brdf_light_weights(brdf, l), e);
+            let e_lux = luminance(e) * max(dot(n, l), 0.0);
+            lux += e_lux;
+            let w = brdf_light_weights(brdf, l);
+            add_light(w, e);
+            let unshadowed = brdf_apply_weights(brdf, e * w.x, e * w.y, e * w.z, e * w.w);
+            offer(&keys, &ratios, &total, pixel, i | PUNCTUAL_KEY, unshadowed, e_lux);
         }
     }
-    return brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
+
+    // Without rays (or where no light brings radiance), the unshadowed sum.
+    var radiance = brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
+    // The shadows: each pick's rays (the budget split over the picks), its visibility the ratio
+    // estimator over all the rays that went to the same light, and the pixel's light
+    // W / picks x sum over picks of visibility x (light / weight): unbiased in the selection,
+    // never negative, and of exact luminance where the picked lights are wholly visible (the
+    // weights are the lights' luminances; only the colour varies with the picks).
+    let picks = params.counts.z;
+    if picks > 0u && total > 0.0 {
+        var num: array<f32, MAX_PER_PIXEL>;
+        var den: array<f32, MAX_PER_PIXEL>;
+        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+            num[k] = 0.0;
+            den[k] = 0.0;
+        }
+        let each = params.counts.x / picks;
+        let extra = params.counts.x % picks;
+        for (var s = 0u; s < picks; s++) {
+            let key = pick(&keys, s);
+            if key == NONE {
+                continue;
+            }
+            let first = s * each + min(s, extra);
+            let rays = each + select(0u, 1u, s < extra);
+            var nd = vec2<f32>(0.0);
+            for (var r = first; r < first + rays; r++) {
+                nd += shadow_ray(key, r, pixel, origin, n);
+            }
+            put(&num, s, nd.x);
+            put(&den, s, nd.y);
+        }
+        var shadowed = vec4<f32>(0.0);
+        for (var s = 0u; s < MAX_PER_PIXEL; s++) {
+            if s < picks && keys[s] != NONE {
+                var nn = 0.0;
+                var dd = 0.0;
+                for (var q = 0u; q < MAX_PER_PIXEL; q++) {
+                    if q < picks && keys[q] == keys[s] {
+                        nn += num[q];
+                        dd += den[q];
+                    }
+                }
+                let vis = select(1.0, nn / dd, dd > 0.0);
+                shadowed += vis * ratios[s];
+            }
+        }
+        shadowed *= total / f32(picks);
+        radiance = shadowed.rgb;
+        lux = shadowed.a;
+    }
+    return radiance;
 }
 
 @compute @workgroup_size(16, 16, 1)
