@@ -884,9 +884,9 @@ fn village_at_night_gpu_matches_its_twin_within_the_ray_budget() {
             let g = f.radiance.pixel(x, y);
             lit += (s.radiance.max_element() > 0.0) as usize;
             let mut px = (g[3] - s.lux).abs() / (0.02 * s.lux + 0.01 * mean_lux);
-            for k in 0..3 {
+            for (k, gk) in g.iter().take(3).enumerate() {
                 let tol = 0.02 * s.radiance[k].abs() + 0.01 * mean;
-                px = px.max((g[k] - s.radiance[k]).abs() / tol);
+                px = px.max((gk - s.radiance[k]).abs() / tol);
             }
             worst = worst.max(px);
             bad += (px > 1.0) as usize;
