@@ -41,13 +41,12 @@ pub fn pcg(v: u32) -> u32 {
     (word >> 22) ^ word
 }
 
-/// The shader's uniform number in [0, 1) for pick `s` of light `key` at `pixel` in frame
-/// `frame` (`AreaLightParams::config[2]`).
-pub fn pick_random(frame: u32, pixel: [u32; 2], key: u32, s: u32) -> f32 {
-    let h = pcg(
-        pcg(pcg(pcg(key) ^ s.wrapping_mul(0x9e37_79b9) ^ frame) ^ pixel[0])
-            ^ pixel[1].wrapping_mul(0x85eb_ca6b),
-    );
+/// The shader's offset in [0, 1) of the pixel's picks in frame `frame`
+/// (`AreaLightParams::config[2]`): a hash of the pixel plus the frame times the golden ratio,
+/// in 32-bit fixed point.
+pub fn pick_offset(frame: u32, pixel: [u32; 2]) -> f32 {
+    let h =
+        pcg(pixel[0] ^ pcg(pixel[1] ^ 0x5bd1_e995)).wrapping_add(frame.wrapping_mul(2_654_435_769));
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
@@ -243,20 +242,34 @@ pub fn shade_counted(
     let shares = light_shares(p, lights, punctual, world, &f);
     let mut out = shares.iter().map(|s| s.radiance).sum::<Vec3>();
     let mut lux = shares.iter().map(|s| s.lux).sum::<f32>();
-    // The picks: one weighted reservoir each, offered the lights in the shader's order.
+    // The picks: systematic sampling of the lights by weight, in the shader's order, pick s at
+    // (s + offset) W / picks along the running sum; rounding's leftovers to the last light.
     let picks = p.counts[2].min(MAX_SHADOW_PICKS) as usize;
     let mut keys = [None::<usize>; MAX_SHADOW_PICKS as usize];
-    let mut total = 0.0f32;
-    for (j, share) in shares.iter().enumerate() {
-        let w = luminance(share.radiance);
-        if w.is_nan() || w <= 0.0 {
+    let weights: Vec<f32> = shares
+        .iter()
+        .map(|s| luminance(s.radiance))
+        .map(|w| if w > 0.0 { w } else { 0.0 })
+        .collect();
+    let total = weights.iter().fold(0.0f32, |t, &w| t + w);
+    let step = total / picks.max(1) as f32;
+    let offset = pick_offset(p.config[2], pixel);
+    let (mut cum, mut last) = (0.0f32, None);
+    for (j, &w) in weights.iter().enumerate() {
+        if w <= 0.0 {
             continue;
         }
-        total += w;
+        cum += w;
+        last = Some(j);
         for (s, slot) in keys.iter_mut().enumerate().take(picks) {
-            if slot.is_none() || pick_random(p.config[2], pixel, share.key, s as u32) * total < w {
+            if slot.is_none() && (s as f32 + offset) * step < cum {
                 *slot = Some(j);
             }
+        }
+    }
+    for slot in keys.iter_mut().take(picks) {
+        if slot.is_none() {
+            *slot = last;
         }
     }
     let mut rays = 0;

@@ -44,7 +44,7 @@ impl Default for AreaLightsSettings {
 /// Most lights per pixel the shader keeps (its selection arrays' length).
 pub const MAX_LIGHTS_PER_PIXEL: u32 = 8;
 
-/// Most lights a pixel picks for its shadow rays per frame (the shader's reservoirs): a
+/// Most lights a pixel picks for its shadow rays per frame (the shader's arrays): a
 /// budget above this splits its rays over the picks.
 pub const MAX_SHADOW_PICKS: u32 = 8;
 

@@ -4,11 +4,11 @@
 // irradiance of each front-facing triangle clipped to the surface's horizon: exact for the
 // diffuse lobe), the specular lobe at a representative point with Karis's widening. Point and
 // spot lights: as the deferred lighting shades them. Shadows within a budget of rays per pixel:
-// a few lights picked at random in proportion to their unshadowed radiance (weighted
-// reservoirs, one per pick), each pick's light over its chance times its visibility, the ratio
-// estimator of stochastic shadows (Heitz et al. 2018) over the rays that went to that light
-// (points sampled by area, or on a disc of a point light's radius, weighted by their
-// unshadowed integrand). Rays: hikari::bvh.
+// a few lights picked at random in proportion to their unshadowed radiance (systematic
+// sampling, offset per pixel and frame), each pick's light over its chance times its
+// visibility, the ratio estimator of stochastic shadows (Heitz et al. 2018) over the rays that
+// went to that light (points sampled by area, or on a disc of a point light's radius, weighted
+// by their unshadowed integrand). Rays: hikari::bvh.
 // Lights are culled per 16x16 tile against the bounds of the surfaces it sees (hikari::
 // tile_bounds): a point or spot light beyond its range, an area light beyond the distance where
 // its illuminance must fall below the frame's cut-off or wholly behind its one-sided plane.
@@ -292,29 +292,52 @@ fn pcg(v: u32) -> u32 {
     return (word >> 22u) ^ word;
 }
 
-// Uniform in [0, 1) for pick `s` of light `key` at `pixel` this frame (new every frame, so the
-// temporal passes average the picks; frame 0 repeats).
-fn pick_random(pixel: vec2<u32>, key: u32, s: u32) -> f32 {
-    let h = pcg(pcg(pcg(pcg(key) ^ (s * 0x9e3779b9u) ^ params.config.z) ^ pixel.x) ^ (pixel.y * 0x85ebca6bu));
+// The pixel's offset in [0, 1) of its picks' positions this frame: a hash of the pixel, moved
+// each frame by the golden ratio (a Weyl sequence, in 32-bit fixed point), so that over frames
+// the positions stratify the pixel's lights for TAA to average; frame 0 repeats.
+fn pick_offset(pixel: vec2<u32>) -> f32 {
+    let h = pcg(pixel.x ^ pcg(pixel.y ^ 0x5bd1e995u)) + params.config.z * 2654435769u;
     return f32(h >> 8u) * (1.0 / 16777216.0);
 }
 
-// Offers a light of unshadowed radiance `c` (nits) and illuminance `e_lux` to each pick's
-// weighted reservoir: pick `s` ends holding light j with probability w_j / W, w = luminance(c),
-// W the pixel's sum; it keeps (c, e_lux) / w_j, which times W is the light over its chance.
-// A light is offered even when it is the only one: every pick then holds it.
-// Constant-bound loop (see insert_best).
-fn offer(keys: ptr<function, array<u32, MAX_PER_PIXEL>>, ratios: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, total: ptr<function, f32>, pixel: vec2<u32>, key: u32, c: vec3<f32>, e_lux: f32) {
-    let w = luminance(c);
+// Places the picks that fall on a light of unshadowed radiance `c.rgb` (nits) and illuminance
+// `c.a` (lux), walked in the same order as the lights were summed into W: systematic sampling
+// by weight w = luminance(c), pick s at (s + offset) W / picks along the lights' running sum
+// `cum`, so light j is picked about picks w_j / W times (at least once when w_j >= W / picks).
+// Each pick keeps (c / w) and its light's key; `last` is the last light of weight, which takes
+// any pick that rounding leaves past the end. Constant-bound loop (see insert_best).
+fn place(keys: ptr<function, array<u32, MAX_PER_PIXEL>>, ratios: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, cum: ptr<function, f32>, last: ptr<function, vec4<f32>>, last_key: ptr<function, u32>, step: f32, offset: f32, key: u32, c: vec4<f32>) {
+    let w = luminance(c.rgb);
     if !(w > 0.0) {
         return;
     }
-    *total += w;
+    *cum += w;
+    *last = c / w;
+    *last_key = key;
     let picks = params.counts.z;
     for (var s = 0u; s < MAX_PER_PIXEL; s++) {
-        if s < picks && ((*keys)[s] == NONE || pick_random(pixel, key, s) * *total < w) {
+        if s < picks && (*keys)[s] == NONE && (f32(s) + offset) * step < *cum {
             (*keys)[s] = key;
-            (*ratios)[s] = vec4<f32>(c, e_lux) / w;
+            (*ratios)[s] = c / w;
+        }
+    }
+}
+
+// Entry `k` of `a`, through a constant-bound loop (see insert_best).
+fn get4(a: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, k: u32) -> vec4<f32> {
+    var v = vec4<f32>(0.0);
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            v = (*a)[j];
+        }
+    }
+    return v;
+}
+
+fn put4(a: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, k: u32, v: vec4<f32>) {
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            (*a)[j] = v;
         }
     }
 }
@@ -386,8 +409,9 @@ fn put(a: ptr<function, array<f32, MAX_PER_PIXEL>>, k: u32, v: f32) {
     }
 }
 
-// Adds area light `i`'s unshadowed light to the sums and offers it to the picks.
-fn shade_area_light(i: u32, pixel: vec2<u32>, world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView, keys: ptr<function, array<u32, MAX_PER_PIXEL>>, ratios: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, total: ptr<function, f32>) {
+// Adds area light `i`'s unshadowed light to the sums; returns it: radiance (nits, rgb) and
+// illuminance (lux, a), 0 where it brings none.
+fn shade_area_light(i: u32, world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView) -> vec4<f32> {
     let light = area_lights[i];
     let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
     var f = vec3<f32>(0.0);
@@ -410,7 +434,7 @@ fn shade_area_light(i: u32, pixel: vec2<u32>, world: vec3<f32>, n: vec3<f32>, v:
     // Irradiance per unit radiance (sr): the light's projected solid angle.
     let e = dot(f, n);
     if !(e > 0.0) {
-        return;
+        return vec4<f32>(0.0);
     }
     let radiance = light.radiance_flux.rgb * e;
     let e_lux = luminance(radiance);
@@ -453,7 +477,7 @@ fn shade_area_light(i: u32, pixel: vec2<u32>, world: vec3<f32>, n: vec3<f32>, v:
     let w = vec4<f32>(w_s.x, w_s.y, w_d.z, w_d.w);
     add_light(w, radiance);
     let unshadowed = brdf_apply_weights(brdf, radiance * w.x, radiance * w.y, radiance * w.z, radiance * w.w);
-    offer(keys, ratios, total, pixel, i, unshadowed, e_lux);
+    return vec4<f32>(unshadowed, e_lux);
 }
 
 fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
@@ -475,20 +499,24 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
     sums = Sums(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     lux = 0.0;
     let flags = params.config.y;
-    // The picks for the shadow rays (see offer) and the sum of their weights.
+    // The picks for the shadow rays (see place), the sum W of the lights' weights, and the
+    // area lights' unshadowed light by slot (the walk of the picks reads it again).
     var keys: array<u32, MAX_PER_PIXEL>;
     var ratios: array<vec4<f32>, MAX_PER_PIXEL>;
+    var area_light: array<vec4<f32>, MAX_PER_PIXEL>;
     var total = 0.0;
     for (var k = 0u; k < MAX_PER_PIXEL; k++) {
         keys[k] = NONE;
         ratios[k] = vec4<f32>(0.0);
+        area_light[k] = vec4<f32>(0.0);
     }
+    var sel: array<u32, MAX_PER_PIXEL>;
+    var keep = 0u;
 
     if (flags & AREA_POLYGONS) != 0u {
         // The lights of largest flux / distance^2 here, at most counts.y, largest first.
-        var sel: array<u32, MAX_PER_PIXEL>;
         var score: array<f32, MAX_PER_PIXEL>;
-        let keep = min(params.counts.y, MAX_PER_PIXEL);
+        keep = min(params.counts.y, MAX_PER_PIXEL);
         for (var k = 0u; k < MAX_PER_PIXEL; k++) {
             sel[k] = NONE;
             score[k] = 0.0;
@@ -510,7 +538,9 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             if id == NONE {
                 break;
             }
-            shade_area_light(id, pixel, world, n, v, brdf, &keys, &ratios, &total);
+            let c = shade_area_light(id, world, n, v, brdf);
+            total += luminance(c.rgb);
+            put4(&area_light, k, c);
         }
     }
 
@@ -530,20 +560,57 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             lux += e_lux;
             let w = brdf_light_weights(brdf, l);
             add_light(w, e);
-            let unshadowed = brdf_apply_weights(brdf, e * w.x, e * w.y, e * w.z, e * w.w);
-            offer(&keys, &ratios, &total, pixel, i | PUNCTUAL_KEY, unshadowed, e_lux);
+            total += luminance(brdf_apply_weights(brdf, e * w.x, e * w.y, e * w.z, e * w.w));
         }
     }
 
     // Without rays (or where no light brings radiance), the unshadowed sum.
     var radiance = brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
-    // The shadows: each pick's rays (the budget split over the picks), its visibility the ratio
-    // estimator over all the rays that went to the same light, and the pixel's light
+    // The shadows: `picks` lights picked by systematic sampling of their weights (see place),
+    // each pick's rays (the budget split over the picks), its visibility the ratio estimator
+    // over all the rays that went to the same light, and the pixel's light
     // W / picks x sum over picks of visibility x (light / weight): unbiased in the selection,
     // never negative, and of exact luminance where the picked lights are wholly visible (the
     // weights are the lights' luminances; only the colour varies with the picks).
     let picks = params.counts.z;
     if picks > 0u && total > 0.0 {
+        // The walk of the picks: the same lights in the same order, the area lights' light as
+        // stored, the point and spot lights' computed again as above.
+        let step = total / f32(picks);
+        let offset = pick_offset(pixel);
+        var cum = 0.0;
+        var last = vec4<f32>(0.0);
+        var last_key = NONE;
+        for (var k = 0u; k < keep; k++) {
+            let id = pick(&sel, k);
+            if id == NONE {
+                break;
+            }
+            place(&keys, &ratios, &cum, &last, &last_key, step, offset, id, get4(&area_light, k));
+        }
+        if (flags & AREA_PUNCTUAL) != 0u {
+            let listed = min(tile_counts.x, TILE_LIGHTS);
+            for (var t = 0u; t < listed; t++) {
+                let i = tile_punctual[t];
+                let light = lights[i];
+                let to_light = light.position_range.xyz - world;
+                let d2 = dot(to_light, to_light);
+                let l = to_light * inverseSqrt(max(d2, 1e-8));
+                let e = light.intensity.rgb * punctual_attenuation(light, l, d2);
+                if !(luminance(e) > 0.0) {
+                    continue;
+                }
+                let w = brdf_light_weights(brdf, l);
+                let c = brdf_apply_weights(brdf, e * w.x, e * w.y, e * w.z, e * w.w);
+                place(&keys, &ratios, &cum, &last, &last_key, step, offset, i | PUNCTUAL_KEY, vec4<f32>(c, luminance(e) * max(dot(n, l), 0.0)));
+            }
+        }
+        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+            if k < picks && keys[k] == NONE {
+                keys[k] = last_key;
+                ratios[k] = last;
+            }
+        }
         var num: array<f32, MAX_PER_PIXEL>;
         var den: array<f32, MAX_PER_PIXEL>;
         for (var k = 0u; k < MAX_PER_PIXEL; k++) {
