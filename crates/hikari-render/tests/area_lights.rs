@@ -306,7 +306,7 @@ fn penumbra_profile(side: f32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
     let frame = |blocker| {
         let scene = penumbra_scene(side, blocker);
         let mut s = common::small_frame_settings(&scene, w, h);
-        s.settings.area_lights.shadow_rays = 32;
+        s.settings.area_lights.ray_budget = 32;
         s.settings.area_lights.lights_per_pixel = 1;
         render(&scene, s).1
     };
@@ -585,7 +585,7 @@ fn point_lights_cast_ray_traced_shadows() {
     let settings = |scene: &Scene, punctual_shadows: bool| {
         let mut s = common::small_frame_settings(scene, w, h);
         s.settings.area_lights.punctual_shadows = punctual_shadows;
-        s.settings.area_lights.punctual_shadow_rays = 8;
+        s.settings.area_lights.ray_budget = 8;
         s.settings.direct_lighting.placeholder_ambient = false;
         s
     };
@@ -682,7 +682,7 @@ fn gpu_irradiance_of_a_square_light_matches_the_closed_form() {
     let side = 0.8f64;
     let scene = penumbra_scene(side as f32, false);
     let mut s = common::small_frame_settings(&scene, 64, 16);
-    s.settings.area_lights.shadow_rays = 1;
+    s.settings.area_lights.ray_budget = 1;
     let (_, f) = render(&scene, s);
     let luminance = 20000.0;
     let mut worst = 0f64;
@@ -743,4 +743,335 @@ fn an_area_light_brings_less_than_the_cut_off_beyond_its_reach() {
             );
         }
     }
+}
+
+/// The G-buffer texel of a rendered frame at (x, y), as the twin reads it.
+fn texel_at(f: &Frame, x: u32, y: u32) -> direct_lighting::reference::Texel {
+    let v4 = Vec4::from_array;
+    direct_lighting::reference::Texel {
+        depth: f.depth.pixel(x, y)[0],
+        normal: v4(f.normal.pixel(x, y)),
+        albedo: v4(f.albedo.pixel(x, y)),
+        material: v4(f.material.pixel(x, y)),
+        emissive: Vec3::ZERO,
+    }
+}
+
+/// The shadow rays' BVH as the twin traces it: every instance but the shells around a light.
+fn twin_bvh(scene: &Scene) -> (Vec<hikari_bvh::Blas>, Tlas) {
+    let blases = scene_bvh::blases(scene, &BuildOptions::default()).unwrap();
+    let tlas = Tlas::build(
+        &scene_bvh::instances(scene),
+        &area_lights::shadow_casters(scene),
+        &blases,
+    )
+    .unwrap();
+    (blases, tlas)
+}
+
+/// The village's `night_street` view with no sun or sky (the cut-off at its night floor,
+/// 0.01 lux, as at 23:00), 64 x 48: every pixel of the GPU pass against the twin, which
+/// picks the same lights by the same hash and traces the same rays on the CPU; and the budget
+/// held (the twin counts its rays: at most `ray_budget` a pixel).
+///
+/// Tolerance as on the Cornell box: 2 % of the pixel plus 1 % of the image's mean, at most 3 %
+/// of the lit pixels beyond it. Besides a ray grazing an edge, a pixel may differ where a pick
+/// flips: f32 rounding of the pick's weight against the hash's uniform (about 1e-6 of a
+/// chance per pick), or an instance the frame's BVH culls far from the camera that the
+/// twin's whole-scene BVH keeps.
+#[test]
+fn village_at_night_gpu_matches_its_twin_within_the_ray_budget() {
+    let village = hikari_scene::builtin::village();
+    let (w, h) = (64u32, 48u32);
+    let mut settings = common::small_frame_settings(&village, w, h);
+    settings.camera = village
+        .cameras
+        .iter()
+        .find(|c| c.name == "night_street")
+        .expect("the village has a night_street camera")
+        .clone();
+    settings.sun = None;
+    let budget = settings.settings.area_lights.ray_budget;
+    let (renderer, f) = render(&village, settings);
+    assert!(
+        f.params.values[2] <= 0.0101,
+        "night cut-off {}",
+        f.params.values[2]
+    );
+    let lights = &renderer.area_lights().lights;
+    let punctual = &renderer.scene().cpu.lights;
+    let (blases, tlas) = twin_bvh(&village);
+    let filter = SceneAlphaFilter::new(&village);
+    let accept = |i, p, u, v| filter.accept(i, p, u, v);
+    let twin_scene = TwinScene {
+        blases: &blases,
+        tlas: &tlas,
+        accept: &accept,
+    };
+    let eye = f.settings.camera.position;
+    let mut want = Vec::new();
+    let (mut rays, mut most_rays, mut shaded, mut most_shaded) = (0u64, 0u32, 0usize, 0usize);
+    let (mut most_area_in_reach, mut most_punctual) = (0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let texel = texel_at(&f, x, y);
+            let world = world_at(&f, x, y);
+            let s = reference::shade_counted(
+                &f.params,
+                lights,
+                punctual,
+                &twin_scene,
+                [x, y],
+                &texel,
+                world,
+                eye,
+            );
+            assert!(s.rays <= budget, "({x}, {y}): {} rays", s.rays);
+            rays += s.rays as u64;
+            most_rays = most_rays.max(s.rays);
+            if texel.depth > 0.0 {
+                let shares =
+                    reference::pixel_shares(&f.params, lights, punctual, &texel, world, eye);
+                shaded += shares.len();
+                most_shaded = most_shaded.max(shares.len());
+                let np = shares
+                    .iter()
+                    .filter(|s| s.key & reference::PUNCTUAL_KEY != 0)
+                    .count();
+                most_punctual = most_punctual.max(np);
+                let in_reach = lights
+                    .lights
+                    .iter()
+                    .filter(|l| {
+                        Vec3::from_slice(&l.centroid_radius[..3]).distance(world)
+                            < reference::area_light_reach(&f.params, l)
+                    })
+                    .count();
+                most_area_in_reach = most_area_in_reach.max(in_reach);
+            }
+            want.push(s);
+        }
+    }
+    let pixels = (w * h) as f64;
+    println!(
+        "{} area lights, {} point and spot lights; shadow rays {:.2} a pixel (most {most_rays}, \
+         budget {budget}); lights shaded {:.1} a pixel (most {most_shaded}); most area lights \
+         in reach of a pixel {most_area_in_reach}, most point and spot lights lighting one \
+         {most_punctual}",
+        lights.lights.len(),
+        punctual.len(),
+        rays as f64 / pixels,
+        shaded as f64 / pixels,
+    );
+    // The tile lists hold 256 lights of each kind: the whole village's fit, so no tile drops one.
+    assert!(
+        lights.lights.len() <= 256 && punctual.len() <= 256,
+        "the tile lists of 256 could overflow"
+    );
+    let mean = want
+        .iter()
+        .map(|s| s.radiance.element_sum() / 3.0)
+        .sum::<f32>()
+        / want.len() as f32;
+    let mean_lux = want.iter().map(|s| s.lux).sum::<f32>() / want.len() as f32;
+    assert!(
+        mean > 0.0 && rays > 0,
+        "the street is lit at night: mean {mean} nits, {rays} rays"
+    );
+    let (mut bad, mut lit, mut worst) = (0, 0, 0f32);
+    for y in 0..h {
+        for x in 0..w {
+            let s = want[(y * w + x) as usize];
+            let g = f.radiance.pixel(x, y);
+            lit += (s.radiance.max_element() > 0.0) as usize;
+            let mut px = (g[3] - s.lux).abs() / (0.02 * s.lux + 0.01 * mean_lux);
+            for (k, gk) in g.iter().take(3).enumerate() {
+                let tol = 0.02 * s.radiance[k].abs() + 0.01 * mean;
+                px = px.max((gk - s.radiance[k]).abs() / tol);
+            }
+            worst = worst.max(px);
+            bad += (px > 1.0) as usize;
+        }
+    }
+    println!("lit {lit}, beyond tolerance {bad}, worst {worst} x tolerance");
+    assert!(lit * 2 > (w * h) as usize, "{lit}");
+    assert!(
+        bad * 100 <= lit * 3,
+        "{bad} of {lit} pixels beyond tolerance"
+    );
+}
+
+/// Several coloured lights, area and point, over a floor, partly behind a blocker: lit by many
+/// lights at once, each pixel's budget shared among them.
+fn many_lights_scene() -> Scene {
+    let mut scene = penumbra_scene(0.05, false);
+    scene.cameras[0].position = Vec3::new(0.0, 2.5, 0.0);
+    scene.cameras[0].vfov_deg = 60.0;
+    // A 0.8 m blocker 0.8 m above the floor (mesh 2 is the 4 m plane; a new one).
+    scene.meshes.push(shapes::plane(0.8));
+    scene.instances.push(Instance {
+        mesh: scene.meshes.len() - 1,
+        material: 0,
+        transform: Mat4::from_translation(Vec3::new(0.2, 0.8, 0.1)),
+    });
+    let flip = Mat4::from_rotation_x(std::f32::consts::PI);
+    let colours = [
+        Vec3::new(270000.0, 108000.0, 36000.0),
+        Vec3::new(36000.0, 81000.0, 270000.0),
+        Vec3::new(108000.0, 270000.0, 72000.0),
+        Vec3::new(180000.0, 180000.0, 180000.0),
+    ];
+    for (k, (x, z, y)) in [
+        (-0.9, 0.3, 1.6),
+        (0.6, -0.4, 1.3),
+        (1.2, 0.5, 1.8),
+        (-0.3, -0.7, 1.5),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        scene.materials.push(Material::emissive("lamp", colours[k]));
+        scene.instances.push(Instance {
+            mesh: 1,
+            material: scene.materials.len() - 1,
+            transform: Mat4::from_translation(Vec3::new(x, y, z)) * flip,
+        });
+    }
+    for (k, (x, z)) in [(-1.4, -0.2), (0.2, 0.9), (1.6, -0.8)]
+        .into_iter()
+        .enumerate()
+    {
+        scene.lights.push(hikari_scene::Light::point(
+            "bulb",
+            Vec3::new(x, 1.4, z),
+            200.0 + 100.0 * k as f32,
+            colours[(k + 1) % 4] / 270000.0,
+        ));
+    }
+    scene
+}
+
+/// The budget's picks are unbiased: on the many-lights scene at 32 x 24 with a budget of 3 rays
+/// (fewer than its 5 area and 3 point lights), the twin's mean over 256 frames (a new pick and
+/// rotation each frame) against the same lights without a budget, each with its own 1024 rays.
+///
+/// Bound: each pixel's mean within 4 standard errors (its frames' spread / 16) plus 0.5 % of
+/// its value (the unbudgeted reference's own noise and the ratio estimator's small bias with
+/// few rays, small here: the lights are 5 cm wide) in at least 99 % of the lit pixels, and the
+/// image's total within 4 of its standard errors plus 0.1 %. The
+/// budget is held in every frame (the twin counts its rays), and the GPU's first frame is the
+/// twin's (the same tolerance as on the Cornell box).
+#[test]
+fn budgeted_shadows_average_to_the_unbudgeted_light() {
+    let scene = many_lights_scene();
+    let (w, h) = (32u32, 24u32);
+    let mut settings = common::small_frame_settings(&scene, w, h);
+    settings.settings.area_lights.ray_budget = 3;
+    settings.settings.area_lights.lights_per_pixel = 8;
+    settings.settings.direct_lighting.placeholder_ambient = false;
+    let (renderer, f) = render(&scene, settings);
+    let lights = &renderer.area_lights().lights;
+    assert_eq!(lights.lights.len(), 5, "{:?}", lights.skipped);
+    let punctual = &renderer.scene().cpu.lights;
+    let (blases, tlas) = twin_bvh(&scene);
+    let accept = |_, _, _, _| true;
+    let twin_scene = TwinScene {
+        blases: &blases,
+        tlas: &tlas,
+        accept: &accept,
+    };
+    let eye = f.settings.camera.position;
+    let frames = 256u64;
+    let gpu_mean = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| f.radiance.pixel(x, y)[..3].iter().sum::<f32>() / 3.0)
+        .sum::<f32>()
+        / (w * h) as f32;
+    let (mut bad_gpu, mut bad, mut lit, mut most_rays) = (0, 0, 0, 0);
+    let (mut sum_mean, mut sum_want, mut var_sum) = (0f64, 0f64, 0f64);
+    for y in 0..h {
+        for x in 0..w {
+            let texel = texel_at(&f, x, y);
+            let world = world_at(&f, x, y);
+            let (want, _) = reference::shade_unbudgeted(
+                &f.params,
+                lights,
+                punctual,
+                &twin_scene,
+                [x, y],
+                &texel,
+                world,
+                eye,
+                1024,
+            );
+            let want = want.element_sum() as f64;
+            let (mut s1, mut s2) = (0f64, 0f64);
+            for frame in 0..frames {
+                let p = AreaLightParams {
+                    config: [
+                        f.params.config[0],
+                        f.params.config[1],
+                        frame as u32,
+                        f.params.config[3],
+                    ],
+                    rotation: area_lights::frame_rotation(frame),
+                    ..f.params
+                };
+                let s = reference::shade_counted(
+                    &p,
+                    lights,
+                    punctual,
+                    &twin_scene,
+                    [x, y],
+                    &texel,
+                    world,
+                    eye,
+                );
+                assert!(s.rays <= 3, "({x}, {y}) frame {frame}: {} rays", s.rays);
+                most_rays = most_rays.max(s.rays);
+                if frame == 0 {
+                    let g = f.radiance.pixel(x, y);
+                    if (0..3).any(|k| {
+                        (g[k] - s.radiance[k]).abs() > 0.02 * s.radiance[k] + 0.01 * gpu_mean
+                    }) {
+                        bad_gpu += 1;
+                    }
+                }
+                let v = s.radiance.element_sum() as f64;
+                s1 += v;
+                s2 += v * v;
+            }
+            let mean = s1 / frames as f64;
+            let var = (s2 / frames as f64 - mean * mean).max(0.0);
+            let se = (var / frames as f64).sqrt();
+            if want > 0.0 {
+                lit += 1;
+                if (mean - want).abs() > 4.0 * se + 5e-3 * want {
+                    bad += 1;
+                    println!("({x}, {y}): mean {mean} vs {want}, standard error {se}");
+                }
+            }
+            sum_mean += mean;
+            sum_want += want;
+            var_sum += var / frames as f64;
+        }
+    }
+    let total_error = (sum_mean - sum_want).abs() / sum_want;
+    println!(
+        "{lit} lit pixels, {bad} beyond 4 standard errors; image total {sum_mean:.1} vs \
+         {sum_want:.1} (relative {total_error:.2e}, standard error {:.2e}); most rays {most_rays}; \
+         GPU frame 0 off the twin at {bad_gpu} pixels",
+        var_sum.sqrt() / sum_want
+    );
+    assert!(lit > 500, "{lit}");
+    assert_eq!(most_rays, 3, "the budget is used");
+    assert!(bad * 100 <= lit, "{bad} of {lit} pixels biased");
+    assert!(
+        total_error < 4.0 * var_sum.sqrt() / sum_want + 1e-3,
+        "image total off by {total_error}"
+    );
+    assert!(
+        bad_gpu * 100 <= lit * 3,
+        "GPU off the twin at {bad_gpu} pixels"
+    );
 }

@@ -25,6 +25,9 @@ use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
+// The shader keeps its picks in arrays of its per-pixel length.
+const _: () = assert!(settings::MAX_SHADOW_PICKS == settings::MAX_LIGHTS_PER_PIXEL);
+
 /// [`AreaLightParams::config`] `.y` bit: shade the polygonal lights.
 pub const AREA_POLYGONS: u32 = 1;
 /// [`AreaLightParams::config`] `.y` bit: shade point and spot lights, with shadows.
@@ -35,8 +38,8 @@ pub const AREA_PUNCTUAL: u32 = 2;
 pub struct AreaLightParams {
     /// Area lights, `AREA_*` flags, frame index, point and spot lights.
     pub config: [u32; 4],
-    /// Shadow rays per area light, area lights per pixel, shadowed point and spot lights per
-    /// pixel, shadow rays per point or spot light.
+    /// Shadow rays per pixel in all (the budget), area lights per pixel, lights picked for
+    /// those rays per pixel (min(budget, [`settings::MAX_SHADOW_PICKS`])), 0.
     pub counts: [u32; 4],
     /// Minimum flux (lm), point and spot radius (m), point and spot cut-off (lux), 0.
     pub values: [f32; 4],
@@ -64,10 +67,10 @@ impl AreaLightParams {
         Self {
             config: [area_lights, flags, frame as u32, punctual_lights],
             counts: [
-                s.shadow_rays,
+                s.ray_budget,
                 s.lights_per_pixel,
-                s.shadowed_punctual_per_pixel,
-                s.punctual_shadow_rays,
+                s.ray_budget.min(settings::MAX_SHADOW_PICKS),
+                0,
             ],
             values: [
                 s.min_flux_lm,
@@ -83,6 +86,17 @@ impl AreaLightParams {
     /// leave them out).
     pub fn shades_punctual(&self) -> bool {
         self.config[1] & AREA_PUNCTUAL != 0
+    }
+
+    /// Shadow rays of pick `s` (of `counts.z`): the budget split as evenly as it goes, the
+    /// first picks taking the remainder. Returns (first ray's index in the pixel, rays).
+    pub fn pick_rays(&self, s: u32) -> (u32, u32) {
+        let (budget, picks) = (self.counts[0], self.counts[2]);
+        if picks == 0 {
+            return (0, 0);
+        }
+        let (each, extra) = (budget / picks, budget % picks);
+        (s * each + s.min(extra), each + (s < extra) as u32)
     }
 }
 

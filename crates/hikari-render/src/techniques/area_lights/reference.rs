@@ -1,5 +1,6 @@
 //! CPU twin of `area_lights.shade`: the polygon integration in f64, the BRDF from
-//! hikari-math (f64), shadow rays through hikari-bvh's CPU traversal of the same BVH, with
+//! hikari-math (f64), the shader's picks of lights for the shadow-ray budget (the same hash,
+//! in the same order), shadow rays through hikari-bvh's CPU traversal of the same BVH, with
 //! the shader's sample pattern.
 
 use glam::{DVec3, Vec2, Vec3};
@@ -7,7 +8,7 @@ use hikari_bvh::{Blas, Ray, Tlas};
 use hikari_math::brdf::{self, Material};
 
 use super::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, AreaTriangleGpu, PolygonLights};
-use super::settings::MAX_LIGHTS_PER_PIXEL;
+use super::settings::{MAX_LIGHTS_PER_PIXEL, MAX_SHADOW_PICKS};
 use super::{AREA_POLYGONS, AREA_PUNCTUAL, AreaLightParams};
 use crate::reference::octahedral;
 use crate::scene_gpu::LightGpu;
@@ -31,6 +32,48 @@ pub fn sample_2d(pixel: [u32; 2], i: u32, rotation: [f32; 4]) -> Vec2 {
     let r2 = Vec2::new(fract(i as f32 * 0.754_877_7), fract(i as f32 * 0.569_840_3));
     let s = r2 + Vec2::new(ign, ign2) + Vec2::new(rotation[0], rotation[1]);
     Vec2::new(fract(s.x), fract(s.y))
+}
+
+/// The shader's `pcg` hash (O'Neill's PCG output permutation).
+pub fn pcg(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// The shader's offset in [0, 1) of the pixel's picks in frame `frame`
+/// (`AreaLightParams::config[2]`): a hash of the pixel plus the frame times the golden ratio,
+/// in 32-bit fixed point.
+pub fn pick_offset(frame: u32, pixel: [u32; 2]) -> f32 {
+    let h =
+        pcg(pixel[0] ^ pcg(pixel[1] ^ 0x5bd1_e995)).wrapping_add(frame.wrapping_mul(2_654_435_769));
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// A pick's key for point or spot light `i` (area light `i`'s key is `i`).
+pub const PUNCTUAL_KEY: u32 = 0x8000_0000;
+
+/// One light's unshadowed light at a pixel, in the order the shader offers them to the picks
+/// (the selected area lights largest score first, then point and spot lights by index).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightShare {
+    /// Area light index, or point or spot light index | [`PUNCTUAL_KEY`].
+    pub key: u32,
+    /// Radiance it brings unshadowed, nits.
+    pub radiance: Vec3,
+    /// Illuminance it brings unshadowed, lux.
+    pub lux: f32,
+}
+
+/// What the twin computes at one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Shaded {
+    /// Radiance, nits (the texture's rgb).
+    pub radiance: Vec3,
+    /// Illuminance, lux, shadowed (the texture's alpha).
+    pub lux: f32,
+    /// Shadow rays traced through the BVH.
+    pub rays: u32,
 }
 
 /// Lambert's vector irradiance per unit radiance (sr) of the polygon `q` (vertices relative to
@@ -142,23 +185,8 @@ pub fn shade(
     shade_with_lux(p, lights, punctual, scene, pixel, texel, world, eye).0
 }
 
-/// [`shade`] and the illuminance in lux the lights bring to the surface, shadowed (the
-/// texture's alpha, for the exposure meter).
-#[allow(clippy::too_many_arguments)]
-pub fn shade_with_lux(
-    p: &AreaLightParams,
-    lights: &PolygonLights,
-    punctual: &[LightGpu],
-    scene: &TwinScene,
-    pixel: [u32; 2],
-    texel: &Texel,
-    world: Vec3,
-    eye: Vec3,
-) -> (Vec3, f32) {
-    let flags = p.config[1];
-    if texel.depth <= 0.0 || flags == 0 {
-        return (Vec3::ZERO, 0.0);
-    }
+/// The BRDF frame at a pixel and the shadow rays' origin.
+fn pixel_frame(texel: &Texel, world: Vec3, eye: Vec3) -> (Frame, Vec3) {
     let n = octahedral::decode(texel.normal.truncate().truncate());
     let ta = octahedral::decode(Vec2::new(texel.normal.z, texel.normal.w));
     let t = (ta - n * n.dot(ta)).normalize();
@@ -175,8 +203,181 @@ pub fn shade_with_lux(
         },
     };
     let origin = world + n * (1e-3 + 1e-3 * (eye - world).length());
-    let mut out = Vec3::ZERO;
-    let mut lux = 0.0;
+    (f, origin)
+}
+
+/// Radiance of one pixel (nits) and the illuminance in lux the lights bring to the surface,
+/// shadowed (the texture's alpha, for the exposure meter).
+#[allow(clippy::too_many_arguments)]
+pub fn shade_with_lux(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> (Vec3, f32) {
+    let s = shade_counted(p, lights, punctual, scene, pixel, texel, world, eye);
+    (s.radiance, s.lux)
+}
+
+/// [`shade_with_lux`], and the shadow rays it traced: the shader's estimator step by step.
+#[allow(clippy::too_many_arguments)]
+pub fn shade_counted(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> Shaded {
+    if texel.depth <= 0.0 || p.config[1] == 0 {
+        return Shaded::default();
+    }
+    let (f, origin) = pixel_frame(texel, world, eye);
+    let shares = light_shares(p, lights, punctual, world, &f);
+    let mut out = shares.iter().map(|s| s.radiance).sum::<Vec3>();
+    let mut lux = shares.iter().map(|s| s.lux).sum::<f32>();
+    // The picks: systematic sampling of the lights by weight, in the shader's order, pick s at
+    // (s + offset) W / picks along the running sum; rounding's leftovers to the last light.
+    let picks = p.counts[2].min(MAX_SHADOW_PICKS) as usize;
+    let mut keys = [None::<usize>; MAX_SHADOW_PICKS as usize];
+    let weights: Vec<f32> = shares
+        .iter()
+        .map(|s| luminance(s.radiance))
+        .map(|w| if w > 0.0 { w } else { 0.0 })
+        .collect();
+    let total = weights.iter().fold(0.0f32, |t, &w| t + w);
+    let step = total / picks.max(1) as f32;
+    let offset = pick_offset(p.config[2], pixel);
+    let (mut cum, mut last) = (0.0f32, None);
+    for (j, &w) in weights.iter().enumerate() {
+        if w <= 0.0 {
+            continue;
+        }
+        cum += w;
+        last = Some(j);
+        for (s, slot) in keys.iter_mut().enumerate().take(picks) {
+            if slot.is_none() && (s as f32 + offset) * step < cum {
+                *slot = Some(j);
+            }
+        }
+    }
+    for slot in keys.iter_mut().take(picks) {
+        if slot.is_none() {
+            *slot = last;
+        }
+    }
+    let mut rays = 0;
+    if picks > 0 && total > 0.0 {
+        let mut nd = [(0.0f32, 0.0f32); MAX_SHADOW_PICKS as usize];
+        for s in 0..picks {
+            let Some(j) = keys[s] else { continue };
+            let (first, count) = p.pick_rays(s as u32);
+            for r in first..first + count {
+                let (num, den, traced) = shadow_ray(
+                    p,
+                    lights,
+                    punctual,
+                    scene,
+                    shares[j].key,
+                    r,
+                    pixel,
+                    origin,
+                    f.n,
+                );
+                nd[s].0 += num;
+                nd[s].1 += den;
+                rays += traced as u32;
+            }
+        }
+        let mut shadowed = (Vec3::ZERO, 0.0f32);
+        for s in 0..picks {
+            let Some(j) = keys[s] else { continue };
+            let (nn, dd) = (0..picks)
+                .filter(|&q| keys[q] == Some(j))
+                .fold((0.0, 0.0), |a, q| (a.0 + nd[q].0, a.1 + nd[q].1));
+            let vis = if dd > 0.0 { nn / dd } else { 1.0 };
+            let w = luminance(shares[j].radiance);
+            shadowed.0 += vis * (shares[j].radiance / w);
+            shadowed.1 += vis * (shares[j].lux / w);
+        }
+        out = shadowed.0 * (total / picks as f32);
+        lux = shadowed.1 * (total / picks as f32);
+    }
+    let lux = if lux >= 0.0 { lux.min(65000.0) } else { 0.0 };
+    Shaded {
+        radiance: clamp(out),
+        lux,
+        rays,
+    }
+}
+
+/// The light without a budget: every light the pixel shades times its own visibility, the
+/// ratio estimator over `rays_per_light` rays (the shader's pattern, rays 0, 1, ...). With many
+/// rays, what the budgeted estimator's mean over frames must tend to.
+#[allow(clippy::too_many_arguments)]
+pub fn shade_unbudgeted(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    scene: &TwinScene,
+    pixel: [u32; 2],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+    rays_per_light: u32,
+) -> (Vec3, f32) {
+    if texel.depth <= 0.0 || p.config[1] == 0 {
+        return (Vec3::ZERO, 0.0);
+    }
+    let (f, origin) = pixel_frame(texel, world, eye);
+    let (mut out, mut lux) = (Vec3::ZERO, 0.0);
+    for share in light_shares(p, lights, punctual, world, &f) {
+        let (mut num, mut den) = (0.0, 0.0);
+        for r in 0..rays_per_light {
+            let (a, b, _) =
+                shadow_ray(p, lights, punctual, scene, share.key, r, pixel, origin, f.n);
+            num += a;
+            den += b;
+        }
+        let vis = if den > 0.0 { num / den } else { 1.0 };
+        out += share.radiance * vis;
+        lux += share.lux * vis;
+    }
+    (clamp(out), lux.clamp(0.0, 65000.0))
+}
+
+/// The lights a pixel shades, unshadowed, in the shader's order (see [`LightShare`]).
+pub fn pixel_shares(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> Vec<LightShare> {
+    if texel.depth <= 0.0 || p.config[1] == 0 {
+        return Vec::new();
+    }
+    let (f, _) = pixel_frame(texel, world, eye);
+    light_shares(p, lights, punctual, world, &f)
+}
+
+fn light_shares(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    world: Vec3,
+    f: &Frame,
+) -> Vec<LightShare> {
+    let flags = p.config[1];
+    let n = f.n;
+    let mut out = Vec::new();
     if flags & AREA_POLYGONS != 0 {
         let keep = p.counts[1].min(MAX_LIGHTS_PER_PIXEL) as usize;
         let mut scored: Vec<(f32, usize)> = Vec::new();
@@ -208,46 +409,34 @@ pub fn shade_with_lux(
         }
         // Largest first; ties keep the lower index, as the shader's insertion does.
         scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        for (slot, &(_, i)) in scored.iter().take(keep).enumerate() {
-            let (radiance, e) =
-                shade_area_light(p, lights, i, slot as u32, scene, pixel, world, origin, &f);
-            out += radiance;
-            lux += e;
+        for &(_, i) in scored.iter().take(keep) {
+            if let Some((radiance, lux)) = area_light_share(lights, i, world, f) {
+                out.push(LightShare {
+                    key: i as u32,
+                    radiance,
+                    lux,
+                });
+            }
         }
     }
     if flags & AREA_PUNCTUAL != 0 {
-        let keep = p.counts[2].min(MAX_LIGHTS_PER_PIXEL) as usize;
-        let illuminance = |light: &LightGpu| {
+        for (i, light) in punctual.iter().enumerate().take(p.config[3] as usize) {
             let to_light = v3(light.position_range) - world;
             let d2 = to_light.length_squared();
             let l = to_light / d2.max(1e-8).sqrt();
-            (l, v3(light.intensity) * attenuation(p, light, l, d2))
-        };
-        let mut scored: Vec<(f32, usize)> = Vec::new();
-        for (i, light) in punctual.iter().enumerate().take(p.config[3] as usize) {
-            let (l, e) = illuminance(light);
-            let s = luminance(e) * n.dot(l).max(0.0);
-            if s > 0.0 {
-                scored.push((s, i));
-            }
-        }
-        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        scored.truncate(keep);
-        for (i, light) in punctual.iter().enumerate().take(p.config[3] as usize) {
-            let (l, mut e) = illuminance(light);
-            if luminance(e) <= 0.0 {
+            let e = v3(light.intensity) * attenuation(p, light, l, d2);
+            if luminance(e).is_nan() || luminance(e) <= 0.0 {
                 continue;
             }
-            if let Some(slot) = scored.iter().position(|s| s.1 == i) {
-                e *= punctual_visibility(p, light, slot as u32, scene, pixel, origin);
-            }
             let (s, d) = f.lobes(l);
-            out += (s + d) * e * n.dot(l).max(0.0);
-            lux += luminance(e) * n.dot(l).max(0.0);
+            out.push(LightShare {
+                key: i as u32 | PUNCTUAL_KEY,
+                radiance: (s + d) * e * n.dot(l).max(0.0),
+                lux: luminance(e) * n.dot(l).max(0.0),
+            });
         }
     }
-    let lux = if lux >= 0.0 { lux.min(65000.0) } else { 0.0 };
-    (clamp(out), lux)
+    out
 }
 
 /// Distance (m) from an area light's centroid beyond which it brings less than the frame's
@@ -281,100 +470,76 @@ fn orthonormal(n: Vec3) -> Vec3 {
     n.cross(a).normalize()
 }
 
-fn punctual_visibility(
+/// The shader's `shadow_ray`: ray `r` of the pixel towards the light of `key`, as (its weight
+/// if unblocked, its weight, whether it was traced).
+#[allow(clippy::too_many_arguments)]
+fn shadow_ray(
     p: &AreaLightParams,
-    light: &LightGpu,
-    slot: u32,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
     scene: &TwinScene,
+    key: u32,
+    r: u32,
     pixel: [u32; 2],
     origin: Vec3,
-) -> f32 {
-    let rays = p.counts[3];
-    if rays == 0 {
-        return 1.0;
-    }
-    let pos = v3(light.position_range);
-    let axis = (pos - origin).normalize();
-    let t = orthonormal(axis);
-    let b = axis.cross(t);
-    let mut passed = 0;
-    for s in 0..rays {
-        let u = sample_2d(pixel, 64 + slot * rays + s, p.rotation);
+    n: Vec3,
+) -> (f32, f32, bool) {
+    if key & PUNCTUAL_KEY != 0 {
+        let light = &punctual[(key & !PUNCTUAL_KEY) as usize];
+        let pos = v3(light.position_range);
+        let axis = (pos - origin).normalize();
+        let t = orthonormal(axis);
+        let b = axis.cross(t);
+        let u = sample_2d(pixel, 64 + r, p.rotation);
         let rho = p.values[1] * u.x.sqrt();
         let phi = 2.0 * std::f32::consts::PI * u.y;
         let q = pos + rho * (phi.cos() * t + phi.sin() * b);
         let dist = (q - origin).length();
-        if !scene.occluded(origin, (q - origin) / dist.max(1e-6), dist * (1.0 - 1e-3)) {
-            passed += 1;
-        }
+        let blocked = scene.occluded(origin, (q - origin) / dist.max(1e-6), dist * (1.0 - 1e-3));
+        return (if blocked { 0.0 } else { 1.0 }, 1.0, true);
     }
-    passed as f32 / rays as f32
-}
-
-/// The ratio estimator of the light's visibility (see the shader).
-#[allow(clippy::too_many_arguments)]
-pub fn area_visibility(
-    p: &AreaLightParams,
-    lights: &PolygonLights,
-    i: usize,
-    slot: u32,
-    scene: &TwinScene,
-    pixel: [u32; 2],
-    origin: Vec3,
-    n: Vec3,
-) -> f32 {
+    let i = key as usize;
     let light = &lights.lights[i];
     let tris = lights.triangles_of(i);
     let double_sided = light.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
-    let rays = p.counts[0];
-    let (mut num, mut den) = (0.0f32, 0.0f32);
-    for s in 0..rays {
-        let u = sample_2d(pixel, slot * rays + s, p.rotation);
-        let mut j = 0;
-        let mut lo = 0.0;
-        while u.x > tris[j].p0_cdf[3] && j + 1 < tris.len() {
-            lo = tris[j].p0_cdf[3];
-            j += 1;
-        }
-        let tri = &tris[j];
-        let hi = tri.p0_cdf[3];
-        let ux = ((u.x - lo) / (hi - lo).max(1e-12)).clamp(0.0, 1.0);
-        let su = ux.sqrt();
-        let (p0, p1, p2) = (v3(tri.p0_cdf), v3(tri.p1), v3(tri.p2));
-        let q = p0 * (1.0 - su) + p1 * (su * (1.0 - u.y)) + p2 * (su * u.y);
-        let dist = (q - origin).length();
-        if dist.is_nan() || dist <= 1e-6 {
-            continue;
-        }
-        let dir = (q - origin) / dist;
-        let ng = (p1 - p0).cross(p2 - p0).normalize();
-        let mut cos_l = -dir.dot(ng);
-        if double_sided {
-            cos_l = cos_l.abs();
-        }
-        let w = dir.dot(n).max(0.0) * cos_l.max(0.0) / (dist * dist);
-        if w > 0.0 {
-            if !scene.occluded(origin, dir, dist * (1.0 - 1e-3)) {
-                num += w;
-            }
-            den += w;
-        }
+    let u = sample_2d(pixel, r, p.rotation);
+    let mut j = 0;
+    let mut lo = 0.0;
+    while u.x > tris[j].p0_cdf[3] && j + 1 < tris.len() {
+        lo = tris[j].p0_cdf[3];
+        j += 1;
     }
-    if den > 0.0 { num / den } else { 1.0 }
+    let tri = &tris[j];
+    let hi = tri.p0_cdf[3];
+    let ux = ((u.x - lo) / (hi - lo).max(1e-12)).clamp(0.0, 1.0);
+    let su = ux.sqrt();
+    let (p0, p1, p2) = (v3(tri.p0_cdf), v3(tri.p1), v3(tri.p2));
+    let q = p0 * (1.0 - su) + p1 * (su * (1.0 - u.y)) + p2 * (su * u.y);
+    let dist = (q - origin).length();
+    if dist.is_nan() || dist <= 1e-6 {
+        return (0.0, 0.0, false);
+    }
+    let dir = (q - origin) / dist;
+    let ng = (p1 - p0).cross(p2 - p0).normalize();
+    let mut cos_l = -dir.dot(ng);
+    if double_sided {
+        cos_l = cos_l.abs();
+    }
+    let w = dir.dot(n).max(0.0) * cos_l.max(0.0) / (dist * dist);
+    if w.is_nan() || w <= 0.0 {
+        return (0.0, 0.0, false);
+    }
+    let blocked = scene.occluded(origin, dir, dist * (1.0 - 1e-3));
+    (if blocked { 0.0 } else { w }, w, true)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn shade_area_light(
-    p: &AreaLightParams,
+/// Area light `i`'s unshadowed (radiance, lux) at `world`, or `None` where it brings none.
+fn area_light_share(
     lights: &PolygonLights,
     i: usize,
-    slot: u32,
-    scene: &TwinScene,
-    pixel: [u32; 2],
     world: Vec3,
-    origin: Vec3,
     f: &Frame,
-) -> (Vec3, f32) {
+) -> Option<(Vec3, f32)> {
     let light = &lights.lights[i];
     let double_sided = light.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
     let n = f.n;
@@ -386,14 +551,9 @@ fn shade_area_light(
     );
     let e = fv.dot(n.as_dvec3()) as f32;
     if e.is_nan() || e <= 0.0 {
-        return (Vec3::ZERO, 0.0);
+        return None;
     }
-    let vis = if p.counts[0] > 0 {
-        area_visibility(p, lights, i, slot, scene, pixel, origin, n)
-    } else {
-        1.0
-    };
-    let radiance = v3(light.radiance_flux) * (e * vis);
+    let radiance = v3(light.radiance_flux) * e;
     let l_d = fv.normalize().as_vec3();
     let (_, diffuse) = f.lobes(l_d);
     // The representative point of the specular lobe (see the shader).
@@ -428,5 +588,5 @@ fn shade_area_light(
     let widened = (alpha + 0.5 * size).min(1.0);
     let norm = (alpha / widened).powi(2);
     let (specular, _) = f.lobes(l_s);
-    ((specular * norm + diffuse) * radiance, luminance(radiance))
+    Some(((specular * norm + diffuse) * radiance, luminance(radiance)))
 }

@@ -10,18 +10,16 @@ use crate::settings::{Field, Preset, Range, TechniqueSettings};
 pub struct AreaLightsSettings {
     /// The pass runs: polygonal lights, and point and spot lights when `punctual_shadows`.
     pub enabled: bool,
-    /// Shadow rays per pixel towards each shaded area light.
-    pub shadow_rays: u32,
+    /// Shadow rays per pixel per frame, in total over every area, point and spot light the
+    /// pixel shades (0: all unshadowed). They go to at most [`MAX_SHADOW_PICKS`] lights picked
+    /// at random in proportion to each light's unshadowed radiance there
+    /// (docs/area-lights.md, "The shadow-ray budget").
+    pub ray_budget: u32,
     /// Area lights shaded per pixel at most: the ones of largest flux / distance² there.
     pub lights_per_pixel: u32,
     /// Point and spot lights are shaded by this pass, with ray-traced shadows, instead of
     /// unshadowed by the deferred lighting.
     pub punctual_shadows: bool,
-    /// Point and spot lights that get shadow rays per pixel: the ones of largest illuminance
-    /// there; the others are added unshadowed.
-    pub shadowed_punctual_per_pixel: u32,
-    /// Shadow rays per pixel towards each shadowed point or spot light.
-    pub punctual_shadow_rays: u32,
     /// Radius of point and spot lights in metres (the scene model gives them none): the
     /// softness of their shadows.
     pub punctual_radius_m: f32,
@@ -34,11 +32,9 @@ impl Default for AreaLightsSettings {
     fn default() -> Self {
         Self {
             enabled: true,
-            shadow_rays: 4,
+            ray_budget: 4,
             lights_per_pixel: 4,
             punctual_shadows: true,
-            shadowed_punctual_per_pixel: 2,
-            punctual_shadow_rays: 2,
             punctual_radius_m: 0.05,
             min_flux_lm: 50.0,
         }
@@ -48,12 +44,22 @@ impl Default for AreaLightsSettings {
 /// Most lights per pixel the shader keeps (its selection arrays' length).
 pub const MAX_LIGHTS_PER_PIXEL: u32 = 8;
 
+/// Most lights a pixel picks for its shadow rays per frame (the shader's arrays): a
+/// budget above this splits its rays over the picks.
+pub const MAX_SHADOW_PICKS: u32 = 8;
+
+/// Largest `ray_budget`.
+pub const MAX_RAY_BUDGET: u32 = 32;
+
 impl TechniqueSettings for AreaLightsSettings {
     fn fields() -> &'static [Field] {
         const F: &[Field] = &[
             Field {
-                key: "shadow_rays",
-                range: Range::Int { lo: 0, hi: 32 },
+                key: "ray_budget",
+                range: Range::Int {
+                    lo: 0,
+                    hi: MAX_RAY_BUDGET as i64,
+                },
             },
             Field {
                 key: "lights_per_pixel",
@@ -61,17 +67,6 @@ impl TechniqueSettings for AreaLightsSettings {
                     lo: 1,
                     hi: MAX_LIGHTS_PER_PIXEL as i64,
                 },
-            },
-            Field {
-                key: "shadowed_punctual_per_pixel",
-                range: Range::Int {
-                    lo: 0,
-                    hi: MAX_LIGHTS_PER_PIXEL as i64,
-                },
-            },
-            Field {
-                key: "punctual_shadow_rays",
-                range: Range::Int { lo: 0, hi: 32 },
             },
             Field {
                 key: "punctual_radius_m",
@@ -89,25 +84,19 @@ impl TechniqueSettings for AreaLightsSettings {
         let d = Self::default();
         match p {
             Preset::Low => Self {
-                shadow_rays: 1,
+                ray_budget: 1,
                 lights_per_pixel: 2,
-                shadowed_punctual_per_pixel: 1,
-                punctual_shadow_rays: 1,
                 ..d
             },
             Preset::Medium => Self {
-                shadow_rays: 2,
+                ray_budget: 2,
                 lights_per_pixel: 3,
-                shadowed_punctual_per_pixel: 1,
-                punctual_shadow_rays: 1,
                 ..d
             },
             Preset::High => d,
             Preset::Ultra => Self {
-                shadow_rays: 8,
+                ray_budget: 8,
                 lights_per_pixel: 8,
-                shadowed_punctual_per_pixel: 4,
-                punctual_shadow_rays: 4,
                 ..d
             },
         }

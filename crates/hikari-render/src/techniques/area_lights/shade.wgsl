@@ -1,12 +1,14 @@
 // Polygonal area lights and shadowed point and spot lights (docs/area-lights.md).
 //
 // Area lights: the unshadowed light of each polygon in closed form (hikari::area_polygon,
-// Lambert's vector irradiance of each front-facing triangle clipped to the surface's horizon:
-// exact for the diffuse lobe), the specular lobe at a representative point with Karis's widening, both times
-// a shadow factor: the ratio estimator of stochastic shadows (Heitz et al. 2018), shadow rays to
-// points sampled by area on the light, each weighted by its unshadowed integrand. Point and spot
-// lights: as the deferred lighting shades them, the brightest few per pixel times the fraction
-// of shadow rays to a disc of the light's radius that reach it. Rays: hikari::bvh.
+// Lambert's vector irradiance of each front-facing triangle clipped to the surface's horizon: exact for the
+// diffuse lobe), the specular lobe at a representative point with Karis's widening. Point and
+// spot lights: as the deferred lighting shades them. Shadows within a budget of rays per pixel:
+// a few lights picked at random in proportion to their unshadowed radiance (systematic
+// sampling, offset per pixel and frame), each pick's light over its chance times its
+// visibility, the ratio estimator of stochastic shadows (Heitz et al. 2018) over the rays that
+// went to that light (points sampled by area, or on a disc of a point light's radius, weighted
+// by their unshadowed integrand). Rays: hikari::bvh.
 // Lights are culled per 16x16 tile against the bounds of the surfaces it sees (hikari::
 // tile_bounds): a point or spot light beyond its range, an area light beyond the distance where
 // its illuminance must fall below the frame's cut-off or wholly behind its one-sided plane.
@@ -24,8 +26,8 @@
 struct AreaLightParams {
     // x: area lights; y: AREA_* flags; z: frame index; w: point and spot lights.
     config: vec4<u32>,
-    // x: shadow rays per area light; y: area lights per pixel; z: shadowed point and spot
-    // lights per pixel; w: shadow rays per point or spot light.
+    // x: shadow rays per pixel (the budget); y: area lights per pixel; z: lights picked for
+    // those rays per pixel (at most MAX_PER_PIXEL); w: 0.
     counts: vec4<u32>,
     // x: min flux (lm); y: point and spot radius (m); z: point and spot cut-off (lux); w: 0.
     values: vec4<f32>,
@@ -52,6 +54,8 @@ const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
 const AREA_LIGHT_FORCED: u32 = 2u;
 const MAX_PER_PIXEL: u32 = 8u;
 const NONE: u32 = 0xffffffffu;
+// A pick's key: the light's index, with this bit for a point or spot light.
+const PUNCTUAL_KEY: u32 = 0x80000000u;
 const PI: f32 = 3.14159265358979;
 const MAX_RADIANCE: f32 = 65000.0;
 // Lights of each kind listed per tile at most; the rest are left out there (as the deferred
@@ -216,17 +220,6 @@ fn pick(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, k: u32) -> u32 {
     return id;
 }
 
-// The slot of light `i` in `sel` among its first `keep`, or NONE.
-fn slot_of(sel: ptr<function, array<u32, MAX_PER_PIXEL>>, keep: u32, i: u32) -> u32 {
-    var slot = NONE;
-    for (var k = 0u; k < MAX_PER_PIXEL; k++) {
-        if k < keep && (*sel)[k] == i && slot == NONE {
-            slot = k;
-        }
-    }
-    return slot;
-}
-
 fn orthonormal(n: vec3<f32>) -> vec3<f32> {
     let a = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
     return normalize(cross(n, a));
@@ -250,54 +243,133 @@ fn add_light(w: vec4<f32>, e: vec3<f32>) {
     sums.d += e * w.w;
 }
 
-// Fraction of the light of area light `i` that reaches `origin` unblocked (ratio estimator).
-fn area_visibility(i: u32, slot: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> f32 {
-    let light = area_lights[i];
+// PCG's output permutation (O'Neill 2014) as a hash.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// The pixel's offset in [0, 1) of its picks' positions this frame: a hash of the pixel, moved
+// each frame by the golden ratio (a Weyl sequence, in 32-bit fixed point), so that over frames
+// the positions stratify the pixel's lights for TAA to average; frame 0 repeats.
+fn pick_offset(pixel: vec2<u32>) -> f32 {
+    let h = pcg(pixel.x ^ pcg(pixel.y ^ 0x5bd1e995u)) + params.config.z * 2654435769u;
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// Places the picks that fall on a light of unshadowed radiance `c.rgb` (nits) and illuminance
+// `c.a` (lux), walked in the same order as the lights were summed into W: systematic sampling
+// by weight w = luminance(c), pick s at (s + offset) W / picks along the lights' running sum
+// `cum`, so light j is picked about picks w_j / W times (at least once when w_j >= W / picks).
+// Each pick keeps (c / w) and its light's key; `last` is the last light of weight, which takes
+// any pick that rounding leaves past the end. Constant-bound loop (see insert_best).
+fn place(keys: ptr<function, array<u32, MAX_PER_PIXEL>>, ratios: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, cum: ptr<function, f32>, last: ptr<function, vec4<f32>>, last_key: ptr<function, u32>, step: f32, offset: f32, key: u32, c: vec4<f32>) {
+    let w = luminance(c.rgb);
+    if !(w > 0.0) {
+        return;
+    }
+    *cum += w;
+    *last = c / w;
+    *last_key = key;
+    let picks = params.counts.z;
+    for (var s = 0u; s < MAX_PER_PIXEL; s++) {
+        if s < picks && (*keys)[s] == NONE && (f32(s) + offset) * step < *cum {
+            (*keys)[s] = key;
+            (*ratios)[s] = c / w;
+        }
+    }
+}
+
+// Entry `k` of `a`, through a constant-bound loop (see insert_best).
+fn get4(a: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, k: u32) -> vec4<f32> {
+    var v = vec4<f32>(0.0);
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            v = (*a)[j];
+        }
+    }
+    return v;
+}
+
+fn put4(a: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, k: u32, v: vec4<f32>) {
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            (*a)[j] = v;
+        }
+    }
+}
+
+// Shadow ray `r` of the pixel towards the light of `key`: (its weight if unblocked, its
+// weight), the ratio estimator's terms. Area lights: a point by area (a triangle by its share,
+// the square-root warp), weighted by the unshadowed integrand cos cos / d^2; point and spot
+// lights: a point on a disc of the light's radius facing the surface, weight 1.
+fn shadow_ray(key: u32, r: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> vec2<f32> {
+    if (key & PUNCTUAL_KEY) != 0u {
+        let light = lights[key & ~PUNCTUAL_KEY];
+        let axis = normalize(light.position_range.xyz - origin);
+        let t = orthonormal(axis);
+        let b = cross(axis, t);
+        let u = sample_2d(pixel, 64u + r);
+        let rho = params.values.y * sqrt(u.x);
+        let phi = 2.0 * PI * u.y;
+        let p = light.position_range.xyz + rho * (cos(phi) * t + sin(phi) * b);
+        let to_p = p - origin;
+        let dist = length(to_p);
+        let blocked = bvh_occluded(Ray(origin, 0.0, to_p / max(dist, 1e-6), dist * (1.0 - 1e-3)));
+        return vec2<f32>(select(1.0, 0.0, blocked), 1.0);
+    }
+    let light = area_lights[key];
     let first = light.range.x;
     let last = first + light.range.y - 1u;
     let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
-    let rays = params.counts.x;
-    var num = 0.0;
-    var den = 0.0;
-    for (var s = 0u; s < rays; s++) {
-        let u = sample_2d(pixel, slot * rays + s);
-        var j = first;
-        var lo = 0.0;
-        loop {
-            let cdf = area_triangles[j].p0_cdf.w;
-            if u.x <= cdf || j >= last {
-                break;
-            }
-            lo = cdf;
-            j++;
+    let u = sample_2d(pixel, r);
+    var j = first;
+    var lo = 0.0;
+    loop {
+        let cdf = area_triangles[j].p0_cdf.w;
+        if u.x <= cdf || j >= last {
+            break;
         }
-        let tri = area_triangles[j];
-        let hi = tri.p0_cdf.w;
-        let ux = clamp((u.x - lo) / max(hi - lo, 1e-12), 0.0, 1.0);
-        let su = sqrt(ux);
-        let p = tri.p0_cdf.xyz * (1.0 - su) + tri.p1.xyz * (su * (1.0 - u.y)) + tri.p2.xyz * (su * u.y);
-        let to_p = p - origin;
-        let dist = length(to_p);
-        if !(dist > 1e-6) {
-            continue;
-        }
-        let dir = to_p / dist;
-        let ng = normalize(cross(tri.p1.xyz - tri.p0_cdf.xyz, tri.p2.xyz - tri.p0_cdf.xyz));
-        var cos_l = -dot(dir, ng);
-        if double_sided {
-            cos_l = abs(cos_l);
-        }
-        let w = max(dot(dir, n), 0.0) * max(cos_l, 0.0) / (dist * dist);
-        if w > 0.0 {
-            let blocked = bvh_occluded(Ray(origin, 0.0, dir, dist * (1.0 - 1e-3)));
-            num += select(w, 0.0, blocked);
-            den += w;
-        }
+        lo = cdf;
+        j++;
     }
-    return select(1.0, num / den, den > 0.0);
+    let tri = area_triangles[j];
+    let hi = tri.p0_cdf.w;
+    let ux = clamp((u.x - lo) / max(hi - lo, 1e-12), 0.0, 1.0);
+    let su = sqrt(ux);
+    let p = tri.p0_cdf.xyz * (1.0 - su) + tri.p1.xyz * (su * (1.0 - u.y)) + tri.p2.xyz * (su * u.y);
+    let to_p = p - origin;
+    let dist = length(to_p);
+    if !(dist > 1e-6) {
+        return vec2<f32>(0.0);
+    }
+    let dir = to_p / dist;
+    let ng = normalize(cross(tri.p1.xyz - tri.p0_cdf.xyz, tri.p2.xyz - tri.p0_cdf.xyz));
+    var cos_l = -dot(dir, ng);
+    if double_sided {
+        cos_l = abs(cos_l);
+    }
+    let w = max(dot(dir, n), 0.0) * max(cos_l, 0.0) / (dist * dist);
+    if !(w > 0.0) {
+        return vec2<f32>(0.0);
+    }
+    let blocked = bvh_occluded(Ray(origin, 0.0, dir, dist * (1.0 - 1e-3)));
+    return vec2<f32>(select(w, 0.0, blocked), w);
 }
 
-fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origin: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView) {
+// Stores `v` at entry `k` of `a` through a constant-bound loop (see insert_best).
+fn put(a: ptr<function, array<f32, MAX_PER_PIXEL>>, k: u32, v: f32) {
+    for (var j = 0u; j < MAX_PER_PIXEL; j++) {
+        if j == k {
+            (*a)[j] = v;
+        }
+    }
+}
+
+// Adds area light `i`'s unshadowed light to the sums; returns it: radiance (nits, rgb) and
+// illuminance (lux, a), 0 where it brings none.
+fn shade_area_light(i: u32, world: vec3<f32>, n: vec3<f32>, v: vec3<f32>, brdf: BrdfView) -> vec4<f32> {
     let light = area_lights[i];
     let double_sided = (light.range.z & AREA_LIGHT_DOUBLE_SIDED) != 0u;
     var f = vec3<f32>(0.0);
@@ -308,14 +380,11 @@ fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origi
     // Irradiance per unit radiance (sr): the light's projected solid angle.
     let e = dot(f, n);
     if !(e > 0.0) {
-        return;
+        return vec4<f32>(0.0);
     }
-    var vis = 1.0;
-    if params.counts.x > 0u {
-        vis = area_visibility(i, slot, pixel, origin, n);
-    }
-    let radiance = light.radiance_flux.rgb * (e * vis);
-    lux += luminance(radiance);
+    let radiance = light.radiance_flux.rgb * e;
+    let e_lux = luminance(radiance);
+    lux += e_lux;
     // Diffuse lobes from the direction of the vector irradiance.
     let l_d = normalize(f);
     let w_d = brdf_light_weights(brdf, l_d) / max(dot(n, l_d), 1e-4);
@@ -351,32 +420,10 @@ fn shade_area_light(i: u32, slot: u32, pixel: vec2<u32>, world: vec3<f32>, origi
     let widened = min(alpha + 0.5 * size, 1.0);
     let norm = (alpha / widened) * (alpha / widened);
     let w_s = brdf_light_weights(brdf, l_s) * (norm / max(dot(n, l_s), 1e-4));
-    add_light(vec4<f32>(w_s.x, w_s.y, w_d.z, w_d.w), radiance);
-}
-
-// Fraction of shadow rays from `origin` to a disc of the light's radius facing it that pass.
-fn punctual_visibility(light: LightGpu, slot: u32, pixel: vec2<u32>, origin: vec3<f32>) -> f32 {
-    let rays = params.counts.w;
-    if rays == 0u {
-        return 1.0;
-    }
-    let to_light = light.position_range.xyz - origin;
-    let axis = normalize(to_light);
-    let t = orthonormal(axis);
-    let b = cross(axis, t);
-    var passed = 0u;
-    for (var s = 0u; s < rays; s++) {
-        let u = sample_2d(pixel, 64u + slot * rays + s);
-        let rho = params.values.y * sqrt(u.x);
-        let phi = 2.0 * PI * u.y;
-        let p = light.position_range.xyz + rho * (cos(phi) * t + sin(phi) * b);
-        let to_p = p - origin;
-        let dist = length(to_p);
-        if !bvh_occluded(Ray(origin, 0.0, to_p / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
-            passed++;
-        }
-    }
-    return f32(passed) / f32(rays);
+    let w = vec4<f32>(w_s.x, w_s.y, w_d.z, w_d.w);
+    add_light(w, radiance);
+    let unshadowed = brdf_apply_weights(brdf, radiance * w.x, radiance * w.y, radiance * w.z, radiance * w.w);
+    return vec4<f32>(unshadowed, e_lux);
 }
 
 fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
@@ -398,12 +445,24 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
     sums = Sums(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     lux = 0.0;
     let flags = params.config.y;
+    // The picks for the shadow rays (see place), the sum W of the lights' weights, and the
+    // area lights' unshadowed light by slot (the walk of the picks reads it again).
+    var keys: array<u32, MAX_PER_PIXEL>;
+    var ratios: array<vec4<f32>, MAX_PER_PIXEL>;
+    var area_light: array<vec4<f32>, MAX_PER_PIXEL>;
+    var total = 0.0;
+    for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+        keys[k] = NONE;
+        ratios[k] = vec4<f32>(0.0);
+        area_light[k] = vec4<f32>(0.0);
+    }
+    var sel: array<u32, MAX_PER_PIXEL>;
+    var keep = 0u;
 
     if (flags & AREA_POLYGONS) != 0u {
         // The lights of largest flux / distance^2 here, at most counts.y, largest first.
-        var sel: array<u32, MAX_PER_PIXEL>;
         var score: array<f32, MAX_PER_PIXEL>;
-        let keep = min(params.counts.y, MAX_PER_PIXEL);
+        keep = min(params.counts.y, MAX_PER_PIXEL);
         for (var k = 0u; k < MAX_PER_PIXEL; k++) {
             sel[k] = NONE;
             score[k] = 0.0;
@@ -425,49 +484,121 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
             if id == NONE {
                 break;
             }
-            shade_area_light(id, k, pixel, world, origin, n, v, brdf);
+            let c = shade_area_light(id, world, n, v, brdf);
+            total += luminance(c.rgb);
+            put4(&area_light, k, c);
         }
     }
 
     if (flags & AREA_PUNCTUAL) != 0u {
-        var sel: array<u32, MAX_PER_PIXEL>;
-        var score: array<f32, MAX_PER_PIXEL>;
-        let keep = min(params.counts.z, MAX_PER_PIXEL);
-        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
-            sel[k] = NONE;
-            score[k] = 0.0;
-        }
         let listed = min(tile_counts.x, TILE_LIGHTS);
-        if keep > 0u {
-            for (var t = 0u; t < listed; t++) {
-                let i = tile_punctual[t];
-                let light = lights[i];
-                let to_light = light.position_range.xyz - world;
-                let d2 = dot(to_light, to_light);
-                let l = to_light * inverseSqrt(max(d2, 1e-8));
-                let s = luminance(light.intensity.rgb) * punctual_attenuation(light, l, d2) * max(dot(n, l), 0.0);
-                insert_best(&sel, &score, keep, i, s);
-            }
-        }
         for (var t = 0u; t < listed; t++) {
             let i = tile_punctual[t];
             let light = lights[i];
             let to_light = light.position_range.xyz - world;
             let d2 = dot(to_light, to_light);
             let l = to_light * inverseSqrt(max(d2, 1e-8));
-            var e = light.intensity.rgb * punctual_attenuation(light, l, d2);
+            let e = light.intensity.rgb * punctual_attenuation(light, l, d2);
             if !(luminance(e) > 0.0) {
                 continue;
             }
-            let slot = slot_of(&sel, keep, i);
-            if slot != NONE {
-                e *= punctual_visibility(light, slot, pixel, origin);
-            }
-            lux += luminance(e) * max(dot(n, l), 0.0);
-            add_light(brdf_light_weights(brdf, l), e);
+            let e_lux = luminance(e) * max(dot(n, l), 0.0);
+            lux += e_lux;
+            let w = brdf_light_weights(brdf, l);
+            add_light(w, e);
+            total += luminance(brdf_apply_weights(brdf, e * w.x, e * w.y, e * w.z, e * w.w));
         }
     }
-    return brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
+
+    // Without rays (or where no light brings radiance), the unshadowed sum.
+    var radiance = brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
+    // The shadows: `picks` lights picked by systematic sampling of their weights (see place),
+    // each pick's rays (the budget split over the picks), its visibility the ratio estimator
+    // over all the rays that went to the same light, and the pixel's light
+    // W / picks x sum over picks of visibility x (light / weight): unbiased in the selection,
+    // never negative, and of exact luminance where the picked lights are wholly visible (the
+    // weights are the lights' luminances; only the colour varies with the picks).
+    let picks = params.counts.z;
+    if picks > 0u && total > 0.0 {
+        // The walk of the picks: the same lights in the same order, the area lights' light as
+        // stored, the point and spot lights' computed again as above.
+        let step = total / f32(picks);
+        let offset = pick_offset(pixel);
+        var cum = 0.0;
+        var last = vec4<f32>(0.0);
+        var last_key = NONE;
+        for (var k = 0u; k < keep; k++) {
+            let id = pick(&sel, k);
+            if id == NONE {
+                break;
+            }
+            place(&keys, &ratios, &cum, &last, &last_key, step, offset, id, get4(&area_light, k));
+        }
+        if (flags & AREA_PUNCTUAL) != 0u {
+            let listed = min(tile_counts.x, TILE_LIGHTS);
+            for (var t = 0u; t < listed; t++) {
+                let i = tile_punctual[t];
+                let light = lights[i];
+                let to_light = light.position_range.xyz - world;
+                let d2 = dot(to_light, to_light);
+                let l = to_light * inverseSqrt(max(d2, 1e-8));
+                let e = light.intensity.rgb * punctual_attenuation(light, l, d2);
+                if !(luminance(e) > 0.0) {
+                    continue;
+                }
+                let w = brdf_light_weights(brdf, l);
+                let c = brdf_apply_weights(brdf, e * w.x, e * w.y, e * w.z, e * w.w);
+                place(&keys, &ratios, &cum, &last, &last_key, step, offset, i | PUNCTUAL_KEY, vec4<f32>(c, luminance(e) * max(dot(n, l), 0.0)));
+            }
+        }
+        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+            if k < picks && keys[k] == NONE {
+                keys[k] = last_key;
+                ratios[k] = last;
+            }
+        }
+        var num: array<f32, MAX_PER_PIXEL>;
+        var den: array<f32, MAX_PER_PIXEL>;
+        for (var k = 0u; k < MAX_PER_PIXEL; k++) {
+            num[k] = 0.0;
+            den[k] = 0.0;
+        }
+        let each = params.counts.x / picks;
+        let extra = params.counts.x % picks;
+        for (var s = 0u; s < picks; s++) {
+            let key = pick(&keys, s);
+            if key == NONE {
+                continue;
+            }
+            let first = s * each + min(s, extra);
+            let rays = each + select(0u, 1u, s < extra);
+            var nd = vec2<f32>(0.0);
+            for (var r = first; r < first + rays; r++) {
+                nd += shadow_ray(key, r, pixel, origin, n);
+            }
+            put(&num, s, nd.x);
+            put(&den, s, nd.y);
+        }
+        var shadowed = vec4<f32>(0.0);
+        for (var s = 0u; s < MAX_PER_PIXEL; s++) {
+            if s < picks && keys[s] != NONE {
+                var nn = 0.0;
+                var dd = 0.0;
+                for (var q = 0u; q < MAX_PER_PIXEL; q++) {
+                    if q < picks && keys[q] == keys[s] {
+                        nn += num[q];
+                        dd += den[q];
+                    }
+                }
+                let vis = select(1.0, nn / dd, dd > 0.0);
+                shadowed += vis * ratios[s];
+            }
+        }
+        shadowed *= total / f32(picks);
+        radiance = shadowed.rgb;
+        lux = shadowed.a;
+    }
+    return radiance;
 }
 
 @compute @workgroup_size(16, 16, 1)
