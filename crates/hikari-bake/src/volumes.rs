@@ -112,7 +112,9 @@ pub fn building_volume(
 }
 
 /// The village's volumes: each house (3 m around it, 1.5 m probes), the temple hall (4 m
-/// around, 2 m probes) and the courtyard (its circle's square, 1 m to 9 m up, 4 m probes).
+/// around, 2 m probes) and the courtyard with the ring of golden trees around it (its circle's
+/// square widened by 8 m, so that the ground under the trees, 27.5 m from the centre, has probes
+/// of its own to carry their yellow bounce; 1 m to 13 m up, through the crowns; 4 m probes).
 pub fn village_volumes(layout: &VillageLayout) -> Vec<ProbeVolume> {
     let mut out: Vec<ProbeVolume> = layout
         .houses
@@ -123,8 +125,8 @@ pub fn village_volumes(layout: &VillageLayout) -> Vec<ProbeVolume> {
     let r = layout.courtyard_radius;
     out.push(ProbeVolume {
         name: "courtyard".into(),
-        transform: Mat4::from_translation(layout.courtyard_centre + Vec3::new(0.0, 5.0, 0.0))
-            * Mat4::from_scale(Vec3::new(r, 4.0, r)),
+        transform: Mat4::from_translation(layout.courtyard_centre + Vec3::new(0.0, 7.0, 0.0))
+            * Mat4::from_scale(Vec3::new(r + 8.0, 6.0, r + 8.0)),
         spacing: 4.0,
     });
     out
