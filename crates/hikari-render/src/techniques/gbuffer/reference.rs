@@ -196,10 +196,17 @@ pub fn resolve(
     let occ_tex = sample(material.occlusion_texture, false).x;
     let emissive =
         material.emissive_nits.as_dvec3() * sample(material.emissive_texture, true).truncate();
-    let interior = match material.interior {
-        Some(i) => i as f64,
-        None => lerp3(&|a| DVec3::splat((a.extra & 0xffff) as f64 / 65535.0)).x,
-    };
+    // From the scene model's own rule (`Mesh::interior_at`), not from the packed vertices.
+    let mesh = &scene.meshes[inst.mesh];
+    let first_vertex: usize = scene.meshes[..inst.mesh]
+        .iter()
+        .map(|m| m.positions.len())
+        .sum();
+    let interior = idx
+        .iter()
+        .zip([w.x, w.y, w.z])
+        .map(|(&i, wk)| mesh.interior_at(i as usize - first_vertex, material) as f64 * wk)
+        .sum::<f64>();
     let q = object[0] * w.x + object[1] * w.y + object[2] * w.z;
     let prev_vp = DMat4::from_cols_array_2d(&view.prev_view_proj.map(|c| c.map(|x| x as f64)));
     let c = prev_vp * model.transform_point3(q).extend(1.0);
