@@ -51,7 +51,7 @@ fn triangle(
         attributes["_HIKARI_INTERIOR"] = json!(accessors.len() - 1);
         bin.extend(bytes);
     }
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     std::fs::write(dir.join(format!("{name}.bin")), &bin).unwrap();
