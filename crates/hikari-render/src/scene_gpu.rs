@@ -111,9 +111,9 @@ pub struct MaterialGpu {
     pub emissive: [f32; 4],
     /// Perceptual roughness, metalness, anisotropy strength, anisotropy rotation (radians).
     pub params: [f32; 4],
-    /// Occlusion strength, interior mask (negative: none; a mesh's own mask wins over it), alpha cut-off (0:
-    /// opaque; else a fragment is drawn where base colour alpha, factor times texture A times
-    /// vertex colour A, is at least it), 0.
+    /// Occlusion strength, interior mask (negative: none; a mesh's own mask wins over it),
+    /// alpha cut-off (0: opaque; else a fragment is drawn where base colour alpha, factor times
+    /// texture A times vertex colour A, is at least it), 0.
     pub extra: [f32; 4],
     /// Texture layers: base colour and emissive in the sRGB array, metallic-roughness and
     /// normal in the linear array; [`NO_TEXTURE`] where absent.
