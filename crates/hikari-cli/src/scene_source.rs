@@ -82,6 +82,8 @@ pub enum CameraOrigin {
     SceneFirst,
     /// The scene has no camera: one framing its bounds.
     Framing,
+    /// The scene has neither a camera nor geometry: one looking at the horizon.
+    Horizon,
 }
 
 impl CameraOrigin {
@@ -91,6 +93,7 @@ impl CameraOrigin {
             Self::ConfigFile => "config file",
             Self::SceneFirst => "the scene's first",
             Self::Framing => "framing the scene's bounds",
+            Self::Horizon => "looking at the horizon: nothing to frame",
         }
     }
 }
@@ -111,16 +114,18 @@ pub fn choose_camera(
     Ok((first.clone(), CameraOrigin::SceneFirst))
 }
 
-/// The scene's first camera, or one framing its bounds when it has none.
+/// The scene's first camera, or one framing its bounds when it has none, or one looking at
+/// the horizon ([`Camera::horizon`], with a warning) when it has no geometry either.
 pub fn first_or_framing_camera(
     scene: &Scene,
     name: &str,
 ) -> anyhow::Result<(Camera, CameraOrigin)> {
-    match scene.cameras.first() {
-        Some(c) => Ok((c.clone(), CameraOrigin::SceneFirst)),
-        None => {
-            let (lo, hi) = scene.bounds().context("the scene has no geometry")?;
-            Ok((Camera::framing(name, lo, hi), CameraOrigin::Framing))
+    match (scene.cameras.first(), scene.bounds()) {
+        (Some(c), _) => Ok((c.clone(), CameraOrigin::SceneFirst)),
+        (None, Some((lo, hi))) => Ok((Camera::framing(name, lo, hi), CameraOrigin::Framing)),
+        (None, None) => {
+            log::warn!("the scene has neither a camera nor geometry: looking at the horizon");
+            Ok((Camera::horizon(name), CameraOrigin::Horizon))
         }
     }
 }

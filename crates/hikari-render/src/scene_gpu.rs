@@ -38,13 +38,15 @@ pub struct VertexAttr {
     /// Linear RGBA vertex colour in [0, 1], unorm16x4.
     pub color: [u32; 2],
     /// Interior mask as unorm16 in the low bits; bit 16: bitangent = -cross(n, t); bit 17: the
-    /// mesh has tangents.
+    /// mesh has tangents; bit 18: the mesh has its own interior mask, which wins over the
+    /// material's (`Mesh::interior_at`: vertex, then material, then the default).
     pub extra: u32,
     pub pad: u32,
 }
 
 pub const EXTRA_BITANGENT_NEGATIVE: u32 = 1 << 16;
 pub const EXTRA_HAS_TANGENT: u32 = 1 << 17;
+pub const EXTRA_HAS_INTERIOR: u32 = 1 << 18;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -109,9 +111,9 @@ pub struct MaterialGpu {
     pub emissive: [f32; 4],
     /// Perceptual roughness, metalness, anisotropy strength, anisotropy rotation (radians).
     pub params: [f32; 4],
-    /// Occlusion strength, interior mask (negative: none, use the vertex's), alpha cut-off (0:
-    /// opaque; else a fragment is drawn where base colour alpha, factor times texture A times
-    /// vertex colour A, is at least it), 0.
+    /// Occlusion strength, interior mask (negative: none; a mesh's own mask wins over it),
+    /// alpha cut-off (0: opaque; else a fragment is drawn where base colour alpha, factor times
+    /// texture A times vertex colour A, is at least it), 0.
     pub extra: [f32; 4],
     /// Texture layers: base colour and emissive in the sRGB array, metallic-roughness and
     /// normal in the linear array; [`NO_TEXTURE`] where absent.
@@ -253,12 +255,15 @@ impl SceneCpu {
                     .as_ref()
                     .and_then(|c| c.get(v).copied())
                     .unwrap_or(Vec4::ONE);
-                let interior = m
-                    .interior
-                    .get(v)
-                    .copied()
-                    .unwrap_or(hikari_scene::DEFAULT_INTERIOR);
-                let mut extra = (interior.clamp(0.0, 1.0) * 65535.0).round() as u32;
+                let interior = m.interior.get(v).copied();
+                let mut extra = (interior
+                    .unwrap_or(hikari_scene::DEFAULT_INTERIOR)
+                    .clamp(0.0, 1.0)
+                    * 65535.0)
+                    .round() as u32;
+                if interior.is_some() {
+                    extra |= EXTRA_HAS_INTERIOR;
+                }
                 if negative {
                     extra |= EXTRA_BITANGENT_NEGATIVE;
                 }

@@ -89,8 +89,12 @@ fn textured_scene() -> Scene {
         occlusion_texture: Some(TextureRef::new(0)),
         occlusion_strength: 0.5,
         emissive_nits: Vec3::new(10.0, 20.0, 30.0),
+        // Under the quad's own per-vertex mask, which wins (`Mesh::interior_at`).
+        interior: Some(0.9),
         ..Material::default()
     });
+    // The boxes' meshes have no mask of their own: their material's value is theirs.
+    scene.materials[0].interior = Some(0.8);
     scene.instances.push(hikari_scene::Instance {
         mesh: scene.meshes.len() - 1,
         material: scene.materials.len() - 1,

@@ -11,6 +11,8 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
+mod interior_mask;
+
 use crate::{
     AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef,
     Wrap,
@@ -588,14 +590,20 @@ impl<'o> Loader<'o> {
         scene.materials = self.load_materials(scene.textures.len())?;
         let meshes = self.load_meshes(&mut scene)?;
         self.load_nodes(&mut scene, &meshes)?;
+        let bounds = scene.bounds();
+        if bounds.is_none() {
+            self.warn("the file has no triangles to draw: only the sky is rendered".into());
+        }
         if scene.cameras.is_empty() {
-            if let Some((lo, hi)) = scene.bounds() {
-                scene.cameras.push(Camera::framing("auto", lo, hi));
-            } else {
-                scene.cameras.push(Camera {
-                    name: "auto".into(),
-                    ..Default::default()
-                });
+            match bounds {
+                Some((lo, hi)) => scene.cameras.push(Camera::framing("auto", lo, hi)),
+                None => {
+                    self.warn(format!(
+                        "no camera and nothing to frame: camera `auto` stands {} m up, looking at the horizon (-z)",
+                        Camera::HORIZON_EYE_HEIGHT_M
+                    ));
+                    scene.cameras.push(Camera::horizon("auto"));
+                }
             }
         }
         if scene.sun.is_none() && scene.lights.is_empty() {
@@ -745,6 +753,8 @@ impl<'o> Loader<'o> {
                     .map_err(|e| format!("material `{name}`: {e}"))?,
                 gi_albedo: gi_albedo_override(m.extras())
                     .map_err(|e| format!("material `{name}`: {e}"))?,
+                interior: interior_mask::material_interior(m.extras())
+                    .map_err(|e| format!("material `{name}`: {e}"))?,
                 name,
                 ..Default::default()
             };
@@ -868,6 +878,14 @@ impl<'o> Loader<'o> {
                 .collect();
             per_vertex("COLOR_0", c.len())?;
             mesh.colors = Some(c);
+        }
+        if let Some(a) = prim.get(&gltf::Semantic::Extras(interior_mask::ATTRIBUTE.into())) {
+            let (_, v) = self
+                .read_floats(&a, "_HIKARI_INTERIOR", &[Dimensions::Scalar], true)
+                .map_err(err)?;
+            per_vertex("_HIKARI_INTERIOR", v.len())?;
+            interior_mask::check_vertices(&v).map_err(err)?;
+            mesh.interior = v;
         }
         mesh.indices = match prim.indices() {
             Some(a) => {
@@ -1176,6 +1194,9 @@ fn flat_normals(mesh: &mut Mesh) {
             }
             if let Some(c) = old.colors.as_ref().and_then(|c| c.get(i)) {
                 mesh.colors.get_or_insert_with(Vec::new).push(*c);
+            }
+            if let Some(w) = old.interior.get(i) {
+                mesh.interior.push(*w);
             }
         }
     }

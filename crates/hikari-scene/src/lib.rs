@@ -78,7 +78,14 @@
 //! value of that key is an error).
 //!
 //! A file without cameras gets one named `auto` framing the bounds of the whole scene
-//! ([`Camera::framing`]); a file without any light gets [`Sun::default`] (100 000 lux).
+//! ([`Camera::framing`]), or, with nothing to frame, looking level at the horizon
+//! ([`Camera::horizon`]; the file still loads, with a warning, and renders as sky only); a
+//! file without any light gets [`Sun::default`] (100 000 lux).
+//!
+//! The interior mask (docs/irradiance-probes.md): a material's `extras`
+//! `{"hikari": {"interior": w}}` ([`Material::interior`]) and the vertex attribute
+//! `_HIKARI_INTERIOR` ([`Mesh::interior`], SCALAR float or normalized u8/u16), each in [0, 1]
+//! (0 outdoors, 1 indoors); anything else under that key or out of range is an error.
 //!
 //! Malformed files give a [`gltf::GltfError`] naming the file and what is wrong, never a
 //! panic: unreadable or truncated files, bad JSON, glTF validation failures (indices of

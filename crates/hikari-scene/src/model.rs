@@ -691,6 +691,21 @@ impl Camera {
     /// A camera named `name` that sees the whole box `lo..hi` at any aspect ratio of at least
     /// 1 (wider than tall): it looks at the box centre from the +Z, +Y, +X side, backed off
     /// until the bounding sphere fits inside the vertical field of view.
+    /// Eye height of [`Camera::horizon`], in metres: a standing person's.
+    pub const HORIZON_EYE_HEIGHT_M: f32 = 1.7;
+
+    /// A camera for a scene with nothing to frame: at the origin, [`Self::HORIZON_EYE_HEIGHT_M`]
+    /// up, looking level along -z so that the horizon crosses the middle of the image.
+    pub fn horizon(name: &str) -> Camera {
+        let eye = Vec3::new(0.0, Self::HORIZON_EYE_HEIGHT_M, 0.0);
+        Camera {
+            name: name.into(),
+            position: eye,
+            target: eye - Vec3::Z,
+            ..Default::default()
+        }
+    }
+
     pub fn framing(name: &str, lo: Vec3, hi: Vec3) -> Camera {
         let vfov_deg = 45.0f32;
         let center = 0.5 * (lo + hi);

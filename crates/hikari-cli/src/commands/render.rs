@@ -27,9 +27,11 @@ pub struct RenderArgs {
     /// Do not write the EXR.
     #[arg(long)]
     pub no_exr: bool,
-    /// Frames of the same view to render; the last is written. Default: one jitter cycle of
-    /// TAA (`taa.jitter_samples`, 8), after which the history is the exact mean of every
-    /// sub-pixel position; 1 with TAA off.
+    /// Frames of the same view to render; the last is written. Default: enough for the
+    /// temporal passes to converge, whole TAA jitter cycles: with ray-traced GI 16 (the GI
+    /// denoiser's combiner reaches its steady speed, `gi_denoiser.max_accumulation_speed`
+    /// 0.93, at 15 frames of history), else one cycle (`taa.jitter_samples`, 8, after which
+    /// TAA's history is the mean of every sub-pixel position); 1 with both off.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub frames: Option<u32>,
     /// Print a per-pass GPU timing table.
@@ -91,11 +93,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         TimestampMode::Frame
     });
-    let frames = args.frames.unwrap_or(if settings.settings.taa.enabled {
-        settings.settings.taa.jitter_samples
-    } else {
-        1
-    });
+    let frames = args
+        .frames
+        .unwrap_or_else(|| default_frames(&settings.settings));
     for _ in 1..frames {
         renderer.render(&settings, false)?;
     }
@@ -143,4 +143,81 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         report::print_single_frame(&frame.result);
     }
     Ok(())
+}
+
+/// Frames `render` draws of a still view when `--frames` is not given: the larger of what TAA
+/// and the ray-traced GI need, in whole jitter cycles of TAA.
+///
+/// * TAA: one jitter cycle (`taa.jitter_samples`), after which its history is the mean of every
+///   sub-pixel position.
+/// * GI: the denoiser's combiner keeps `0.5 x speed` of the accumulated signal, where speed =
+///   min(1 - 1 / history, `gi_denoiser.max_accumulation_speed`); the frames until speed reaches
+///   that cap (history >= 1 / (1 - cap): 15 for the talk's 0.93), at most the accumulation's
+///   `max_history`. Before then the image is mostly the spatially denoised single frames.
+pub fn default_frames(s: &hikari_render::Settings) -> u32 {
+    let cycle = if s.taa.enabled {
+        s.taa.jitter_samples.max(1)
+    } else {
+        1
+    };
+    let gi = &s.ray_traced_gi;
+    let gi_frames = if gi.enabled && gi.accumulate {
+        let cap = s.gi_denoiser.max_accumulation_speed as f64;
+        // Less a hair, so that a cap such as 0.8 (0.800000012 in f32) settles at 5, not 6.
+        let history = if cap < 1.0 {
+            (1.0 / (1.0 - cap) - 1e-4).ceil() as u32
+        } else {
+            u32::MAX
+        };
+        history.min(gi.max_history.max(1))
+    } else {
+        1
+    };
+    gi_frames.max(cycle).div_ceil(cycle) * cycle
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The history length at which the combiner's speed, min(1 - 1/h, cap), first equals
+    /// the cap: stepped frame by frame as the accumulation counts.
+    fn combiner_settles(cap: f32, max_history: u32) -> u32 {
+        (1..=max_history)
+            .find(|&h| (1.0 - 1.0 / h as f32).min(cap) >= cap)
+            .unwrap_or(max_history)
+    }
+
+    #[test]
+    fn default_frames_cover_taa_cycles_and_the_gi_combiners_settling() {
+        let mut s = hikari_render::Settings::default();
+        let settle = combiner_settles(
+            s.gi_denoiser.max_accumulation_speed,
+            s.ray_traced_gi.max_history,
+        );
+        assert_eq!(
+            settle, 15,
+            "the talk's 0.93 settles at 15 frames of history"
+        );
+        // 15 frames, rounded up to whole 8-frame jitter cycles.
+        assert_eq!(default_frames(&s), 16);
+        s.taa.enabled = false;
+        assert_eq!(default_frames(&s), settle);
+        s.ray_traced_gi.enabled = false;
+        assert_eq!(default_frames(&s), 1);
+        s.taa.enabled = true;
+        assert_eq!(default_frames(&s), s.taa.jitter_samples);
+        s.ray_traced_gi.enabled = true;
+        s.ray_traced_gi.accumulate = false;
+        assert_eq!(default_frames(&s), s.taa.jitter_samples);
+        s.ray_traced_gi.accumulate = true;
+        for cap in [0.0, 0.5, 0.8, 0.9, 0.95, 0.99, 1.0] {
+            s.gi_denoiser.max_accumulation_speed = cap;
+            s.taa.enabled = false;
+            let want = combiner_settles(cap, s.ray_traced_gi.max_history);
+            assert_eq!(default_frames(&s), want, "cap {cap}");
+            s.taa.enabled = true;
+            assert_eq!(default_frames(&s), want.max(8).div_ceil(8) * 8, "cap {cap}");
+        }
+    }
 }

@@ -73,6 +73,7 @@ const INSTANCE_MOVED: u32 = 4u;
 const INSTANCE_ALPHA_TESTED: u32 = 8u;
 const EXTRA_BITANGENT_NEGATIVE: u32 = 0x10000u;
 const EXTRA_HAS_TANGENT: u32 = 0x20000u;
+const EXTRA_HAS_INTERIOR: u32 = 0x40000u;
 
 // Texture addressing the sampler cannot do per texture (`MaterialGpu::more_textures` y):
 // 0 repeat, 1 mirrored, 2 clamp. The sampler repeats, so a mirrored or clamped coordinate

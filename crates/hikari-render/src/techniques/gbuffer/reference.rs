@@ -210,10 +210,17 @@ pub fn resolve_deformed(
     let occ_tex = sample(material.occlusion_texture, false).x;
     let emissive =
         material.emissive_nits.as_dvec3() * sample(material.emissive_texture, true).truncate();
-    let interior = match material.interior {
-        Some(i) => i as f64,
-        None => lerp3(&|a| DVec3::splat((a.extra & 0xffff) as f64 / 65535.0)).x,
-    };
+    // From the scene model's own rule (`Mesh::interior_at`), not from the packed vertices.
+    let mesh = &scene.meshes[inst.mesh];
+    let first_vertex: usize = scene.meshes[..inst.mesh]
+        .iter()
+        .map(|m| m.positions.len())
+        .sum();
+    let interior = idx
+        .iter()
+        .zip([w.x, w.y, w.z])
+        .map(|(&i, wk)| mesh.interior_at(i as usize - first_vertex, material) as f64 * wk)
+        .sum::<f64>();
     let prev_object = idx
         .iter()
         .map(|&i| {

@@ -5,7 +5,7 @@
 
 #import hikari::view::View
 #import hikari::octahedral::oct_encode
-#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, INSTANCE_OWN_NORMAL_MATRIX, INSTANCE_MOVED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT, wrap_uv}
+#import hikari::scene_gpu::{VertexAttr, InstanceGpu, MaterialGpu, Chunk, CHUNK_TRIANGLES, NO_TEXTURE, INSTANCE_DOUBLE_SIDED, INSTANCE_OWN_NORMAL_MATRIX, INSTANCE_MOVED, EXTRA_BITANGENT_NEGATIVE, EXTRA_HAS_TANGENT, EXTRA_HAS_INTERIOR, wrap_uv}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<storage, read> visibility: array<vec2<u32>>;
@@ -231,7 +231,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let emissive = mat.emissive.rgb * sample_color(mat.textures.w, (wraps >> 12u) & 15u, g).rgb;
 
     let vertex_interior = f32(a0.extra & 0xffffu) * w.x + f32(a1.extra & 0xffffu) * w.y + f32(a2.extra & 0xffffu) * w.z;
-    let interior = select(vertex_interior / 65535.0, mat.extra.y, mat.extra.y >= 0.0);
+    // `Mesh::interior_at`'s order: the mesh's own mask, else the material's, else the default
+    // (which a mesh without a mask carries in its vertices).
+    let material_wins = mat.extra.y >= 0.0 && (a0.extra & EXTRA_HAS_INTERIOR) == 0u;
+    let interior = select(vertex_interior / 65535.0, mat.extra.y, material_wins);
 
     // Motion: where this surface point was last frame, minus where it is now, in pixels. Now is
     // the pixel centre less this frame's jitter: `prev_view_proj` is unjittered.
