@@ -35,7 +35,7 @@ pub const HEADER_RECORDS: usize = 2;
 
 /// The cut-off (lux) the grid is built for: the frame's rounded down to a power of two.
 pub fn grid_cutoff(cutoff_lux: f32) -> f32 {
-    if !(cutoff_lux > 0.0) || !cutoff_lux.is_finite() {
+    if cutoff_lux.is_nan() || cutoff_lux <= 0.0 || cutoff_lux.is_infinite() {
         return cutoff_lux;
     }
     2f32.powi(cutoff_lux.log2().floor() as i32)

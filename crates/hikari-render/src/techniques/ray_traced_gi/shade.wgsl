@@ -11,8 +11,10 @@
 // averaged) unless it is an area light, whose direct light the area-light pass gives every
 // surface already (its light on the hit is counted here). Output: the raw sample, encoded as
 // luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// Local lights are visited through the light grid (ray_traced_gi::light_grid): only those
+// listed in the hit's cell, which are all that can reach it, in ascending order.
 // CPU twins: ray_traced_gi::reference (punctual_irradiance, area_light_irradiance,
-// pick_light, area_light_point, random).
+// pick_light, area_light_point, random), light_grid::LightGrid::lights_at.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
