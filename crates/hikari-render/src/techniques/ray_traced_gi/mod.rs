@@ -18,10 +18,11 @@
 //! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
 
 pub mod instance_albedo;
+pub mod light_grid;
 pub mod reference;
 pub mod settings;
 
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -217,13 +218,35 @@ impl RtGiParams {
 }
 
 /// What the technique keeps of a scene besides the frame's BVH (`scene_rt::SceneRt`, which it
-/// traces through [`RtGiInputs::bvh`]): the per-instance albedo table, on the GPU.
+/// traces through [`RtGiInputs::bvh`]): the per-instance albedo table, on the GPU, and the
+/// grid of light lists that lights hits ([`light_grid`]), rebuilt when what it was built from
+/// changes.
 pub struct RtGiScene {
+    /// The scene's point and spot lights, for their reach ([`light_grid::punctual_records`]).
+    punctual: Vec<crate::scene_gpu::LightGpu>,
+    light_grid: Mutex<Option<LightGridGpu>>,
     /// [`reference::instance_table`].
     instance_table: wgpu::Buffer,
     /// [`reference::normal_tables`]: per instance, then per mesh triangle.
     instance_normals: wgpu::Buffer,
     triangle_normals: wgpu::Buffer,
+}
+
+/// The uploaded light grid and what it was built from.
+struct LightGridGpu {
+    key: light_grid::LightGridKey,
+    cells: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    stats: LightGridStats,
+}
+
+/// What the last light grid built holds, for logs and the documentation's numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightGridStats {
+    pub cells: [u32; 3],
+    /// Light indices over all cells.
+    pub entries: usize,
+    pub bytes: usize,
 }
 
 impl std::fmt::Debug for RtGiScene {
@@ -256,6 +279,8 @@ impl RtGiScene {
         let table = non_empty(&reference::instance_table(scene));
         let (instance_normals, triangle_normals) = reference::normal_tables(scene);
         Ok(Self {
+            punctual: light_grid::punctual_records(scene),
+            light_grid: Mutex::new(None),
             instance_table: storage_buffer(
                 ctx,
                 "ray_traced_gi.instance_table",
@@ -285,6 +310,67 @@ impl RtGiScene {
     /// The per-instance table in a frame.
     pub fn import(&self, g: &mut FrameGraph<'_>) -> Buf {
         g.import_buffer("ray_traced_gi.instance_table", &self.instance_table)
+    }
+
+    /// The light grid for `area`'s lights and the scene's point and spot lights at `params`'
+    /// cut-off and minimum flux, in a frame (cells, indices): built and uploaded when the key
+    /// changed, else the last one.
+    fn import_light_grid(
+        &self,
+        g: &mut FrameGraph<'_>,
+        area: &AreaLightScene,
+        params: &RtGiParams,
+    ) -> Result<(Buf, Buf)> {
+        let (min_flux, cutoff) = (params.area[1], params.distances[3]);
+        let key =
+            light_grid::LightGridKey::new(&area.lights.lights, &self.punctual, min_flux, cutoff);
+        let mut slot = self.light_grid.lock().map_err(|_| {
+            crate::error::RenderError::Graph("ray_traced_gi: light grid lock poisoned".into())
+        })?;
+        if slot.as_ref().map(|s| s.key) != Some(key) {
+            let grid = light_grid::LightGrid::build(
+                &area.lights.lights,
+                &self.punctual,
+                min_flux,
+                light_grid::grid_cutoff(cutoff),
+            );
+            let s = LightGridStats {
+                cells: grid.dims(),
+                entries: grid.entries(),
+                bytes: grid.bytes(),
+            };
+            log::info!(
+                "ray_traced_gi: light grid {:?} cells, {} entries, {} KiB",
+                s.cells,
+                s.entries,
+                s.bytes / 1024
+            );
+            let ctx = g.ctx();
+            *slot = Some(LightGridGpu {
+                key,
+                cells: storage_buffer(
+                    ctx,
+                    "ray_traced_gi.light_grid",
+                    bytemuck::cast_slice(&grid.cells),
+                ),
+                indices: storage_buffer(
+                    ctx,
+                    "ray_traced_gi.light_grid_indices",
+                    bytemuck::cast_slice(&grid.indices),
+                ),
+                stats: s,
+            });
+        }
+        let grid = slot.as_ref().expect("set above");
+        Ok((
+            g.import_buffer("ray_traced_gi.light_grid", &grid.cells),
+            g.import_buffer("ray_traced_gi.light_grid_indices", &grid.indices),
+        ))
+    }
+
+    /// The stats of the light grid in use (built by the last frame), `None` before one.
+    pub fn light_grid_stats(&self) -> Option<LightGridStats> {
+        Some(self.light_grid.lock().ok()?.as_ref()?.stats)
     }
 }
 
@@ -477,6 +563,7 @@ impl RayTracedGi {
         let noise = self.noise_set(g);
         let bvh_set = inputs.shadow_bvh.binding_set(g);
         let (area_lights, area_triangles) = inputs.area.import(g);
+        let (grid_cells, grid_indices) = scene.import_light_grid(g, inputs.area, params)?;
         g.pass("ray_traced_gi.shade")
             .constants(view)
             .constants(params)
@@ -495,6 +582,8 @@ impl RayTracedGi {
             .read(area_lights)
             .read(area_triangles)
             .read(hit_normals)
+            .read(grid_cells)
+            .read(grid_indices)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)

@@ -11,8 +11,10 @@
 // averaged) unless it is an area light, whose direct light the area-light pass gives every
 // surface already (its light on the hit is counted here). Output: the raw sample, encoded as
 // luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// Local lights are visited through the light grid (ray_traced_gi::light_grid): only those
+// listed in the hit's cell, which are all that can reach it, in ascending order.
 // CPU twins: ray_traced_gi::reference (punctual_irradiance, area_light_irradiance,
-// pick_light, area_light_point, random).
+// pick_light, area_light_point, random), light_grid::LightGrid::lights_at.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
@@ -47,6 +49,11 @@
 @group(0) @binding(14) var<storage, read> area_lights: array<AreaLightGpu>;
 @group(0) @binding(15) var<storage, read> area_triangles: array<AreaTriangleGpu>;
 @group(0) @binding(16) var<storage, read> hit_normals: array<u32>;
+// The grid of light lists (`ray_traced_gi::light_grid`): record 0 the origin (xyz) and cell
+// size (w) as f32 bits, record 1 the cells along x, y, z, then per cell: first index, area
+// lights, punctual lights. Indices: per cell its area lights, then its punctual lights.
+@group(0) @binding(17) var<storage, read> light_grid: array<vec4<u32>>;
+@group(0) @binding(18) var<storage, read> light_grid_indices: array<u32>;
 
 // Mirrors of area_lights/shade.wgsl's records (`area_lights::lights`).
 struct AreaLightGpu {
@@ -67,6 +74,20 @@ const AREA_LIGHT_FORCED: u32 = 2u;
 const NO_LIGHT: u32 = 0xffffffffu;
 
 const MAX_RADIANCE: f32 = 65000.0;
+
+// The light lists of x's grid cell: first index, area lights, punctual lights (0, 0, 0
+// outside the grid, where no local light reaches).
+fn grid_cell(x: vec3<f32>) -> vec3<u32> {
+    let h = light_grid[0];
+    let dims = light_grid[1].xyz;
+    let g = floor((x - bitcast<vec3<f32>>(h.xyz)) / bitcast<f32>(h.w));
+    // NaN fails both comparisons: no cell.
+    if !(all(g >= vec3<f32>(0.0)) && all(g < vec3<f32>(dims))) {
+        return vec3<u32>(0u);
+    }
+    let c = vec3<u32>(g);
+    return light_grid[2u + (c.z * dims.y + c.y) * dims.x + c.x].xyz;
+}
 
 fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
     return mix(params.sky_horizon.rgb, params.sky_zenith.rgb, sqrt(clamp(dir.y, 0.0, 1.0)));
@@ -263,7 +284,13 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     var chosen = NO_LIGHT;
     var chosen_s = 0.0;
     let count = min(u32(params.area.x), arrayLength(&area_lights));
-    for (var i = 0u; i < count; i++) {
+    // Only the lights listed in x's cell can reach it: the others score 0 (light_grid).
+    let cell = grid_cell(x);
+    for (var k = 0u; k < cell.y; k++) {
+        let i = light_grid_indices[cell.x + k];
+        if i >= count {
+            continue;
+        }
         let s = area_light_score(i, x, n);
         if !(s > 0.0) {
             continue;
@@ -332,10 +359,16 @@ fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32
         return vec3<f32>(0.0);
     }
     let count = min(params.config.w, arrayLength(&lights));
+    // Only the lights listed in x's cell can reach it: the others give 0 (light_grid).
+    let cell = grid_cell(x);
+    let first = cell.x + cell.y;
     if (flags & RTGI_PUNCTUAL_SHADOWS) == 0u {
         var e = vec3<f32>(0.0);
-        for (var i = 0u; i < count; i++) {
-            e += punctual_light_irradiance(i, x, n);
+        for (var k = 0u; k < cell.z; k++) {
+            let i = light_grid_indices[first + k];
+            if i < count {
+                e += punctual_light_irradiance(i, x, n);
+            }
         }
         return e;
     }
@@ -343,7 +376,11 @@ fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32
     var total = 0.0;
     var chosen = NO_LIGHT;
     var chosen_e = vec3<f32>(0.0);
-    for (var i = 0u; i < count; i++) {
+    for (var k = 0u; k < cell.z; k++) {
+        let i = light_grid_indices[first + k];
+        if i >= count {
+            continue;
+        }
         let e = punctual_light_irradiance(i, x, n);
         let s = luminance(e);
         if !(s > 0.0) {
