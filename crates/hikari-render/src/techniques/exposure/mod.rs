@@ -23,6 +23,9 @@ pub const EXPOSURE_FIXED: u32 = 1;
 /// The highlight rule takes part.
 pub const EXPOSURE_HIGHLIGHTS: u32 = 2;
 
+/// Rows of pixels each thread of `exposure.meter` counts (`ROWS` in meter.wgsl).
+pub const METER_ROWS: u32 = 16;
+
 /// Bytes of `exposure.value`: `vec4<f32>(scale, ev100, metered_lux, 0)`.
 pub const VALUE_BYTES: u64 = 16;
 
@@ -133,7 +136,7 @@ impl Exposure {
                 .read(radiance)
                 .read(illuminance)
                 .write(histogram)
-                .dispatch_threads(&self.meter, [size[0], size[1], 1])?;
+                .dispatch_threads(&self.meter, [size[0], size[1].div_ceil(METER_ROWS), 1])?;
         }
         let state = g.history_texture(
             "exposure.state",
