@@ -62,11 +62,16 @@ fn look(contrast: f32, shadow_contrast: f32, detail: f32) -> Look {
     }
 }
 
+/// The exposure buffer of these tests: scale 1, and a highlight (exposed log2) under the
+/// highlight fit's default target, so that the look's contrast holds.
+const NO_FIT: f32 = 0.0;
+
 fn twin(rgb: &[[f32; 3]], size: [usize; 2], s: &LocalTonemapSettings, l: Look) -> Twin {
     reference::run(
         rgb,
         size,
         1.0,
+        NO_FIT,
         &LocalTonemapParams::new(s, l),
         s.blur_sigma_xy,
         s.blur_sigma_z,
@@ -141,6 +146,17 @@ fn run_gpu(
     s: &LocalTonemapSettings,
     l: Look,
 ) -> hikari_render::graph::FrameResult {
+    run_gpu_with_highlight(log2, size, s, l, NO_FIT)
+}
+
+/// As [`run_gpu`], with `exposure.value.w` (the frame's exposed highlight) = `highlight`.
+fn run_gpu_with_highlight(
+    log2: &[f32],
+    size: [usize; 2],
+    s: &LocalTonemapSettings,
+    l: Look,
+    highlight: f32,
+) -> hikari_render::graph::FrameResult {
     let ctx = common::gpu_context();
     let (_, halves) = radiance_of(log2);
     let (w, h) = (size[0] as u32, size[1] as u32);
@@ -155,7 +171,7 @@ fn run_gpu(
         .device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("test exposure"),
-            contents: bytemuck::cast_slice(&[1.0f32, 0.0, 1.0, 0.0]),
+            contents: bytemuck::cast_slice(&[1.0f32, 0.0, 1.0, highlight]),
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
@@ -268,6 +284,44 @@ fn flat_images_follow_the_contrast_formula() {
     }
 }
 
+/// The highlight fit on flat images: with the frame's highlight H above the target T, the
+/// contrast above the midpoint becomes (T − M) / (H − M) (bounded by the least contrast and
+/// the look's), so the gain is (c − 1)(I − M) with that c; below the midpoint, and with H
+/// under T, the look's contrasts hold.
+#[test]
+fn the_highlight_fit_lowers_the_contrast_as_its_formula_says() {
+    let size = [64usize, 64];
+    let s = LocalTonemapSettings::default();
+    let (m, t) = (s.midpoint, s.highlight_target_ev);
+    let l = look(0.6, 0.85, 1.0);
+    for (v, highlight, c) in [
+        // (0.5 + 3) / (5 + 3) = 0.4375.
+        (m + 3.0, 5.0, (t - m) / (5.0 - m)),
+        // Far above: the least contrast.
+        (m + 3.0, 30.0, s.min_contrast),
+        // Under the target: the look.
+        (m + 3.0, t - 1.0, l.contrast),
+        // Below the midpoint the shadow contrast, whatever the highlight.
+        (m - 2.0, 5.0, l.shadow_contrast),
+    ] {
+        let want = (c - 1.0) * (v - m);
+        let img = vec![v; size[0] * size[1]];
+        let mut r = run_gpu_with_highlight(&img, size, &s, l, highlight);
+        let gain = r.take_image("local_tonemap.log2_gain").unwrap();
+        for g in &gain.rgba {
+            assert!(
+                (g[0] - want).abs() < 5e-3,
+                "at {v} with highlight {highlight}: gain {} want {want}",
+                g[0]
+            );
+        }
+        let p = LocalTonemapParams::new(&s, l);
+        if v > m {
+            assert!((reference::contrast_above(&p, highlight) - c).abs() < 1e-6);
+        }
+    }
+}
+
 #[test]
 fn off_gives_a_gain_of_zero() {
     let f = fixture();
@@ -307,7 +361,7 @@ fn the_tonemap_evaluates_the_gain_as_the_twins_do() {
         .device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("test exposure"),
-            contents: bytemuck::cast_slice(&[1.0f32, 0.0, 1.0, 0.0]),
+            contents: bytemuck::cast_slice(&[1.0f32, 0.0, 1.0, NO_FIT]),
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,

@@ -4,7 +4,7 @@
 // to workgroup memory together; then one thread walks them there (a serial walk over global
 // memory waits on a load each step).
 
-#import hikari::exposure::{ExposureParams, EXPOSURE_FIXED, EXPOSURE_HIGHLIGHTS, HISTOGRAM_BINS}
+#import hikari::exposure::{ExposureParams, EXPOSURE_FIXED, EXPOSURE_HIGHLIGHTS, HISTOGRAM_BINS, NO_HIGHLIGHT}
 
 @group(0) @binding(0) var<uniform> params: ExposureParams;
 @group(0) @binding(1) var<storage, read> histogram_in: array<u32>;
@@ -77,9 +77,13 @@ fn main(@builtin(local_invocation_index) lid: u32) {
             + log2(INCIDENT_C / REFLECTED_K);
     }
     var ev = log2_lux + log2(100.0 / INCIDENT_C);
+    // Log2 nits of the highlight percentile of all pixels; its exposed value at an EV is
+    // hi - log2(1.2) - ev (scale = 1 / (1.2 * 2^ev)).
+    var hi = 0.0;
+    if n_l > 0.0 {
+        hi = percentile(HISTOGRAM_BINS, n_l, params.meter.z, h.z, h.w);
+    }
     if (params.config.x & EXPOSURE_HIGHLIGHTS) != 0u && n_l > 0.0 {
-        let hi = percentile(HISTOGRAM_BINS, n_l, params.meter.z, h.z, h.w);
-        // The highlight's exposed log2 luminance at this EV: scale = 1 / (1.2 * 2^ev).
         let excess = hi - log2(1.2) - ev - params.meter.w;
         ev += params.rule.x * max(excess, 0.0);
     }
@@ -93,5 +97,7 @@ fn main(@builtin(local_invocation_index) lid: u32) {
         ev = prev.x + clamp(ev - prev.x, -params.adapt.y * dt, params.adapt.x * dt);
     }
     textureStore(state, vec2<u32>(0u), vec4<f32>(ev, 1.0, 0.0, 0.0));
-    value = vec4<f32>(1.0 / (1.2 * exp2(ev)), ev, exp2(log2_lux), 0.0);
+    // The highlight as this frame exposes it, for the local tonemap's highlight fit.
+    let highlight = select(NO_HIGHLIGHT, hi - log2(1.2) - ev, n_l > 0.0);
+    value = vec4<f32>(1.0 / (1.2 * exp2(ev)), ev, exp2(log2_lux), highlight);
 }

@@ -20,5 +20,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
     let v = grid_log2(textureLoad(radiance, id.xy, 0).rgb, exposure.x, params);
-    textureStore(gain, id.xy, vec4<f32>(local_gain(v, uv, params, grid, wide), 0.0, 0.0, 0.0));
+    textureStore(gain, id.xy, vec4<f32>(local_gain(v, uv, params, exposure.w, grid, wide), 0.0, 0.0, 0.0));
 }

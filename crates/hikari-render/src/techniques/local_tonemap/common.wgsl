@@ -8,7 +8,8 @@ struct LocalTonemapParams {
     grid: vec4<f32>,
     // x: contrast above the midpoint, y: below it, z: detail, w: midpoint (exposed log2).
     tone: vec4<f32>,
-    // x: the bilateral grid's share of the base layer, yzw: unused.
+    // x: the bilateral grid's share of the base layer, y: the highlight fit's target (exposed
+    // log2), z: the least contrast it may choose, w: unused.
     blend: vec4<f32>,
 }
 
@@ -49,6 +50,19 @@ fn taps(pos: f32, n: u32) -> vec3<f32> {
     return vec3<f32>(a, min(a + 1.0, f32(n - 1u)), p - a);
 }
 
+// The contrast above the midpoint: the look's, lowered where the frame's highlight (exposed
+// log2, `exposure.value.w`) lies above the target to the contrast that brings a base layer at
+// the highlight to the target, (T - M) / (H - M), but not below the least contrast.
+fn contrast_above(p: LocalTonemapParams, highlight: f32) -> f32 {
+    let m = p.tone.w;
+    let t = p.blend.y;
+    var c = p.tone.x;
+    if highlight > t && t > m {
+        c = min(c, max((t - m) / (highlight - m), p.blend.z));
+    }
+    return c;
+}
+
 // The log2 gain at normalised position `uv` of a pixel whose grid log2 is `v` (`grid_log2`):
 // the blurred grid sampled trilinearly and normalised, blended with the wide Gaussian, then the
 // talk's detail-preserving contrast I_o = c (B - M) + d (I_i - B) + M with c per side of the
@@ -58,6 +72,7 @@ fn local_gain(
     v: f32,
     uv: vec2<f32>,
     p: LocalTonemapParams,
+    highlight: f32,
     grid: texture_3d<f32>,
     wide: texture_2d<f32>,
 ) -> f32 {
@@ -94,7 +109,7 @@ fn local_gain(
     let b = mix(wide_v, bilateral, p.blend.x) + p.grid.x;
     let i = v + p.grid.x;
     let m = p.tone.w;
-    let c = select(p.tone.y, p.tone.x, b > m);
+    let c = select(p.tone.y, contrast_above(p, highlight), b > m);
     let o = c * (b - m) + p.tone.z * (i - b) + m;
     return clamp(o - i, -p.grid.w, p.grid.w);
 }

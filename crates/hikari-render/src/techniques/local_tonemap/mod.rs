@@ -44,7 +44,12 @@ impl LocalTonemapParams {
                 s.max_gain_ev,
             ],
             tone: [look.contrast, look.shadow_contrast, look.detail, s.midpoint],
-            blend: [s.bilateral_weight, 0.0, 0.0, 0.0],
+            blend: [
+                s.bilateral_weight,
+                s.highlight_target_ev,
+                s.min_contrast,
+                0.0,
+            ],
         }
     }
 }

@@ -32,7 +32,7 @@ struct TonemapParams {
 
 @group(0) @binding(0) var<uniform> params: TonemapParams;
 @group(0) @binding(1) var hdr: texture_2d<f32>;
-// The exposure technique's `exposure.value`: (scale, ev100, metered lux, 0).
+// The exposure technique's `exposure.value`: (scale, ev100, metered lux, highlight).
 @group(0) @binding(2) var<storage, read> exposure: vec4<f32>;
 @group(0) @binding(3) var log2_gain: texture_2d<f32>;
 // The local tonemap's blurred grid and upsampled wide Gaussian (LOCAL_GRID).
@@ -132,7 +132,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         // From the radiance as it came, as `local_tonemap.apply` computes it.
         let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
         let v = grid_log2(raw, exposure.x, params.local);
-        scale = scale * exp2(local_gain(v, uv, params.local, local_grid, local_wide));
+        scale = scale * exp2(local_gain(v, uv, params.local, exposure.w, local_grid, local_wide));
     } else if (flags & LOCAL_GAIN) != 0u {
         scale = scale * exp2(textureLoad(log2_gain, id.xy, 0).r);
     }

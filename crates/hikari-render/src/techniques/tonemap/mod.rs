@@ -172,14 +172,14 @@ impl TonemapParams {
     }
 }
 
-/// `exposure.value` as the exposure technique lays it out: `(scale, ev100, metered lux, 0)`,
-/// scale = 1 / (1.2 · 2^ev100).
+/// `exposure.value` as the exposure technique lays it out: `(scale, ev100, metered lux,
+/// highlight)`, scale = 1 / (1.2 · 2^ev100), no highlight metered.
 pub fn exposure_value_from_ev100(ev100: f32, metered_lux: f32) -> [f32; 4] {
     [
         crate::techniques::exposure::reference::scale_from_ev100(ev100),
         ev100,
         metered_lux,
-        0.0,
+        crate::techniques::exposure::NO_HIGHLIGHT,
     ]
 }
 
@@ -188,7 +188,7 @@ pub fn exposure_value_from_ev100(ev100: f32, metered_lux: f32) -> [f32; 4] {
 pub struct TonemapInputs {
     /// Linear Rec.709 radiance in nits (Rgba16Float).
     pub hdr: Tex,
-    /// `exposure.value`, 16 bytes: `(scale, ev100, metered lux, 0)`.
+    /// `exposure.value`, 16 bytes: `(scale, ev100, metered lux, highlight)`.
     pub exposure: Buf,
     /// The local tonemap's gain, if it ran.
     pub local: Option<LocalGain>,
