@@ -62,9 +62,9 @@ fn look(contrast: f32, shadow_contrast: f32, detail: f32) -> Look {
     }
 }
 
-/// The exposure buffer of these tests: scale 1, and a highlight (exposed log2) under the
-/// highlight fit's default target, so that the look's contrast holds.
-const NO_FIT: f32 = 0.0;
+/// The exposure buffer of these tests: scale 1, and no highlight metered (as with a fixed
+/// exposure), so that the look's contrast holds.
+const NO_FIT: f32 = hikari_render::techniques::exposure::NO_HIGHLIGHT;
 
 fn twin(rgb: &[[f32; 3]], size: [usize; 2], s: &LocalTonemapSettings, l: Look) -> Twin {
     reference::run(
@@ -295,8 +295,8 @@ fn the_highlight_fit_lowers_the_contrast_as_its_formula_says() {
     let (m, t) = (s.midpoint, s.highlight_target_ev);
     let l = look(0.6, 0.85, 1.0);
     for (v, highlight, c) in [
-        // (0.5 + 3) / (5 + 3) = 0.4375.
-        (m + 3.0, 5.0, (t - m) / (5.0 - m)),
+        // (-0.5 + 3) / (3 + 3) = 0.417: between the least contrast and the look's.
+        (m + 3.0, 3.0, (t - m) / (3.0 - m)),
         // Far above: the least contrast.
         (m + 3.0, 30.0, s.min_contrast),
         // Under the target: the look.

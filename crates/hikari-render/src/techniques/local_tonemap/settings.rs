@@ -40,7 +40,9 @@ pub struct LocalTonemapSettings {
     /// is lowered to (target − M) / (highlight − M), the contrast that brings a base layer at
     /// the highlight to the target, but not below `min_contrast` nor above the look's. A room
     /// looking out onto noon gets more compression; an open noon view, whose highlights sit
-    /// below the target, keeps the look. 8 or more: off in practice.
+    /// below the target, keeps the look. −0.5 (exposed 0.7, where Uchimura's shoulder has
+    /// begun): the brightest percent of the frame stays below display white. 8 or more: off
+    /// in practice.
     pub highlight_target_ev: f32,
     /// The least contrast the highlight fit may choose.
     pub min_contrast: f32,
@@ -61,7 +63,7 @@ impl Default for LocalTonemapSettings {
             blur_sigma_z: 1.0,
             wide_sigma: 2.5,
             max_gain_ev: 8.0,
-            highlight_target_ev: 0.5,
+            highlight_target_ev: -0.5,
             min_contrast: 0.35,
         }
     }
