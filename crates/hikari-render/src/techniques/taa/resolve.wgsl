@@ -86,7 +86,9 @@ fn main(
             hi = max(hi, v);
         }
     }
-    let cur = ycocg_to_rgb(cur_y);
+    // The pixel's own radiance as loaded, not back from YCoCg: a frame without history is then
+    // its input to the bit (the texel is in cache from the tile's load).
+    let cur = sanitize(textureLoad(current, px, 0).rgb);
 
     var resolved = vec4<f32>(cur, 1.0);
     let prev_pos = vec2<f32>(px) + 0.5 + textureLoad(motion, px, 0).xy;
