@@ -26,7 +26,7 @@ use crate::techniques::ray_traced_gi::{
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::techniques::taa::{self, Taa};
-use crate::techniques::tonemap::{Tonemap, TonemapInputs};
+use crate::techniques::tonemap::{LocalGain, Tonemap, TonemapInputs};
 use crate::view::View;
 
 /// What a frame depends on besides the scene.
@@ -154,7 +154,11 @@ pub struct FrameOutputs {
     pub denoised_gi: Option<DenoisedGi>,
     /// Its hit words and BVH queue.
     pub ray_traced_gi_rays: Option<RtGiRays>,
-    /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA.
+    /// Linear radiance in nits (Rgba16Float), for the EXR: the lit image after TAA. With TAA
+    /// on this is its history, whose alpha counts the frames it averages ([`Renderer::render`]
+    /// sets alpha to 1 in the image it reads back).
+    ///
+    /// [`Renderer::render`]: crate::renderer::Renderer::render
     pub hdr: Tex,
     /// The lit image before TAA.
     pub lit: Tex,
@@ -405,8 +409,9 @@ pub fn record<'r>(
         lit
     };
 
-    // 14. Exposure, metered on the illuminance; the local tonemap's gain; the tonemap: Purkinje
-    //     shift, white balance, the curve in the tonemapping space, LUT grade, dither.
+    // 14. Exposure, metered on the illuminance; the local tonemap's grid; the tonemap: the local
+    //     gain from that grid, Purkinje shift, white balance, the curve in the tonemapping
+    //     space, LUT grade, dither.
     let exposure = t.exposure.record(
         g,
         hdr,
@@ -442,7 +447,7 @@ pub fn record<'r>(
         TonemapInputs {
             hdr,
             exposure: exposure.value,
-            log2_gain: Some(local_tonemap.log2_gain),
+            local: LocalGain::of(&local_tonemap),
         },
         size,
     )?;

@@ -200,7 +200,8 @@ pub fn all() -> Vec<StructLayout> {
                 curve_shoulder,
                 lut_domain_min,
                 lut_domain_max,
-                switches
+                switches,
+                local
             ]
         ),
         gpu_layout!(graph_check::FillParams, "graph_check/fill.wgsl", [value]),

@@ -114,7 +114,14 @@ impl Renderer {
             }
         })?;
         let (hdr, ldr) = match (read_images, picked) {
-            (true, Some((hdr, ldr))) => (result.take_image_of(hdr), result.take_image_of(ldr)),
+            (true, Some((hdr, ldr))) => (
+                // TAA's history is the HDR output; its alpha counts frames, the EXR's is 1.
+                result.take_image_of(hdr).map(|mut img| {
+                    img.rgba.iter_mut().for_each(|p| p[3] = 1.0);
+                    img
+                }),
+                result.take_image_of(ldr),
+            ),
             _ => (None, None),
         };
         Ok(RenderedFrame { result, hdr, ldr })

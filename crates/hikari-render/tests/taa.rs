@@ -13,8 +13,10 @@ use hikari_render::techniques::taa::{Taa, TaaParams};
 use hikari_render::{FrameSettings, Renderer};
 use rand::{Rng, SeedableRng, rngs::SmallRng};
 
-const W: u32 = 64;
-const H: u32 = 48;
+// Not multiples of the resolve's 16x16 tiles, so that partial tiles and their clamped aprons
+// are checked too.
+const W: u32 = 70;
+const H: u32 = 45;
 
 fn round_half(v: f32) -> f32 {
     f16::from_f32(v).to_f32()
@@ -58,7 +60,7 @@ fn resolve_matches_twin(clip: bool) {
             current[W as usize + 9] = [f32::NAN; 4];
         }
         // Up to 3 pixels, so some reprojections leave the image.
-        let motion: Vec<[f32; 4]> = (0..W * H)
+        let mut motion: Vec<[f32; 4]> = (0..W * H)
             .map(|_| {
                 [
                     rng.random_range(-3.0..3.0),
@@ -68,6 +70,10 @@ fn resolve_matches_twin(clip: bool) {
                 ]
             })
             .collect();
+        if frame == 2 {
+            // Off the image: the NaN pixel's output is its sanitised current value alone.
+            motion[5] = [-10.0, -10.0, 0.0, 0.0];
+        }
         let cur_tex = half_texture(&ctx, &current);
         let motion_tex = half_texture(&ctx, &motion);
 
@@ -77,10 +83,10 @@ fn resolve_matches_twin(clip: bool) {
         let out = taa
             .record(&mut g, cur, mot, [W, H], &settings, true)
             .unwrap();
+        // The history is the output.
         g.readback(out.output);
-        g.readback(out.history);
         let r = g.execute().unwrap();
-        let got = &r.image("taa.output").unwrap().rgba;
+        let got = &r.image("taa.history").unwrap().rgba;
 
         let cur_in: Vec<Vec3> = current
             .iter()

@@ -11,7 +11,7 @@ use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::tonemap::cube::CubeLut;
 use hikari_render::techniques::tonemap::settings::TonemapSettings;
 use hikari_render::techniques::tonemap::{
-    self, Tonemap, TonemapInputs, TonemapParams, exposure_value_from_ev100, reference,
+    self, LocalGain, Tonemap, TonemapInputs, TonemapParams, exposure_value_from_ev100, reference,
 };
 use rand::{Rng, SeedableRng, rngs::SmallRng};
 use serde_json::Value;
@@ -304,7 +304,7 @@ fn run_gpu(
             TonemapInputs {
                 hdr: hdr_t,
                 exposure,
-                log2_gain: use_gain.then_some(gain_t),
+                local: use_gain.then_some(LocalGain::Image(gain_t)),
             },
             [W, H],
         )

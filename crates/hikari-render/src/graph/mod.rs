@@ -373,6 +373,12 @@ impl<'r> FrameGraph<'r> {
         self.readbacks.push(res.into());
     }
 
+    /// Whether `--dump` asks for a resource named `name` this frame: a technique records an
+    /// image that the frame itself does not need (it evaluates it inline) only then.
+    pub fn dump_requested(&self, name: &str) -> bool {
+        self.rt.dumps.iter().any(|d| d == name)
+    }
+
     /// Asks for a buffer to be copied back without making anyone wait for it (the
     /// rasteriser's queue counts): while the runtime waits for read-backs (the default, for
     /// offline renders) it behaves as [`FrameGraph::readback`]; in a runtime that does not

@@ -1,17 +1,21 @@
 // The frame's exposure from the histograms: the incident-meter rule on a trimmed mean of log2
 // illuminance, darkened where highlights exceed their limit, compensated, clamped, and moved
-// towards from last frame's value at the adaptation speeds. One thread: 256 bins are nothing.
+// towards from last frame's value at the adaptation speeds. The workgroup copies the 256 bins
+// to workgroup memory together; then one thread walks them there (a serial walk over global
+// memory waits on a load each step).
 
-#import hikari::exposure::{ExposureParams, EXPOSURE_FIXED, EXPOSURE_HIGHLIGHTS, HISTOGRAM_BINS}
+#import hikari::exposure::{ExposureParams, EXPOSURE_FIXED, EXPOSURE_HIGHLIGHTS, HISTOGRAM_BINS, NO_HIGHLIGHT}
 
 @group(0) @binding(0) var<uniform> params: ExposureParams;
-@group(0) @binding(1) var<storage, read> histogram: array<u32>;
+@group(0) @binding(1) var<storage, read> histogram_in: array<u32>;
 @group(0) @binding(2) var prev_state: texture_2d<f32>;
 @group(0) @binding(3) var state: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(4) var<storage, read_write> value: vec4<f32>;
 
 // ISO 2720's incident-light calibration constant C and the reflected-light K: a reflected
 // reading equals an incident one for E = L * C / K.
+var<workgroup> histogram: array<u32, 256>;
+
 const INCIDENT_C: f32 = 250.0;
 const REFLECTED_K: f32 = 12.5;
 
@@ -54,8 +58,13 @@ fn percentile(first: u32, n: f32, p: f32, bin0: f32, per_ev: f32) -> f32 {
     return bin0 + f32(HISTOGRAM_BINS) / per_ev;
 }
 
-@compute @workgroup_size(1, 1, 1)
-fn main() {
+@compute @workgroup_size(256, 1, 1)
+fn main(@builtin(local_invocation_index) lid: u32) {
+    histogram[lid] = histogram_in[lid];
+    workgroupBarrier();
+    if lid != 0u {
+        return;
+    }
     let h = params.histogram;
     let n_e = count(0u);
     let n_l = count(HISTOGRAM_BINS);
@@ -68,9 +77,13 @@ fn main() {
             + log2(INCIDENT_C / REFLECTED_K);
     }
     var ev = log2_lux + log2(100.0 / INCIDENT_C);
+    // Log2 nits of the highlight percentile of all pixels; its exposed value at an EV is
+    // hi - log2(1.2) - ev (scale = 1 / (1.2 * 2^ev)).
+    var hi = 0.0;
+    if n_l > 0.0 {
+        hi = percentile(HISTOGRAM_BINS, n_l, params.meter.z, h.z, h.w);
+    }
     if (params.config.x & EXPOSURE_HIGHLIGHTS) != 0u && n_l > 0.0 {
-        let hi = percentile(HISTOGRAM_BINS, n_l, params.meter.z, h.z, h.w);
-        // The highlight's exposed log2 luminance at this EV: scale = 1 / (1.2 * 2^ev).
         let excess = hi - log2(1.2) - ev - params.meter.w;
         ev += params.rule.x * max(excess, 0.0);
     }
@@ -84,5 +97,7 @@ fn main() {
         ev = prev.x + clamp(ev - prev.x, -params.adapt.y * dt, params.adapt.x * dt);
     }
     textureStore(state, vec2<u32>(0u), vec4<f32>(ev, 1.0, 0.0, 0.0));
-    value = vec4<f32>(1.0 / (1.2 * exp2(ev)), ev, exp2(log2_lux), 0.0);
+    // The highlight as this frame exposes it, for the local tonemap's highlight fit.
+    let highlight = select(NO_HIGHLIGHT, hi - log2(1.2) - ev, n_l > 0.0);
+    value = vec4<f32>(1.0 / (1.2 * exp2(ev)), ev, exp2(log2_lux), highlight);
 }

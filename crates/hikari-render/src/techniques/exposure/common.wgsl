@@ -23,6 +23,9 @@ struct ExposureParams {
 const EXPOSURE_FIXED: u32 = 1u;
 const EXPOSURE_HIGHLIGHTS: u32 = 2u;
 
+// `exposure.value.w` when no pixel was metered (a fixed exposure): no highlight.
+const NO_HIGHLIGHT: f32 = -1000.0;
+
 // Bins of each histogram; the buffer holds the illuminance bins, then the luminance bins.
 const HISTOGRAM_BINS: u32 = 128u;
 

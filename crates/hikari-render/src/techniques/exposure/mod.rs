@@ -15,7 +15,7 @@ use crate::graph::{Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
 
-pub use reference::{HISTOGRAM_BINS, HistogramLayout};
+pub use reference::{HISTOGRAM_BINS, HistogramLayout, NO_HIGHLIGHT};
 pub use settings::ExposureSettings;
 
 /// `exposure.value` is fixed.
@@ -23,7 +23,11 @@ pub const EXPOSURE_FIXED: u32 = 1;
 /// The highlight rule takes part.
 pub const EXPOSURE_HIGHLIGHTS: u32 = 2;
 
-/// Bytes of `exposure.value`: `vec4<f32>(scale, ev100, metered_lux, 0)`.
+/// Rows of pixels each thread of `exposure.meter` counts (`ROWS` in meter.wgsl).
+pub const METER_ROWS: u32 = 16;
+
+/// Bytes of `exposure.value`: `vec4<f32>(scale, ev100, metered_lux, highlight)`, highlight the
+/// exposed log2 luminance of the highlight percentile ([`NO_HIGHLIGHT`] if nothing metered).
 pub const VALUE_BYTES: u64 = 16;
 
 #[repr(C)]
@@ -88,8 +92,10 @@ impl ExposureParams {
 /// The exposure of one frame, for the tonemap.
 #[derive(Clone, Copy, Debug)]
 pub struct ExposureFrame {
-    /// `exposure.value`: `vec4<f32>(scale, ev100, metered_lux, 0)`, 16 bytes; exposed linear
-    /// colour = radiance in nits × scale, scale = 1 / (1.2 × 2^ev100).
+    /// `exposure.value`: `vec4<f32>(scale, ev100, metered_lux, highlight)`, 16 bytes; exposed
+    /// linear colour = radiance in nits × scale, scale = 1 / (1.2 × 2^ev100); highlight: the
+    /// exposed log2 luminance of `highlight_percentile` of all pixels ([`NO_HIGHLIGHT`] when
+    /// nothing was metered), which the local tonemap fits its contrast to.
     pub value: Buf,
     /// `exposure.histogram`: [`HISTOGRAM_BINS`] u32 counts of log2 illuminance, then as many
     /// of log2 luminance ([`HistogramLayout`]); absent when the exposure is fixed.
@@ -133,7 +139,7 @@ impl Exposure {
                 .read(radiance)
                 .read(illuminance)
                 .write(histogram)
-                .dispatch_threads(&self.meter, [size[0], size[1], 1])?;
+                .dispatch_threads(&self.meter, [size[0], size[1].div_ceil(METER_ROWS), 1])?;
         }
         let state = g.history_texture(
             "exposure.state",

@@ -127,6 +127,10 @@ pub fn adapt(prev: Option<f32>, target: f32, p: &ExposureParams) -> f32 {
     }
 }
 
+/// `exposure.value.w` when no pixel was metered (a fixed exposure): no highlight, so the local
+/// tonemap's highlight fit leaves the look's contrast alone.
+pub const NO_HIGHLIGHT: f32 = -1000.0;
+
 /// Exposure multiplier for a camera at `ev100` (saturation-based sensitivity, Lagarde and de
 /// Rousiers 2014, eq. 15 with q = 0.65, S = 100, K = 12.5): the scale of `exposure.value`.
 pub fn scale_from_ev100(ev100: f32) -> f32 {
@@ -137,7 +141,22 @@ pub fn scale_from_ev100(ev100: f32) -> f32 {
 pub fn value(bins: &[u32], prev: Option<f32>, p: &ExposureParams) -> [f32; 4] {
     let (log2_lux, t) = target(bins, p);
     let ev = adapt(prev, t, p);
-    [scale_from_ev100(ev), ev, log2_lux.exp2(), 0.0]
+    [
+        scale_from_ev100(ev),
+        ev,
+        log2_lux.exp2(),
+        highlight(bins, ev, p),
+    ]
+}
+
+/// `exposure.value.w`: the exposed log2 luminance (at `ev`) of the highlight percentile of all
+/// pixels, or [`NO_HIGHLIGHT`] when nothing was metered.
+pub fn highlight(bins: &[u32], ev: f32, p: &ExposureParams) -> f32 {
+    let lum = &bins[HISTOGRAM_BINS..];
+    if lum.iter().all(|&c| c == 0) {
+        return NO_HIGHLIGHT;
+    }
+    percentile(lum, p.meter[2], p.histogram[2], p.histogram[3]) - 1.2f32.log2() - ev
 }
 
 #[cfg(test)]

@@ -20,7 +20,22 @@ const FIXED: f32 = 1024.0;
 var<workgroup> acc_wv: array<atomic<u32>, 64>;
 var<workgroup> acc_w: array<atomic<u32>, 64>;
 
-@compute @workgroup_size(16, 16, 1)
+fn flush(k: i32, w0: u32, w1: u32, wv0: u32, wv1: u32) {
+    let k0 = u32(clamp(k, 0, i32(GRID_D) - 1));
+    let k1 = u32(clamp(k + 1, 0, i32(GRID_D) - 1));
+    atomicAdd(&acc_w[k0], w0);
+    atomicAdd(&acc_w[k1], w1);
+    atomicAdd(&acc_wv[k0], wv0);
+    atomicAdd(&acc_wv[k1], wv1);
+}
+
+// 64 threads across a cell (60 px wide at 3840: one column each, neighbours read neighbouring
+// texels), 4 bands of rows down it. Each thread walks its column downwards and keeps the sums
+// of its current run of pixels that share a slice pair in registers, adding them to workgroup
+// memory only when the pair changes: neighbouring pixels mostly share one, so the workgroup's
+// atomics (256 threads on the same one or two slices, which serialise) drop by the run length.
+// The integer sums are those of one add per pixel, so the grid is unchanged to the bit.
+@compute @workgroup_size(64, 4, 1)
 fn main(
     @builtin(workgroup_id) cell: vec3<u32>,
     @builtin(local_invocation_id) lid3: vec3<u32>,
@@ -34,20 +49,40 @@ fn main(
     let size = textureDimensions(radiance);
     let lo = cell.xy * size / vec2<u32>(GRID_W, GRID_H);
     let hi = (cell.xy + 1u) * size / vec2<u32>(GRID_W, GRID_H);
+    let rows = hi.y - lo.y;
+    let y0 = lo.y + rows * lid3.y / 4u;
+    let y1 = lo.y + rows * (lid3.y + 1u) / 4u;
     let scale = exposure.x;
-    for (var y = lo.y + lid3.y; y < hi.y; y += 16u) {
-        for (var x = lo.x + lid3.x; x < hi.x; x += 16u) {
+    for (var x = lo.x + lid3.x; x < hi.x; x += 64u) {
+        var run = -2;
+        var w0s = 0u;
+        var w1s = 0u;
+        var wv0s = 0u;
+        var wv1s = 0u;
+        for (var y = y0; y < y1; y++) {
             let v = grid_log2(textureLoad(radiance, vec2<u32>(x, y), 0).rgb, scale, params);
             let t = v * params.grid.y - 0.5;
-            let k = floor(t);
-            let w1 = u32(round((t - k) * FIXED));
+            let kf = floor(t);
+            let k = i32(kf);
+            let w1 = u32(round((t - kf) * FIXED));
             let w0 = u32(FIXED) - w1;
-            let k0 = u32(clamp(k, 0.0, f32(GRID_D - 1u)));
-            let k1 = u32(clamp(k + 1.0, 0.0, f32(GRID_D - 1u)));
-            atomicAdd(&acc_w[k0], w0);
-            atomicAdd(&acc_w[k1], w1);
-            atomicAdd(&acc_wv[k0], u32(round(f32(w0) * v)));
-            atomicAdd(&acc_wv[k1], u32(round(f32(w1) * v)));
+            if k != run {
+                if run != -2 {
+                    flush(run, w0s, w1s, wv0s, wv1s);
+                }
+                run = k;
+                w0s = 0u;
+                w1s = 0u;
+                wv0s = 0u;
+                wv1s = 0u;
+            }
+            w0s += w0;
+            w1s += w1;
+            wv0s += u32(round(f32(w0) * v));
+            wv1s += u32(round(f32(w1) * v));
+        }
+        if run != -2 {
+            flush(run, w0s, w1s, wv0s, wv1s);
         }
     }
     workgroupBarrier();

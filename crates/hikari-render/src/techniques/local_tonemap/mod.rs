@@ -1,7 +1,9 @@
 //! Local tonemapping with a bilateral grid (Chen et al. 2007, as the talk's "Tonemapping"
 //! uses it): a 64x32x64 grid over exposed log2 luminance, blurred and sampled back per pixel,
 //! blended with a very wide Gaussian against ringing, then the talk's detail-preserving
-//! contrast. Writes `local_tonemap.log2_gain`. CPU twin:
+//! contrast. The gain is evaluated per pixel by `tonemap.apply` (from the blurred grid and the
+//! wide Gaussian this technique leaves); `local_tonemap.apply` writes it as an image,
+//! `local_tonemap.log2_gain`, only when a dump or a test asks. CPU twin:
 //! [`crate::techniques::local_tonemap::reference`].
 
 pub mod reference;
@@ -42,7 +44,12 @@ impl LocalTonemapParams {
                 s.max_gain_ev,
             ],
             tone: [look.contrast, look.shadow_contrast, look.detail, s.midpoint],
-            blend: [s.bilateral_weight, 0.0, 0.0, 0.0],
+            blend: [
+                s.bilateral_weight,
+                s.highlight_target_ev,
+                s.min_contrast,
+                0.0,
+            ],
         }
     }
 }
@@ -68,19 +75,31 @@ impl BlurParams {
     }
 }
 
-/// The local tonemap of one frame.
+/// The local tonemap of one frame: what the tonemap needs to evaluate the gain per pixel.
 #[derive(Clone, Copy, Debug)]
 pub struct LocalTonemapFrame {
-    /// `local_tonemap.log2_gain`: full resolution, R16Float; the exposed linear colour is
-    /// multiplied by exp2(log2_gain) before the tone curve. 0 where the technique is off.
-    pub log2_gain: Tex,
     /// `local_tonemap.grid_blurred`: the blurred grid (x: Σ w V, y: Σ w; V relative to
     /// `grid_min_ev`), 64x32x64 Rgba32Float; `None` when off.
     pub grid: Option<Tex>,
     /// `local_tonemap.wide`: the wide Gaussian of log2 luminance (relative to `grid_min_ev`),
     /// 256x128 R32Float; `None` when off.
     pub wide: Option<Tex>,
+    /// The uniforms the gain is evaluated with.
+    pub params: LocalTonemapParams,
+    /// `local_tonemap.log2_gain` (full resolution, R16Float; 0 where off), written only when
+    /// `--dump local_tonemap.log2_gain` asks for it; see [`LocalTonemap::gain_image`].
+    pub log2_gain: Option<Tex>,
 }
+
+impl LocalTonemapFrame {
+    /// The grid, the wide Gaussian and the uniforms, when the technique ran.
+    pub fn lookup(&self) -> Option<(Tex, Tex, LocalTonemapParams)> {
+        Some((self.grid?, self.wide?, self.params))
+    }
+}
+
+/// The name of the gain image, for `--dump`.
+pub const GAIN_NAME: &str = "local_tonemap.log2_gain";
 
 pub struct LocalTonemap {
     fill: ComputePipeline,
@@ -115,28 +134,69 @@ impl LocalTonemap {
         s: &LocalTonemapSettings,
         look: Look,
     ) -> Result<LocalTonemapFrame> {
-        let log2_gain = g.texture(
-            "local_tonemap.log2_gain",
-            TextureDesc::d2(size[0], size[1], GAIN_FORMAT),
-        )?;
-        if !s.enabled {
-            g.pass("local_tonemap.zero")
-                .write(log2_gain)
-                .dispatch_threads(&self.zero, [size[0], size[1], 1])?;
-            return Ok(LocalTonemapFrame {
-                log2_gain,
-                grid: None,
-                wide: None,
-            });
-        }
         let params = LocalTonemapParams::new(s, look);
+        let mut frame = LocalTonemapFrame {
+            grid: None,
+            wide: None,
+            params,
+            log2_gain: None,
+        };
+        if s.enabled {
+            let (grid, wide) = self.record_grid(g, radiance, exposure, s, &params)?;
+            frame.grid = Some(grid);
+            frame.wide = Some(wide);
+        }
+        if g.dump_requested(GAIN_NAME) {
+            frame.log2_gain = Some(self.gain_image(g, radiance, exposure, size, &frame)?);
+        }
+        Ok(frame)
+    }
+
+    /// `local_tonemap.log2_gain`: the gain the tonemap evaluates, as a full-resolution image
+    /// (zero where the technique is off). For dumps and tests; the frame does not need it.
+    pub fn gain_image<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        radiance: Tex,
+        exposure: Buf,
+        size: [u32; 2],
+        frame: &LocalTonemapFrame,
+    ) -> Result<Tex> {
+        let log2_gain = g.texture(GAIN_NAME, TextureDesc::d2(size[0], size[1], GAIN_FORMAT))?;
+        match frame.lookup() {
+            None => g
+                .pass("local_tonemap.zero")
+                .write(log2_gain)
+                .dispatch_threads(&self.zero, [size[0], size[1], 1])?,
+            Some((grid, wide, params)) => g
+                .pass("local_tonemap.apply")
+                .constants(&params)
+                .read(radiance)
+                .read(exposure)
+                .read(grid)
+                .read(wide)
+                .write(log2_gain)
+                .dispatch_threads(&self.apply, [size[0], size[1], 1])?,
+        }
+        Ok(log2_gain)
+    }
+
+    /// The fill, the blurs and the upsampled wide Gaussian: the blurred grid and the wide image.
+    fn record_grid<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        radiance: Tex,
+        exposure: Buf,
+        s: &LocalTonemapSettings,
+        params: &LocalTonemapParams,
+    ) -> Result<(Tex, Tex)> {
         let [gw, gh, gd] = GRID_SIZE;
         let grid_desc = TextureDesc::d3(gw, gh, gd, GRID_FORMAT);
         let coarse_desc = TextureDesc::d2(gw, gh, GRID_FORMAT);
         let grid = g.texture("local_tonemap.grid", grid_desc)?;
         let coarse = g.texture("local_tonemap.coarse", coarse_desc)?;
         g.pass("local_tonemap.fill")
-            .constants(&params)
+            .constants(params)
             .read(radiance)
             .read(exposure)
             .write(grid)
@@ -180,23 +240,10 @@ impl LocalTonemap {
             TextureDesc::d2(WIDE_SIZE[0], WIDE_SIZE[1], wgpu::TextureFormat::R32Float),
         )?;
         g.pass("local_tonemap.upsample")
-            .constants(&params)
+            .constants(params)
             .read(wide_xy)
             .write(wide)
             .dispatch_threads(&self.upsample, [WIDE_SIZE[0], WIDE_SIZE[1], 1])?;
-
-        g.pass("local_tonemap.apply")
-            .constants(&params)
-            .read(radiance)
-            .read(exposure)
-            .read(blurred)
-            .read(wide)
-            .write(log2_gain)
-            .dispatch_threads(&self.apply, [size[0], size[1], 1])?;
-        Ok(LocalTonemapFrame {
-            log2_gain,
-            grid: Some(blurred),
-            wide: Some(wide),
-        })
+        Ok((blurred, wide))
     }
 }

@@ -213,11 +213,26 @@ pub struct Twin {
     pub bilateral: Vec<f32>,
 }
 
-/// Twin of the whole technique on `radiance` (nits) exposed by `scale`.
+/// The contrast above the midpoint for a frame whose highlight (exposed log2,
+/// `exposure.value.w`) is `highlight`: the look's, or lower where the highlight lies above the
+/// fit's target, (T − M) / (H − M), at least the least contrast.
+pub fn contrast_above(p: &LocalTonemapParams, highlight: f32) -> f32 {
+    let (m, t) = (p.tone[3], p.blend[1]);
+    let mut c = p.tone[0];
+    if highlight > t && t > m {
+        c = c.min(((t - m) / (highlight - m)).max(p.blend[2]));
+    }
+    c
+}
+
+/// Twin of the whole technique on `radiance` (nits) exposed by `scale`, with the frame's
+/// highlight `highlight` (`exposure.value.w`).
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     radiance: &[[f32; 3]],
     size: [usize; 2],
     scale: f32,
+    highlight: f32,
     p: &LocalTonemapParams,
     sigma_xy: f32,
     sigma_z: f32,
@@ -257,7 +272,11 @@ pub fn run(
             let b = lerp(wide_v, bil, p.blend[0]) + p.grid[0];
             let i = v + p.grid[0];
             let m = p.tone[3];
-            let c = if b > m { p.tone[0] } else { p.tone[1] };
+            let c = if b > m {
+                contrast_above(p, highlight)
+            } else {
+                p.tone[1]
+            };
             let o = c * (b - m) + p.tone[2] * (i - b) + m;
             gain.push((o - i).clamp(-p.grid[3], p.grid[3]));
             base.push(b);

@@ -35,6 +35,17 @@ pub struct LocalTonemapSettings {
     pub wide_sigma: f32,
     /// The gain never exceeds this many EV either way.
     pub max_gain_ev: f32,
+    /// Highlight fit: where the scene's highlight (the exposure's `highlight_percentile` of
+    /// all pixels, exposed log2 luminance) lies above this, the contrast above the midpoint
+    /// is lowered to (target − M) / (highlight − M), the contrast that brings a base layer at
+    /// the highlight to the target, but not below `min_contrast` nor above the look's. A room
+    /// looking out onto noon gets more compression; an open noon view, whose highlights sit
+    /// below the target, keeps the look. −0.5 (exposed 0.7, where Uchimura's shoulder has
+    /// begun): the brightest percent of the frame stays below display white. 8 or more: off
+    /// in practice.
+    pub highlight_target_ev: f32,
+    /// The least contrast the highlight fit may choose.
+    pub min_contrast: f32,
 }
 
 impl Default for LocalTonemapSettings {
@@ -52,6 +63,8 @@ impl Default for LocalTonemapSettings {
             blur_sigma_z: 1.0,
             wide_sigma: 2.5,
             max_gain_ev: 8.0,
+            highlight_target_ev: -0.5,
+            min_contrast: 0.35,
         }
     }
 }
@@ -158,6 +171,8 @@ impl TechniqueSettings for LocalTonemapSettings {
             float("blur_sigma_z", 0.0, 4.0),
             float("wide_sigma", 0.5, 4.0),
             float("max_gain_ev", 0.0, 16.0),
+            float("highlight_target_ev", -8.0, 16.0),
+            float("min_contrast", 0.0, 2.0),
         ];
         FIELDS
     }

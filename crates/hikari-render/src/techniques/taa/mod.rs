@@ -44,10 +44,9 @@ impl TaaParams {
 /// What TAA leaves in a frame.
 #[derive(Clone, Copy, Debug)]
 pub struct TaaFrame {
-    /// The anti-aliased radiance in nits (alpha 1).
+    /// The anti-aliased radiance in nits: this frame's history (`taa.history`), which the
+    /// passes after TAA read; its alpha is the number of frames it averages, not coverage.
     pub output: Tex,
-    /// This frame's history: rgb radiance, alpha the frames it averages.
-    pub history: Tex,
 }
 
 pub struct Taa {
@@ -73,7 +72,6 @@ impl Taa {
         history_valid: bool,
     ) -> Result<TaaFrame> {
         let history = g.history_texture("taa.history", TextureDesc::d2(w, h, HISTORY_FORMAT))?;
-        let out = g.texture("taa.output", TextureDesc::d2(w, h, HISTORY_FORMAT))?;
         let params = TaaParams::new(s, history_valid && history.valid);
         g.pass("taa.resolve")
             .constants(&params)
@@ -81,11 +79,9 @@ impl Taa {
             .read(motion)
             .read(history.prev)
             .write(history.cur)
-            .write(out)
             .dispatch_threads(&self.resolve, [w, h, 1])?;
         Ok(TaaFrame {
-            output: out,
-            history: history.cur,
+            output: history.cur,
         })
     }
 }

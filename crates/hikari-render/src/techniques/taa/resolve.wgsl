@@ -1,5 +1,11 @@
 // Temporal anti-aliasing resolve: this frame's radiance blended into the reprojected history,
 // the history clipped to the current 3x3 neighbourhood in YCoCg. Twin: taa/reference.rs.
+//
+// Bytes a pixel: the current radiance once (a 16x16 tile and its 1-pixel apron go through
+// workgroup memory, converted to YCoCg once per texel, so that the nine neighbours cost no
+// texture reads), the motion vector, the bilinear history (mostly hits in cache: neighbours
+// share texels) and one 8-byte store. The history is the output: the passes after TAA read it
+// (its alpha is the number of frames it averages, not coverage).
 
 struct TaaParams {
     history_valid: u32,
@@ -13,7 +19,11 @@ struct TaaParams {
 @group(0) @binding(2) var motion: texture_2d<f32>;
 @group(0) @binding(3) var history_prev: texture_2d<f32>;
 @group(0) @binding(4) var history_cur: texture_storage_2d<rgba16float, write>;
-@group(0) @binding(5) var out_radiance: texture_storage_2d<rgba16float, write>;
+
+const TILE: i32 = 16;
+const APRON: i32 = TILE + 2;
+// This frame's radiance around the workgroup's tile, sanitised, in YCoCg.
+var<workgroup> tile: array<vec3<f32>, 324>;
 
 const MAX_HALF: f32 = 65504.0;
 
@@ -43,31 +53,42 @@ fn clip_to_box(p: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> vec3<f32> {
     return select(p, centre + d / ratio, ratio > 1.0);
 }
 
-fn load_current(p: vec2<i32>, size: vec2<i32>) -> vec3<f32> {
-    return sanitize(textureLoad(current, clamp(p, vec2<i32>(0), size - 1), 0).rgb);
-}
-
 fn load_history(p: vec2<i32>, size: vec2<i32>) -> vec4<f32> {
     return textureLoad(history_prev, clamp(p, vec2<i32>(0), size - 1), 0);
 }
 
 @compute @workgroup_size(16, 16, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+fn main(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) lid: u32,
+) {
     let size = vec2<i32>(textureDimensions(current));
+    // The tile and its apron: 18x18 texels, edges clamped, two loads a thread at most.
+    let origin = vec2<i32>(wg.xy) * TILE - 1;
+    for (var k = i32(lid); k < APRON * APRON; k += TILE * TILE) {
+        let q = clamp(origin + vec2<i32>(k % APRON, k / APRON), vec2<i32>(0), size - 1);
+        tile[k] = rgb_to_ycocg(sanitize(textureLoad(current, q, 0).rgb));
+    }
+    workgroupBarrier();
     let px = vec2<i32>(id.xy);
     if any(px >= size) {
         return;
     }
-    let cur = load_current(px, size);
-    var lo = vec3<f32>(3.0e38);
-    var hi = vec3<f32>(-3.0e38);
+    let t = px - origin;
+    let cur_y = tile[t.y * APRON + t.x];
+    var lo = cur_y;
+    var hi = cur_y;
     for (var dy = -1; dy <= 1; dy++) {
         for (var dx = -1; dx <= 1; dx++) {
-            let v = rgb_to_ycocg(load_current(px + vec2<i32>(dx, dy), size));
+            let v = tile[(t.y + dy) * APRON + t.x + dx];
             lo = min(lo, v);
             hi = max(hi, v);
         }
     }
+    // The pixel's own radiance as loaded, not back from YCoCg: a frame without history is then
+    // its input to the bit (the texel is in cache from the tile's load).
+    let cur = sanitize(textureLoad(current, px, 0).rgb);
 
     var resolved = vec4<f32>(cur, 1.0);
     let prev_pos = vec2<f32>(px) + 0.5 + textureLoad(motion, px, 0).xy;
@@ -90,5 +111,4 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         resolved = vec4<f32>(sanitize(mix(p, cur, alpha)), min(n + 1.0, params.max_history));
     }
     textureStore(history_cur, px, resolved);
-    textureStore(out_radiance, px, vec4<f32>(resolved.rgb, 1.0));
 }

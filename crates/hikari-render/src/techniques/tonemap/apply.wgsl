@@ -2,6 +2,11 @@
 // Purkinje shift at absolute luminance -> exposure and local gain -> Rec.709 to the
 // tonemapping space with the white balance folded in -> Uchimura's curve per channel ->
 // Rec.709 -> sRGB -> 3D LUT grade -> dither. CPU twin: `tonemap::reference::apply`.
+// The local gain is either evaluated here from the local tonemap's blurred grid and wide
+// Gaussian (the frame: no full-resolution gain image is written or read) or read from a gain
+// image (tests and tools).
+
+#import hikari::local_tonemap::{LocalTonemapParams, grid_log2, local_gain}
 
 struct TonemapParams {
     // Rows L, M, S, R of the talk's shader matrix (w unused).
@@ -21,22 +26,28 @@ struct TonemapParams {
     lut_domain_max: vec4<f32>,
     // x: switch bits (1 Purkinje, 2 local gain, 4 curve, 8 LUT, 16 dither); y: dither seed.
     switches: vec4<u32>,
+    // The local tonemap's uniforms, when LOCAL_GRID is set.
+    local: LocalTonemapParams,
 }
 
 @group(0) @binding(0) var<uniform> params: TonemapParams;
 @group(0) @binding(1) var hdr: texture_2d<f32>;
-// The exposure technique's `exposure.value`: (scale, ev100, metered lux, 0).
+// The exposure technique's `exposure.value`: (scale, ev100, metered lux, highlight).
 @group(0) @binding(2) var<storage, read> exposure: vec4<f32>;
 @group(0) @binding(3) var log2_gain: texture_2d<f32>;
-@group(0) @binding(4) var lut: texture_3d<f32>;
-@group(0) @binding(5) var lut_sampler: sampler;
-@group(0) @binding(6) var ldr: texture_storage_2d<rgba8unorm, write>;
+// The local tonemap's blurred grid and upsampled wide Gaussian (LOCAL_GRID).
+@group(0) @binding(4) var local_grid: texture_3d<f32>;
+@group(0) @binding(5) var local_wide: texture_2d<f32>;
+@group(0) @binding(6) var lut: texture_3d<f32>;
+@group(0) @binding(7) var lut_sampler: sampler;
+@group(0) @binding(8) var ldr: texture_storage_2d<rgba8unorm, write>;
 
 const PURKINJE: u32 = 1u;
 const LOCAL_GAIN: u32 = 2u;
 const CURVE: u32 = 4u;
 const LUT: u32 = 8u;
 const DITHER: u32 = 16u;
+const LOCAL_GRID: u32 = 32u;
 
 fn rows3(m: array<vec4<f32>, 3>, c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(m[0].xyz, c), dot(m[1].xyz, c), dot(m[2].xyz, c));
@@ -108,7 +119,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let flags = params.switches.x;
-    var c = textureLoad(hdr, id.xy, 0).rgb;
+    let raw = textureLoad(hdr, id.xy, 0).rgb;
+    var c = raw;
     // `!(x >= 0)` also catches NaN.
     c = select(vec3<f32>(0.0), c, c >= vec3<f32>(0.0));
     c = min(c, vec3<f32>(6.0e4));
@@ -116,7 +128,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         c = max(purkinje_shift(c), vec3<f32>(0.0));
     }
     var scale = exposure.x;
-    if (flags & LOCAL_GAIN) != 0u {
+    if (flags & LOCAL_GRID) != 0u {
+        // From the radiance as it came, as `local_tonemap.apply` computes it.
+        let uv = (vec2<f32>(id.xy) + 0.5) / vec2<f32>(size);
+        let v = grid_log2(raw, exposure.x, params.local);
+        scale = scale * exp2(local_gain(v, uv, params.local, exposure.w, local_grid, local_wide));
+    } else if (flags & LOCAL_GAIN) != 0u {
         scale = scale * exp2(textureLoad(log2_gain, id.xy, 0).r);
     }
     c = c * scale;

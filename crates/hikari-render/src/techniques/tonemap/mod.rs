@@ -4,7 +4,8 @@
 //! 1. Purkinje shift at absolute scene luminance, before exposure (the talk's three-line
 //!    shader with the matrices of [`hikari_math::color::purkinje`], times a strength, faded
 //!    out as the rods saturate);
-//! 2. times the exposure's scale (`exposure.value`) and `exp2` of the local tonemap's gain;
+//! 2. times the exposure's scale (`exposure.value`) and `exp2` of the local tonemap's gain,
+//!    evaluated here from its blurred grid and wide Gaussian (no full-resolution gain image);
 //! 3. one matrix to the tonemapping space (ACEScg with red x 0.75), the white balance (von
 //!    Kries in Bradford LMS to the artist's white) folded in;
 //! 4. Uchimura's curve per channel (toe, linear section, shoulder), back to Rec.709;
@@ -34,6 +35,7 @@ use crate::error::{RenderError, Result};
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
+use crate::techniques::local_tonemap::{GAIN_FORMAT, LocalTonemapFrame, LocalTonemapParams};
 use cube::CubeLut;
 use settings::TonemapSettings;
 
@@ -45,6 +47,8 @@ pub const SWITCH_LOCAL_GAIN: u32 = 2;
 pub const SWITCH_CURVE: u32 = 4;
 pub const SWITCH_LUT: u32 = 8;
 pub const SWITCH_DITHER: u32 = 16;
+/// The local gain is evaluated from the local tonemap's grid ([`LocalGain::Grid`]).
+pub const SWITCH_LOCAL_GRID: u32 = 32;
 
 /// The uniforms of `tonemap/apply.wgsl` (see it for each field). Matrices are rows.
 #[repr(C)]
@@ -60,6 +64,8 @@ pub struct TonemapParams {
     pub lut_domain_min: [f32; 4],
     pub lut_domain_max: [f32; 4],
     pub switches: [u32; 4],
+    /// The local tonemap's uniforms (zero unless [`SWITCH_LOCAL_GRID`] is set).
+    pub local: LocalTonemapParams,
 }
 
 fn rows4(m: &Mat3Rows, scale: f64) -> [[f32; 4]; 3] {
@@ -153,18 +159,27 @@ impl TonemapParams {
             lut_domain_min: [dmin[0], dmin[1], dmin[2], n],
             lut_domain_max: [dmax[0], dmax[1], dmax[2], 0.0],
             switches: [switches, dither_seed, 0, 0],
+            local: LocalTonemapParams::zeroed(),
         })
+    }
+
+    /// The same uniforms with the local gain evaluated from the local tonemap's grid with
+    /// `local` (instead of read from a gain image).
+    pub fn with_local_grid(mut self, local: LocalTonemapParams) -> Self {
+        self.switches[0] = (self.switches[0] & !SWITCH_LOCAL_GAIN) | SWITCH_LOCAL_GRID;
+        self.local = local;
+        self
     }
 }
 
-/// `exposure.value` as the exposure technique lays it out: `(scale, ev100, metered lux, 0)`,
-/// scale = 1 / (1.2 · 2^ev100).
+/// `exposure.value` as the exposure technique lays it out: `(scale, ev100, metered lux,
+/// highlight)`, scale = 1 / (1.2 · 2^ev100), no highlight metered.
 pub fn exposure_value_from_ev100(ev100: f32, metered_lux: f32) -> [f32; 4] {
     [
         crate::techniques::exposure::reference::scale_from_ev100(ev100),
         ev100,
         metered_lux,
-        0.0,
+        crate::techniques::exposure::NO_HIGHLIGHT,
     ]
 }
 
@@ -173,10 +188,33 @@ pub fn exposure_value_from_ev100(ev100: f32, metered_lux: f32) -> [f32; 4] {
 pub struct TonemapInputs {
     /// Linear Rec.709 radiance in nits (Rgba16Float).
     pub hdr: Tex,
-    /// `exposure.value`, 16 bytes: `(scale, ev100, metered lux, 0)`.
+    /// `exposure.value`, 16 bytes: `(scale, ev100, metered lux, highlight)`.
     pub exposure: Buf,
-    /// `local_tonemap.log2_gain` (R16Float, full resolution), if the local tonemap ran.
-    pub log2_gain: Option<Tex>,
+    /// The local tonemap's gain, if it ran.
+    pub local: Option<LocalGain>,
+}
+
+/// Where `tonemap.apply` takes the local tonemap's log2 gain from.
+#[derive(Clone, Copy, Debug)]
+pub enum LocalGain {
+    /// Evaluated per pixel from the blurred grid (`local_tonemap.grid_blurred`) and the wide
+    /// Gaussian (`local_tonemap.wide`) with these uniforms: what the frame does.
+    Grid {
+        grid: Tex,
+        wide: Tex,
+        params: LocalTonemapParams,
+    },
+    /// Read from a full-resolution R16Float image (`local_tonemap.log2_gain`; tests, tools).
+    Image(Tex),
+}
+
+impl LocalGain {
+    /// The grid lookup of a frame's local tonemap, `None` when it was off.
+    pub fn of(frame: &LocalTonemapFrame) -> Option<Self> {
+        frame
+            .lookup()
+            .map(|(grid, wide, params)| LocalGain::Grid { grid, wide, params })
+    }
 }
 
 struct LoadedLut {
@@ -288,23 +326,40 @@ impl Tonemap {
             Some(p) => Some(self.lut(g.ctx(), p)?),
             None => None,
         };
-        let params = TonemapParams::new(
+        let mut params = TonemapParams::new(
             s,
             loaded.as_ref().map(|l| &l.lut),
-            inputs.log2_gain.is_some(),
+            matches!(inputs.local, Some(LocalGain::Image(_))),
             // One fixed pattern: a frame's image depends on its input alone (renders of the
             // same input are bitwise equal), and nothing after this pass averages frames.
             0,
         )?;
-        let gain = match inputs.log2_gain {
-            Some(t) => t,
-            // Never read (the switch is off); persistent so that it counts as written.
-            None => {
-                g.persistent_texture(
-                    "tonemap.no_gain",
-                    TextureDesc::d2(1, 1, wgpu::TextureFormat::R16Float),
-                )?
-                .0
+        let (gain, grid, wide) = match inputs.local {
+            Some(LocalGain::Grid {
+                grid,
+                wide,
+                params: p,
+            }) => {
+                params = params.with_local_grid(p);
+                let gain = stand_in(g, "tonemap.no_gain", TextureDesc::d2(1, 1, GAIN_FORMAT))?;
+                (gain, grid, wide)
+            }
+            other => {
+                let gain = match other {
+                    Some(LocalGain::Image(t)) => t,
+                    _ => stand_in(g, "tonemap.no_gain", TextureDesc::d2(1, 1, GAIN_FORMAT))?,
+                };
+                let grid = stand_in(
+                    g,
+                    "tonemap.no_grid",
+                    TextureDesc::d3(1, 1, 1, wgpu::TextureFormat::Rgba32Float),
+                )?;
+                let wide = stand_in(
+                    g,
+                    "tonemap.no_wide",
+                    TextureDesc::d2(1, 1, wgpu::TextureFormat::R32Float),
+                )?;
+                (gain, grid, wide)
             }
         };
         let lut = match &loaded {
@@ -323,12 +378,20 @@ impl Tonemap {
             .read(inputs.hdr)
             .read(inputs.exposure)
             .read(gain)
+            .read(grid)
+            .read(wide)
             .read(lut)
             .sampler(SamplerKind::LinearClamp)
             .write(ldr)
             .dispatch_threads(&self.apply, [size[0], size[1], 1])?;
         Ok(ldr)
     }
+}
+
+/// A 1-texel texture bound where the switches leave a binding unread; persistent so that it
+/// counts as written.
+fn stand_in(g: &mut FrameGraph<'_>, name: &str, desc: TextureDesc) -> Result<Tex> {
+    Ok(g.persistent_texture(name, desc)?.0)
 }
 
 /// An `exposure.value` buffer written from a fixed EV100 on the CPU, for driving the tonemap

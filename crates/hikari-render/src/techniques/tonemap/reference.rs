@@ -4,7 +4,8 @@
 
 use super::cube::CubeLut;
 use super::{
-    SWITCH_CURVE, SWITCH_DITHER, SWITCH_LOCAL_GAIN, SWITCH_LUT, SWITCH_PURKINJE, TonemapParams,
+    SWITCH_CURVE, SWITCH_DITHER, SWITCH_LOCAL_GAIN, SWITCH_LOCAL_GRID, SWITCH_LUT, SWITCH_PURKINJE,
+    TonemapParams,
 };
 
 fn rows3(m: &[[f32; 4]; 3], c: [f32; 3]) -> [f32; 3] {
@@ -108,7 +109,7 @@ pub fn apply(
         c = purkinje(p, c).map(|v| v.max(0.0));
     }
     let mut s = scale;
-    if flags & SWITCH_LOCAL_GAIN != 0 {
+    if flags & (SWITCH_LOCAL_GAIN | SWITCH_LOCAL_GRID) != 0 {
         s *= log2_gain.exp2();
     }
     let c = tone(p, c.map(|v| v * s)).map(|v| if v.is_nan() { 0.0 } else { v });

@@ -15,7 +15,8 @@ pub struct TonemapSettings {
     /// Scale of the Purkinje colour change (1: the talk's constants as they are). The talk
     /// does not give its receptor normalisation; with hikari-math's (a white of 1 cd/m² gives
     /// LMSR ≈ 1) strength 1 turns a moonlit grey into (1, 8.5, 36) times itself, so the
-    /// default is 0.1: clearly blue at night, readable (docs/tonemapping.md).
+    /// default is 0.05: moonlight clearly blue and readable, lamplight still warm (at 0.1 the
+    /// lamp-lit trees of the village at 23:00 turn pink; docs/tonemapping.md).
     pub purkinje_strength: f32,
     /// Rod response, in cd/m² of scotopic-weighted luminance, at which the shift is halved:
     /// the change is multiplied by `sat / (sat + rod)`, so the rods fade out of daylight as
@@ -57,7 +58,7 @@ impl Default for TonemapSettings {
     fn default() -> Self {
         Self {
             purkinje: true,
-            purkinje_strength: 0.1,
+            purkinje_strength: 0.05,
             purkinje_rod_saturation: 0.5,
             white_balance: true,
             white: [1.0, 1.0, 1.0],
