@@ -824,6 +824,8 @@ fn hits_are_lit_like_the_twin() {
     let mut s = rtgi_settings(&scene, w, h);
     s.sun = None;
     s.settings.ray_traced_gi.accumulate = false;
+    // Exact against the twin: no roulette on the shadow rays (tested on its own).
+    s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let light = renderer.scene().cpu.lights[0];
     let area = renderer.area_lights().lights.clone();
@@ -1049,6 +1051,21 @@ fn resolve_helpers_match_the_cpu_twin() {
 /// edge). At least 5 % of the hits must be shadowed from the light picked.
 #[test]
 fn point_lights_at_hits_cast_shadows_like_the_twin() {
+    point_lights_at_hits(0.0);
+}
+
+/// As [`point_lights_at_hits_cast_shadows_like_the_twin`], with the shadow ray's Russian
+/// roulette at 100 times the metered illuminance (a fixed EV100 of 0: 2.5 lux, so 250 lux, above
+/// every light's estimate here): each hit's shadow ray is traced only if the seventh random
+/// number of its pixel falls below estimate / 250 lux, and its light is then divided by that
+/// chance, so that a traced, unblocked light always has a luminance of 250 lux. At least 5 %
+/// of the hits must be skipped by the roulette and 5 % traced.
+#[test]
+fn point_light_shadow_rays_at_hits_play_russian_roulette_like_the_twin() {
+    point_lights_at_hits(100.0);
+}
+
+fn point_lights_at_hits(roulette: f32) {
     use hikari_scene::{Light, LightKind};
     let (board_y, board_half) = (1.3f32, 0.2f32);
     let board_at = Vec3::new(0.3, board_y, 0.2);
@@ -1118,6 +1135,10 @@ fn point_lights_at_hits_cast_shadows_like_the_twin() {
     // Every ray through the BVH: the pre-trace's screen-space hits near the board's edges are
     // its own approximation (`pretrace_hits_agree_with_the_bvh`).
     s.settings.ray_traced_gi.pretrace = false;
+    s.settings.ray_traced_gi.hit_shadow_roulette = roulette;
+    s.settings.exposure.ev100 = Some(0.0);
+    let level = roulette * s.metered_lux();
+    let (mut skipped, mut traced) = (0, 0);
     assert!(s.settings.area_lights.enabled && s.settings.area_lights.punctual_shadows);
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let lights = renderer.scene().cpu.lights.clone();
@@ -1194,10 +1215,20 @@ fn point_lights_at_hits_cast_shadows_like_the_twin() {
                         let sb = (board_y - p.y) / (at.y - p.y);
                         let blocked =
                             (p.y - board_y) * (at.y - board_y) < 0.0 && in_board(p + (at - p) * sb);
-                        if blocked {
+                        // The roulette (off at level 0): the estimate's luminance is `total`.
+                        let q = if level > 0.0 {
+                            (total / level).clamp(1e-6, 1.0)
+                        } else {
+                            1.0
+                        };
+                        if reference::random([x, y], 0, 5) >= q {
+                            skipped += 1;
+                        } else if blocked {
+                            traced += 1;
                             shadowed += 1;
                         } else {
-                            e = ek * (total / lum(ek));
+                            traced += 1;
+                            e = ek * (total / lum(ek)) / q;
                         }
                         dbg_pick = Some((k, blocked, p));
                     }
@@ -1237,10 +1268,16 @@ fn point_lights_at_hits_cast_shadows_like_the_twin() {
         off <= (w * h) as usize / 200,
         "{off} pixels differ from the twin"
     );
-    assert!(
-        shadowed >= (w * h) as usize / 20,
-        "only {shadowed} pixels' hits are shadowed"
-    );
+    if roulette > 0.0 {
+        eprintln!("roulette: {skipped} hits skipped, {traced} traced");
+        assert!(skipped >= hits / 20 && traced >= hits / 20);
+    } else {
+        assert_eq!(skipped, 0);
+        assert!(
+            shadowed >= (w * h) as usize / 20,
+            "only {shadowed} pixels' hits are shadowed"
+        );
+    }
 }
 
 /// The sun's shadow at hits from the shadow maps (inside a cascade) against shadow rays
@@ -1904,6 +1941,8 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
     let mut s = rtgi_settings(&scene, w, h);
     s.sun = None;
     s.settings.ray_traced_gi.accumulate = false;
+    // Exact against the twin: no roulette on the shadow rays (tested on its own).
+    s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
     s.settings.area_lights.min_flux_lm = 0.25;
     let min_flux = s.settings.area_lights.min_flux_lm;
     let shadows = s.settings.area_lights.punctual_shadows;

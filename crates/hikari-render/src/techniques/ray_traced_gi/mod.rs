@@ -113,7 +113,8 @@ pub struct RtGiParams {
     /// Placeholder sky radiance in nits at the zenith and the horizon.
     pub sky_zenith: [f32; 4],
     pub sky_horizon: [f32; 4],
-    /// Lights at hits: the area lights (a count), their minimum flux (lm), 0, 0.
+    /// Lights at hits: the area lights (a count), their minimum flux (lm), the illuminance (lux)
+    /// below which a local light's shadow ray plays Russian roulette (0: never), 0.
     pub area: [f32; 4],
     /// The accumulation's firefly clamp ([`reference::FireflyClamp`]): k (0: off), the floor
     /// (SH c0 units), the history length from which it applies; w unused.
@@ -182,7 +183,7 @@ impl RtGiParams {
             sun_color: color.extend(1.0).to_array(),
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky_scale).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
-            area: [0.0; 4],
+            area: [0.0, 0.0, s.hit_shadow_roulette * metered_lux.max(0.0), 0.0],
             firefly: reference::FireflyClamp::new(s.firefly_clamp, metered_lux).to_array(),
         }
     }
@@ -200,7 +201,7 @@ impl RtGiParams {
     ) -> Self {
         self.set_flag(FLAG_AREA, enabled && area_lights > 0);
         self.set_flag(FLAG_PUNCTUAL_SHADOWS, enabled && punctual_shadows);
-        self.area = [area_lights as f32, min_flux_lm, 0.0, 0.0];
+        self.area = [area_lights as f32, min_flux_lm, self.area[2], 0.0];
         self
     }
 

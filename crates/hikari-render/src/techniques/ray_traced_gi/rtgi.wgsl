@@ -136,7 +136,9 @@ struct RtGiParams {
     // Placeholder sky radiance (nits) at the zenith and the horizon (atmosphere off).
     sky_zenith: vec4<f32>,
     sky_horizon: vec4<f32>,
-    // Lights at hits: x area lights (a count, exact in f32), y their minimum flux (lm), z, w 0.
+    // Lights at hits: x area lights (a count, exact in f32), y their minimum flux (lm), z the
+    // illuminance (lux) below which a local light's shadow ray plays Russian roulette (0: never),
+    // w 0.
     area: vec4<f32>,
     // The accumulation's firefly clamp: x: k (0: off), y: the floor (SH c0), z: the history
     // length from which it applies.

@@ -313,8 +313,24 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     if !(luminance(e) > 0.0) {
         return vec3<f32>(0.0);
     }
+    let est = e * (total / chosen_s);
+    let q = roulette_chance(est);
+    if rtgi_random(pixel, frame, 4u) >= q {
+        return vec3<f32>(0.0);
+    }
     let uv = vec2<f32>(rtgi_random(pixel, frame, 1u), rtgi_random(pixel, frame, 2u));
-    return e * (total / chosen_s * area_light_visible(chosen, x, n, uv));
+    return est * (area_light_visible(chosen, x, n, uv) / q);
+}
+
+// The chance (in (0, 1]) that the shadow ray of a local light's estimate `est` (lux) is
+// traced: 1 at or above the roulette's illuminance, else in proportion to it (reference::
+// roulette_chance). The light is divided by it where traced and 0 where not.
+fn roulette_chance(est: vec3<f32>) -> f32 {
+    let level = params.area.z;
+    if !(level > 0.0) {
+        return 1.0;
+    }
+    return clamp(luminance(est) / level, 1e-6, 1.0);
 }
 
 // Irradiance (lux) at x on a surface facing n from the sun or moon and the sky.
@@ -400,12 +416,17 @@ fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32
     if chosen == NO_LIGHT {
         return vec3<f32>(0.0);
     }
+    let est = chosen_e * (total / luminance(chosen_e));
+    let q = roulette_chance(est);
+    if rtgi_random(pixel, params.config.x, 5u) >= q {
+        return vec3<f32>(0.0);
+    }
     let to_light = lights[chosen].position_range.xyz - x;
     let dist = length(to_light);
     if bvh_occluded(Ray(x, 0.0, to_light / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
         return vec3<f32>(0.0);
     }
-    return chosen_e * (total / luminance(chosen_e));
+    return est / q;
 }
 
 @compute @workgroup_size(8, 8, 1)
