@@ -81,7 +81,7 @@ impl Default for RayTracedGiSettings {
             max_history: 32,
             depth_tolerance: 0.05,
             firefly_clamp: 8.0,
-            hit_shadow_roulette: 0.05,
+            hit_shadow_roulette: 1.0,
             near_field_m: 250.0,
             near_field_blend: 0.2,
         }
