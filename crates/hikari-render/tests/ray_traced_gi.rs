@@ -2122,3 +2122,41 @@ fn village_light_grid_size() {
         grid.bytes() as f64 / 1024.0
     );
 }
+
+/// A lamp's glowing shell around a point light (the village's paper lanterns, left out of the
+/// area lights) is marked like an area light in the GI's instance table (w = 1), so that a hit
+/// on it does not add its emission: the light inside already lights the hits, and the small,
+/// bright paper hit by few rays made white speckle at night. Emissive instances that no light
+/// stands for keep w = 0.
+#[test]
+fn lamp_shells_do_not_add_their_emission_at_hits() {
+    use hikari_render::techniques::area_lights::PolygonLights;
+    use hikari_render::techniques::area_lights::lights::SKIPPED_LAMP_SHELL;
+    let scene = hikari_scene::builtin::village();
+    let table = reference::instance_table(&scene);
+    let area = PolygonLights::for_scene(&scene);
+    let shells: Vec<usize> = area
+        .skipped
+        .iter()
+        .filter(|(_, why)| *why == SKIPPED_LAMP_SHELL)
+        .map(|(k, _)| *k)
+        .collect();
+    assert!(
+        shells.len() >= 10,
+        "the village's lanterns: {} shells",
+        shells.len()
+    );
+    for &k in &shells {
+        let e = table[2 * k + 1];
+        assert!(e[0] + e[1] + e[2] > 0.0, "shell {k} emits");
+        assert_eq!(
+            e[3], 1.0,
+            "shell {k}: its emission must not be added at hits"
+        );
+    }
+    for (k, why) in &area.skipped {
+        if *why != SKIPPED_LAMP_SHELL {
+            assert_eq!(table[2 * k + 1][3], 0.0, "instance {k}, skipped as {why}");
+        }
+    }
+}

@@ -50,6 +50,10 @@ pub struct AreaTriangleGpu {
     pub p2: [f32; 4],
 }
 
+/// Why [`PolygonLights::for_scene`] leaves out a lamp's glowing shell: a point or spot light lies
+/// inside it, and that light stands for the shell's own (the village's paper lanterns).
+pub const SKIPPED_LAMP_SHELL: &str = "a point or spot light lies inside it";
+
 /// The scene's area lights.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PolygonLights {
@@ -76,6 +80,25 @@ impl PolygonLights {
                     .push((i, "its material's area_light flag is false"));
                 continue;
             }
+            // A lamp's shell before the size rule: the GI's instance table tells shells from
+            // other skipped emitters by this reason, whatever their triangle count.
+            if forced.is_none() {
+                let (lo, hi) = mesh.positions.iter().fold(
+                    (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+                    |(lo, hi), p| {
+                        let p = inst.transform.transform_point3(*p);
+                        (lo.min(p), hi.max(p))
+                    },
+                );
+                if scene
+                    .lights
+                    .iter()
+                    .any(|l| l.position.cmpge(lo).all() && l.position.cmple(hi).all())
+                {
+                    out.skipped.push((i, SKIPPED_LAMP_SHELL));
+                    continue;
+                }
+            }
             let limit = if forced == Some(true) {
                 MAX_FORCED_LIGHT_TRIANGLES
             } else {
@@ -93,21 +116,6 @@ impl PolygonLights {
                         .map(|v| inst.transform.transform_point3(mesh.positions[v as usize]))
                 })
                 .collect();
-            if forced.is_none() {
-                let (lo, hi) = tris.iter().flatten().fold(
-                    (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-                    |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-                );
-                if scene
-                    .lights
-                    .iter()
-                    .any(|l| l.position.cmpge(lo).all() && l.position.cmple(hi).all())
-                {
-                    out.skipped
-                        .push((i, "a point or spot light lies inside it"));
-                    continue;
-                }
-            }
             let areas: Vec<f32> = tris
                 .iter()
                 .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())

@@ -206,8 +206,18 @@ pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
             let m = &scene.materials[i.material];
             let albedo = albedo[k];
             let emission = m.emissive_nits * mean_of(m.emissive_texture);
-            let is_area_light =
-                emission.max_element() > 0.0 && !area.skipped.iter().any(|(s, _)| *s == k);
+            // w = 1: a GI hit does not add this emission, because a light already sends it:
+            // an area light (the area-light pass), or a lamp's shell around a point or spot
+            // light (that light, which lights hits itself). Added too, a lantern's paper was
+            // counted twice and, small and bright, hit by few rays: night's white speckle.
+            let skipped = area
+                .skipped
+                .iter()
+                .find(|(s, _)| *s == k)
+                .map(|(_, why)| *why);
+            let is_area_light = emission.max_element() > 0.0
+                && (skipped.is_none()
+                    || skipped == Some(crate::techniques::area_lights::lights::SKIPPED_LAMP_SHELL));
             [
                 albedo.extend(0.0).to_array(),
                 emission
