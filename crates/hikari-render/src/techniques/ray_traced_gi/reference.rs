@@ -709,35 +709,6 @@ pub fn resolve_specular(s: &ShL1YCoCg, n: Vec3, v: Vec3, f0: Vec3, material_alph
     (f * spec * e * n_l).as_vec3()
 }
 
-#[cfg(test)]
-mod tests {
-    use super::pick_weighted;
-
-    /// The hit's one-light estimate `v_k * total / s_k`, averaged over the random number,
-    /// is the sum of every light's value whatever the scores (all above 0 where a value is):
-    /// the selection is unbiased. A score of 0 drops its light.
-    #[test]
-    fn picking_by_score_is_unbiased() {
-        let scores = [3.0f32, 0.0, 0.5, 10.0, 0.2];
-        let values = [2.0f32, 0.0, 7.0, 0.25, 40.0];
-        let n = 200_000;
-        let mean = (0..n)
-            .map(|k| {
-                let u = (k as f32 + 0.5) / n as f32;
-                let (i, s, total) = pick_weighted(scores, u).expect("some score is above 0");
-                (values[i] * total / s) as f64
-            })
-            .sum::<f64>()
-            / n as f64;
-        let want: f32 = values.iter().sum();
-        assert!(
-            (mean - want as f64).abs() < 2e-3 * want as f64,
-            "mean {mean}, sum {want}"
-        );
-        assert_eq!(pick_weighted([0.0, f32::NAN], 0.5), None);
-    }
-}
-
 /// Largest radiance (nits) in any channel of a sample: what f16 holds, with margin.
 pub const MAX_SAMPLE_RADIANCE: f32 = 65_000.0;
 
@@ -781,5 +752,34 @@ pub fn cap_sample_radiance(l: Vec3, cap_nits: f32) -> Vec3 {
         l * (cap_nits / y)
     } else {
         l
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pick_weighted;
+
+    /// The hit's one-light estimate `v_k * total / s_k`, averaged over the random number,
+    /// is the sum of every light's value whatever the scores (all above 0 where a value is):
+    /// the selection is unbiased. A score of 0 drops its light.
+    #[test]
+    fn picking_by_score_is_unbiased() {
+        let scores = [3.0f32, 0.0, 0.5, 10.0, 0.2];
+        let values = [2.0f32, 0.0, 7.0, 0.25, 40.0];
+        let n = 200_000;
+        let mean = (0..n)
+            .map(|k| {
+                let u = (k as f32 + 0.5) / n as f32;
+                let (i, s, total) = pick_weighted(scores, u).expect("some score is above 0");
+                (values[i] * total / s) as f64
+            })
+            .sum::<f64>()
+            / n as f64;
+        let want: f32 = values.iter().sum();
+        assert!(
+            (mean - want as f64).abs() < 2e-3 * want as f64,
+            "mean {mean}, sum {want}"
+        );
+        assert_eq!(pick_weighted([0.0, f32::NAN], 0.5), None);
     }
 }
