@@ -290,6 +290,8 @@ pub fn record<'r>(
             bvh: rt_bvh.gi,
             shadow_bvh: rt_bvh.shadow,
             area,
+            // Step 14's exposure of the last frame: this frame's is not known yet.
+            exposure: Exposure::previous(g)?,
         };
         let (frame, rays) =
             t.ray_traced_gi

@@ -134,7 +134,8 @@ pub fn all() -> Vec<StructLayout> {
                 sky_zenith,
                 sky_horizon,
                 area,
-                firefly
+                firefly,
+                exposure
             ]
         ),
         gpu_layout!(

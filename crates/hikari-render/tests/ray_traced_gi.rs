@@ -826,6 +826,9 @@ fn hits_are_lit_like_the_twin() {
     s.settings.ray_traced_gi.accumulate = false;
     // Exact against the twin: no roulette on the shadow rays (tested on its own).
     s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
+    // No sun and the meter's exposure: a first frame's CPU meter reads its floor, 1e-3 lux, and
+    // would cap every sample; the cap has its own test (`a_hit_beside_a_lamp_is_capped_...`).
+    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let light = renderer.scene().cpu.lights[0];
     let area = renderer.area_lights().lights.clone();
@@ -1137,6 +1140,8 @@ fn point_lights_at_hits(roulette: f32) {
     s.settings.ray_traced_gi.pretrace = false;
     s.settings.ray_traced_gi.hit_shadow_roulette = roulette;
     s.settings.exposure.ev100 = Some(0.0);
+    // Compared uncapped; the cap has its own test.
+    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
     let level = roulette * s.metered_lux();
     let (mut skipped, mut traced) = (0, 0);
     assert!(s.settings.area_lights.enabled && s.settings.area_lights.punctual_shadows);
@@ -1277,6 +1282,195 @@ fn point_lights_at_hits(roulette: f32) {
             shadowed >= (w * h) as usize / 20,
             "only {shadowed} pixels' hits are shadowed"
         );
+    }
+}
+
+/// The cap on a sample's radiance relative to the exposure (`hit_radiance_cap`), against the
+/// twin (`reference::cap_sample_radiance`, `hit_radiance_cap_nits`): a floor under a ceiling
+/// 0.5 m up with a 2000 cd point light 1 cm below it, whose rays that hit the ceiling right
+/// beside the light bring E = I / d² (up to 2·10⁷ lux, hundreds of times the cap), and the
+/// rest a few hundred nits. Metered exposure, no sun. Frame 1 has no last exposure: no cap
+/// (the CPU meter's floor, 1e-3 lux, would cap every lit sample). Frame 2's
+/// cap is k · 1.2 · 2^EV100 of frame 1's adapted exposure, read back from `exposure.value`
+/// (which the adapt pass writes with the same EV100 as `exposure.state`). k = 4, so that the
+/// capped disk around the light is some 7 cm wide. Both frames: every pixel's sample as the
+/// twin lights and caps it (tolerance as `hits_are_lit_like_the_twin`'s, relative to the
+/// capped value); frame 2 must have both capped samples and lit ones left alone, frame 1 none
+/// capped. A cap from the wrong exposure is off by orders of magnitude.
+#[test]
+fn a_hit_beside_a_lamp_is_capped_relative_to_the_last_exposure() {
+    use hikari_scene::{Light, LightKind};
+    let (ceiling_y, ceiling_albedo) = (0.5f32, Vec3::new(0.8, 0.7, 0.6));
+    let k_cap = 4.0f32;
+    let scene = Scene {
+        meshes: vec![shapes::plane(400.0)],
+        materials: vec![
+            Material::diffuse("floor", Vec3::splat(0.5)),
+            Material::diffuse("ceiling", ceiling_albedo),
+        ],
+        instances: vec![
+            Instance {
+                mesh: 0,
+                material: 0,
+                transform: Mat4::IDENTITY,
+            },
+            Instance {
+                mesh: 0,
+                material: 1,
+                transform: Mat4::from_translation(Vec3::new(0.0, ceiling_y, 0.0))
+                    * Mat4::from_rotation_x(std::f32::consts::PI),
+            },
+        ],
+        lights: vec![Light {
+            name: "against the ceiling".into(),
+            kind: LightKind::Point,
+            position: Vec3::new(0.05, ceiling_y - 0.01, 0.02),
+            direction: Vec3::NEG_Y,
+            intensity_cd: 2000.0,
+            color: Vec3::new(1.0, 0.8, 0.6),
+            range: None,
+        }],
+        cameras: vec![Camera {
+            name: "down".into(),
+            position: Vec3::new(0.0, 0.4, 0.0),
+            target: Vec3::ZERO,
+            up: Vec3::Z,
+            ..Camera::default()
+        }],
+        sun: None,
+        ..Default::default()
+    };
+    let (w, h) = (64u32, 64u32);
+    let mut s = rtgi_settings(&scene, w, h);
+    s.sun = None;
+    s.settings.ray_traced_gi.accumulate = false;
+    s.settings.ray_traced_gi.pretrace = false;
+    s.settings.ray_traced_gi.reuse_lit = false;
+    s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
+    s.settings.ray_traced_gi.hit_radiance_cap = k_cap;
+    // Frame 2 unjittered, so that its pixels' points are the twin's.
+    s.settings.taa.enabled = false;
+    assert_eq!(s.settings.exposure.ev100, None, "the metered exposure");
+    let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
+    let light = renderer.scene().cpu.lights[0];
+    let view = View::new(&s.camera, w, h);
+    let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
+    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let down = reference::oct_decode(
+        reference::unpack_normal(reference::pack_normal(reference::oct_encode(Vec3::NEG_Y)))
+            .unwrap(),
+    );
+    let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    // The first frame's EV100: the CPU meter's (`FrameSettings::ev100`), no history.
+    let mut ev100 = s.ev100();
+    assert!((ev100 - (1e-3f32 * 0.4).log2()).abs() < 1e-5, "{ev100}");
+    for frame in 0..2u32 {
+        // No cap without a last exposure (0: none).
+        let cap = if frame == 0 {
+            0.0
+        } else {
+            reference::hit_radiance_cap_nits(k_cap, ev100)
+        };
+        assert!(cap >= 0.0 && cap.is_finite());
+        let mut picked = None;
+        let mut r = renderer
+            .render_reading(&s, |o| {
+                let f = o.ray_traced_gi.unwrap();
+                picked = Some(f);
+                vec![
+                    f.gi_y.into(),
+                    f.gi_cocg.into(),
+                    f.hit_distance.into(),
+                    o.gbuffer.depth.into(),
+                    o.gbuffer.normal.into(),
+                    o.exposure.value.into(),
+                ]
+            })
+            .unwrap();
+        let f = picked.unwrap();
+        let gy = r.take_image_of(f.gi_y).unwrap();
+        let gc = r.take_image_of(f.gi_cocg).unwrap();
+        let gd = r.take_image_of(f.hit_distance).unwrap();
+        let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
+        let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
+        let value: Vec<f32> = bytemuck::pod_collect_to_vec(r.buffer("exposure.value").unwrap());
+        let (mut off, mut capped, mut untouched, mut hits) = (0, 0, 0, 0);
+        let mut hottest = 0f32;
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let d = depth[i][0];
+                assert!(d > 0.0, "pixel ({x}, {y}) sees the floor");
+                let n = reference::oct_decode(Vec2::new(normal[i][0], normal[i][1]));
+                let world = reference::world_from_depth(inv_vp, [w, h], [x, y], d);
+                let o = reference::ray_origin(world, n, s.camera.position);
+                let (dir, weight) = reference::ray([x, y], frame, n);
+                let t = (ceiling_y - o.y) / dir.y;
+                let raw = match unpack_hit(pack_hit(Some(t), ceiling_albedo)) {
+                    HitWord::Hit { distance, albedo } if t < 250.0 => {
+                        hits += 1;
+                        let gpu_t = gd.rgba[i][0];
+                        let used = if (gpu_t - distance).abs() <= distance * 2f32.powi(-10) * 1.001
+                        {
+                            gpu_t
+                        } else {
+                            distance
+                        };
+                        let eps = 1e-3 + 1e-3 * used;
+                        let p = o + dir * (used - eps) + down * eps;
+                        albedo / std::f32::consts::PI
+                            * reference::punctual_irradiance(p, down, &light, cutoff)
+                    }
+                    _ => Vec3::ZERO,
+                };
+                let radiance = reference::cap_sample_radiance(raw, cap);
+                hottest = hottest.max(lum(raw) / cap.max(1e-30));
+                if cap > 0.0 && lum(raw) > cap * 1.01 {
+                    capped += 1;
+                    assert!((lum(radiance) - cap).abs() <= cap * 1e-5);
+                } else if lum(raw) > 0.0 && lum(raw) < cap * 0.99 {
+                    untouched += 1;
+                }
+                let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
+                let got = [
+                    gy.rgba[i][0],
+                    gy.rgba[i][1],
+                    gy.rgba[i][2],
+                    gy.rgba[i][3],
+                    gc.rgba[i][0],
+                    gc.rgba[i][1],
+                ];
+                let scale = (want[0].abs() / C0 as f32).max(1e-9);
+                if (0..6).any(|k| (got[k] - want[k]).abs() > scale * 2f32.powi(-9)) {
+                    off += 1;
+                    if off <= 5 {
+                        eprintln!("frame {frame} pixel ({x}, {y}): GPU {got:?}, twin {want:?}");
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "frame {frame}: EV100 {ev100:.3}, cap {cap:.4} nits; {hits} hits, {capped} capped \
+             (hottest {hottest:.0} times the cap), {untouched} below it, {off} off the twin"
+        );
+        assert!(hits > 4000, "only {hits} hits");
+        assert!(
+            off <= (w * h) as usize / 200,
+            "{off} pixels differ from the twin"
+        );
+        if frame == 0 {
+            assert_eq!(capped, 0, "no cap on a first frame");
+        } else {
+            assert!(capped >= 20, "only {capped} samples capped");
+            assert!(
+                hottest > 100.0,
+                "the hottest sample is {hottest} times the cap"
+            );
+            assert!(untouched >= 1000, "only {untouched} samples below the cap");
+        }
+        // The next frame's cap: this frame's adapted exposure, as `exposure.state` keeps it.
+        ev100 = value[1];
+        assert!(ev100.is_finite(), "exposure.value {value:?}");
     }
 }
 
@@ -1943,6 +2137,9 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
     s.settings.ray_traced_gi.accumulate = false;
     // Exact against the twin: no roulette on the shadow rays (tested on its own).
     s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
+    // No sun and the meter's exposure: a first frame's CPU meter reads its floor, 1e-3 lux, and
+    // would cap every sample; the cap has its own test (`a_hit_beside_a_lamp_is_capped_...`).
+    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
     s.settings.area_lights.min_flux_lm = 0.25;
     let min_flux = s.settings.area_lights.min_flux_lm;
     let shadows = s.settings.area_lights.punctual_shadows;

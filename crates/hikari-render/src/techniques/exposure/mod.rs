@@ -102,6 +102,23 @@ pub struct ExposureFrame {
     pub histogram: Option<Buf>,
 }
 
+/// `exposure.state`: one Rgba32Float texel, (EV100, 1 once written, 0, 0) (adapt.wgsl).
+const STATE: &str = "exposure.state";
+
+fn state_desc() -> TextureDesc {
+    TextureDesc::d2(1, 1, wgpu::TextureFormat::Rgba32Float)
+}
+
+/// Last frame's adapted exposure, for passes that run before this frame's.
+#[derive(Clone, Copy, Debug)]
+pub struct PreviousExposure {
+    /// `exposure.state` as the last frame left it: Rgba32Float 1x1, x the EV100 (scale =
+    /// 1 / (1.2 · 2^x)), y 1 once written (zeros in a new history).
+    pub state: Tex,
+    /// Whether a frame has written it (false on a graph runtime's first frame).
+    pub valid: bool,
+}
+
 pub struct Exposure {
     clear: ComputePipeline,
     meter: ComputePipeline,
@@ -114,6 +131,16 @@ impl Exposure {
             clear: ComputePipeline::new(ctx, lib, "exposure/clear.wgsl", "main", &[])?,
             meter: ComputePipeline::new(ctx, lib, "exposure/meter.wgsl", "main", &[])?,
             adapt: ComputePipeline::new(ctx, lib, "exposure/adapt.wgsl", "main", &[])?,
+        })
+    }
+
+    /// Last frame's exposure, readable by any pass of this frame (before or after
+    /// [`Exposure::record`], which reads the same texture and writes the other of the pair).
+    pub fn previous(g: &mut FrameGraph<'_>) -> Result<PreviousExposure> {
+        let state = g.history_texture(STATE, state_desc())?;
+        Ok(PreviousExposure {
+            state: state.prev,
+            valid: state.valid,
         })
     }
 
@@ -141,10 +168,7 @@ impl Exposure {
                 .write(histogram)
                 .dispatch_threads(&self.meter, [size[0], size[1].div_ceil(METER_ROWS), 1])?;
         }
-        let state = g.history_texture(
-            "exposure.state",
-            TextureDesc::d2(1, 1, wgpu::TextureFormat::Rgba32Float),
-        )?;
+        let state = g.history_texture(STATE, state_desc())?;
         let value = g.buffer("exposure.value", VALUE_BYTES)?;
         g.pass("exposure.adapt")
             .constants(params)

@@ -9,7 +9,7 @@
 //! | `ray_traced_gi.clear` | empties the BVH queue | `ray_traced_gi.queue` |
 //! | `ray_traced_gi.pretrace` | screen-space march | `ray_traced_gi.hits` (one word a pixel), `.hit_instances`, `.hit_normals`, the queue |
 //! | `ray_traced_gi.trace` | BVH closest hit of the queued rays | the same three |
-//! | `ray_traced_gi.shade` | lights hits (sun, sky, point, spot and area lights, shadowed), sky for misses, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
+//! | `ray_traced_gi.shade` | lights hits (sun, sky, point, spot and area lights, shadowed), sky for misses, caps the radiance relative to last frame's exposure, encodes | `ray_traced_gi.raw_y`, `ray_traced_gi.raw_cocg_ao`, `ray_traced_gi.hit_distance` |
 //! | `ray_traced_gi.accumulate` | temporal accumulation | `ray_traced_gi.gi_y`, `.gi_cocg`, `.ao`, `.history_length`, `.view_depth` |
 //!
 //! Every texture above can be dumped by that name. The hit word packs the distance (f16, bits
@@ -35,6 +35,7 @@ use super::area_lights::AreaLightScene;
 use super::direct_lighting::{
     LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH,
 };
+use super::exposure::PreviousExposure;
 use super::gbuffer::GBuffer;
 use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
@@ -119,6 +120,11 @@ pub struct RtGiParams {
     /// The accumulation's firefly clamp ([`reference::FireflyClamp`]): k (0: off), the floor
     /// (SH c0 units), the history length from which it applies; w unused.
     pub firefly: [f32; 4],
+    /// The cap on each sample's radiance ([`reference::hit_radiance_cap_nits`]): x: times the
+    /// radiance that maps to display white (0: off), y: the CPU meter's EV100 (kept for the
+    /// twin tests; a first frame is not capped), z: 1 when `exposure.state` holds last frame's
+    /// exposure (set by [`RayTracedGi::record_raw`]; 0: no cap), w unused.
+    pub exposure: [f32; 4],
 }
 
 /// Where the sky for misses and ambient light comes from.
@@ -185,6 +191,14 @@ impl RtGiParams {
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky_scale).extend(0.0).to_array(),
             area: [0.0, 0.0, s.hit_shadow_roulette * metered_lux.max(0.0), 0.0],
             firefly: reference::FireflyClamp::new(s.firefly_clamp, metered_lux).to_array(),
+            // The CPU meter's EV100 of `metered_lux` (`FrameSettings::ev100_with_sky`, whose
+            // illuminance this is): what a frame without last frame's exposure is capped by.
+            exposure: [
+                s.hit_radiance_cap.max(0.0),
+                reference::cpu_meter_ev100(metered_lux),
+                0.0,
+                0.0,
+            ],
         }
     }
 
@@ -392,6 +406,8 @@ pub struct RtGiInputs<'a> {
     pub shadow_bvh: BvhBuffers,
     /// The area lights that light hits (`RtGiParams::with_hit_lights`).
     pub area: &'a AreaLightScene,
+    /// Last frame's exposure, which caps each sample's radiance (`hit_radiance_cap`).
+    pub exposure: PreviousExposure,
 }
 
 /// The raw (unaccumulated) signal of a frame.
@@ -560,6 +576,7 @@ impl RayTracedGi {
         if !(lit.valid && vz.valid) {
             params.set_flag(FLAG_REUSE_LIT, false);
         }
+        params.exposure[2] = if inputs.exposure.valid { 1.0 } else { 0.0 };
         let params = &params;
         let noise = self.noise_set(g);
         let bvh_set = inputs.shadow_bvh.binding_set(g);
@@ -585,6 +602,7 @@ impl RayTracedGi {
             .read(hit_normals)
             .read(grid_cells)
             .read(grid_indices)
+            .read(inputs.exposure.state)
             .set(noise)
             .set(bvh_set)
             .set(inputs.sky.lookup)

@@ -719,6 +719,52 @@ pub fn resolve_specular(s: &ShL1YCoCg, n: Vec3, v: Vec3, f0: Vec3, material_alph
     (f * spec * e * n_l).as_vec3()
 }
 
+/// Largest radiance (nits) in any channel of a sample: what f16 holds, with margin.
+pub const MAX_SAMPLE_RADIANCE: f32 = 65_000.0;
+
+/// The CPU meter's EV100 for `metered_lux` (lux): ISO 2720's incident-light rule,
+/// EV100 = log2(E · 100 / 250), as `FrameSettings::ev100_with_sky` forms it (a fixed EV100 comes
+/// back from its illuminance 2^EV100 · 2.5). The illuminance is held to at least 1e-3 lux.
+pub fn cpu_meter_ev100(metered_lux: f32) -> f32 {
+    (metered_lux.max(1e-3) * 100.0 / 250.0).log2()
+}
+
+/// Radiance (nits) that an exposure of `ev100` maps to display white: the inverse of the
+/// exposure's scale 1 / (1.2 · 2^EV100) (exposure/adapt.wgsl).
+pub fn display_white_nits(ev100: f32) -> f32 {
+    1.2 * ev100.exp2()
+}
+
+/// The cap on a GI sample's luminance (nits): `k` times display white under `ev100`; 0 (off)
+/// where `k` is not above 0.
+pub fn hit_radiance_cap_nits(k: f32, ev100: f32) -> f32 {
+    if k > 0.0 {
+        k * display_white_nits(ev100)
+    } else {
+        0.0
+    }
+}
+
+/// A sample's radiance `l` (nits) as the shade pass stores it: NaN and negative channels 0,
+/// each channel at most [`MAX_SAMPLE_RADIANCE`], then the luminance held to `cap_nits` (0: no
+/// cap) by scaling the whole colour, which keeps its chromaticity.
+pub fn cap_sample_radiance(l: Vec3, cap_nits: f32) -> Vec3 {
+    let c = |v: f32| {
+        if v >= 0.0 {
+            v.min(MAX_SAMPLE_RADIANCE)
+        } else {
+            0.0
+        }
+    };
+    let l = Vec3::new(c(l.x), c(l.y), c(l.z));
+    let y = luminance(l);
+    if cap_nits > 0.0 && y > cap_nits {
+        l * (cap_nits / y)
+    } else {
+        l
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::pick_weighted;

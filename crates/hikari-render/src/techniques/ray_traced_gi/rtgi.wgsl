@@ -143,6 +143,9 @@ struct RtGiParams {
     // The accumulation's firefly clamp: x: k (0: off), y: the floor (SH c0), z: the history
     // length from which it applies.
     firefly: vec4<f32>,
+    // The cap on each sample's radiance (shade.wgsl): x: times the radiance of display white
+    // (0: off), y: the EV100 of a first frame, z: 1 when the exposure state holds last frame's.
+    exposure: vec4<f32>,
 }
 
 const RTGI_PRETRACE: u32 = 1u;

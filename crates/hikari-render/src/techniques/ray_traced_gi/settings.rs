@@ -53,6 +53,12 @@ pub struct RayTracedGiSettings {
     /// is traced with probability estimate / (fraction · metered) and the light divided by it,
     /// else the light is 0 (unbiased). Far, dim lamps at night cost few rays. 0: always traced.
     pub hit_shadow_roulette: f32,
+    /// Cap on each GI sample's radiance, relative to the display: its luminance is held to
+    /// this many times the radiance (nits) that the previous frame's exposure maps to display
+    /// white, 1.2 · 2^EV100 (the CPU meter's EV100 on a first frame), the colour scaled with
+    /// it. Stops one ray's hit beside a lamp (E = I / d²) from becoming a speckle that the
+    /// firefly clamp and the denoiser spread. 0 turns it off. Unitless.
+    pub hit_radiance_cap: f32,
     /// The deferred lighting takes its ambient light from the GI within this distance of the
     /// camera (metres) and from the probes or the sky beyond.
     pub near_field_m: f32,
@@ -82,6 +88,7 @@ impl Default for RayTracedGiSettings {
             depth_tolerance: 0.05,
             firefly_clamp: 8.0,
             hit_shadow_roulette: 1.0,
+            hit_radiance_cap: 64.0,
             near_field_m: 250.0,
             near_field_blend: 0.2,
         }
@@ -153,6 +160,10 @@ impl TechniqueSettings for RayTracedGiSettings {
             Field {
                 key: "hit_shadow_roulette",
                 range: Range::Float { lo: 0.0, hi: 100.0 },
+            },
+            Field {
+                key: "hit_radiance_cap",
+                range: Range::Float { lo: 0.0, hi: 1.0e6 },
             },
         ];
         F

@@ -10,7 +10,8 @@
 // unshadowed light; plus the emission of the hit's instance (its material's, textures
 // averaged) unless it is an area light, whose direct light the area-light pass gives every
 // surface already (its light on the hit is counted here). Output: the raw sample, encoded as
-// luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance.
+// luminance L1 SH + CoCg (uniform-hemisphere normalisation), AO and hit distance. Each
+// sample's luminance is capped at a multiple of display white under last frame's exposure.
 // Local lights are visited through the light grid (ray_traced_gi::light_grid): only those
 // listed in the hit's cell, which are all that can reach it, in ascending order.
 // CPU twins: ray_traced_gi::reference (punctual_irradiance, area_light_irradiance,
@@ -54,6 +55,8 @@
 // lights, punctual lights. Indices: per cell its area lights, then its punctual lights.
 @group(0) @binding(17) var<storage, read> light_grid: array<vec4<u32>>;
 @group(0) @binding(18) var<storage, read> light_grid_indices: array<u32>;
+// Last frame's exposure (`exposure.state`): x EV100, y 1 once written.
+@group(0) @binding(19) var prev_exposure: texture_2d<f32>;
 
 // Mirrors of area_lights/shade.wgsl's records (`area_lights::lights`).
 struct AreaLightGpu {
@@ -429,6 +432,26 @@ fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32
     return est / q;
 }
 
+// The cap on a sample's luminance (nits), 0 for none: params.exposure.x times the radiance
+// that last frame's exposure maps to display white, 1.2 · 2^EV100 (exposure/adapt.wgsl); none
+// where there is no last frame (the CPU meter knows only the sun and the sky: in a scene lit
+// by its own lights, the Cornell box, its floor of 1e-3 lux took the first frame's GI away). A ray that hits a post beside a lamp
+// (E = I / d²) would otherwise bring thousands of times the frame's light in one sample, more
+// than the accumulation's firefly clamp, relative to a dark history, holds back.
+// Twin: reference::hit_radiance_cap_nits.
+fn radiance_cap() -> f32 {
+    let k = params.exposure.x;
+    if !(k > 0.0) {
+        return 0.0;
+    }
+    let prev = textureLoad(prev_exposure, vec2<u32>(0u), 0);
+    // NaN fails the range test: no cap then.
+    if !(params.exposure.z > 0.5 && prev.y > 0.5 && abs(prev.x) < 64.0) {
+        return 0.0;
+    }
+    return k * 1.2 * exp2(prev.x);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let size = textureDimensions(depth);
@@ -486,6 +509,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // NaN fails every comparison, so this also turns NaN into 0.
     radiance = select(vec3<f32>(0.0), min(radiance, vec3<f32>(MAX_RADIANCE)), radiance >= vec3<f32>(0.0));
+    // Twin: reference::cap_sample_radiance.
+    let cap = radiance_cap();
+    let y = luminance(radiance);
+    if cap > 0.0 && y > cap {
+        radiance *= cap / y;
+    }
     let s = shy_encode(radiance, dir);
     let w = ray.w;
     textureStore(out_y, pixel, s.y * w);
