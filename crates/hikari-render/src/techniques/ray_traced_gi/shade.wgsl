@@ -271,6 +271,39 @@ fn area_light_visible(i: u32, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>) -> f32 {
     return select(1.0, 0.0, bvh_occluded(Ray(x, 0.0, dir, dist * (1.0 - 1e-3))));
 }
 
+// One light picked in proportion to its weight in one pass over the candidates: a running
+// choice on one random number `u`, rescaled after each candidate so that it stays uniform
+// (twin: reference::pick_weighted). `chosen` NO_LIGHT while no weight was above 0.
+struct LightPick {
+    u: f32,
+    total: f32,
+    chosen: u32,
+    weight: f32,
+    value: vec3<f32>,
+}
+
+fn light_pick(u: f32) -> LightPick {
+    return LightPick(u, 0.0, NO_LIGHT, 0.0, vec3<f32>(0.0));
+}
+
+// Offers light i with weight w (and a value kept with it) to the pick.
+fn offer(p: ptr<function, LightPick>, i: u32, w: f32, value: vec3<f32>) {
+    if !(w > 0.0) {
+        return;
+    }
+    (*p).total += w;
+    let q = w / (*p).total;
+    if (*p).u < q {
+        (*p).chosen = i;
+        (*p).weight = w;
+        (*p).value = value;
+        (*p).u = (*p).u / q;
+    } else {
+        (*p).u = ((*p).u - q) / max(1.0 - q, 1e-7);
+    }
+    (*p).u = min((*p).u, 0.99999994);
+}
+
 // Irradiance (lux) at x on a surface facing n from the area lights, with one polygon
 // integration and one shadow ray: one light is picked in proportion to its score (one pass, a
 // running choice on one random number, rescaled after each light), and its unshadowed light
@@ -282,10 +315,7 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let frame = params.config.x;
-    var u = rtgi_random(pixel, frame, 0u);
-    var total = 0.0;
-    var chosen = NO_LIGHT;
-    var chosen_s = 0.0;
+    var pick = light_pick(rtgi_random(pixel, frame, 0u));
     let count = min(u32(params.area.x), arrayLength(&area_lights));
     // Only the lights listed in x's cell can reach it: the others score 0 (light_grid).
     let cell = grid_cell(x);
@@ -294,21 +324,9 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         if i >= count {
             continue;
         }
-        let s = area_light_score(i, x, n);
-        if !(s > 0.0) {
-            continue;
-        }
-        total += s;
-        let p = s / total;
-        if u < p {
-            chosen = i;
-            chosen_s = s;
-            u = u / p;
-        } else {
-            u = (u - p) / max(1.0 - p, 1e-7);
-        }
-        u = min(u, 0.99999994);
+        offer(&pick, i, area_light_score(i, x, n), vec3<f32>(0.0));
     }
+    let chosen = pick.chosen;
     if chosen == NO_LIGHT {
         return vec3<f32>(0.0);
     }
@@ -316,7 +334,7 @@ fn area_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     if !(luminance(e) > 0.0) {
         return vec3<f32>(0.0);
     }
-    let est = e * (total / chosen_s);
+    let est = e * (pick.total / pick.weight);
     let q = roulette_chance(est);
     if rtgi_random(pixel, frame, 4u) >= q {
         return vec3<f32>(0.0);
@@ -391,35 +409,20 @@ fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32
         }
         return e;
     }
-    var u = rtgi_random(pixel, params.config.x, 3u);
-    var total = 0.0;
-    var chosen = NO_LIGHT;
-    var chosen_e = vec3<f32>(0.0);
+    var pick = light_pick(rtgi_random(pixel, params.config.x, 3u));
     for (var k = 0u; k < cell.z; k++) {
         let i = light_grid_indices[first + k];
         if i >= count {
             continue;
         }
         let e = punctual_light_irradiance(i, x, n);
-        let s = luminance(e);
-        if !(s > 0.0) {
-            continue;
-        }
-        total += s;
-        let p = s / total;
-        if u < p {
-            chosen = i;
-            chosen_e = e;
-            u = u / p;
-        } else {
-            u = (u - p) / max(1.0 - p, 1e-7);
-        }
-        u = min(u, 0.99999994);
+        offer(&pick, i, luminance(e), e);
     }
+    let chosen = pick.chosen;
     if chosen == NO_LIGHT {
         return vec3<f32>(0.0);
     }
-    let est = chosen_e * (total / luminance(chosen_e));
+    let est = pick.value * (pick.total / pick.weight);
     let q = roulette_chance(est);
     if rtgi_random(pixel, params.config.x, 5u) >= q {
         return vec3<f32>(0.0);
