@@ -88,7 +88,7 @@ impl Default for RayTracedGiSettings {
             depth_tolerance: 0.05,
             firefly_clamp: 8.0,
             hit_shadow_roulette: 1.0,
-            hit_radiance_cap: 64.0,
+            hit_radiance_cap: 4.0,
             near_field_m: 250.0,
             near_field_blend: 0.2,
         }
