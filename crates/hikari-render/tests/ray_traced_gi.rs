@@ -527,6 +527,11 @@ struct Read {
     instances: Vec<u32>,
     normals: Vec<u32>,
     queue: Vec<u32>,
+    /// The G-buffer's depth and normal texels.
+    depth: Vec<[f32; 4]>,
+    normal: Vec<[f32; 4]>,
+    /// `exposure.value` after the frame.
+    exposure: Vec<f32>,
 }
 
 fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
@@ -546,6 +551,9 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
                 rays.hit_instances.into(),
                 rays.hit_normals.into(),
                 rays.queue.into(),
+                o.gbuffer.depth.into(),
+                o.gbuffer.normal.into(),
+                o.exposure.value.into(),
             ]
         })
         .unwrap();
@@ -555,6 +563,9 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
     let queue = words("ray_traced_gi.queue");
     let instances = words("ray_traced_gi.hit_instances");
     let normals = words("ray_traced_gi.hit_normals");
+    let exposure = bytemuck::pod_collect_to_vec(r.buffer("exposure.value").unwrap());
+    let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
+    let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
     Read {
         y: r.take_image_of(f.gi_y).unwrap(),
         cocg: r.take_image_of(f.gi_cocg).unwrap(),
@@ -565,6 +576,9 @@ fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
         instances,
         normals,
         queue,
+        depth,
+        normal,
+        exposure,
     }
 }
 
@@ -846,31 +860,16 @@ fn hits_are_lit_like_the_twin() {
         reference::oct_decode(reference::unpack_normal(w).unwrap())
     };
     assert!(ceiling_normal.dot(Vec3::NEG_Y) > 0.9999, "{ceiling_normal}");
-    let mut picked = None;
-    let mut r = renderer
-        .render_reading(&s, |o| {
-            let f = o.ray_traced_gi.unwrap();
-            picked = Some(f);
-            vec![
-                f.gi_y.into(),
-                f.gi_cocg.into(),
-                f.ao.into(),
-                f.hit_distance.into(),
-                o.gbuffer.depth.into(),
-                o.gbuffer.normal.into(),
-                o.ray_traced_gi_rays.unwrap().hit_normals.into(),
-            ]
-        })
-        .unwrap();
-    let f = picked.unwrap();
-    let gy = r.take_image_of(f.gi_y).unwrap();
-    let gc = r.take_image_of(f.gi_cocg).unwrap();
-    let ga = r.take_image_of(f.ao).unwrap();
-    let gd = r.take_image_of(f.hit_distance).unwrap();
-    let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
-    let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
-    let hit_normals: Vec<u32> =
-        bytemuck::pod_collect_to_vec(r.buffer("ray_traced_gi.hit_normals").unwrap());
+    let Read {
+        y: gy,
+        cocg: gc,
+        ao: ga,
+        distance: gd,
+        depth,
+        normal,
+        normals: hit_normals,
+        ..
+    } = render(&mut renderer, &s);
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
     let cutoff = (s.metered_lux() * 1e-4).max(0.01);
@@ -1147,26 +1146,14 @@ fn point_lights_at_hits(roulette: f32) {
     assert!(s.settings.area_lights.enabled && s.settings.area_lights.punctual_shadows);
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let lights = renderer.scene().cpu.lights.clone();
-    let mut picked = None;
-    let mut r = renderer
-        .render_reading(&s, |o| {
-            let f = o.ray_traced_gi.unwrap();
-            picked = Some(f);
-            vec![
-                f.gi_y.into(),
-                f.gi_cocg.into(),
-                f.hit_distance.into(),
-                o.gbuffer.depth.into(),
-                o.gbuffer.normal.into(),
-            ]
-        })
-        .unwrap();
-    let f = picked.unwrap();
-    let gy = r.take_image_of(f.gi_y).unwrap();
-    let gc = r.take_image_of(f.gi_cocg).unwrap();
-    let gd = r.take_image_of(f.hit_distance).unwrap();
-    let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
-    let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
+    let Read {
+        y: gy,
+        cocg: gc,
+        distance: gd,
+        depth,
+        normal,
+        ..
+    } = render(&mut renderer, &s);
 
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
@@ -1372,28 +1359,15 @@ fn a_hit_beside_a_lamp_is_capped_relative_to_the_last_exposure() {
             reference::hit_radiance_cap_nits(k_cap, ev100)
         };
         assert!(cap >= 0.0 && cap.is_finite());
-        let mut picked = None;
-        let mut r = renderer
-            .render_reading(&s, |o| {
-                let f = o.ray_traced_gi.unwrap();
-                picked = Some(f);
-                vec![
-                    f.gi_y.into(),
-                    f.gi_cocg.into(),
-                    f.hit_distance.into(),
-                    o.gbuffer.depth.into(),
-                    o.gbuffer.normal.into(),
-                    o.exposure.value.into(),
-                ]
-            })
-            .unwrap();
-        let f = picked.unwrap();
-        let gy = r.take_image_of(f.gi_y).unwrap();
-        let gc = r.take_image_of(f.gi_cocg).unwrap();
-        let gd = r.take_image_of(f.hit_distance).unwrap();
-        let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
-        let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
-        let value: Vec<f32> = bytemuck::pod_collect_to_vec(r.buffer("exposure.value").unwrap());
+        let Read {
+            y: gy,
+            cocg: gc,
+            distance: gd,
+            depth,
+            normal,
+            exposure: value,
+            ..
+        } = render(&mut renderer, &s);
         let (mut off, mut capped, mut untouched, mut hits) = (0, 0, 0, 0);
         let mut hottest = 0f32;
         for y in 0..h {
@@ -2147,20 +2121,14 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
     let lights = renderer.scene().cpu.lights.clone();
     let area = renderer.area_lights().lights.clone();
     assert_eq!(area.lights.len(), 50, "every lamp is an area light");
-    let mut picked = None;
-    let mut r = renderer
-        .render_reading(&s, |o| {
-            let f = o.ray_traced_gi.unwrap();
-            picked = Some(f);
-            vec![
-                f.gi_y.into(),
-                f.gi_cocg.into(),
-                f.hit_distance.into(),
-                o.gbuffer.depth.into(),
-                o.gbuffer.normal.into(),
-            ]
-        })
-        .unwrap();
+    let Read {
+        y: gy,
+        cocg: gc,
+        distance: gd,
+        depth,
+        normal,
+        ..
+    } = render(&mut renderer, &s);
     // The grid the frame used: several cells, each listing a small part of the lights.
     let cutoff = (s.metered_lux() * 1e-4).max(0.01);
     let grid = light_grid::LightGrid::build(
@@ -2181,12 +2149,6 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
         grid.dims(),
         grid.entries()
     );
-    let f = picked.unwrap();
-    let gy = r.take_image_of(f.gi_y).unwrap();
-    let gc = r.take_image_of(f.gi_cocg).unwrap();
-    let gd = r.take_image_of(f.hit_distance).unwrap();
-    let depth = r.image("gbuffer.depth").unwrap().rgba.clone();
-    let normal = r.image("gbuffer.normal").unwrap().rgba.clone();
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
     let down = reference::oct_decode(
