@@ -534,6 +534,18 @@ struct Read {
     exposure: Vec<f32>,
 }
 
+/// The six numbers of pixel `i`'s GI sample as the shade pass wrote them: Y SH, then Co, Cg.
+fn sample_at(gy: &ImageRgba32, gc: &ImageRgba32, i: usize) -> [f32; 6] {
+    [
+        gy.rgba[i][0],
+        gy.rgba[i][1],
+        gy.rgba[i][2],
+        gy.rgba[i][3],
+        gc.rgba[i][0],
+        gc.rgba[i][1],
+    ]
+}
+
 fn render(renderer: &mut Renderer, s: &FrameSettings) -> Read {
     let mut picked = None;
     let mut r = renderer
@@ -928,14 +940,7 @@ fn hits_are_lit_like_the_twin() {
             };
             lit += (radiance.max_element() > 0.0) as u32;
             let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
-            let got = [
-                gy.rgba[i][0],
-                gy.rgba[i][1],
-                gy.rgba[i][2],
-                gy.rgba[i][3],
-                gc.rgba[i][0],
-                gc.rgba[i][1],
-            ];
+            let got = sample_at(&gy, &gc, i);
             let scale = (want[0].abs() / C0 as f32).max(1e-6);
             if (0..6).any(|k| (got[k] - want[k]).abs() > scale * 2f32.powi(-9)) {
                 off += 1;
@@ -1231,14 +1236,7 @@ fn point_lights_at_hits(roulette: f32) {
             };
             let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
             let plain = reference::to_floats(&reference::encode_sample(unshadowed, dir, weight));
-            let got = [
-                gy.rgba[i][0],
-                gy.rgba[i][1],
-                gy.rgba[i][2],
-                gy.rgba[i][3],
-                gc.rgba[i][0],
-                gc.rgba[i][1],
-            ];
+            let got = sample_at(&gy, &gc, i);
             let scale = (want[0].abs() / C0 as f32)
                 .max(plain[0].abs() / C0 as f32)
                 .max(1e-6);
@@ -1406,14 +1404,7 @@ fn a_hit_beside_a_lamp_is_capped_relative_to_the_last_exposure() {
                     untouched += 1;
                 }
                 let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
-                let got = [
-                    gy.rgba[i][0],
-                    gy.rgba[i][1],
-                    gy.rgba[i][2],
-                    gy.rgba[i][3],
-                    gc.rgba[i][0],
-                    gc.rgba[i][1],
-                ];
+                let got = sample_at(&gy, &gc, i);
                 let scale = (want[0].abs() / C0 as f32).max(1e-9);
                 if (0..6).any(|k| (got[k] - want[k]).abs() > scale * 2f32.powi(-9)) {
                     off += 1;
@@ -2204,14 +2195,7 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
                 _ => Vec3::ZERO,
             };
             let want = reference::to_floats(&reference::encode_sample(radiance, dir, weight));
-            let got = [
-                gy.rgba[i][0],
-                gy.rgba[i][1],
-                gy.rgba[i][2],
-                gy.rgba[i][3],
-                gc.rgba[i][0],
-                gc.rgba[i][1],
-            ];
+            let got = sample_at(&gy, &gc, i);
             let scale = (want[0].abs() / C0 as f32).max(1e-6);
             if (0..6).any(|k| (got[k] - want[k]).abs() > scale * 2f32.powi(-9)) {
                 off += 1;
