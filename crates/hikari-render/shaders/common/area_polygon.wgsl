@@ -6,6 +6,28 @@
 // the area lights' pass (area_lights/shade.wgsl) and the lighting of GI hits
 // (ray_traced_gi/shade.wgsl). CPU twin: area_lights::reference::light_vector_irradiance.
 
+// An area light's record as both passes read it (`area_lights::lights::AreaLightGpu`). Its
+// triangles' record stays in each pass: naga_oil refuses the field names `p1`, `p2` in a
+// module, and they are the Rust struct's.
+struct AreaLightGpu {
+    centroid_radius: vec4<f32>,
+    normal_area: vec4<f32>,
+    radiance_flux: vec4<f32>,
+    range: vec4<u32>,
+}
+
+// AreaLightGpu::range.z bits.
+const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
+const AREA_LIGHT_FORCED: u32 = 2u;
+
+// Distance (m) from an area light's centroid beyond which its illuminance is below
+// `cutoff_lux`: no point of it is nearer than d - r, and each triangle brings at most
+// L A_tri / d_min^2, so E <= L A / (d - r)^2.
+fn area_light_reach(light: AreaLightGpu, cutoff_lux: f32) -> f32 {
+    let peak = dot(light.radiance_flux.rgb, vec3<f32>(0.2126, 0.7152, 0.0722)) * light.normal_area.w;
+    return light.centroid_radius.w + sqrt(max(peak, 0.0) / cutoff_lux);
+}
+
 // Half the angle-weighted edge normal of edge a -> b (unit vectors from the point), oriented
 // for a polygon whose front faces the point: the vector irradiance is the sum over edges.
 fn area_edge_vector(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {

@@ -21,7 +21,13 @@
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::tile_bounds::{TileBounds, tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
-#import hikari::area_polygon::area_triangle_vector_irradiance
+#import hikari::area_polygon::{AreaLightGpu, AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, area_light_reach, area_triangle_vector_irradiance}
+
+struct AreaTriangleGpu {
+    p0_cdf: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+}
 
 struct AreaLightParams {
     // x: area lights; y: AREA_* flags; z: frame index; w: point and spot lights.
@@ -35,23 +41,8 @@ struct AreaLightParams {
     rotation: vec4<f32>,
 }
 
-struct AreaLightGpu {
-    centroid_radius: vec4<f32>,
-    normal_area: vec4<f32>,
-    radiance_flux: vec4<f32>,
-    range: vec4<u32>,
-}
-
-struct AreaTriangleGpu {
-    p0_cdf: vec4<f32>,
-    p1: vec4<f32>,
-    p2: vec4<f32>,
-}
-
 const AREA_POLYGONS: u32 = 1u;
 const AREA_PUNCTUAL: u32 = 2u;
-const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
-const AREA_LIGHT_FORCED: u32 = 2u;
 const MAX_PER_PIXEL: u32 = 8u;
 const NONE: u32 = 0xffffffffu;
 // A pick's key: the light's index, with this bit for a point or spot light.
@@ -104,14 +95,6 @@ fn punctual_attenuation(light: LightGpu, l: vec3<f32>, d2: f32) -> f32 {
     return light_attenuation(light, l, 1.0 / max(d2, 1e-4), d2 / (range * range));
 }
 
-// Distance (m) from an area light's centroid beyond which its illuminance is below the frame's
-// cut-off (lux): no point of it is nearer than d - r, and each triangle brings at most
-// L A_tri / d_min^2, so E <= L A / (d - r)^2.
-fn area_light_reach(light: AreaLightGpu) -> f32 {
-    let peak = luminance(light.radiance_flux.rgb) * light.normal_area.w;
-    return light.centroid_radius.w + sqrt(max(peak, 0.0) / params.values.z);
-}
-
 // Whether area light `i` can light a surface at `lo..hi` (a point, or a tile's bounds): bright
 // enough to be a light, within its reach, not wholly behind its one-sided plane.
 fn area_light_reaches(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
@@ -120,7 +103,7 @@ fn area_light_reaches(i: u32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
         return false;
     }
     let c = light.centroid_radius.xyz;
-    let reach = area_light_reach(light);
+    let reach = area_light_reach(light, params.values.z);
     if tile_bounds_distance2(TileBounds(lo, hi), c) >= reach * reach {
         return false;
     }

@@ -25,7 +25,7 @@
 #import hikari::sky::sky_background_no_disks
 #import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
-#import hikari::area_polygon::area_triangle_vector_irradiance
+#import hikari::area_polygon::{AreaLightGpu, AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, area_light_reach, area_triangle_vector_irradiance}
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
@@ -58,22 +58,12 @@
 // Last frame's exposure (`exposure.state`): x EV100, y 1 once written.
 @group(0) @binding(19) var prev_exposure: texture_2d<f32>;
 
-// Mirrors of area_lights/shade.wgsl's records (`area_lights::lights`).
-struct AreaLightGpu {
-    centroid_radius: vec4<f32>,
-    normal_area: vec4<f32>,
-    radiance_flux: vec4<f32>,
-    range: vec4<u32>,
-}
-
 struct AreaTriangleGpu {
     p0_cdf: vec4<f32>,
     p1: vec4<f32>,
     p2: vec4<f32>,
 }
 
-const AREA_LIGHT_DOUBLE_SIDED: u32 = 1u;
-const AREA_LIGHT_FORCED: u32 = 2u;
 const NO_LIGHT: u32 = 0xffffffffu;
 
 const MAX_RADIANCE: f32 = 65000.0;
@@ -197,7 +187,7 @@ fn area_light_reaches(i: u32, x: vec3<f32>, n: vec3<f32>) -> bool {
     }
     let c = light.centroid_radius.xyz;
     let r = light.centroid_radius.w;
-    let reach = r + sqrt(max(luminance(light.radiance_flux.rgb) * light.normal_area.w, 0.0) / params.distances.w);
+    let reach = area_light_reach(light, params.distances.w);
     let to_c = c - x;
     let nl = light.normal_area.xyz;
     return !(dot(to_c, to_c) >= reach * reach || dot(to_c, n) < -r
