@@ -58,6 +58,8 @@
 // Last frame's exposure (`exposure.state`): x EV100, y 1 once written.
 @group(0) @binding(19) var prev_exposure: texture_2d<f32>;
 
+// The area lights' triangle record, as area_lights/shade.wgsl declares it (hikari::area_polygon says
+// why it is not shared).
 struct AreaTriangleGpu {
     p0_cdf: vec4<f32>,
     p1: vec4<f32>,
