@@ -517,6 +517,18 @@ fn rtgi_settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
     s
 }
 
+/// One frame of the GI without a sun, accumulation, the shadow rays' roulette or the radiance
+/// cap, so that each pixel's raw sample is the twin's exactly (the roulette and the cap have
+/// tests of their own).
+fn twin_settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
+    let mut s = rtgi_settings(scene, w, h);
+    s.sun = None;
+    s.settings.ray_traced_gi.accumulate = false;
+    s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
+    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
+    s
+}
+
 struct Read {
     y: ImageRgba32,
     cocg: ImageRgba32,
@@ -847,14 +859,7 @@ fn hits_are_lit_like_the_twin() {
         ..Default::default()
     };
     let (w, h) = (64u32, 64u32);
-    let mut s = rtgi_settings(&scene, w, h);
-    s.sun = None;
-    s.settings.ray_traced_gi.accumulate = false;
-    // Exact against the twin: no roulette on the shadow rays (tested on its own).
-    s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
-    // No sun and the meter's exposure: a first frame's CPU meter reads its floor, 1e-3 lux, and
-    // would cap every sample; the cap has its own test (`a_hit_beside_a_lamp_is_capped_...`).
-    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
+    let mut s = twin_settings(&scene, w, h);
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let light = renderer.scene().cpu.lights[0];
     let area = renderer.area_lights().lights.clone();
@@ -1136,16 +1141,12 @@ fn point_lights_at_hits(roulette: f32) {
         ..Default::default()
     };
     let (w, h) = (64u32, 64u32);
-    let mut s = rtgi_settings(&scene, w, h);
-    s.sun = None;
-    s.settings.ray_traced_gi.accumulate = false;
+    let mut s = twin_settings(&scene, w, h);
     // Every ray through the BVH: the pre-trace's screen-space hits near the board's edges are
     // its own approximation (`pretrace_hits_agree_with_the_bvh`).
     s.settings.ray_traced_gi.pretrace = false;
     s.settings.ray_traced_gi.hit_shadow_roulette = roulette;
     s.settings.exposure.ev100 = Some(0.0);
-    // Compared uncapped; the cap has its own test.
-    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
     let level = roulette * s.metered_lux();
     let (mut skipped, mut traced) = (0, 0);
     assert!(s.settings.area_lights.enabled && s.settings.area_lights.punctual_shadows);
@@ -2097,14 +2098,7 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
         ..Default::default()
     };
     let (w, h) = (64u32, 64u32);
-    let mut s = rtgi_settings(&scene, w, h);
-    s.sun = None;
-    s.settings.ray_traced_gi.accumulate = false;
-    // Exact against the twin: no roulette on the shadow rays (tested on its own).
-    s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
-    // No sun and the meter's exposure: a first frame's CPU meter reads its floor, 1e-3 lux, and
-    // would cap every sample; the cap has its own test (`a_hit_beside_a_lamp_is_capped_...`).
-    s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
+    let mut s = twin_settings(&scene, w, h);
     s.settings.area_lights.min_flux_lm = 0.25;
     let min_flux = s.settings.area_lights.min_flux_lm;
     let shadows = s.settings.area_lights.punctual_shadows;
