@@ -859,7 +859,7 @@ fn hits_are_lit_like_the_twin() {
         ..Default::default()
     };
     let (w, h) = (64u32, 64u32);
-    let mut s = twin_settings(&scene, w, h);
+    let s = twin_settings(&scene, w, h);
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
     let light = renderer.scene().cpu.lights[0];
     let area = renderer.area_lights().lights.clone();
