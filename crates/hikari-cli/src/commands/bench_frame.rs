@@ -7,6 +7,7 @@ use clap::Args;
 use serde_json::json;
 
 use hikari_render::graph::TimestampMode;
+use hikari_render::techniques::ray_traced_gi::reference::HIT_NOT_TRACED;
 use hikari_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
@@ -109,6 +110,11 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
     }
     let summary = timings.summary();
     let triangles = renderer.scene().triangles;
+    let rays = if settings.settings.ray_traced_gi.enabled {
+        Some(gi_ray_counts(&mut renderer, &settings)?)
+    } else {
+        None
+    };
     if a.output.json {
         let out = json!({
             "benchmark": "frame",
@@ -130,6 +136,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             "frame_gpu_ms": summary.span_ms.map(|s| s.json()),
             "frame_cpu_encode_us": summary.encode_us.json(),
             "scene_bvh_update": bvh.json(),
+            "gi_rays": rays.map(|r| r.json()),
         });
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
@@ -146,5 +153,68 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
     );
     summary.print_table();
     bvh.print();
+    if let Some(r) = rays {
+        r.print();
+    }
     Ok(())
+}
+
+/// Where one frame's GI rays ended (read back after the timed frames, so the read-back
+/// costs none of them): rays are the pixels with a surface; the pre-trace resolved those it
+/// hit in the depth buffer, and queued the rest for the BVH.
+struct GiRayCounts {
+    traced: u64,
+    queued: u64,
+}
+
+impl GiRayCounts {
+    fn resolved(&self) -> u64 {
+        self.traced.saturating_sub(self.queued)
+    }
+
+    fn percent(&self) -> f64 {
+        100.0 * self.resolved() as f64 / self.traced.max(1) as f64
+    }
+
+    fn json(&self) -> serde_json::Value {
+        json!({
+            "traced": self.traced,
+            "pretrace_resolved": self.resolved(),
+            "bvh_queued": self.queued,
+            "pretrace_percent": self.percent(),
+        })
+    }
+
+    fn print(&self) {
+        println!(
+            "GI rays: {} traced, the pre-trace resolved {} ({:.1} %), {} went to the BVH",
+            self.traced,
+            self.resolved(),
+            self.percent(),
+            self.queued
+        );
+    }
+}
+
+fn gi_ray_counts(
+    renderer: &mut Renderer,
+    settings: &hikari_render::FrameSettings,
+) -> anyhow::Result<GiRayCounts> {
+    let r = renderer.render_reading(settings, |o| match o.ray_traced_gi_rays {
+        Some(rays) => vec![rays.hits.into(), rays.queue.into()],
+        None => Vec::new(),
+    })?;
+    let words = |name: &str| -> Vec<u32> {
+        r.buffer(name)
+            .unwrap_or_default()
+            .chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect()
+    };
+    let hits = words("ray_traced_gi.hits");
+    let queue = words("ray_traced_gi.queue");
+    Ok(GiRayCounts {
+        traced: hits.iter().filter(|&&w| w != HIT_NOT_TRACED).count() as u64,
+        queued: queue.first().copied().unwrap_or(0) as u64,
+    })
 }
