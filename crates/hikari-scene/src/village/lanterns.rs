@@ -1,6 +1,8 @@
-//! Paper lanterns (chōchin) on wooden posts along the street and the temple path: a glowing
-//! paper barrel ([`super::materials::LANTERN_NITS`]) between black caps, and in every other
-//! street lantern a point light.
+//! Paper lanterns (chōchin) on wooden posts along the street and the temple path: a paper
+//! barrel between black caps. Every other street lantern is lit: a point light inside and its
+//! paper glowing ([`super::materials::LANTERN_NITS`]); the others are dark. A glowing paper
+//! always has its light, so that what lights the street is sampled as a light, not found by
+//! chance by one GI ray a pixel.
 //!
 //! The point light emits the luminous flux the paper would emit as a Lambertian surface of
 //! that luminance, Φ = π L A (A the paper's area), so the light a lantern casts and how bright
@@ -115,7 +117,8 @@ pub struct Placed {
 }
 
 /// Posts along both edges of the street every 8 m, and along the temple path, the arms
-/// reaching over the roadway; a point light in every other street lantern.
+/// reaching over the roadway; a point light in every other street lantern, whose paper glows,
+/// the others' paper dark.
 pub fn street(b: &mut Builder, pal: &Palette, terrain: &Terrain, lantern: &Lantern) -> Vec<Placed> {
     let s = &terrain.sites;
     let edge = s.street_half_width + 0.3;
@@ -147,7 +150,11 @@ pub fn street(b: &mut Builder, pal: &Palette, terrain: &Terrain, lantern: &Lante
         b.instance(lantern.post, pal.timber_out, post);
         let centre = lantern.hang(
             b,
-            pal.lantern_paper,
+            if lit {
+                pal.lantern_paper
+            } else {
+                pal.lantern_paper_dark
+            },
             pal.lantern_cap,
             post * Mat4::from_translation(HANG),
         );

@@ -54,6 +54,9 @@ pub struct Palette {
     pub maple: usize,
     pub needles: usize,
     pub lantern_paper: usize,
+    /// The same paper without a candle behind it: a lantern that glows without a light
+    /// inside would light the street only through the GI's rays (white speckle at night).
+    pub lantern_paper_dark: usize,
     pub lantern_cap: usize,
     pub andon_paper: usize,
     pub rope: usize,
@@ -160,6 +163,12 @@ impl Palette {
                 emissive_nits: warm_white() * LANTERN_NITS,
                 double_sided: true,
                 ..Material::diffuse("lantern paper", Vec3::ONE)
+            })),
+            lantern_paper_dark: b.material(outdoor(Material {
+                base_color: Vec3::new(0.80, 0.76, 0.66),
+                roughness: 0.9,
+                double_sided: true,
+                ..Material::diffuse("unlit lantern paper", Vec3::ONE)
             })),
             lantern_cap: b.material(outdoor(rough("black lacquer", Vec3::splat(0.03), 0.3))),
             andon_paper: b.material(indoor(Material {

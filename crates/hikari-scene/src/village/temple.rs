@@ -341,7 +341,15 @@ pub fn build(
             glam::Quat::IDENTITY,
             Vec3::new(x, by0 - 0.55 * scale, -bz),
         );
-        lantern_centres.push(lantern.hang(b, pal.lantern_paper, pal.lantern_cap, to_world * at));
+        let centre = lantern.hang(b, pal.lantern_paper, pal.lantern_cap, to_world * at);
+        // The glowing paper's light, as in the street's lit lanterns.
+        b.scene.lights.push(Light::point_lumens(
+            &format!("temple lantern light {}", if x < 0.0 { 1 } else { 2 }),
+            centre,
+            lantern.flux_lm(super::materials::LANTERN_NITS, scale),
+            warm_white(),
+        ));
+        lantern_centres.push(centre);
     }
     for x in [-1.2f32, 1.2] {
         b.scene.lights.push(Light::spot_lumens(
