@@ -11,12 +11,12 @@ use glam::{Mat4, Vec2, Vec3};
 use super::Footprint;
 use super::builder::{Builder, placed};
 use super::furniture;
-use super::materials::Palette;
+use super::materials::{ANDON_NITS, Palette, warm_white};
 use super::rng::Rng;
 use super::roof::gable_roof;
 use super::terrain::Terrain;
-use crate::Mesh;
 use crate::shapes::{Opening, append, cuboid, gable, wall};
+use crate::{Light, Mesh};
 
 /// Thickness of every wall, metres (the issue asks for no more than 0.15 m).
 pub const WALL_THICKNESS: f32 = 0.12;
@@ -165,6 +165,9 @@ struct FurnitureMeshes {
     cushion: usize,
     andon_frame: usize,
     andon_paper: usize,
+    /// The glowing paper's flux (Φ = π L A, lm) and centre (lamp frame), for its light.
+    andon_lumens: f32,
+    andon_centre: Vec3,
     step: usize,
 }
 
@@ -259,7 +262,11 @@ fn kind_meshes(b: &mut Builder, k: &Kind) -> KindMeshes {
 
 fn furniture_meshes(b: &mut Builder) -> FurnitureMeshes {
     let (frame, paper) = furniture::andon();
+    let andon_lumens = std::f32::consts::PI * ANDON_NITS * super::lanterns::area(&paper);
+    let (lo, hi) = paper.bounds().expect("fixed andon paper");
     FurnitureMeshes {
+        andon_lumens,
+        andon_centre: 0.5 * (lo + hi),
         table: b.mesh("low table", furniture::low_table()),
         tansu: b.mesh("tansu", furniture::tansu()),
         shelves: b.mesh("shelves", furniture::shelves()),
@@ -429,6 +436,14 @@ pub fn build(b: &mut Builder, pal: &Palette, terrain: &Terrain, seed: u64) -> Ve
         let lamp = at(-inside_x + 0.35, boards, -hd + t + 1.3, 0.0);
         put(b, f.andon_frame, pal.furniture, lamp);
         put(b, f.andon_paper, pal.andon_paper, lamp);
+        // The glowing paper's light, inside it (a glowing paper without its light would light
+        // the room only through the GI's rays).
+        b.scene.lights.push(Light::point_lumens(
+            &format!("andon light {}", houses.len()),
+            (to_world * lamp).transform_point3(f.andon_centre),
+            f.andon_lumens,
+            warm_white(),
+        ));
         houses.push(House {
             footprint,
             kind: k,

@@ -100,7 +100,8 @@ impl Lantern {
     }
 }
 
-fn area(m: &Mesh) -> f32 {
+/// Surface area of a mesh, m².
+pub(super) fn area(m: &Mesh) -> f32 {
     m.indices
         .chunks_exact(3)
         .map(|t| {

@@ -275,7 +275,14 @@ pub fn build(
     for x in [-2.0, 2.0] {
         // Hung from the ceiling by its cord (0.55 m above the lantern's bottom).
         let at = Mat4::from_translation(Vec3::new(x, top - 0.06 - 0.55, 0.8));
-        lantern_centres.push(lantern.hang(b, pal.andon_paper, pal.timber_in, to_world * at));
+        let centre = lantern.hang(b, pal.andon_paper, pal.timber_in, to_world * at);
+        b.scene.lights.push(Light::point_lumens(
+            &format!("temple hall lantern light {}", if x < 0.0 { 1 } else { 2 }),
+            centre,
+            lantern.flux_lm(super::materials::ANDON_NITS, 1.0),
+            warm_white(),
+        ));
+        lantern_centres.push(centre);
     }
     b.scene.lights.push(Light::point_lumens(
         "temple hall light",
