@@ -92,6 +92,103 @@ pub struct FrameState {
     pub rtgi_scene: Option<SharedRtGiScene>,
     /// Drop the ray-traced GI history next frame (a camera cut); cleared once used.
     pub rtgi_reset: bool,
+    /// Tests only: G-buffer texels overwritten every frame after the G-buffer pass
+    /// ([`crate::renderer::Renderer::override_gbuffer_texels`]).
+    pub gbuffer_overrides: Vec<GBufferTexel>,
+}
+
+/// Which G-buffer texture a [`GBufferTexel`] overwrites.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GBufferTarget {
+    /// `gbuffer.depth` (R32Float, reverse-Z).
+    Depth,
+    /// `gbuffer.normal` (Rgba16Float, octahedral).
+    Normal,
+    /// `gbuffer.albedo` (Rgba8Unorm: it cannot hold NaN or infinity).
+    Albedo,
+    /// `gbuffer.motion` (Rgba16Float).
+    Motion,
+}
+
+/// One G-buffer texel to overwrite, so that tests can put bad values (NaN, infinity) where the
+/// frame's later passes read them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GBufferTexel {
+    pub target: GBufferTarget,
+    pub pixel: [u32; 2],
+    /// The texel's bytes in the target's format (4 for depth and albedo, 8 for normal and
+    /// motion).
+    pub bytes: Vec<u8>,
+}
+
+/// Records the copies of `texels` into the G-buffer; a texel outside the image or of the
+/// wrong size is an error naming it.
+fn override_gbuffer<'r>(
+    g: &mut FrameGraph<'r>,
+    gbuffer: &GBuffer,
+    size: [u32; 2],
+    texels: &[GBufferTexel],
+) -> Result<()> {
+    use wgpu::util::DeviceExt;
+    for (i, t) in texels.iter().enumerate() {
+        let (tex, format) = match t.target {
+            GBufferTarget::Depth => (gbuffer.depth, crate::techniques::gbuffer::DEPTH_FORMAT),
+            GBufferTarget::Normal => (gbuffer.normal, crate::techniques::gbuffer::NORMAL_FORMAT),
+            GBufferTarget::Albedo => (gbuffer.albedo, crate::techniques::gbuffer::ALBEDO_FORMAT),
+            GBufferTarget::Motion => (gbuffer.motion, crate::techniques::gbuffer::MOTION_FORMAT),
+        };
+        let texel_bytes = format.block_copy_size(None).unwrap_or(0) as usize;
+        if t.bytes.len() != texel_bytes || t.pixel[0] >= size[0] || t.pixel[1] >= size[1] {
+            return Err(crate::error::RenderError::Graph(format!(
+                "G-buffer override {i} ({:?} at {:?}): {} bytes for a {texel_bytes}-byte texel \
+                 of a {}x{} image",
+                t.target,
+                t.pixel,
+                t.bytes.len(),
+                size[0],
+                size[1]
+            )));
+        }
+        let data = g
+            .ctx()
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("gbuffer.override"),
+                contents: &t.bytes,
+                usage: wgpu::BufferUsages::COPY_SRC,
+            });
+        let origin = wgpu::Origin3d {
+            x: t.pixel[0],
+            y: t.pixel[1],
+            z: 0,
+        };
+        g.pass("gbuffer.override")
+            .uses(tex, true)
+            .encode(move |enc, res| {
+                enc.copy_buffer_to_texture(
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: &data,
+                        layout: wgpu::TexelCopyBufferLayout {
+                            offset: 0,
+                            bytes_per_row: None,
+                            rows_per_image: None,
+                        },
+                    },
+                    wgpu::TexelCopyTextureInfo {
+                        texture: res.texture(tex),
+                        mip_level: 0,
+                        origin,
+                        aspect: wgpu::TextureAspect::All,
+                    },
+                    wgpu::Extent3d {
+                        width: 1,
+                        height: 1,
+                        depth_or_array_layers: 1,
+                    },
+                );
+            })?;
+    }
+    Ok(())
 }
 
 /// Every technique's pipelines, built once.
@@ -244,6 +341,7 @@ pub fn record<'r>(
     let gbuffer = t
         .gbuffer
         .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
+    override_gbuffer(g, &gbuffer, size, &state.gbuffer_overrides)?;
 
     // The probes' irradiance per pixel, only for `--dump irradiance_probes.pixels`.
     t.irradiance_probes
