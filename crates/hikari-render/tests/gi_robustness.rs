@@ -492,7 +492,7 @@ fn flicker(scene: &Scene, s: &FrameSettings, step: impl Fn(&mut hikari_scene::Ca
                 for x in 1..SIZE - 1 {
                     let i = (y * SIZE + x) as usize;
                     let d = img.depth.rgba[i][0];
-                    if !(d > 0.0) {
+                    if d <= 0.0 {
                         continue;
                     }
                     let world = world_from_depth(inv_now, [SIZE, SIZE], [x, y], d);
@@ -510,7 +510,7 @@ fn flicker(scene: &Scene, s: &FrameSettings, step: impl Fn(&mut hikari_scene::Ca
                     let (qx, qy) = (px as u32, py as u32);
                     let j = (qy * SIZE + qx) as usize;
                     let dq = p.depth.rgba[j][0];
-                    if !(dq > 0.0) {
+                    if dq <= 0.0 {
                         continue;
                     }
                     // Seen in both: the point the previous frame saw there is this one, within
