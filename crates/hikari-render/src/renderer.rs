@@ -103,8 +103,8 @@ impl Renderer {
     }
 
     /// Tests only: overwrites these G-buffer texels in every following frame, right after the
-    /// G-buffer pass (bad input for the passes that read it); an empty list stops it. A texel
-    /// outside the image or of the wrong size makes the frame an error.
+    /// G-buffer pass (bad input for the passes that read it); an empty list stops it. A
+    /// rectangle outside the image or a texel of the wrong size makes the frame an error.
     pub fn override_gbuffer_texels(&mut self, texels: Vec<crate::frame::GBufferTexel>) {
         self.state.gbuffer_overrides = texels;
     }

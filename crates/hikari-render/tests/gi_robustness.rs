@@ -168,8 +168,8 @@ fn chebyshev(a: usize, b: [u32; 2]) -> u32 {
 /// blended twice.
 const BAD_GBUFFER_FRAMES: u32 = 3;
 
-/// NaN and infinity in G-buffer texels (depth, octahedral normal, motion vector), overwritten
-/// every frame after the G-buffer pass, go through pre-trace, BVH trace, shade, accumulation,
+/// NaN and infinity in G-buffer texels (depth, octahedral normal, motion vector, emission),
+/// overwritten every frame after the G-buffer pass, go through pre-trace, BVH trace, shade, accumulation,
 /// both GI denoiser passes and the AO denoiser, over [`BAD_GBUFFER_FRAMES`] frames:
 ///
 /// - every GI texture (raw sample, hit distance, accumulated signal, history length and view
@@ -203,6 +203,7 @@ fn non_finite_gbuffer_texels_stay_out_of_every_gi_output() {
         GBufferTexel {
             target,
             pixel,
+            size: [1, 1],
             bytes,
         }
     };
@@ -244,6 +245,16 @@ fn non_finite_gbuffer_texels_stay_out_of_every_gi_output() {
             GBufferTarget::Motion,
             [12, 52],
             f16_bytes([0.0, 0.0, nan, 0.0]),
+        ),
+        texel(
+            GBufferTarget::Emissive,
+            [16, 56],
+            f16_bytes([nan, 1.0, 1.0, 0.0]),
+        ),
+        texel(
+            GBufferTarget::Emissive,
+            [16, 60],
+            f16_bytes([inf, inf, inf, 0.0]),
         ),
     ];
     let pixels: Vec<[u32; 2]> = texels.iter().map(|t| t.pixel).collect();
@@ -602,5 +613,77 @@ fn denoised_gi_is_stable_with_a_moving_camera() {
         dropped.mean > FLICKER_BOUND,
         "without accumulation the flicker {} should break the bound {FLICKER_BOUND}",
         dropped.mean
+    );
+}
+
+/// The hit words, instances and normals of one frame's GI rays.
+fn rays(renderer: &mut Renderer, s: &FrameSettings) -> [Vec<u32>; 3] {
+    let r = renderer
+        .render_reading(s, |o| {
+            let rays = o.ray_traced_gi_rays.expect("ray-traced GI is on");
+            vec![
+                rays.hits.into(),
+                rays.hit_instances.into(),
+                rays.hit_normals.into(),
+            ]
+        })
+        .unwrap();
+    let words = |name: &str| -> Vec<u32> { bytemuck::pod_collect_to_vec(r.buffer(name).unwrap()) };
+    [
+        words("ray_traced_gi.hits"),
+        words("ray_traced_gi.hit_instances"),
+        words("ray_traced_gi.hit_normals"),
+    ]
+}
+
+/// A pre-trace hit takes the normal of the G-buffer texel it crossed; where that texel's normal
+/// is not finite it records none (`RTGI_NO_NORMAL`, 0), rather than whatever direction packing
+/// a NaN gives. NaN normals over the right half of `boxes` (frame 0): the left half's rays are
+/// the clean run's (same hit words and instances: the march reads depth, not normals), and each
+/// hit normal is the clean run's or, where it changed, none. At least a few of the left half's
+/// pre-trace hits must land in the right half, or nothing was tested.
+#[test]
+fn a_pretrace_hit_on_a_non_finite_normal_records_no_normal() {
+    let scene = hikari_scene::builtin::boxes();
+    let s = gi_settings(&scene);
+    let [hits, instances, normals] = rays(&mut new_renderer(&scene), &s);
+    let mut bad = new_renderer(&scene);
+    bad.override_gbuffer_texels(vec![GBufferTexel {
+        target: GBufferTarget::Normal,
+        pixel: [SIZE / 2, 0],
+        size: [SIZE / 2, SIZE],
+        bytes: f16_bytes([f32::NAN, f32::NAN, 0.0, 0.0]),
+    }]);
+    let [b_hits, b_instances, b_normals] = rays(&mut bad, &s);
+    let mut dropped = 0;
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let i = (y * SIZE + x) as usize;
+            if x >= SIZE / 2 {
+                assert_eq!(
+                    b_normals[i], 0,
+                    "({x}, {y}) has a bad normal: no ray, no normal"
+                );
+                continue;
+            }
+            assert_eq!(
+                (b_hits[i], b_instances[i]),
+                (hits[i], instances[i]),
+                "({x}, {y})"
+            );
+            if b_normals[i] != normals[i] {
+                assert_eq!(
+                    b_normals[i], 0,
+                    "({x}, {y}): a hit normal packed from a NaN texel (clean {:#x})",
+                    normals[i]
+                );
+                dropped += 1;
+            }
+        }
+    }
+    eprintln!("{dropped} pre-trace hits crossed a NaN normal");
+    assert!(
+        dropped >= 3,
+        "only {dropped} pre-trace hits crossed the NaN half"
     );
 }
