@@ -686,4 +686,23 @@ fn a_pretrace_hit_on_a_non_finite_normal_records_no_normal() {
         dropped >= 3,
         "only {dropped} pre-trace hits crossed the NaN half"
     );
+
+    // The hook's own bad input: a rectangle past the image's edge and a texel of the wrong
+    // size are errors that name the override, not panics.
+    for (pixel, size, bytes) in [
+        ([SIZE - 2, 0], [4, 1], f16_bytes([0.0; 4])),
+        ([0, 0], [1, 1], vec![0u8; 3]),
+    ] {
+        bad.override_gbuffer_texels(vec![GBufferTexel {
+            target: GBufferTarget::Normal,
+            pixel,
+            size,
+            bytes,
+        }]);
+        let e = bad
+            .render(&s, false)
+            .err()
+            .expect("a bad override is an error");
+        assert!(e.to_string().contains("G-buffer override 0"), "{e}");
+    }
 }
