@@ -102,6 +102,13 @@ impl Renderer {
         self.state.rtgi_reset = true;
     }
 
+    /// Tests only: overwrites these G-buffer texels in every following frame, right after the
+    /// G-buffer pass (bad input for the passes that read it); an empty list stops it. A
+    /// rectangle outside the image or a texel of the wrong size makes the frame an error.
+    pub fn override_gbuffer_texels(&mut self, texels: Vec<crate::frame::GBufferTexel>) {
+        self.state.gbuffer_overrides = texels;
+    }
+
     /// Renders one frame; with `read_images`, copies the HDR and LDR results back.
     pub fn render(&mut self, settings: &FrameSettings, read_images: bool) -> Result<RenderedFrame> {
         let mut picked = None;

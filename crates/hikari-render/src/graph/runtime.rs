@@ -459,6 +459,15 @@ impl GraphRuntime {
         }
     }
 
+    /// The texture of the temporal resource `name` that the next frame reads as its previous
+    /// one (what the last committed frame wrote), so that tests can put bad values into a
+    /// history; `None` if no frame has used it.
+    pub fn history_for_next_frame(&self, name: &str) -> Option<&wgpu::Texture> {
+        self.history
+            .get(name)
+            .map(|h| &h.textures[h.parity].texture)
+    }
+
     /// Index of the next frame to be recorded: the number of frames committed so far.
     pub fn frame_index(&self) -> u64 {
         self.frame

@@ -29,6 +29,18 @@ const NO_INSTANCE: u32 = 0xffffffffu;
 // The pixel the pre-trace hit, if any.
 var<private> hit_pixel: vec2<u32>;
 
+// Bit tests, not `x == x` or ordered comparisons alone: compilers may fold those under
+// fast-math rules (the denoiser guards the same way), and a NaN that slipped through would
+// reach the ray and its sample.
+fn finite3(v: vec3<f32>) -> bool {
+    return all((bitcast<vec3<u32>>(v) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
+}
+
+// A G-buffer depth that holds a surface: finite, in (0, 1] (0 is the sky).
+fn is_surface(d: f32) -> bool {
+    return finite3(vec3<f32>(d)) && d > 0.0 && d <= 1.0;
+}
+
 fn to_pixel(h: vec4<f32>) -> vec2<f32> {
     let ndc = h.xy / h.w;
     return vec2<f32>((ndc.x * 0.5 + 0.5) * view.viewport.x, (0.5 - ndc.y * 0.5) * view.viewport.y);
@@ -72,9 +84,10 @@ fn march(o: vec3<f32>, dir: vec3<f32>) -> u32 {
         let p = vec2<u32>(s);
         let z_before = prev_z;
         prev_z = ray_z;
-        if textureLoad(depth, p, 0).r <= 0.0 {
+        if !is_surface(textureLoad(depth, p, 0).r) {
             continue;
         }
+        // A non-finite view depth fails the comparison and the texel is passed over.
         let surf_z = textureLoad(gbuffer_motion, p, 0).z;
         if ray_z > surf_z * 1.002 {
             if min(z_before, ray_z) > surf_z + params.pretrace.z {
@@ -89,7 +102,7 @@ fn march(o: vec3<f32>, dir: vec3<f32>) -> u32 {
                 let mid = 0.5 * (lo + hi);
                 let pm = vec2<u32>(clamp(mix(s0, s1, mid), vec2<f32>(0.0), size - 1.0));
                 let zm = 1.0 / mix(1.0 / h0.w, 1.0 / h1.w, mid);
-                if textureLoad(depth, pm, 0).r > 0.0 && zm > textureLoad(gbuffer_motion, pm, 0).z {
+                if is_surface(textureLoad(depth, pm, 0).r) && zm > textureLoad(gbuffer_motion, pm, 0).z {
                     hi = mid;
                     q = pm;
                 } else {
@@ -116,8 +129,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = pixel.y * size.x + pixel.x;
     let d = textureLoad(depth, pixel, 0).r;
     let n = oct_decode(textureLoad(gbuffer_normal, pixel, 0).xy);
-    // NaN fails every comparison: a bad G-buffer texel traces nothing.
-    if !(d > 0.0 && d <= 1.0) || !all(n == n) || !(dot(n, n) > 0.5) {
+    // A bad G-buffer texel (non-finite depth or normal) traces nothing.
+    if !is_surface(d) || !finite3(n) || !(dot(n, n) > 0.5) {
         hits[i] = RTGI_HIT_NOT_TRACED;
         hit_instances[i] = NO_INSTANCE;
         hit_normals[i] = RTGI_NO_NORMAL;
@@ -135,7 +148,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var normal = RTGI_NO_NORMAL;
     if word != RTGI_HIT_UNRESOLVED {
         instance = textureLoad(gbuffer_instance, hit_pixel, 0).x;
-        normal = rtgi_pack_normal(textureLoad(gbuffer_normal, hit_pixel, 0).xy);
+        // The crossed texel's normal, unless it is not finite (rtgi_pack_normal would turn
+        // it into some valid-looking direction).
+        let e = textureLoad(gbuffer_normal, hit_pixel, 0).xy;
+        if finite3(vec3<f32>(e, 0.0)) {
+            normal = rtgi_pack_normal(e);
+        }
     }
     hit_instances[i] = instance;
     hit_normals[i] = normal;
