@@ -200,9 +200,18 @@ impl Renderer {
             sun.validate().map_err(|e| invalid("sun", e))?;
         }
         if settings.settings.ray_traced_gi.enabled && self.state.rtgi_scene.is_none() {
-            self.state.rtgi_scene = Some(std::sync::Arc::new(
-                crate::techniques::ray_traced_gi::RtGiScene::new(&self.ctx, &self.scene_source)?,
-            ));
+            let rtgi =
+                crate::techniques::ray_traced_gi::RtGiScene::new(&self.ctx, &self.scene_source)?;
+            // BLAS refitted before the GI was turned on show a pose its tables do not.
+            let cpu = &mut self.scene_rt.cpu;
+            for mesh in cpu.animated_meshes().collect::<Vec<_>>() {
+                if let Some(t) = cpu.shown_time(mesh)
+                    && let Some((positions, _)) = cpu.pose_at(mesh, Some(t))
+                {
+                    rtgi.update_triangle_normals(&self.ctx, &self.scene_source, mesh, positions);
+                }
+            }
+            self.state.rtgi_scene = Some(std::sync::Arc::new(rtgi));
         }
         // The BVH follows the frame: culled around this camera, deforming meshes at the
         // frame's time (refits throttled), and the raster's vertices at the same time.
@@ -212,6 +221,14 @@ impl Renderer {
         let stats = self
             .scene_rt
             .update(&self.ctx, settings.camera.position, &view_proj, rt)?;
+        // The GI's hit normals follow the refitted BLAS (its tables hold the rest pose).
+        if let Some(rtgi) = self.state.rtgi_scene.clone() {
+            for mesh in self.scene_rt.refitted().to_vec() {
+                if let Some((positions, _)) = self.scene_rt.cpu.pose_at(mesh, rt.time_s) {
+                    rtgi.update_triangle_normals(&self.ctx, &self.scene_source, mesh, positions);
+                }
+            }
+        }
         if self
             .scene_rt
             .update_raster(&self.ctx, &self.scene, rt.time_s)

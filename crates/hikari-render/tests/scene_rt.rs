@@ -658,3 +658,93 @@ fn motion_vectors_follow_deforming_vertices() {
     let worst = motion.iter().map(|m| m.length()).fold(0f32, f32::max);
     assert!(worst <= 1e-3, "a still frame has motion {worst} px");
 }
+
+/// GI hits on a deforming mesh carry the normal of the triangle the ray met in the pose its
+/// BLAS was refitted to, not its rest pose: a tree swaying by 2 m beside a floor, GI on
+/// without the pre-trace (every hit comes from the BVH trace and its normal tables), at
+/// t = 0.6 s. Every hit on the tree must carry (within the normal word's precision) the world
+/// normal of one of the tree's triangles in that pose, and many of those normals must match no
+/// triangle of the rest pose (so the rest pose's tables, the code before, fail the test).
+#[test]
+fn gi_hit_normals_follow_a_deforming_mesh() {
+    use hikari_render::techniques::ray_traced_gi::reference::{oct_encode, unpack_normal};
+    let mut scene = Scene {
+        materials: vec![Material::diffuse("grey", Vec3::splat(0.5))],
+        meshes: vec![shapes::plane(40.0)],
+        instances: vec![Instance {
+            mesh: 0,
+            material: 0,
+            transform: Mat4::IDENTITY,
+        }],
+        cameras: vec![hikari_scene::Camera {
+            position: Vec3::new(0.0, 2.0, 7.0),
+            target: Vec3::new(0.0, 1.0, 0.0),
+            ..Default::default()
+        }],
+        sun: Some(hikari_scene::Sun::default()),
+        ..Default::default()
+    };
+    let mut t = tree(6.0, 0.0);
+    if let Some(Deformation::Sway { amplitude_m, .. }) = &mut t.deformation {
+        *amplitude_m = 2.0;
+    }
+    scene.meshes.push(t);
+    for x in [-1.5f32, 1.5] {
+        scene.instances.push(Instance {
+            mesh: 1,
+            material: 0,
+            transform: Mat4::from_translation(Vec3::new(x, 0.0, 0.0)),
+        });
+    }
+    let time = 0.6f32;
+    let mut s = common::small_frame_settings(&scene, 96, 64);
+    s.settings.ray_traced_gi.enabled = true;
+    s.settings.ray_traced_gi.pretrace = false;
+    s.settings.scene_rt.time_s = Some(time);
+    let mut renderer = hikari_render::Renderer::new(common::gpu_context(), &scene).unwrap();
+    let r = renderer
+        .render_reading(&s, |o| {
+            let rays = o.ray_traced_gi_rays.expect("GI is on");
+            vec![rays.hit_normals.into(), rays.hit_instances.into()]
+        })
+        .unwrap();
+    let normals: Vec<u32> =
+        bytemuck::pod_collect_to_vec(r.buffer("ray_traced_gi.hit_normals").unwrap());
+    let instances: Vec<u32> =
+        bytemuck::pod_collect_to_vec(r.buffer("ray_traced_gi.hit_instances").unwrap());
+    // The tree's instances are translations: world normals are the mesh's.
+    let words = |positions: &[Vec3]| -> Vec<Vec2> {
+        scene.meshes[1]
+            .indices
+            .chunks_exact(3)
+            .filter_map(|t| {
+                let p = |k: usize| positions[t[k] as usize];
+                let n = (p(1) - p(0)).cross(p(2) - p(0));
+                (n.length_squared() > 0.0).then(|| oct_encode(n.normalize()))
+            })
+            .collect()
+    };
+    let (deformed, _) = scene.meshes[1].deformed(time);
+    let posed = words(&deformed);
+    let rest = words(&scene.meshes[1].positions);
+    let near = |set: &[Vec2], e: Vec2| set.iter().any(|q| (*q - e).abs().max_element() < 1e-4);
+    let (mut hits, mut off_rest) = (0, 0);
+    for (w, &inst) in normals.iter().zip(&instances) {
+        if inst != 1 && inst != 2 {
+            continue;
+        }
+        let e = unpack_normal(*w).expect("a BVH hit on the tree has a normal");
+        hits += 1;
+        assert!(
+            near(&posed, e),
+            "hit normal {e} is no triangle's of the swayed tree"
+        );
+        off_rest += usize::from(!near(&rest, e));
+    }
+    println!("{hits} GI hits on the trees, {off_rest} with a normal the rest pose lacks");
+    assert!(hits >= 50, "only {hits} GI rays hit the trees");
+    assert!(
+        off_rest * 2 >= hits,
+        "only {off_rest} of {hits} hit normals moved with the sway"
+    );
+}

@@ -96,6 +96,8 @@ pub struct SceneRt {
     blas_depth: u32,
     tlas_depth: u32,
     last: Option<FrameBvhStats>,
+    /// Scene meshes whose BLAS the last [`SceneRt::update`] refitted.
+    last_refitted: Vec<usize>,
     /// Per scene mesh: its first vertex in `SceneGpu::positions` and `attributes`.
     vertex_base: Vec<u64>,
     /// The time the raster's vertices show (`None`: the rest pose).
@@ -176,6 +178,7 @@ impl SceneRt {
             blas_depth,
             tlas_depth: 0,
             last: None,
+            last_refitted: Vec::new(),
             vertex_base: scene
                 .meshes
                 .iter()
@@ -234,12 +237,19 @@ impl SceneRt {
     ) -> Result<FrameBvhStats> {
         let frame = self.cpu.update(camera, view_proj, s).map_err(bvh_error)?;
         let bytes = self.upload(ctx, &frame)?;
+        self.last_refitted.clone_from(&frame.refitted);
         let stats = FrameBvhStats {
             upload_bytes: bytes,
             ..frame.stats
         };
         self.last = Some(stats);
         Ok(stats)
+    }
+
+    /// Scene meshes whose BLAS the last [`SceneRt::update`] refitted (their pose at that
+    /// frame's time is `cpu.pose_at(mesh, time)`).
+    pub fn refitted(&self) -> &[usize] {
+        &self.last_refitted
     }
 
     /// The last [`SceneRt::update`]'s stats (`None` before the first).

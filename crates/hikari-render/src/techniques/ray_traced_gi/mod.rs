@@ -245,6 +245,8 @@ pub struct RtGiScene {
     /// [`reference::normal_tables`]: per instance, then per mesh triangle.
     instance_normals: wgpu::Buffer,
     triangle_normals: wgpu::Buffer,
+    /// Per scene mesh, its first entry in `triangle_normals`.
+    mesh_first: Vec<u32>,
 }
 
 /// The uploaded light grid and what it was built from.
@@ -293,7 +295,27 @@ impl RtGiScene {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
         let table = non_empty(&reference::instance_table(scene));
         let (instance_normals, triangle_normals) = reference::normal_tables(scene);
+        let mesh_first = scene
+            .meshes
+            .iter()
+            .scan(0u32, |first, m| {
+                let at = *first;
+                *first += (m.indices.len() / 3) as u32;
+                Some(at)
+            })
+            .collect();
+        let triangle_normals = ctx
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("ray_traced_gi.triangle_normals"),
+                contents: bytemuck::cast_slice(&non_empty(&triangle_normals)),
+                // COPY_DST: a deforming mesh's entries follow its refitted BLAS.
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+            });
         Ok(Self {
+            mesh_first,
             punctual: light_grid::punctual_records(scene),
             light_grid: Mutex::new(None),
             instance_table: storage_buffer(
@@ -306,12 +328,33 @@ impl RtGiScene {
                 "ray_traced_gi.instance_normals",
                 bytemuck::cast_slice(&non_empty(&instance_normals)),
             ),
-            triangle_normals: storage_buffer(
-                ctx,
-                "ray_traced_gi.triangle_normals",
-                bytemuck::cast_slice(&non_empty(&triangle_normals)),
-            ),
+            triangle_normals,
         })
+    }
+
+    /// Rewrites the hit normals of scene mesh `mesh` of `scene` for `positions`, the pose its
+    /// BLAS was just refitted to, so that hits on a deforming mesh are lit with the normal of
+    /// the triangle the ray met. Returns the bytes written (0 for an unknown mesh).
+    pub fn update_triangle_normals(
+        &self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        mesh: usize,
+        positions: &[Vec3],
+    ) -> u64 {
+        let (Some(&first), Some(m)) = (self.mesh_first.get(mesh), scene.meshes.get(mesh)) else {
+            return 0;
+        };
+        let words: Vec<u32> = reference::triangle_normals(&m.indices, positions).collect();
+        if words.is_empty() {
+            return 0;
+        }
+        ctx.queue.write_buffer(
+            &self.triangle_normals,
+            4 * first as u64,
+            bytemuck::cast_slice(&words),
+        );
+        4 * words.len() as u64
     }
 
     /// The normal tables in a frame (instances, triangles).

@@ -270,26 +270,14 @@ pub fn unpack_normal(w: u32) -> Option<Vec2> {
 /// with the bits of its mesh's first entry in the second table and of its triangle count in
 /// the first two `w`; per mesh triangle, in mesh order (the BVH's primitive index), its
 /// geometric normal `(p1 - p0) x (p2 - p0)` in object space as a [`pack_normal`] word (0 for
-/// a degenerate one). The rest pose: a deforming mesh's hits keep its rest normals.
+/// a degenerate one). The rest pose; [`triangle_normals`] rewrites a deforming mesh's entries
+/// when its BLAS is refitted.
 pub fn normal_tables(scene: &Scene) -> (Vec<[f32; 4]>, Vec<u32>) {
     let mut triangles = Vec::new();
     let mut first = Vec::with_capacity(scene.meshes.len());
     for m in &scene.meshes {
         first.push(triangles.len() as u32);
-        triangles.extend(m.indices.chunks_exact(3).map(|t| {
-            let p = |k: usize| {
-                m.positions
-                    .get(t[k] as usize)
-                    .copied()
-                    .unwrap_or(Vec3::ZERO)
-            };
-            let n = (p(1) - p(0)).cross(p(2) - p(0));
-            if n.is_finite() && n.length_squared() > 0.0 {
-                pack_normal(oct_encode(n.normalize()))
-            } else {
-                0
-            }
-        }));
+        triangles.extend(triangle_normals(&m.indices, &m.positions));
     }
     let instances = scene
         .instances
@@ -305,6 +293,23 @@ pub fn normal_tables(scene: &Scene) -> (Vec<[f32; 4]>, Vec<u32>) {
         })
         .collect();
     (instances, triangles)
+}
+
+/// Geometric normals `(p1 - p0) x (p2 - p0)` of a mesh's triangles in `positions` (a pose),
+/// as [`pack_normal`] words in mesh order (0 for a degenerate triangle or a missing vertex).
+pub fn triangle_normals<'a>(
+    indices: &'a [u32],
+    positions: &'a [Vec3],
+) -> impl Iterator<Item = u32> + 'a {
+    indices.chunks_exact(3).map(|t| {
+        let p = |k: usize| positions.get(t[k] as usize).copied().unwrap_or(Vec3::ZERO);
+        let n = (p(1) - p(0)).cross(p(2) - p(0));
+        if n.is_finite() && n.length_squared() > 0.0 {
+            pack_normal(oct_encode(n.normalize()))
+        } else {
+            0
+        }
+    })
 }
 
 /// Irradiance (lux) from one point or spot light at `x` on a surface facing `n`, as the

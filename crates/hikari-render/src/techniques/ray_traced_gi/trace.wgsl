@@ -1,7 +1,7 @@
 // The rays the pre-trace left (the queue), traced through the scene's BVH with cut-outs, up
 // to the near field's length; a hit takes its instance's albedo and records the instance and
-// its triangle's geometric normal (the mesh's rest pose, turned into world space by the
-// instance's normal matrix). Output: their hit words.
+// its triangle's geometric normal (in the pose its BLAS was last refitted to, turned into
+// world space by the instance's normal matrix). Output: their hit words.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::{oct_decode, oct_encode}
