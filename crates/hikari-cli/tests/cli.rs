@@ -64,6 +64,48 @@ fn render_writes_png_exr_and_dumps() {
     assert!(leftovers.is_empty());
 }
 
+/// `--dolly` moves the camera over the frames and arrives at the view: the written frame
+/// differs from a still camera's (the history saw other views) and stays close to it (it is
+/// the same view).
+#[test]
+fn render_dolly_arrives_at_the_view_in_motion() {
+    let dir = tmp("dolly");
+    let run = |name: &str, dolly: &str| {
+        let png = dir.join(name);
+        let o = hikari(&[
+            "render",
+            "--scene",
+            "boxes",
+            "--width",
+            "48",
+            "--height",
+            "32",
+            "--frames",
+            "4",
+            "--dolly",
+            dolly,
+            "--no-exr",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o));
+        image::open(&png).unwrap().to_rgb8()
+    };
+    let still = run("still.png", "0");
+    let moving = run("moving.png", "1.5");
+    let diffs: Vec<i32> = still
+        .pixels()
+        .zip(moving.pixels())
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] as i32 - b[c] as i32).abs()))
+        .collect();
+    let mean = diffs.iter().sum::<i32>() as f64 / diffs.len() as f64;
+    assert!(diffs.iter().any(|&d| d > 0), "the move left no trace");
+    assert!(
+        mean < 20.0,
+        "mean difference {mean} levels: not the same view"
+    );
+}
+
 fn assert_clean_failure(args: &[&str], needle: &str) {
     let o = hikari(args);
     let t = text(&o);
@@ -89,6 +131,8 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
     assert_clean_failure(&["bench", "frame", "--frames", "0"], "--frames");
     assert_clean_failure(&["bench", "frame", "--time-step", "NaN"], "--time-step");
     assert_clean_failure(&["bench", "frame", "--time-step", "11"], "--time-step");
+    assert_clean_failure(&["render", "--dolly", "NaN"], "--dolly");
+    assert_clean_failure(&["render", "--dolly", "-101"], "--dolly");
     assert_clean_failure(
         &["render", "--set", "scene_rt.cull_margin_m=-1"],
         "scene_rt.cull_margin_m",

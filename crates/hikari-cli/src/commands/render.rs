@@ -34,6 +34,12 @@ pub struct RenderArgs {
     /// TAA's history is the mean of every sub-pixel position); 1 with both off.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub frames: Option<u32>,
+    /// Arrive at the view moving: over the frames rendered the camera travels this many
+    /// metres a frame along its view direction (negative: backing away) and reaches the
+    /// view on the last frame, the one written. Shows what the temporal passes (TAA, the
+    /// GI's history) make of a camera in motion. 0: a still camera.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub dolly: f32,
     /// Print a per-pass GPU timing table.
     #[arg(long)]
     pub timings: bool,
@@ -54,9 +60,14 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.dolly.is_finite() && args.dolly.abs() <= 100.0,
+        "--dolly {} is outside -100 to 100 metres a frame",
+        args.dolly
+    );
     let ResolvedFrame {
         scene,
-        settings,
+        mut settings,
         description,
     } = scene_source::resolve(&args.frame)?;
     log::info!("{}", description.line());
@@ -96,8 +107,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let frames = args
         .frames
         .unwrap_or_else(|| default_frames(&settings.settings));
-    for _ in 1..frames {
-        renderer.render(&settings, false)?;
+    let view = settings.camera.clone();
+    let forward = view.forward();
+    for f in 1..=frames {
+        if args.dolly != 0.0 {
+            let back = forward * (args.dolly * (frames - f) as f32);
+            settings.prev_camera = (f > 1).then(|| settings.camera.clone());
+            settings.camera.position = view.position - back;
+            settings.camera.target = view.target - back;
+        }
+        if f < frames {
+            renderer.render(&settings, false)?;
+        }
     }
     let frame = renderer.render(&settings, true)?;
 
