@@ -1338,7 +1338,9 @@ fn assert_close4(what: &str, w: u32, gpu: &[[f32; 4]], cpu: &[[f32; 4]], rel: f3
     for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
         for k in 0..4 {
             let tol = rel * c[k].abs() + abs;
-            if !((g[k] - c[k]).abs() <= tol) {
+            // Written so that NaN fails.
+            let ok = (g[k] - c[k]).abs() <= tol;
+            if !ok {
                 bad.push((i as u32 % w, i as u32 / w, k, g[k], c[k]));
             }
         }

@@ -674,8 +674,7 @@ pub fn denoise_temporal(
                 let Some(prev) = prev.filter(|_| p.config[0] & SHADOW_DENOISE_RESET == 0) else {
                     break 'px (r, 1.0, z);
                 };
-                if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite())
-                    || !world.is_finite()
+                if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite() && world.is_finite())
                     || px < 0.0
                     || py < 0.0
                     || px >= w as f32
@@ -686,12 +685,9 @@ pub fn denoise_temporal(
                 let j = (py as u32 * w + px as u32) as usize;
                 let (hv, hl, hz) = (prev.visibility[j], prev.length[j], prev.view_depth[j]);
                 let expected = (prev_vp * world.extend(1.0)).w;
-                if !finite4(hv)
-                    || !hl.is_finite()
-                    || !(hl >= 1.0)
-                    || !hz.is_finite()
-                    || !((hz - expected).abs() <= p.values[0] * expected.abs())
-                {
+                // Written so that NaN rejects.
+                let depth_ok = (hz - expected).abs() <= p.values[0] * expected.abs();
+                if !finite4(hv) || !hl.is_finite() || hl < 1.0 || !hz.is_finite() || !depth_ok {
                     break 'px (r, 1.0, z);
                 }
                 let len = (hl + 1.0).min(p.config[1].max(1) as f32);
@@ -758,7 +754,7 @@ pub fn denoise_spatial(
                         let q = glam::UVec2::new(qx as u32, qy as u32);
                         let mut wt =
                             gi::geometry_weight(&s, gi::world_from_depth(view, q, dq), &plane);
-                        if !(wt > 0.0) {
+                        if wt.is_nan() || wt <= 0.0 {
                             continue;
                         }
                         let o = Vec2::from_array(input.normal_oct[j]);
@@ -766,7 +762,7 @@ pub fn denoise_spatial(
                             continue;
                         }
                         wt *= s.normal.dot(octahedral::decode(o)).max(0.0);
-                        if !(wt > 0.0) {
+                        if wt.is_nan() || wt <= 0.0 {
                             continue;
                         }
                         let (vq, uq) = (acc.visibility[j], input.unshadowed[j]);
