@@ -1569,3 +1569,58 @@ fn nan_in_the_denoisers_inputs_never_reaches_its_outputs() {
         assert!(b.history.length.iter().all(|l| l.is_finite()));
     }
 }
+
+/// The denoiser in the frame: its history grows one frame at a time on a still view, and a
+/// camera cut or a resize starts it again (length 1 on every surface pixel); with `denoise` off
+/// it does not run and the deferred lighting adds the raw light.
+#[test]
+fn the_frames_shadow_history_grows_and_resets_on_a_cut_or_a_resize() {
+    let scene = point_light_scene(true);
+    let ctx = common::gpu_context();
+    let mut renderer = Renderer::new(ctx, &scene).unwrap();
+    let mut lengths = |s: &FrameSettings| -> Vec<f32> {
+        let mut r = renderer
+            .render_reading(s, |o| {
+                let d = o.area_lights_denoised.expect("the denoiser runs");
+                vec![d.history_length.into(), o.gbuffer.depth.into()]
+            })
+            .unwrap();
+        let depth = r.take_image("gbuffer.depth").unwrap().rgba;
+        let len = r
+            .take_image("area_lights.visibility_history_length")
+            .unwrap()
+            .rgba;
+        len.iter()
+            .zip(&depth)
+            .filter(|(_, d)| d[0] > 0.0)
+            .map(|(l, _)| l[0])
+            .collect()
+    };
+    let all = |v: &[f32], want: f32| !v.is_empty() && v.iter().all(|&l| l == want);
+    let still = common::small_frame_settings(&scene, 32, 16);
+    for frame in 1..=3 {
+        let l = lengths(&still);
+        assert!(all(&l, frame as f32), "still frame {frame}: {l:?}");
+    }
+    // A cut: another camera that claims it did not move.
+    let mut cut = still.clone();
+    cut.camera.position += Vec3::new(0.05, 0.0, 0.0);
+    cut.camera.target += Vec3::new(0.05, 0.0, 0.0);
+    let l = lengths(&cut);
+    assert!(all(&l, 1.0), "after a cut: {l:?}");
+    assert!(all(&lengths(&cut), 2.0));
+    let mut resized = cut.clone();
+    resized.width = 24;
+    let l = lengths(&resized);
+    assert!(all(&l, 1.0), "after a resize: {l:?}");
+
+    // Off: no denoiser, and the frame's radiance is the raw pass's.
+    let mut off = still.clone();
+    off.settings.area_lights.denoise = false;
+    renderer
+        .render_reading(&off, |o| {
+            assert!(o.area_lights_denoised.is_none());
+            vec![]
+        })
+        .unwrap();
+}
