@@ -391,7 +391,7 @@ pub fn record<'r>(
     )?;
     // The shadows' visibility accumulated and filtered (docs/area-lights.md, "Denoising the
     // shadows"); the deferred lighting then adds the denoised light.
-    let area_lights_denoised = if s.settings.area_lights.denoise && area_params.config[1] != 0 {
+    let area_lights_denoised = if s.settings.area_lights.denoise && area_params.shades_any() {
         Some(t.area_lights.denoiser.record(
             g,
             &view,

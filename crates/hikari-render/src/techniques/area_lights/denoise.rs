@@ -151,7 +151,7 @@ impl ShadowDenoiser {
         let filtered = g.texture("area_lights.visibility_filtered", d2(VISIBILITY_FORMAT))?;
         let radiance = g.texture(
             "area_lights.denoised",
-            d2(super::super::direct_lighting::RADIANCE_FORMAT),
+            d2(crate::techniques::direct_lighting::RADIANCE_FORMAT),
         )?;
         g.pass("area_lights.spatial")
             .constants(view)

@@ -86,6 +86,12 @@ impl AreaLightParams {
         }
     }
 
+    /// Whether this pass shades any light this frame (else it writes zeros, which the shadow
+    /// denoiser need not see).
+    pub fn shades_any(&self) -> bool {
+        self.config[1] != 0
+    }
+
     /// Whether this pass shades the point and spot lights (the deferred lighting must then
     /// leave them out).
     pub fn shades_punctual(&self) -> bool {
