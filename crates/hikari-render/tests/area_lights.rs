@@ -211,6 +211,7 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
     };
     let v4 = Vec4::from_array;
     let mut want = Vec::new();
+    let mut want_unshadowed = Vec::new();
     for y in 0..64 {
         for x in 0..64 {
             let texel = direct_lighting::reference::Texel {
@@ -220,6 +221,14 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
                 material: v4(f.material.pixel(x, y)),
                 emissive: Vec3::ZERO,
             };
+            want_unshadowed.push(reference::shade_unshadowed(
+                &f.params,
+                lights,
+                &renderer.scene().cpu.lights,
+                &texel,
+                world_at(&f, x, y),
+                f.settings.camera.position,
+            ));
             want.push(reference::shade_with_lux(
                 &f.params,
                 lights,
@@ -257,6 +266,25 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
         bad * 100 <= lit * 3,
         "{bad} of {lit} pixels beyond tolerance"
     );
+    // The unshadowed light (the shadow denoiser's denominator) has no rays: every pixel within
+    // the same tolerance.
+    for y in 0..64 {
+        for x in 0..64 {
+            let (w, w_lux) = want_unshadowed[(y * 64 + x) as usize];
+            let g = f.unshadowed.pixel(x, y);
+            assert!(
+                (g[3] - w_lux).abs() <= 0.02 * w_lux + 0.01 * mean_lux,
+                "({x}, {y}) unshadowed lux {} vs {w_lux}",
+                g[3]
+            );
+            for k in 0..3 {
+                assert!(
+                    (g[k] - w[k]).abs() <= 0.02 * w[k].abs() + 0.01 * mean,
+                    "({x}, {y}) unshadowed {g:?} vs {w}"
+                );
+            }
+        }
+    }
 }
 
 /// A floor, a square light `side` metres wide facing down 2 m above it, and optionally a

@@ -352,6 +352,21 @@ pub fn shade_unbudgeted(
     (clamp(out), lux.clamp(0.0, 65000.0))
 }
 
+/// A pixel's light without shadows, (radiance in nits, illuminance in lux): the pass's
+/// `area_lights.unshadowed`, the sum of [`pixel_shares`].
+pub fn shade_unshadowed(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> (Vec3, f32) {
+    pixel_shares(p, lights, punctual, texel, world, eye)
+        .iter()
+        .fold((Vec3::ZERO, 0.0), |(r, e), s| (r + s.radiance, e + s.lux))
+}
+
 /// The lights a pixel shades, unshadowed, in the shader's order (see [`LightShare`]).
 pub fn pixel_shares(
     p: &AreaLightParams,
