@@ -12,7 +12,10 @@ use crate::scene_gpu::SceneGpu;
 use crate::scene_rt::SceneRt;
 use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
-use crate::techniques::area_lights::{AreaLightParams, AreaLightScene, AreaLights};
+use crate::techniques::area_lights::{
+    AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,
+    ShadowDenoiseParams,
+};
 use crate::techniques::direct_lighting::GiLight;
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
@@ -267,8 +270,13 @@ pub struct FrameOutputs {
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
     pub probes: ProbesFrame,
-    /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`).
+    /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`), this
+    /// frame's estimate before the shadow denoiser.
     pub area_lights: Tex,
+    /// The same lights unshadowed (`area_lights.unshadowed`).
+    pub area_lights_unshadowed: Tex,
+    /// The shadow denoiser's textures (`None` with `area_lights.denoise` off).
+    pub area_lights_denoised: Option<DenoisedShadows>,
     /// Ray-traced GI and AO, accumulated (`None` with the technique off).
     pub ray_traced_gi: Option<RtGiFrame>,
     /// The GI and AO after the denoisers (`None` with ray-traced GI or the denoiser off).
@@ -493,7 +501,7 @@ pub fn record<'r>(
     if area_params.shades_punctual() {
         lighting.skip_punctual();
     }
-    let area_lights = t.area_lights.record(
+    let area_frame = t.area_lights.record(
         g,
         area,
         &rt_bvh.shadow,
@@ -503,6 +511,27 @@ pub fn record<'r>(
         &view,
         &area_params,
     )?;
+    // The shadows' visibility accumulated and filtered (docs/area-lights.md, "Denoising the
+    // shadows"); the deferred lighting then adds the denoised light.
+    let area_lights_denoised = if s.settings.area_lights.denoise && area_params.shades_any() {
+        Some(t.area_lights.denoiser.record(
+            g,
+            &view,
+            &ShadowDenoiseParams::new(&s.settings.area_lights, camera_cut),
+            &ShadowDenoiseInputs {
+                depth: gbuffer.depth,
+                normal: gbuffer.normal,
+                motion: gbuffer.motion,
+                shadowed: area_frame.radiance,
+                unshadowed: area_frame.unshadowed,
+            },
+            size,
+        )?)
+    } else {
+        None
+    };
+    let area_lights = area_frame.radiance;
+    let area_light_for_lighting = area_lights_denoised.map_or(area_lights, |d| d.radiance);
     let lit_frame = t.direct_lighting.record(
         g,
         &gbuffer,
@@ -513,7 +542,7 @@ pub fn record<'r>(
         scene,
         &view,
         &lighting,
-        area_lights,
+        area_light_for_lighting,
         gi_light.as_ref(),
     )?;
     if ray_traced_gi.is_some() {
@@ -582,6 +611,8 @@ pub fn record<'r>(
         sky,
         probes,
         area_lights,
+        area_lights_unshadowed: area_frame.unshadowed,
+        area_lights_denoised,
         ray_traced_gi,
         denoised_gi,
         ray_traced_gi_rays,

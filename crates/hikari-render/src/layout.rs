@@ -296,5 +296,10 @@ pub fn all() -> Vec<StructLayout> {
             "area_lights/shade.wgsl",
             [p0_cdf, p1, p2]
         ),
+        gpu_layout!(
+            crate::techniques::area_lights::ShadowDenoiseParams,
+            "area_lights/temporal.wgsl",
+            [config, values]
+        ),
     ]
 }

@@ -190,12 +190,16 @@ pub struct LightGpu {
     pub direction_kind: [f32; 4],
     /// rgb: colour (luminance 1) times intensity in candela; a unused.
     pub intensity: [f32; 4],
-    /// Spot cone: scale and offset such that the angular factor is
-    /// `saturate(cos_angle * scale + offset)^2`; zw unused.
+    /// xy: spot cone scale and offset such that the angular factor is
+    /// `saturate(cos_angle * scale + offset)^2`; z: the light's radius in metres for its
+    /// shadow rays ([`LIGHT_RADIUS_FROM_SETTING`] where the scene gives none); w unused.
     pub spot: [f32; 4],
 }
 
 pub const LIGHT_POINT: f32 = 0.0;
+/// [`LightGpu::spot`]`[2]` of a light without its own radius: the shadow rays take
+/// `area_lights.punctual_radius_m` (any negative value means the same).
+pub const LIGHT_RADIUS_FROM_SETTING: f32 = -1.0;
 pub const LIGHT_SPOT: f32 = 1.0;
 
 pub fn snorm16x2(v: glam::Vec2) -> u32 {
@@ -396,7 +400,12 @@ impl SceneCpu {
                 position_range: l.position.extend(l.range.unwrap_or(f32::MAX)).to_array(),
                 direction_kind: dir.extend(kind).to_array(),
                 intensity: (l.color * l.intensity_cd).extend(0.0).to_array(),
-                spot,
+                spot: [
+                    spot[0],
+                    spot[1],
+                    l.radius_m.unwrap_or(LIGHT_RADIUS_FROM_SETTING),
+                    0.0,
+                ],
             });
         }
         cpu

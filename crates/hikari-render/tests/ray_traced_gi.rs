@@ -847,6 +847,7 @@ fn hits_are_lit_like_the_twin() {
             intensity_cd: 50.0,
             color: Vec3::ONE,
             range: None,
+            radius_m: None,
         }],
         cameras: vec![Camera {
             name: "down".into(),
@@ -1090,6 +1091,7 @@ fn point_lights_at_hits(roulette: f32) {
         intensity_cd,
         color,
         range: None,
+        radius_m: None,
     };
     let scene = Scene {
         meshes: vec![shapes::plane(400.0)],
@@ -1315,6 +1317,7 @@ fn a_hit_beside_a_lamp_is_capped_relative_to_the_last_exposure() {
             intensity_cd: 2000.0,
             color: Vec3::new(1.0, 0.8, 0.6),
             range: None,
+            radius_m: None,
         }],
         cameras: vec![Camera {
             name: "down".into(),
@@ -2080,6 +2083,7 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
             intensity_cd: rng.random_range(0.2..3.0),
             color: Vec3::new(1.0, 0.9, 0.7),
             range: Some(rng.random_range(0.3..1.5)),
+            radius_m: None,
         })
         .collect();
     let scene = Scene {

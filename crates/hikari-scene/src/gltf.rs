@@ -1034,12 +1034,14 @@ impl<'o> Loader<'o> {
                 let color = Vec3::from(light.color());
                 let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
                 let position = world.transform_point3(Vec3::ZERO);
-                check_light(&light, direction).map_err(|e| {
-                    format!(
-                        "light `{name}` (KHR_lights_punctual lights[{}]): {e}",
-                        light.index()
-                    )
-                })?;
+                let radius_m = check_light(&light, direction)
+                    .and_then(|()| light_radius(light.extras()))
+                    .map_err(|e| {
+                        format!(
+                            "light `{name}` (KHR_lights_punctual lights[{}]): {e}",
+                            light.index()
+                        )
+                    })?;
                 match light.kind() {
                     gltf::khr_lights_punctual::Kind::Directional => {
                         if scene.sun.is_some() {
@@ -1071,6 +1073,7 @@ impl<'o> Loader<'o> {
                             intensity_cd: light.intensity(),
                             color,
                             range: light.range(),
+                            radius_m,
                         });
                     }
                 }
@@ -1104,6 +1107,25 @@ fn area_light_flag(extras: &gltf::json::Extras) -> Res<Option<bool>> {
         Some(gltf::json::Value::Bool(b)) => Ok(Some(*b)),
         Some(other) => Err(format!(
             "extras hikari.area_light must be true or false, not {other}"
+        )),
+    }
+}
+
+/// The light `extras` value `{"hikari": {"radius": r}}` ([`Light::radius_m`], metres); `None`
+/// when absent. Other extras are ignored; anything but a finite number >= 0 is an error.
+fn light_radius(extras: &gltf::json::Extras) -> Res<Option<f32>> {
+    let Some(raw) = extras else {
+        return Ok(None);
+    };
+    let value: gltf::json::Value = gltf::json::deserialize::from_str(raw.get())
+        .map_err(|e| format!("extras are not JSON: {e}"))?;
+    let Some(v) = value.get("hikari").and_then(|h| h.get("radius")) else {
+        return Ok(None);
+    };
+    match v.as_f64().map(|r| r as f32) {
+        Some(r) if r >= 0.0 && r.is_finite() => Ok(Some(r)),
+        _ => Err(format!(
+            "extras hikari.radius must be a finite number of metres >= 0, not {v}"
         )),
     }
 }

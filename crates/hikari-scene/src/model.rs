@@ -382,6 +382,10 @@ pub struct Light {
     pub color: Vec3,
     /// Distance in metres beyond which the light may be treated as zero; `None`: infinite.
     pub range: Option<f32>,
+    /// Radius in metres of the light's emitting sphere, which softens its ray-traced shadows
+    /// (finite, >= 0; 0 is a hard shadow); `None`: the renderer's setting
+    /// (`area_lights.punctual_radius_m`). It does not change the light's intensity.
+    pub radius_m: Option<f32>,
 }
 
 impl Light {
@@ -394,6 +398,7 @@ impl Light {
             intensity_cd,
             color,
             range: None,
+            radius_m: None,
         }
     }
 

@@ -106,7 +106,8 @@ impl Sun {
 impl Light {
     /// Checks the light: finite `position`; `direction` finite (a unit vector for spots);
     /// `intensity_cd` finite and non-negative; `color` finite and non-negative; `range`
-    /// positive and finite when given; spot cones 0 <= inner < outer <= pi/2.
+    /// positive and finite when given; `radius_m` finite and non-negative when given; spot
+    /// cones 0 <= inner < outer <= pi/2.
     pub fn validate(&self) -> Result<(), SceneError> {
         let err = |what: String| SceneError::Light {
             light: self.name.clone(),
@@ -135,6 +136,13 @@ impl Light {
         {
             return Err(err(format!(
                 "range {r} m must be positive and finite (None means unlimited)"
+            )));
+        }
+        if let Some(r) = self.radius_m
+            && !(r >= 0.0 && r.is_finite())
+        {
+            return Err(err(format!(
+                "radius_m {r} must be finite and non-negative (None means the renderer's setting)"
             )));
         }
         if let LightKind::Spot {
@@ -404,6 +412,20 @@ mod tests {
                     ..p()
                 },
                 "range inf",
+            ),
+            (
+                Light {
+                    radius_m: Some(-0.1),
+                    ..p()
+                },
+                "radius_m -0.1",
+            ),
+            (
+                Light {
+                    radius_m: Some(f32::NAN),
+                    ..s()
+                },
+                "radius_m NaN",
             ),
             (
                 Light {

@@ -42,6 +42,8 @@ struct LightGpu {
     position_range: vec4<f32>,
     direction_kind: vec4<f32>,
     intensity: vec4<f32>,
+    // xy: the spot cone's scale and offset; z: radius (m) for shadow rays, negative where the
+    // scene gives none (the setting's); w unused.
     spot: vec4<f32>,
 }
 

@@ -1,8 +1,10 @@
 //! Polygonal area lights with ray-traced soft shadows, and the ray-traced shadows of point
 //! and spot lights (docs/area-lights.md). One pass, `area_lights.shade`, writes
-//! `area_lights.radiance` (nits) before the deferred lighting, which adds it. CPU twin:
-//! [`reference`].
+//! `area_lights.radiance` (nits) and the same light unshadowed (`area_lights.unshadowed`)
+//! before the deferred lighting, which adds the first, or the shadow denoiser's output
+//! ([`denoise`], `area_lights.denoised`) with `denoise` on. CPU twin: [`reference`].
 
+pub mod denoise;
 pub mod lights;
 pub mod reference;
 pub mod settings;
@@ -11,6 +13,7 @@ use bytemuck::{Pod, Zeroable};
 use hikari_scene::Scene;
 use naga_oil::compose::ShaderDefValue;
 
+pub use denoise::{DenoisedShadows, ShadowDenoiseInputs, ShadowDenoiseParams, ShadowDenoiser};
 pub use lights::{AreaLightGpu, AreaTriangleGpu, PolygonLights};
 pub use settings::AreaLightsSettings;
 
@@ -41,7 +44,8 @@ pub struct AreaLightParams {
     /// Shadow rays per pixel in all (the budget), area lights per pixel, lights picked for
     /// those rays per pixel (min(budget, [`settings::MAX_SHADOW_PICKS`])), 0.
     pub counts: [u32; 4],
-    /// Minimum flux (lm), point and spot radius (m), point and spot cut-off (lux), 0.
+    /// Minimum flux (lm), point and spot radius (m) where a light has none of its own, point
+    /// and spot cut-off (lux), 0.
     pub values: [f32; 4],
     /// xy: the frame's random rotation of the sample pattern, in [0, 1).
     pub rotation: [f32; 4],
@@ -80,6 +84,12 @@ impl AreaLightParams {
             ],
             rotation: frame_rotation(frame),
         }
+    }
+
+    /// Whether this pass shades any light this frame (else it writes zeros, which the shadow
+    /// denoiser need not see).
+    pub fn shades_any(&self) -> bool {
+        self.config[1] != 0
     }
 
     /// Whether this pass shades the point and spot lights (the deferred lighting must then
@@ -191,6 +201,16 @@ impl AreaLightScene {
 
 pub struct AreaLights {
     shade: ComputePipeline,
+    pub denoiser: ShadowDenoiser,
+}
+
+/// What `area_lights.shade` writes.
+#[derive(Clone, Copy, Debug)]
+pub struct AreaLightsFrame {
+    /// `area_lights.radiance`: shadowed, nits (rgb) and lux (a).
+    pub radiance: Tex,
+    /// `area_lights.unshadowed`: the same lights in closed form without shadows.
+    pub unshadowed: Tex,
 }
 
 impl AreaLights {
@@ -203,14 +223,15 @@ impl AreaLights {
                 "main",
                 &[("BVH_ALPHA", ShaderDefValue::Bool(true))],
             )?,
+            denoiser: ShadowDenoiser::new(ctx, lib)?,
         })
     }
 
     /// `area_lights.radiance`: the area lights' light, and the point and spot lights' when
     /// `params` says so, in nits (rgb), and the illuminance in lux they bring to the surface,
     /// shadowed (a: what the deferred lighting's illuminance for the exposure meter lacks);
-    /// zero where the pass is off and on the sky. `bvh`: the frame's shadow TLAS
-    /// (`SceneRtBuffers::shadow`).
+    /// zero where the pass is off and on the sky; and `area_lights.unshadowed`, the same
+    /// without shadows. `bvh`: the frame's shadow TLAS (`SceneRtBuffers::shadow`).
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
@@ -222,10 +243,14 @@ impl AreaLights {
         scene: &SceneInFrame,
         view: &View,
         params: &AreaLightParams,
-    ) -> Result<Tex> {
+    ) -> Result<AreaLightsFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
             "area_lights.radiance",
+            TextureDesc::d2(w, h, RADIANCE_FORMAT),
+        )?;
+        let unshadowed = g.texture(
+            "area_lights.unshadowed",
             TextureDesc::d2(w, h, RADIANCE_FORMAT),
         )?;
         let bvh = bvh.binding_set(g);
@@ -241,9 +266,13 @@ impl AreaLights {
             .read(triangles)
             .read(scene.lights)
             .write(radiance)
+            .write(unshadowed)
             .set(brdf_tables)
             .set(bvh)
             .dispatch_threads(&self.shade, [w, h, 1])?;
-        Ok(radiance)
+        Ok(AreaLightsFrame {
+            radiance,
+            unshadowed,
+        })
     }
 }

@@ -352,6 +352,21 @@ pub fn shade_unbudgeted(
     (clamp(out), lux.clamp(0.0, 65000.0))
 }
 
+/// A pixel's light without shadows, (radiance in nits, illuminance in lux): the pass's
+/// `area_lights.unshadowed`, the sum of [`pixel_shares`].
+pub fn shade_unshadowed(
+    p: &AreaLightParams,
+    lights: &PolygonLights,
+    punctual: &[LightGpu],
+    texel: &Texel,
+    world: Vec3,
+    eye: Vec3,
+) -> (Vec3, f32) {
+    pixel_shares(p, lights, punctual, texel, world, eye)
+        .iter()
+        .fold((Vec3::ZERO, 0.0), |(r, e), s| (r + s.radiance, e + s.lux))
+}
+
 /// The lights a pixel shades, unshadowed, in the shader's order (see [`LightShare`]).
 pub fn pixel_shares(
     p: &AreaLightParams,
@@ -491,7 +506,12 @@ fn shadow_ray(
         let t = orthonormal(axis);
         let b = axis.cross(t);
         let u = sample_2d(pixel, 64 + r, p.rotation);
-        let rho = p.values[1] * u.x.sqrt();
+        let radius = if light.spot[2] >= 0.0 {
+            light.spot[2]
+        } else {
+            p.values[1]
+        };
+        let rho = radius * u.x.sqrt();
         let phi = 2.0 * std::f32::consts::PI * u.y;
         let q = pos + rho * (phi.cos() * t + phi.sin() * b);
         let dist = (q - origin).length();
@@ -589,4 +609,207 @@ fn area_light_share(
     let norm = (alpha / widened).powi(2);
     let (specular, _) = f.lobes(l_s);
     Some(((specular * norm + diffuse) * radiance, luminance(radiance)))
+}
+
+// The shadow denoiser's twins (`area_lights/temporal.wgsl`, `area_lights/spatial.wgsl`), in
+// f32 as the shaders compute; the GPU stores f16, which the tests' tolerances allow for.
+
+use super::denoise::{MAX_VISIBILITY, SHADOW_DENOISE_RESET, ShadowDenoiseParams, VISIBILITY_EPS};
+use crate::techniques::gi_denoiser::GiDenoiserParams;
+use crate::techniques::gi_denoiser::reference as gi;
+use crate::view::View;
+
+/// One frame of the denoiser's inputs: row-major images of `width` x `height` texels.
+pub struct DenoiseInput<'a> {
+    pub width: u32,
+    pub height: u32,
+    /// Reverse-Z depth (0 on the sky).
+    pub depth: &'a [f32],
+    /// The G-buffer normal's octahedral encoding (its xy).
+    pub normal_oct: &'a [[f32; 2]],
+    /// The G-buffer's motion: xy to last frame's pixel, z view depth (m).
+    pub motion: &'a [[f32; 4]],
+    /// `area_lights.radiance` and `area_lights.unshadowed`.
+    pub shadowed: &'a [[f32; 4]],
+    pub unshadowed: &'a [[f32; 4]],
+}
+
+/// The temporal pass's history: visibility, length (frames) and view depth per texel.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VisibilityHistory {
+    pub visibility: Vec<[f32; 4]>,
+    pub length: Vec<f32>,
+    pub view_depth: Vec<f32>,
+}
+
+fn finite4(v: [f32; 4]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// Per channel, shadowed / unshadowed where the unshadowed light is defined (finite, above
+/// [`VISIBILITY_EPS`]) and the shadowed finite, else 1 (the shader's `raw_visibility`).
+pub fn raw_visibility(shadowed: [f32; 4], unshadowed: [f32; 4]) -> [f32; 4] {
+    let ok = finite4(shadowed) && finite4(unshadowed);
+    std::array::from_fn(|c| {
+        if ok && unshadowed[c] > VISIBILITY_EPS {
+            (shadowed[c] / unshadowed[c]).clamp(0.0, MAX_VISIBILITY)
+        } else {
+            1.0
+        }
+    })
+}
+
+/// The temporal pass: (this frame's raw visibility, the history after it). `prev`: last
+/// frame's history (`None`: no valid history, as on a reset).
+pub fn denoise_temporal(
+    p: &ShadowDenoiseParams,
+    view: &View,
+    input: &DenoiseInput,
+    prev: Option<&VisibilityHistory>,
+) -> (Vec<[f32; 4]>, VisibilityHistory) {
+    let (w, h) = (input.width, input.height);
+    let n = (w * h) as usize;
+    let mut raw = Vec::with_capacity(n);
+    let mut out = VisibilityHistory::default();
+    let prev_vp = glam::Mat4::from_cols_array_2d(&view.prev_view_proj);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let r = raw_visibility(input.shadowed[i], input.unshadowed[i]);
+            raw.push(r);
+            let d = input.depth[i];
+            let (v, len, z) = 'px: {
+                if !(d > 0.0 && d.is_finite()) {
+                    break 'px ([1.0; 4], 0.0, 0.0);
+                }
+                let m = input.motion[i];
+                let z = if m[2].is_finite() { m[2] } else { 0.0 };
+                let world = gi::world_from_depth(view, glam::UVec2::new(x, y), d);
+                let (px, py) = (x as f32 + 0.5 + m[0], y as f32 + 0.5 + m[1]);
+                let Some(prev) = prev.filter(|_| p.config[0] & SHADOW_DENOISE_RESET == 0) else {
+                    break 'px (r, 1.0, z);
+                };
+                if !(m[0].is_finite() && m[1].is_finite() && m[2].is_finite() && world.is_finite())
+                    || px < 0.0
+                    || py < 0.0
+                    || px >= w as f32
+                    || py >= h as f32
+                {
+                    break 'px (r, 1.0, z);
+                }
+                let j = (py as u32 * w + px as u32) as usize;
+                let (hv, hl, hz) = (prev.visibility[j], prev.length[j], prev.view_depth[j]);
+                let expected = (prev_vp * world.extend(1.0)).w;
+                // Written so that NaN rejects.
+                let depth_ok = (hz - expected).abs() <= p.values[0] * expected.abs();
+                if !finite4(hv) || !hl.is_finite() || hl < 1.0 || !hz.is_finite() || !depth_ok {
+                    break 'px (r, 1.0, z);
+                }
+                let len = (hl + 1.0).min(p.config[1].max(1) as f32);
+                let k = 1.0 / len;
+                (std::array::from_fn(|c| hv[c] + (r[c] - hv[c]) * k), len, z)
+            };
+            out.visibility.push(v);
+            out.length.push(len);
+            out.view_depth.push(z);
+        }
+    }
+    (raw, out)
+}
+
+/// The spatial pass over the accumulated history `acc`: (filtered visibility, the pixel's
+/// light: unshadowed x filtered visibility, or the raw shadowed light where the unshadowed is
+/// below [`VISIBILITY_EPS`]).
+pub fn denoise_spatial(
+    p: &ShadowDenoiseParams,
+    view: &View,
+    input: &DenoiseInput,
+    acc: &VisibilityHistory,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+    let (w, h) = (input.width, input.height);
+    let or = |v: [f32; 4], f: f32| if finite4(v) { v } else { [f; 4] };
+    let plane = GiDenoiserParams {
+        radius: [0.0, 0.0, 0.0, p.values[1]],
+        ..bytemuck::Zeroable::zeroed()
+    };
+    let (mut filtered, mut light) = (Vec::new(), Vec::new());
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let v0 = or(acc.visibility[i], 1.0);
+            let (s0, u0) = (or(input.shadowed[i], 0.0), or(input.unshadowed[i], 0.0));
+            let mut f = v0;
+            let oct = input.normal_oct[i];
+            let surface = gi::make_surface(
+                view,
+                glam::UVec2::new(x, y),
+                input.depth[i],
+                Vec2::from_array(oct),
+            );
+            let l = acc.length[i];
+            let len = if l.is_finite() { l.max(1.0) } else { 1.0 };
+            let r = p.values[2] / len.sqrt();
+            if let Some(s) = surface.filter(|_| r >= 0.5) {
+                let reach = (r.ceil() as i32).min(super::settings::MAX_DENOISE_RADIUS_PX as i32);
+                let (mut sum, mut sum_w) = ([0.0f32; 4], [0.0f32; 4]);
+                for dy in -reach..=reach {
+                    for dx in -reach..=reach {
+                        if (dx * dx + dy * dy) as f32 > r * r {
+                            continue;
+                        }
+                        let (qx, qy) = (x as i32 + dx, y as i32 + dy);
+                        if qx < 0 || qy < 0 || qx >= w as i32 || qy >= h as i32 {
+                            continue;
+                        }
+                        let j = (qy as u32 * w + qx as u32) as usize;
+                        let dq = input.depth[j];
+                        if !(dq > 0.0 && dq.is_finite()) {
+                            continue;
+                        }
+                        let q = glam::UVec2::new(qx as u32, qy as u32);
+                        let mut wt =
+                            gi::geometry_weight(&s, gi::world_from_depth(view, q, dq), &plane);
+                        if wt.is_nan() || wt <= 0.0 {
+                            continue;
+                        }
+                        let o = Vec2::from_array(input.normal_oct[j]);
+                        if !o.is_finite() {
+                            continue;
+                        }
+                        wt *= s.normal.dot(octahedral::decode(o)).max(0.0);
+                        if wt.is_nan() || wt <= 0.0 {
+                            continue;
+                        }
+                        let (vq, uq) = (acc.visibility[j], input.unshadowed[j]);
+                        if !finite4(vq) || !finite4(uq) {
+                            continue;
+                        }
+                        for c in 0..4 {
+                            if uq[c] > VISIBILITY_EPS {
+                                sum[c] += wt * vq[c];
+                                sum_w[c] += wt;
+                            }
+                        }
+                    }
+                }
+                f = std::array::from_fn(|c| {
+                    if sum_w[c] > 0.0 {
+                        sum[c] / sum_w[c].max(1e-30)
+                    } else {
+                        v0[c]
+                    }
+                });
+            }
+            filtered.push(f);
+            light.push(std::array::from_fn(|c| {
+                let v = if u0[c] > VISIBILITY_EPS {
+                    u0[c] * f[c]
+                } else {
+                    s0[c]
+                };
+                if v >= 0.0 { v.min(65000.0) } else { 0.0 }
+            }));
+        }
+    }
+    (filtered, light)
 }

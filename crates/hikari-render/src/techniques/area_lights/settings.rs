@@ -20,12 +20,21 @@ pub struct AreaLightsSettings {
     /// Point and spot lights are shaded by this pass, with ray-traced shadows, instead of
     /// unshadowed by the deferred lighting.
     pub punctual_shadows: bool,
-    /// Radius of point and spot lights in metres (the scene model gives them none): the
-    /// softness of their shadows.
+    /// Radius in metres of the point and spot lights that give none of their own
+    /// (`Light::radius_m`, glTF light `extras` `hikari.radius`): the softness of their shadows.
     pub punctual_radius_m: f32,
     /// An emissive mesh instance without an `area_light` flag becomes an area light only if it
     /// emits at least this luminous flux (π × luminance × area, lumens).
     pub min_flux_lm: f32,
+    /// Denoise the shadows: the visibility (shadowed over unshadowed light) accumulated over
+    /// frames and filtered spatially, times the noise-free unshadowed light
+    /// (docs/area-lights.md, "Denoising the shadows").
+    pub denoise: bool,
+    /// Frames the accumulated visibility averages at most (its history length's cap).
+    pub denoise_history: u32,
+    /// Radius in pixels of the spatial filter on a fresh history; it shrinks as
+    /// radius / sqrt(history length) while the history grows (0: no spatial filter).
+    pub denoise_radius_px: f32,
 }
 
 impl Default for AreaLightsSettings {
@@ -37,6 +46,9 @@ impl Default for AreaLightsSettings {
             punctual_shadows: true,
             punctual_radius_m: 0.05,
             min_flux_lm: 50.0,
+            denoise: true,
+            denoise_history: 16,
+            denoise_radius_px: 3.0,
         }
     }
 }
@@ -50,6 +62,12 @@ pub const MAX_SHADOW_PICKS: u32 = 8;
 
 /// Largest `ray_budget`.
 pub const MAX_RAY_BUDGET: u32 = 32;
+
+/// Largest `denoise_history`.
+pub const MAX_DENOISE_HISTORY: u32 = 64;
+
+/// Largest `denoise_radius_px` (the spatial filter's taps are a square of side 2 × 8 + 1).
+pub const MAX_DENOISE_RADIUS_PX: f32 = 8.0;
 
 impl TechniqueSettings for AreaLightsSettings {
     fn fields() -> &'static [Field] {
@@ -75,6 +93,20 @@ impl TechniqueSettings for AreaLightsSettings {
             Field {
                 key: "min_flux_lm",
                 range: Range::Float { lo: 0.0, hi: 1e12 },
+            },
+            Field {
+                key: "denoise_history",
+                range: Range::Int {
+                    lo: 1,
+                    hi: MAX_DENOISE_HISTORY as i64,
+                },
+            },
+            Field {
+                key: "denoise_radius_px",
+                range: Range::Float {
+                    lo: 0.0,
+                    hi: MAX_DENOISE_RADIUS_PX as f64,
+                },
             },
         ];
         F

@@ -13,7 +13,8 @@
 // tile_bounds): a point or spot light beyond its range, an area light beyond the distance where
 // its illuminance must fall below the frame's cut-off or wholly behind its one-sided plane.
 // Output: radiance in nits (rgb) and the illuminance in lux these lights bring to the surface,
-// shadowed (a), for the exposure meter. CPU twin: area_lights::reference.
+// shadowed (a), for the exposure meter; and the same unshadowed, for the shadow denoiser
+// (area_lights/temporal.wgsl). CPU twin: area_lights::reference.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
@@ -35,7 +36,8 @@ struct AreaLightParams {
     // x: shadow rays per pixel (the budget); y: area lights per pixel; z: lights picked for
     // those rays per pixel (at most MAX_PER_PIXEL); w: 0.
     counts: vec4<u32>,
-    // x: min flux (lm); y: point and spot radius (m); z: point and spot cut-off (lux); w: 0.
+    // x: min flux (lm); y: point and spot radius (m) where a light has none of its own
+    // (LightGpu.spot.z < 0); z: point and spot cut-off (lux); w: 0.
     values: vec4<f32>,
     // xy: this frame's random rotation of the sample pattern, in [0, 1).
     rotation: vec4<f32>,
@@ -64,6 +66,9 @@ const TILE_THREADS: u32 = 256u;
 @group(0) @binding(7) var<storage, read> area_triangles: array<AreaTriangleGpu>;
 @group(0) @binding(8) var<storage, read> lights: array<LightGpu>;
 @group(0) @binding(9) var out_radiance: texture_storage_2d<rgba16float, write>;
+// The same lights unshadowed, in closed form (no noise): the shadow denoiser's visibility is
+// out_radiance over this.
+@group(0) @binding(10) var out_unshadowed: texture_storage_2d<rgba16float, write>;
 
 // The lights that may reach the tile, in index order (so that the per-pixel selection breaks
 // ties and sums as over all lights): chunks of 256 lights are tested one per invocation into
@@ -218,6 +223,8 @@ struct Sums {
 var<private> sums: Sums;
 // Illuminance (lux) arriving from the lights shaded so far.
 var<private> lux: f32;
+// The pixel's light unshadowed: radiance (nits, rgb) and illuminance (lux, a).
+var<private> unshadowed: vec4<f32>;
 
 fn add_light(w: vec4<f32>, e: vec3<f32>) {
     sums.a += e * w.x;
@@ -286,7 +293,8 @@ fn put4(a: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, k: u32, v: vec4<f32>)
 // Shadow ray `r` of the pixel towards the light of `key`: (its weight if unblocked, its
 // weight), the ratio estimator's terms. Area lights: a point by area (a triangle by its share,
 // the square-root warp), weighted by the unshadowed integrand cos cos / d^2; point and spot
-// lights: a point on a disc of the light's radius facing the surface, weight 1.
+// lights: a point on a disc of the light's radius (its own, else the setting's) facing the
+// surface, weight 1.
 fn shadow_ray(key: u32, r: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> vec2<f32> {
     if (key & PUNCTUAL_KEY) != 0u {
         let light = lights[key & ~PUNCTUAL_KEY];
@@ -294,7 +302,9 @@ fn shadow_ray(key: u32, r: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32
         let t = orthonormal(axis);
         let b = cross(axis, t);
         let u = sample_2d(pixel, 64u + r);
-        let rho = params.values.y * sqrt(u.x);
+        // The light's own radius, or the setting's where the scene gives none.
+        let radius = select(params.values.y, light.spot.z, light.spot.z >= 0.0);
+        let rho = radius * sqrt(u.x);
         let phi = 2.0 * PI * u.y;
         let p = light.position_range.xyz + rho * (cos(phi) * t + sin(phi) * b);
         let to_p = p - origin;
@@ -495,6 +505,7 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
 
     // Without rays (or where no light brings radiance), the unshadowed sum.
     var radiance = brdf_apply_weights(brdf, sums.a, sums.b, sums.c, sums.d);
+    unshadowed = vec4<f32>(radiance, lux);
     // The shadows: `picks` lights picked by systematic sampling of their weights (see place),
     // each pick's rays (the budget split over the picks), its visibility the ratio estimator
     // over all the rays that went to the same light, and the pixel's light
@@ -596,6 +607,7 @@ fn main(
     if params.config.y == 0u {
         if inside {
             textureStore(out_radiance, pixel, vec4<f32>(0.0));
+            textureStore(out_unshadowed, pixel, vec4<f32>(0.0));
         }
         return;
     }
@@ -616,6 +628,7 @@ fn main(
     }
     var radiance = vec3<f32>(0.0);
     lux = 0.0;
+    unshadowed = vec4<f32>(0.0);
     // Tiles no light reaches (and the sky) skip the shading.
     if d > 0.0 && listed.x + listed.y > 0u {
         radiance = shade(pixel, d);
@@ -623,4 +636,5 @@ fn main(
     // NaN fails every comparison, so this also turns NaN into 0.
     let out = vec4<f32>(radiance, lux);
     textureStore(out_radiance, pixel, select(vec4<f32>(0.0), min(out, vec4<f32>(MAX_RADIANCE)), out >= vec4<f32>(0.0)));
+    textureStore(out_unshadowed, pixel, select(vec4<f32>(0.0), min(unshadowed, vec4<f32>(MAX_RADIANCE)), unshadowed >= vec4<f32>(0.0)));
 }
