@@ -3,7 +3,7 @@
 // pixels a thread, which share one set of samples when no edge lies between them (same
 // tangent plane within the tolerance, normals within EDGE_NORMAL_COS). Weights: geometry
 // (distance to the tangent plane) times the normal's dot product. The world radius is capped
-// at a multiple of the harmonic mean hit distance of the 3x3 neighbourhood's rays (AO varies
+// at a multiple of the harmonic mean hit distance of the 5x5 neighbourhood's rays (AO varies
 // over about the distance to the occluders). Output:
 // lerp(denoised, input, 0.5 * accumulation speed). CPU twin: gi_denoiser/reference.rs `ao_pass`.
 
@@ -31,7 +31,7 @@ const NO_CAP: f32 = 1.0e30;
 const HIT_WINDOW: i32 = 2;
 
 // The AO's world radius cap: `scale` times the harmonic mean of the finite, positive hit
-// distances over 3x3 (the split-sphere model of irradiance caching: light and occlusion change
+// distances over 5x5 (the split-sphere model of irradiance caching: light and occlusion change
 // over about the harmonic mean distance to the surroundings). NO_CAP without hits or scale.
 fn hit_radius_cap(pixel: vec2<u32>, size: vec2<u32>, scale: f32) -> f32 {
     var inv_sum = 0.0;

@@ -250,7 +250,7 @@ pub const NO_RADIUS_CAP: f32 = 1.0e30;
 pub const HIT_WINDOW: i32 = 2;
 
 /// The AO denoiser's world radius cap at `pixel` (`hit_radius_cap` in `ao.wgsl`): `scale`
-/// times the harmonic mean of the finite, positive hit distances over 3x3.
+/// times the harmonic mean of the finite, positive hit distances over 5x5.
 pub fn hit_radius_cap(w: u32, h: u32, pixel: UVec2, hit_distance: &[f32], scale: f32) -> f32 {
     let (mut inv_sum, mut count) = (0.0f32, 0.0f32);
     for dy in -HIT_WINDOW..=HIT_WINDOW {

@@ -20,7 +20,7 @@ pub struct GiDenoiserSettings {
     /// Base blur radius of the AO denoiser, in metres.
     pub ao_radius_m: f32,
     /// Cap on the AO denoiser's world radius, as a multiple of the harmonic mean distance of
-    /// the 3x3 neighbourhood's ray hits (AO changes over about the distance to the occluders);
+    /// the 5x5 neighbourhood's ray hits (AO changes over about the distance to the occluders);
     /// 0 turns the cap off. Unitless.
     pub ao_hit_distance_scale: f32,
     /// Poisson-disk samples a GI pass takes at most (the talk: up to 32).
