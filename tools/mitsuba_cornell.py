@@ -7,8 +7,9 @@ with the same camera, light and albedos.
     pip install mitsuba numpy
     python3 tools/mitsuba_cornell.py [--size 64] [--spp 4096] \
         [-o crates/hikari-render/tests/fixtures/mitsuba_cornell_direct_64.pfm]
-    # direct light plus ONE diffuse bounce (path, max_depth 3), for the ray-traced GI:
-    python3 tools/mitsuba_cornell.py --size 128 --spp 4096 --max-depth 3 \
+    # direct light plus ONE diffuse bounce (path, max_depth 3), for the ray-traced GI (65536
+    # spp, about 15 CPU minutes; two 4096-spp renders differ by FLIP 0.013):
+    python3 tools/mitsuba_cornell.py --size 128 --spp 65536 --max-depth 3 --seed 3 \
         -o crates/hikari-render/tests/fixtures/mitsuba_cornell_one_bounce_128.pfm
     # ray-traced AO with hikari's ao_max_distance_m (50 m): Mitsuba's own path tracer under a
     # uniform sky (see the note above `build_scene`; 65536 spp, about 6 CPU minutes, seed 3):
