@@ -12,7 +12,7 @@ with the same camera, light and albedos.
     python3 tools/mitsuba_cornell.py --size 128 --spp 65536 --max-depth 3 --seed 3 \
         -o crates/hikari-render/tests/fixtures/mitsuba_cornell_one_bounce_128.pfm
     # ray-traced AO with hikari's ao_max_distance_m (50 m): Mitsuba's own path tracer under a
-    # uniform sky (see the note above `build_scene`; 65536 spp, about 6 CPU minutes, seed 3):
+    # uniform sky (see the note above `build_scene`; 65536 spp, about 8 CPU minutes, seed 3):
     python3 tools/mitsuba_cornell.py --size 128 --spp 65536 --ao-distance 50 --seed 3 \
         -o crates/hikari-render/tests/fixtures/mitsuba_cornell_ao50_128.pfm
     # the reference's own noise: the same at two seeds, compared with each other
