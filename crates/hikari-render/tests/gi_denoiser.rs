@@ -193,6 +193,8 @@ struct Signal {
     gi: GiImage,
     history: Vec<f32>,
     ao: Vec<f32>,
+    /// This frame's hit distance in metres, 0 for a miss.
+    hit: Vec<f32>,
 }
 
 impl Signal {
@@ -204,6 +206,7 @@ impl Signal {
             },
             history: Vec::with_capacity(n),
             ao: Vec::with_capacity(n),
+            hit: vec![0.0; n],
         };
         for i in 0..n {
             let (sh, history, ao) = f(i);
@@ -216,6 +219,20 @@ impl Signal {
             s.ao.push(f16r(ao));
         }
         s
+    }
+
+    /// The same signal with a hit distance where the AO ray was blocked (AO below 1/2): a
+    /// log-uniform distance from 2 cm to 4 m, so that the AO denoiser's radius cap acts.
+    fn with_hits(mut self, seed: u64) -> Self {
+        let mut rng = SmallRng::seed_from_u64(seed);
+        for (hit, ao) in self.hit.iter_mut().zip(&self.ao) {
+            *hit = if *ao < 0.5 {
+                f16r(0.02 * 200f32.powf(rng.random::<f32>()))
+            } else {
+                0.0
+            };
+        }
+        self
     }
 }
 
@@ -318,7 +335,7 @@ fn inputs(ctx: &GpuContext, scene: &Scene, signal: &Signal) -> Inputs {
     );
     let history = tex(F::R16Float, &halves(signal.history.iter().copied()));
     let ao = tex(F::R16Float, &halves(signal.ao.iter().copied()));
-    let hit = tex(F::R16Float, &halves(vec![0.0; (w * h) as usize]));
+    let hit = tex(F::R16Float, &halves(signal.hit.iter().copied()));
     Inputs {
         depth,
         normal,
@@ -415,7 +432,7 @@ fn run_cpu(scene: &Scene, signal: &Signal, gpu: &GpuOut) -> CpuOut {
     let ao = gpu
         .ao
         .as_ref()
-        .map(|_| reference::ao_pass(pao, v, g, &signal.ao, &signal.history));
+        .map(|_| reference::ao_pass(pao, v, g, &signal.ao, &signal.history, &signal.hit));
     CpuOut { pass1, pass2, ao }
 }
 
@@ -498,7 +515,8 @@ fn gpu_passes_match_their_cpu_twin() {
     let gpu = gpu();
     let scene = mixed_scene();
     assert!(scene.hit.iter().any(Option::is_none), "the scene shows sky");
-    let signal = noisy_signal(&scene, 3, |rng| rng.random_range(1..=32) as f32);
+    // Hit distances where the AO ray was blocked: the AO denoiser's radius cap acts.
+    let signal = noisy_signal(&scene, 3, |rng| rng.random_range(1..=32) as f32).with_hits(4);
     for step_falloff in [false, true] {
         let settings = GiDenoiserSettings {
             step_falloff,
@@ -509,6 +527,27 @@ fn gpu_passes_match_their_cpu_twin() {
         assert_ne!(out.params[0].rotation[1], 0.0);
         let cpu = run_cpu(&scene, &signal, &out);
         compare(&format!("step_falloff {step_falloff}"), &out, &cpu, 1.0);
+        // The hit distances' radius cap acts here: without it the AO comes out otherwise.
+        let mut uncapped = out.params[2];
+        uncapped.scales[3] = 0.0;
+        let free = reference::ao_pass(
+            &uncapped,
+            &scene.view,
+            &scene.geo,
+            &signal.ao,
+            &signal.history,
+            &signal.hit,
+        );
+        let moved = free
+            .iter()
+            .zip(cpu.ao.as_ref().unwrap())
+            .filter(|(a, b)| (*a - *b).abs() > 1e-3)
+            .count();
+        assert!(
+            moved * 4 > free.len(),
+            "the AO radius cap moved {moved} of {} texels",
+            free.len()
+        );
     }
 }
 

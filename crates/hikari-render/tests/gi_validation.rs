@@ -115,51 +115,93 @@ fn rgb(img: &ImageRgba32) -> Vec<[f32; 3]> {
     img.rgba.iter().map(|p| [p[0], p[1], p[2]]).collect()
 }
 
-/// Renders `frames` frames of a still camera and returns the HDR image (after TAA) of each
-/// frame asked for in `keep` (1-based frame numbers), and the denoised AO of the last.
-fn render_frames(
-    s: &FrameSettings,
-    frames: u32,
-    keep: &[u32],
-) -> (Vec<Vec<[f32; 3]>>, ImageRgba32) {
+/// With `HIKARI_GI_VALIDATION_DUMP=dir` set, writes an HDR image there as a PFM (rows from
+/// the bottom, as the format has them), to measure what a comparison saw.
+fn dump_pfm(name: &str, img: &[[f32; 3]], w: u32, h: u32) {
+    if let Some(dir) = std::env::var_os("HIKARI_GI_VALIDATION_DUMP") {
+        let mut bytes = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+        for y in (0..h).rev() {
+            for p in &img[(y * w) as usize..((y + 1) * w) as usize] {
+                for v in p {
+                    bytes.extend_from_slice(&v.to_le_bytes());
+                }
+            }
+        }
+        std::fs::write(
+            std::path::Path::new(&dir).join(format!("{name}.pfm")),
+            bytes,
+        )
+        .unwrap();
+    }
+}
+
+/// What [`render_frames`] keeps.
+struct Rendered {
+    /// The HDR image (after TAA) of each frame asked for, in order.
+    hdr: Vec<Vec<[f32; 3]>>,
+    /// The last frame's denoised AO (`gi_denoiser.ao`).
+    ao: ImageRgba32,
+    /// The last frame's accumulated AO before the denoiser (`ray_traced_gi.ao`).
+    ao_accumulated: ImageRgba32,
+}
+
+/// Renders `frames` frames of a still camera and keeps the HDR image of each frame asked for
+/// in `keep` (1-based frame numbers) and the AO of the last.
+fn render_frames(s: &FrameSettings, frames: u32, keep: &[u32]) -> Rendered {
     let scene = hikari_scene::builtin::cornell();
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
-    let mut kept = Vec::new();
+    let mut hdr = Vec::new();
     let mut ao = None;
     for f in 1..=frames {
         let mut picked = None;
         let mut r = renderer
             .render_reading(s, |o| {
                 let d = o.denoised_gi.expect("the GI denoiser is on by default");
-                picked = Some((o.hdr, d.ao));
-                vec![o.hdr.into(), d.ao.into()]
+                let a = o.ray_traced_gi.expect("the technique is on").ao;
+                picked = Some((o.hdr, d.ao, a));
+                vec![o.hdr.into(), d.ao.into(), a.into()]
             })
             .unwrap();
-        let (hdr, d_ao) = picked.unwrap();
+        let (img, d_ao, a_ao) = picked.unwrap();
         if keep.contains(&f) {
-            kept.push(rgb(&r.take_image_of(hdr).unwrap()));
+            hdr.push(rgb(&r.take_image_of(img).unwrap()));
         }
         if f == frames {
-            ao = r.take_image_of(d_ao);
+            ao = Some((
+                r.take_image_of(d_ao).unwrap(),
+                r.take_image_of(a_ao).unwrap(),
+            ));
         }
     }
-    (kept, ao.unwrap())
+    let (ao, ao_accumulated) = ao.unwrap();
+    Rendered {
+        hdr,
+        ao,
+        ao_accumulated,
+    }
 }
 
 /// The Cornell box at 128 x 128 with GI on, against Mitsuba 3's `path` integrator with
-/// max_depth 3 (the emitter seen, direct light, and one diffuse bounce; 4096 spp, box filter)
+/// max_depth 3 (the emitter seen, direct light, and one diffuse bounce; 65536 spp, box filter)
 /// of the same published geometry, camera and light. FLIP (LDR, default 67 pixels per degree)
 /// on both images through `display`; the issue's bounds: at most 0.15 on the first frame and
 /// at most 0.05 after 16 frames.
 #[test]
-#[ignore = "misses issue 18's bounds (frame 1: 0.17, frame 16: 0.17): docs/ray-traced-gi.md, Validation"]
+#[ignore = "misses issue 18's bounds (frame 1: 0.173, frame 16: 0.155): docs/ray-traced-gi.md, Validation"]
 fn cornell_box_with_gi_matches_mitsuba_direct_plus_one_bounce() {
     let (w, h, mitsuba) = read_pfm(include_bytes!(
         "fixtures/mitsuba_cornell_one_bounce_128.pfm"
     ));
     assert_eq!((w, h), (SIZE, SIZE));
-    let s = cornell_settings(SIZE, SIZE);
-    let (kept, _) = render_frames(&s, 16, &[1, 16]);
+    let mut s = cornell_settings(SIZE, SIZE);
+    // One bounce, as the reference: hits on screen reuse last frame's lit image, which holds
+    // last frame's GI too, so with it the estimate converges towards every bounce (1.04 to
+    // 1.10 of Mitsuba's luminance after 16 frames); computing every hit's light keeps it to
+    // one. The reuse is checked against computed light in `tests/ray_traced_gi.rs`.
+    s.settings.ray_traced_gi.reuse_lit = false;
+    let kept = render_frames(&s, 16, &[1, 16]).hdr;
+    dump_pfm("gi_hikari_1", &kept[0], w, h);
+    dump_pfm("gi_hikari_16", &kept[1], w, h);
     let k = exposure_of(&mitsuba);
     let reference = display(&mitsuba, k);
     let (d1, d16) = (display(&kept[0], k), display(&kept[1], k));
@@ -186,17 +228,22 @@ fn cornell_box_with_gi_matches_mitsuba_direct_plus_one_bounce() {
 }
 
 /// The denoised ray-traced AO (`gi_denoiser.ao`, hikari's `ao_max_distance_m`, 50 m) after 16
-/// frames against Mitsuba's AO with the same distance (cosine-weighted, 1024 spp; our
-/// integrator on Mitsuba's ray queries, as Mitsuba 3 has none). AO is a display value in
-/// [0, 1]: both are written as 8-bit grey without a curve. The issue's bound: FLIP ≤ 0.03.
+/// frames against Mitsuba's AO with the same distance (cosine-weighted, 65536 spp; Mitsuba's
+/// `path` integrator on white surfaces under a uniform sky, which in this closed box is the
+/// 50 m AO: `tools/mitsuba_cornell.py`). AO is a display value in [0, 1]: both are written as
+/// 8-bit grey without a curve. The issue's bound: FLIP ≤ 0.03.
 #[test]
-#[ignore = "misses issue 18's bound (0.18 against 0.03): docs/ray-traced-gi.md, Validation"]
+#[ignore = "misses issue 18's bound (0.099 against 0.03): docs/ray-traced-gi.md, Validation"]
 fn cornell_box_ao_matches_mitsuba() {
     let (w, h, mitsuba) = read_pfm(include_bytes!("fixtures/mitsuba_cornell_ao50_128.pfm"));
     assert_eq!((w, h), (SIZE, SIZE));
     let s = cornell_settings(SIZE, SIZE);
     assert_eq!(s.settings.ray_traced_gi.ao_max_distance_m, 50.0);
-    let (_, ao) = render_frames(&s, 16, &[]);
+    let Rendered {
+        ao, ao_accumulated, ..
+    } = render_frames(&s, 16, &[]);
+    dump_pfm("ao_hikari", &rgb(&ao), w, h);
+    dump_pfm("ao_hikari_accumulated", &rgb(&ao_accumulated), w, h);
     let grey = |v: f32| (255.0 * v.clamp(0.0, 1.0)).round() as u8;
     let reference: Vec<u8> = mitsuba.iter().flat_map(|c| [grey(c[0]); 3]).collect();
     let test: Vec<u8> = ao.rgba.iter().flat_map(|p| [grey(p[0]); 3]).collect();

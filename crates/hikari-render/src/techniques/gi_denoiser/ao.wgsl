@@ -2,7 +2,9 @@
 // rotated once a frame, the count scaled by the AO's 3x3 variance; two horizontally adjacent
 // pixels a thread, which share one set of samples when no edge lies between them (same
 // tangent plane within the tolerance, normals within EDGE_NORMAL_COS). Weights: geometry
-// (distance to the tangent plane) times the normal's dot product. Output:
+// (distance to the tangent plane) times the normal's dot product. The world radius is capped
+// at a multiple of the harmonic mean hit distance of the 5x5 neighbourhood's rays (AO varies
+// over about the distance to the occluders). Output:
 // lerp(denoised, input, 0.5 * accumulation speed). CPU twin: gi_denoiser/reference.rs `ao_pass`.
 
 #import hikari::view::{View, world_from_depth}
@@ -15,12 +17,43 @@
 @group(0) @binding(3) var normal_tex: texture_2d<f32>;
 @group(0) @binding(4) var ao_tex: texture_2d<f32>;
 @group(0) @binding(5) var history_tex: texture_2d<f32>;
-@group(0) @binding(6) var out_ao: texture_storage_2d<r16float, write>;
+// This frame's hit distance in metres (0: a miss or no ray).
+@group(0) @binding(6) var hit_distance_tex: texture_2d<f32>;
+@group(0) @binding(7) var out_ao: texture_storage_2d<r16float, write>;
 
 // Two pixels whose normals differ by more than about 25 degrees do not share samples.
 const EDGE_NORMAL_COS: f32 = 0.9;
 // The fewest samples a pixel takes, however flat its AO.
 const MIN_SAMPLES: u32 = 8u;
+// A radius cap that caps nothing: no ray of the neighbourhood hit, or the cap is off.
+const NO_CAP: f32 = 1.0e30;
+// The hit distances of (2 HIT_WINDOW + 1)^2 pixels set the cap.
+const HIT_WINDOW: i32 = 2;
+
+// The AO's world radius cap: `scale` times the harmonic mean of the finite, positive hit
+// distances over 5x5 (the split-sphere model of irradiance caching: light and occlusion change
+// over about the harmonic mean distance to the surroundings). NO_CAP without hits or scale.
+fn hit_radius_cap(pixel: vec2<u32>, size: vec2<u32>, scale: f32) -> f32 {
+    var inv_sum = 0.0;
+    var count = 0.0;
+    for (var dy = -HIT_WINDOW; dy <= HIT_WINDOW; dy++) {
+        for (var dx = -HIT_WINDOW; dx <= HIT_WINDOW; dx++) {
+            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
+            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+                continue;
+            }
+            let d = textureLoad(hit_distance_tex, q, 0).x;
+            if d > 0.0 && is_finite_f(d) {
+                inv_sum += 1.0 / d;
+                count += 1.0;
+            }
+        }
+    }
+    if !(scale > 0.0) || !(count > 0.0) {
+        return NO_CAP;
+    }
+    return scale * count / inv_sum;
+}
 
 struct AoPixel {
     surface: Surface,
@@ -31,6 +64,8 @@ struct AoPixel {
     keep: f32,
     // F(variance) of the AO over 3x3.
     variance_scale: f32,
+    // Largest world radius in metres from the neighbourhood's hit distances (NO_CAP: none).
+    radius_cap: f32,
 }
 
 fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
@@ -48,15 +83,16 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     p.keep = combine_weight(select(1.0, raw_history, is_finite_f(raw_history)), params.scales);
     let moments = moments_3x3(ao_tex, pixel, size);
     p.variance_scale = radius_scale_variance(moments.x, moments.y, params.scales);
+    p.radius_cap = hit_radius_cap(pixel, size, params.scales.w);
     return p;
 }
 
 // Weighted mean AO of the samples around `centre_px` (pixel units) against the surface `s`,
 // starting from the centre sum `acc` and weight `acc_w`.
-fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
+fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, radius_cap: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
     var acc = acc_in;
     var acc_w = acc_w_in;
-    let radius_m = params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale;
+    let radius_m = min(params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale, radius_cap);
     let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
     let count = min(
         max(u32(ceil(f32(params.flags.x) * variance_scale)), min(MIN_SAMPLES, params.flags.x)),
@@ -126,6 +162,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             vec2<f32>(f32(pa.x) + 1.0, f32(pa.y) + 0.5),
             a.surface,
             max(a.variance_scale, b.variance_scale),
+            max(a.radius_cap, b.radius_cap),
             centre_weight(a) * a.ao + centre_weight(b) * b.ao,
             centre_weight(a) + centre_weight(b),
             size
@@ -136,13 +173,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var out_a = a.ao;
     if a.surface.valid {
-        out_a = combine(a, filter_ao(vec2<f32>(pa) + 0.5, a.surface, a.variance_scale, centre_weight(a) * a.ao, centre_weight(a), size));
+        out_a = combine(a, filter_ao(vec2<f32>(pa) + 0.5, a.surface, a.variance_scale, a.radius_cap, centre_weight(a) * a.ao, centre_weight(a), size));
     }
     textureStore(out_ao, pa, vec4<f32>(out_a, 0.0, 0.0, 1.0));
     if has_b {
         var out_b = b.ao;
         if b.surface.valid {
-            out_b = combine(b, filter_ao(vec2<f32>(pb) + 0.5, b.surface, b.variance_scale, centre_weight(b) * b.ao, centre_weight(b), size));
+            out_b = combine(b, filter_ao(vec2<f32>(pb) + 0.5, b.surface, b.variance_scale, b.radius_cap, centre_weight(b) * b.ao, centre_weight(b), size));
         }
         textureStore(out_ao, pb, vec4<f32>(out_b, 0.0, 0.0, 1.0));
     }

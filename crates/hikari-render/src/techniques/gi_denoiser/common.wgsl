@@ -14,7 +14,8 @@ struct GiDenoiserParams {
     // view depth; w: view depth in metres at which F(viewZ) = 1/2.
     rotation: vec4<f32>,
     // x: coefficient of variation at which F(variance) reaches 1; y: floor of F(variance) and
-    // F(AO); z: largest accumulation speed; w: unused.
+    // F(AO); z: largest accumulation speed; w: AO radius cap over the harmonic mean hit
+    // distance (0: no cap).
     scales: vec4<f32>,
     // x: samples at most; y: 1 = normal weight; z: 1 = step geometry falloff; w: largest step.
     flags: vec4<u32>,

@@ -41,7 +41,8 @@ pub struct GiDenoiserInput {
     pub history_length: Tex,
     /// R16Float: ambient occlusion in [0, 1] (1 = open), accumulated like the GI.
     pub ao: Tex,
-    /// R16Float: hit distance in metres (0 = no hit). Not read by these passes.
+    /// R16Float: this frame's hit distance in metres (0 = no hit). The AO denoiser caps its
+    /// radius with it (`ao_hit_distance_scale`).
     pub hit_distance: Tex,
 }
 
@@ -178,6 +179,7 @@ impl GiDenoiser {
                 .read(geometry.normal)
                 .read(input.ao)
                 .read(input.history_length)
+                .read(input.hit_distance)
                 .write(out_ao)
                 .dispatch_threads(&self.ao, [width.div_ceil(2), height, 1])?;
             ao = out_ao;

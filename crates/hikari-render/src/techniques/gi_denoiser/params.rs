@@ -143,7 +143,9 @@ impl GiDenoiserParams {
 
     /// Constants of the AO denoiser; `disk` holds the 64 Poisson points.
     pub fn ao(s: &GiDenoiserSettings, view: &View, frame_index: u64, disk: &[Vec2]) -> Self {
-        common(s, view, frame_index, s.ao_radius_m, s.ao_samples, disk)
+        let mut p = common(s, view, frame_index, s.ao_radius_m, s.ao_samples, disk);
+        p.scales[3] = s.ao_hit_distance_scale;
+        p
     }
 
     /// Poisson point `i`, rotated by this frame's angle.

@@ -240,6 +240,36 @@ struct AoPixel {
     ao_ok: bool,
     keep: f32,
     variance_scale: f32,
+    /// Largest world radius in metres ([`NO_RADIUS_CAP`]: none).
+    radius_cap: f32,
+}
+
+/// The AO radius cap that caps nothing (as `ao.wgsl`'s `NO_CAP`).
+pub const NO_RADIUS_CAP: f32 = 1.0e30;
+/// The hit distances of (2 `HIT_WINDOW` + 1)^2 pixels set the AO radius cap (as `ao.wgsl`).
+pub const HIT_WINDOW: i32 = 2;
+
+/// The AO denoiser's world radius cap at `pixel` (`hit_radius_cap` in `ao.wgsl`): `scale`
+/// times the harmonic mean of the finite, positive hit distances over 5x5.
+pub fn hit_radius_cap(w: u32, h: u32, pixel: UVec2, hit_distance: &[f32], scale: f32) -> f32 {
+    let (mut inv_sum, mut count) = (0.0f32, 0.0f32);
+    for dy in -HIT_WINDOW..=HIT_WINDOW {
+        for dx in -HIT_WINDOW..=HIT_WINDOW {
+            let (x, y) = (pixel.x as i32 + dx, pixel.y as i32 + dy);
+            if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
+                continue;
+            }
+            let d = hit_distance[(y as u32 * w + x as u32) as usize];
+            if d > 0.0 && d.is_finite() {
+                inv_sum += 1.0 / d;
+                count += 1.0;
+            }
+        }
+    }
+    if !(scale > 0.0) || !(count > 0.0) {
+        return NO_RADIUS_CAP;
+    }
+    scale * count / inv_sum
 }
 
 fn load_ao_pixel(
@@ -248,6 +278,7 @@ fn load_ao_pixel(
     geo: &GeometryImage,
     ao: &[f32],
     history_length: &[f32],
+    hit_distance: &[f32],
     pixel: UVec2,
 ) -> AoPixel {
     let (w, h) = (geo.width, geo.height);
@@ -259,6 +290,7 @@ fn load_ao_pixel(
         ao_ok: ao[i].is_finite(),
         keep: combine_weight(finite_or(history_length[i], 1.0), params),
         variance_scale: radius_scale_variance(mean, mean_sq, params),
+        radius_cap: hit_radius_cap(w, h, pixel, hit_distance, params.scales[3]),
     }
 }
 
@@ -272,10 +304,13 @@ fn filter_ao(
     centre_px: Vec2,
     s: &Surface,
     variance_scale: f32,
+    radius_cap: f32,
     mut acc: Vec2,
 ) -> Vec2 {
     let (w, h) = (geo.width, geo.height);
-    let radius_m = params.radius[0] * radius_scale_z(s.view_z, params.rotation[3]) * variance_scale;
+    let radius_m =
+        (params.radius[0] * radius_scale_z(s.view_z, params.rotation[3]) * variance_scale)
+            .min(radius_cap);
     let radius = radius_pixels(radius_m, s.view_z, params);
     let count = ((params.flags[0] as f32 * variance_scale).ceil() as u32)
         .max(MIN_AO_SAMPLES.min(params.flags[0]))
@@ -324,13 +359,14 @@ fn centre_acc(p: &AoPixel) -> Vec2 {
 }
 
 /// The AO denoiser (`ao.wgsl`): pixel pairs (2x, y), (2x + 1, y) share one set of samples
-/// where no edge lies between them.
+/// where no edge lies between them. `hit_distance`: this frame's, metres, 0 for no hit.
 pub fn ao_pass(
     params: &GiDenoiserParams,
     view: &View,
     geo: &GeometryImage,
     ao: &[f32],
     history_length: &[f32],
+    hit_distance: &[f32],
 ) -> Vec<f32> {
     let (w, h) = (geo.width, geo.height);
     let mut out = vec![0.0; (w * h) as usize];
@@ -339,8 +375,9 @@ pub fn ao_pass(
             let pa = UVec2::new(x, y);
             let pb = UVec2::new(x + 1, y);
             let has_b = pb.x < w;
-            let a = load_ao_pixel(params, view, geo, ao, history_length, pa);
-            let b = has_b.then(|| load_ao_pixel(params, view, geo, ao, history_length, pb));
+            let load = |p| load_ao_pixel(params, view, geo, ao, history_length, hit_distance, p);
+            let a = load(pa);
+            let b = has_b.then(|| load(pb));
             let ia = (y * w + x) as usize;
             if let (Some(b), Some(sa), Some(sb)) =
                 (&b, &a.surface, b.as_ref().and_then(|b| b.surface))
@@ -355,6 +392,7 @@ pub fn ao_pass(
                     Vec2::new(x as f32 + 1.0, y as f32 + 0.5),
                     sa,
                     a.variance_scale.max(b.variance_scale),
+                    a.radius_cap.max(b.radius_cap),
                     centre_acc(&a) + centre_acc(b),
                 );
                 out[ia] = combine_ao(&a, acc);
@@ -374,6 +412,7 @@ pub fn ao_pass(
                             pixel.as_vec2() + 0.5,
                             s,
                             p.variance_scale,
+                            p.radius_cap,
                             centre_acc(p),
                         ),
                     ),

@@ -19,6 +19,10 @@ pub struct GiDenoiserSettings {
     pub pass2_radius_m: f32,
     /// Base blur radius of the AO denoiser, in metres.
     pub ao_radius_m: f32,
+    /// Cap on the AO denoiser's world radius, as a multiple of the harmonic mean distance of
+    /// the 5x5 neighbourhood's ray hits (AO changes over about the distance to the occluders);
+    /// 0 turns the cap off. Unitless.
+    pub ao_hit_distance_scale: f32,
     /// Poisson-disk samples a GI pass takes at most (the talk: up to 32).
     pub samples: u32,
     /// Poisson-disk samples the AO denoiser takes at most (the talk: up to 64).
@@ -52,6 +56,7 @@ impl Default for GiDenoiserSettings {
             pass1_radius_m: 6.0,
             pass2_radius_m: 3.0,
             ao_radius_m: 2.0,
+            ao_hit_distance_scale: 0.1,
             samples: 32,
             ao_samples: 64,
             min_radius_px: 2.0,
@@ -79,6 +84,10 @@ impl TechniqueSettings for GiDenoiserSettings {
             },
             Field {
                 key: "ao_radius_m",
+                range: Range::Float { lo: 0.0, hi: 100.0 },
+            },
+            Field {
+                key: "ao_hit_distance_scale",
                 range: Range::Float { lo: 0.0, hi: 100.0 },
             },
             Field {
