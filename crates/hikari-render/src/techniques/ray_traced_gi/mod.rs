@@ -105,7 +105,7 @@ pub struct RtGiParams {
     pub config: [u32; 4],
     /// GI ray length (m), AO distance (m), history depth tolerance, light cut-off (lux).
     pub distances: [f32; 4],
-    /// Pre-trace step (px), steps at most, thickness (m), length (m).
+    /// Pre-trace step (px), steps at most, thickness (fraction of view depth), length (m).
     pub pretrace: [f32; 4],
     /// Unit vector towards the sun or moon; illuminance in lux.
     pub sun: [f32; 4],
@@ -182,7 +182,7 @@ impl RtGiParams {
             pretrace: [
                 s.pretrace_step_px,
                 s.pretrace_max_steps as f32,
-                s.pretrace_thickness_m,
+                s.pretrace_thickness,
                 s.pretrace_max_distance_m,
             ],
             sun: dir.extend(lux).to_array(),

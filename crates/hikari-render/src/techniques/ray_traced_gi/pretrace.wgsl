@@ -90,7 +90,7 @@ fn march(o: vec3<f32>, dir: vec3<f32>) -> u32 {
         // A non-finite view depth fails the comparison and the texel is passed over.
         let surf_z = textureLoad(gbuffer_motion, p, 0).z;
         if ray_z > surf_z * 1.002 {
-            if min(z_before, ray_z) > surf_z + params.pretrace.z {
+            if min(z_before, ray_z) > surf_z * (1.0 + params.pretrace.z) {
                 // Behind the surface all along the step: what is there is unknown.
                 return RTGI_HIT_UNRESOLVED;
             }

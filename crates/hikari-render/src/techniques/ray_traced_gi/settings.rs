@@ -15,8 +15,10 @@ pub struct RayTracedGiSettings {
     pub pretrace_step_px: f32,
     /// Steps of the pre-trace at most.
     pub pretrace_max_steps: u32,
-    /// How far behind the depth buffer a ray may be and still hit it, in metres.
-    pub pretrace_thickness_m: f32,
+    /// How far behind the depth buffer a ray may be and still hit it, as a fraction of the
+    /// surface's view depth (the depth buffer hides as much behind a surface at 30 m as a
+    /// fixed 0.3 m; a fixed thickness is most of a small room seen from close by).
+    pub pretrace_thickness: f32,
     /// Length of ray the pre-trace marches, in metres.
     pub pretrace_max_distance_m: f32,
     /// Trace what the pre-trace left through the BVH (off: those rays count as misses).
@@ -73,7 +75,7 @@ impl Default for RayTracedGiSettings {
             pretrace: true,
             pretrace_step_px: 4.0,
             pretrace_max_steps: 16,
-            pretrace_thickness_m: 0.3,
+            pretrace_thickness: 0.01,
             pretrace_max_distance_m: 10.0,
             bvh_trace: true,
             max_distance_m: 250.0,
@@ -107,8 +109,8 @@ impl TechniqueSettings for RayTracedGiSettings {
                 range: Range::Int { lo: 1, hi: 256 },
             },
             Field {
-                key: "pretrace_thickness_m",
-                range: Range::Float { lo: 0.0, hi: 100.0 },
+                key: "pretrace_thickness",
+                range: Range::Float { lo: 0.0, hi: 1.0 },
             },
             Field {
                 key: "pretrace_max_distance_m",
