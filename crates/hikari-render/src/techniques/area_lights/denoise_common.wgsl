@@ -3,7 +3,7 @@
 // What the shadow denoiser's two passes (temporal.wgsl, spatial.wgsl) share: their constants
 // and the visibility's definition. CPU twin: area_lights::reference (denoise part).
 
-#import hikari::gi_denoiser_common::is_finite4
+#import hikari::finite::is_finite4
 
 struct ShadowDenoiseParams {
     // x: SHADOW_DENOISE_* flags; y: history length cap (frames, >= 1); z, w: 0.

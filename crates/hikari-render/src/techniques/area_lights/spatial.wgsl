@@ -8,7 +8,8 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::gi_denoiser_common::{make_surface, geometry_weight, is_finite_f, is_finite4}
+#import hikari::finite::{is_finite_f, is_finite4}
+#import hikari::gi_denoiser_common::{make_surface, geometry_weight}
 #import hikari::area_lights_denoise::{ShadowDenoiseParams, VISIBILITY_EPS, MAX_RADIUS_PX}
 
 @group(0) @binding(0) var<uniform> view: View;

@@ -7,7 +7,7 @@
 // never reaches the history. CPU twin: area_lights::reference::denoise_temporal.
 
 #import hikari::view::{View, world_from_depth}
-#import hikari::gi_denoiser_common::{is_finite_f, is_finite4}
+#import hikari::finite::{is_finite_f, is_finite4}
 #import hikari::area_lights_denoise::{ShadowDenoiseParams, SHADOW_DENOISE_RESET, raw_visibility}
 
 @group(0) @binding(0) var<uniform> view: View;

@@ -9,7 +9,8 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, is_finite_f, is_finite4, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3}
+#import hikari::finite::{is_finite_f, is_finite4}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;

@@ -1,10 +1,11 @@
 #define_import_path hikari::gi_denoiser_common
 
-// What the GI passes and the AO denoiser share: their constants, the NaN test, the surface a
+// What the GI passes and the AO denoiser share: their constants, the surface a
 // pixel holds, the radius scale and the geometry weight. CPU twin: gi_denoiser/reference.rs.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
+#import hikari::finite::{is_finite_f, is_finite4}
 
 struct GiDenoiserParams {
     // x: base radius in metres; y, z: smallest and largest radius in pixels; w: distance to the
@@ -29,15 +30,6 @@ struct Surface {
     normal: vec3<f32>,
     // Metres along the camera's forward axis.
     view_z: f32,
-}
-
-// Bit test instead of `x != x`: compilers may fold the latter away under fast-math rules.
-fn is_finite_f(x: f32) -> bool {
-    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
-}
-
-fn is_finite4(v: vec4<f32>) -> bool {
-    return all((bitcast<vec4<u32>>(v) & vec4<u32>(0x7f800000u)) != vec4<u32>(0x7f800000u));
 }
 
 // E[x] and E[x^2] of the red channel over the 3x3 neighbourhood of `pixel`, finite texels

@@ -8,6 +8,7 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_ACCUMULATE, RTGI_RESET}
+#import hikari::finite::is_finite4
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -25,11 +26,6 @@
 @group(0) @binding(13) var out_ao: texture_storage_2d<r16float, write>;
 @group(0) @binding(14) var out_length: texture_storage_2d<r16float, write>;
 @group(0) @binding(15) var out_depth: texture_storage_2d<r32float, write>;
-
-fn finite4(v: vec4<f32>) -> bool {
-    // NaN fails ==; infinities fail the bound.
-    return all(v == v) && all(abs(v) <= vec4<f32>(3.0e38));
-}
 
 fn store(p: vec2<u32>, y: vec4<f32>, cocg: vec2<f32>, ao: f32, len: f32, z: f32) {
     textureStore(out_y, p, y);
@@ -53,18 +49,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var y = textureLoad(raw_y, pixel, 0);
     var cocg_ao = textureLoad(raw_cocg_ao, pixel, 0);
-    if !finite4(y) || !finite4(vec4<f32>(cocg_ao.xy, 0.0, 0.0)) {
+    if !is_finite4(y) || !is_finite4(vec4<f32>(cocg_ao.xy, 0.0, 0.0)) {
         y = vec4<f32>(0.0);
         cocg_ao = vec4<f32>(0.0, 0.0, cocg_ao.zw);
     }
-    var ao = select(1.0, clamp(cocg_ao.z, 0.0, 1.0), finite4(vec4<f32>(cocg_ao.z)));
+    var ao = select(1.0, clamp(cocg_ao.z, 0.0, 1.0), is_finite4(vec4<f32>(cocg_ao.z)));
     let motion = textureLoad(gbuffer_motion, pixel, 0).xyz;
-    let z = select(0.0, motion.z, finite4(vec4<f32>(motion.z)));
+    let z = select(0.0, motion.z, is_finite4(vec4<f32>(motion.z)));
     let world = world_from_depth(view, pixel, d);
     let flags = params.config.y;
     let prev = vec2<f32>(pixel) + 0.5 + motion.xy;
     let sizef = vec2<f32>(size);
-    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || !finite4(vec4<f32>(motion, 0.0)) || !finite4(vec4<f32>(world, 0.0))
+    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || !is_finite4(vec4<f32>(motion, 0.0)) || !is_finite4(vec4<f32>(world, 0.0))
         || any(prev < vec2<f32>(0.0)) || any(prev >= sizef) {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;
@@ -76,7 +72,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let hl = textureLoad(prev_length, q, 0).x;
     let hz = textureLoad(prev_depth, q, 0).x;
     let expected = (view.prev_view_proj * vec4<f32>(world, 1.0)).w;
-    if !finite4(hy) || !finite4(vec4<f32>(hc, ha, hl)) || !finite4(vec4<f32>(hz)) || !(hl >= 1.0)
+    if !is_finite4(hy) || !is_finite4(vec4<f32>(hc, ha, hl)) || !is_finite4(vec4<f32>(hz)) || !(hl >= 1.0)
         || !(abs(hz - expected) <= params.distances.z * abs(expected)) {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;

@@ -7,6 +7,7 @@
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
+#import hikari::finite::is_finite3
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_PRETRACE, RTGI_BVH, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray_direction, rtgi_ray_origin, rtgi_pack_hit, rtgi_pack_miss, rtgi_hit_albedo, rtgi_pack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
@@ -29,16 +30,9 @@ const NO_INSTANCE: u32 = 0xffffffffu;
 // The pixel the pre-trace hit, if any.
 var<private> hit_pixel: vec2<u32>;
 
-// Bit tests, not `x == x` or ordered comparisons alone: compilers may fold those under
-// fast-math rules (the denoiser guards the same way), and a NaN that slipped through would
-// reach the ray and its sample.
-fn finite3(v: vec3<f32>) -> bool {
-    return all((bitcast<vec3<u32>>(v) & vec3<u32>(0x7f800000u)) != vec3<u32>(0x7f800000u));
-}
-
 // A G-buffer depth that holds a surface: finite, in (0, 1] (0 is the sky).
 fn is_surface(d: f32) -> bool {
-    return finite3(vec3<f32>(d)) && d > 0.0 && d <= 1.0;
+    return is_finite3(vec3<f32>(d)) && d > 0.0 && d <= 1.0;
 }
 
 fn to_pixel(h: vec4<f32>) -> vec2<f32> {
@@ -130,7 +124,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let d = textureLoad(depth, pixel, 0).r;
     let n = oct_decode(textureLoad(gbuffer_normal, pixel, 0).xy);
     // A bad G-buffer texel (non-finite depth or normal) traces nothing.
-    if !is_surface(d) || !finite3(n) || !(dot(n, n) > 0.5) {
+    if !is_surface(d) || !is_finite3(n) || !(dot(n, n) > 0.5) {
         hits[i] = RTGI_HIT_NOT_TRACED;
         hit_instances[i] = NO_INSTANCE;
         hit_normals[i] = RTGI_NO_NORMAL;
@@ -151,7 +145,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // The crossed texel's normal, unless it is not finite (rtgi_pack_normal would turn
         // it into some valid-looking direction).
         let e = textureLoad(gbuffer_normal, hit_pixel, 0).xy;
-        if finite3(vec3<f32>(e, 0.0)) {
+        if is_finite3(vec3<f32>(e, 0.0)) {
             normal = rtgi_pack_normal(e);
         }
     }

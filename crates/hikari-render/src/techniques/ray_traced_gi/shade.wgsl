@@ -26,6 +26,7 @@
 #import hikari::sun_shadows::{sun_visibility, shadow}
 #import hikari::sky_ambient::sky_ambient_irradiance
 #import hikari::area_polygon::{AreaLightGpu, AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, area_light_reach, area_triangle_vector_irradiance}
+#import hikari::finite::is_finite4
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
@@ -512,7 +513,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let s = shy_encode(radiance, dir);
     let w = ray.w;
-    textureStore(out_y, pixel, s.y * w);
-    textureStore(out_cocg_ao, pixel, vec4<f32>(s.co_cg * w, ao, 0.0));
+    var sample_y = s.y * w;
+    var co_cg = s.co_cg * w;
+    // The whole sample, not only the radiance: a non-finite direction or weight gives a
+    // non-finite SH even from finite radiance. Such a sample is dropped (zero).
+    if !is_finite4(sample_y) || !is_finite4(vec4<f32>(co_cg, 0.0, 0.0)) {
+        sample_y = vec4<f32>(0.0);
+        co_cg = vec2<f32>(0.0);
+    }
+    textureStore(out_y, pixel, sample_y);
+    textureStore(out_cocg_ao, pixel, vec4<f32>(co_cg, select(1.0, ao, is_finite4(vec4<f32>(ao))), 0.0));
     textureStore(out_hit_distance, pixel, vec4<f32>(distance, 0.0, 0.0, 0.0));
 }
