@@ -90,7 +90,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             for (var dx = -1; dx <= 1; dx++) {
                 let t = clamp(qi + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(size) - 1);
                 let c = textureLoad(prev_y, t, 0).x;
-                if c == c && c <= 3.0e38 {
+                if is_finite4(vec4<f32>(c)) {
                     scale = max(scale, c);
                 }
             }
