@@ -41,7 +41,7 @@ impl Default for AreaLightsSettings {
     fn default() -> Self {
         Self {
             enabled: true,
-            ray_budget: 4,
+            ray_budget: 2,
             lights_per_pixel: 4,
             punctual_shadows: true,
             punctual_radius_m: 0.05,
@@ -121,7 +121,7 @@ impl TechniqueSettings for AreaLightsSettings {
                 ..d
             },
             Preset::Medium => Self {
-                ray_budget: 2,
+                ray_budget: 1,
                 lights_per_pixel: 3,
                 ..d
             },
