@@ -34,7 +34,9 @@ pub struct AreaLightGpu {
     /// rgb: emitted radiance, nits (the emissive texture's mean folded in); a: luminous flux
     /// of the front faces, π × luminance × area, lumens.
     pub radiance_flux: [f32; 4],
-    /// x: first [`AreaTriangleGpu`]; y: triangle count; z: `AREA_LIGHT_*` bits; w: 0.
+    /// x: first [`AreaTriangleGpu`]; y: triangle count; z: `AREA_LIGHT_*` bits; w: for a
+    /// textured emitter its material's index + 1 (the shader reads the emissive layer and
+    /// wrap there), else 0.
     pub range: [u32; 4],
 }
 
@@ -59,6 +61,11 @@ pub const SKIPPED_LAMP_SHELL: &str = "a point or spot light lies inside it";
 pub struct PolygonLights {
     pub lights: Vec<AreaLightGpu>,
     pub triangles: Vec<AreaTriangleGpu>,
+    /// Per triangle two `[f32; 4]`: its vertices' UVs (u0, v0, u1, v1), (u2, v2, 1 / the
+    /// texture's mean luminance, 0); zero for an untextured light.
+    pub uvs: Vec<[f32; 4]>,
+    /// Per light, its emissive texture's luminance for the CPU twin (`None`: untextured).
+    pub textures: Vec<Option<EmitterTexture>>,
     /// Emissive instances left out, with why (for logs and tests).
     pub skipped: Vec<(usize, &'static str)>,
 }
@@ -143,6 +150,7 @@ impl PolygonLights {
                 .map(|p| p.distance(centroid))
                 .fold(0.0f32, f32::max);
             let luminance = radiance.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+            let texture = EmitterTexture::of(scene, mat, mesh);
             let first = out.triangles.len() as u32;
             let mut acc = 0.0;
             for (t, a) in tris.iter().zip(&areas) {
@@ -158,6 +166,17 @@ impl PolygonLights {
                     p2: t[2].extend(0.0).to_array(),
                 });
             }
+            for t in mesh.indices.chunks_exact(3) {
+                let (uv, inv_mean) = match &texture {
+                    Some(tex) => (
+                        [t[0], t[1], t[2]].map(|v| mesh.uvs[v as usize]),
+                        1.0 / tex.mean,
+                    ),
+                    None => ([glam::Vec2::ZERO; 3], 0.0),
+                };
+                out.uvs.push([uv[0].x, uv[0].y, uv[1].x, uv[1].y]);
+                out.uvs.push([uv[2].x, uv[2].y, inv_mean, 0.0]);
+            }
             let mut bits = 0;
             if mat.double_sided {
                 bits |= AREA_LIGHT_DOUBLE_SIDED;
@@ -171,8 +190,18 @@ impl PolygonLights {
                 radiance_flux: radiance
                     .extend(std::f32::consts::PI * luminance * area)
                     .to_array(),
-                range: [first, tri_count as u32, bits, 0],
+                range: [
+                    first,
+                    tri_count as u32,
+                    bits,
+                    if texture.is_some() {
+                        inst.material as u32 + 1
+                    } else {
+                        0
+                    },
+                ],
             });
+            out.textures.push(texture);
         }
         out
     }
@@ -181,6 +210,77 @@ impl PolygonLights {
     pub fn triangles_of(&self, i: usize) -> &[AreaTriangleGpu] {
         let r = self.lights[i].range;
         &self.triangles[r[0] as usize..(r[0] + r[1]) as usize]
+    }
+}
+
+/// An emitter's texture as the shadow rays weigh it: the linear luminance of each texel and
+/// their mean. The GPU samples the scene's sRGB array, where the image may be resampled to
+/// the array's layer size; the twin samples the image itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EmitterTexture {
+    pub width: u32,
+    pub height: u32,
+    pub luminance: Vec<f32>,
+    pub mean: f32,
+    pub wrap: [hikari_scene::Wrap; 2],
+}
+
+impl EmitterTexture {
+    /// The emissive texture of `mat` on `mesh`, if it has one, the mesh has UVs for every
+    /// vertex, and its mean luminance is positive.
+    pub fn of(
+        scene: &Scene,
+        mat: &hikari_scene::Material,
+        mesh: &hikari_scene::Mesh,
+    ) -> Option<Self> {
+        let tex = scene.textures.get(mat.emissive_texture?.texture)?;
+        if mesh.uvs.len() != mesh.positions.len() || tex.width == 0 || tex.height == 0 {
+            return None;
+        }
+        let luminance: Vec<f32> = tex
+            .data
+            .chunks_exact(4)
+            .map(|p| {
+                Vec3::new(srgb(p[0]), srgb(p[1]), srgb(p[2])).dot(Vec3::new(0.2126, 0.7152, 0.0722))
+            })
+            .collect();
+        let mean = emissive_texture_mean(scene, mat).dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        (mean > 0.0 && luminance.len() == (tex.width * tex.height) as usize).then_some(Self {
+            width: tex.width,
+            height: tex.height,
+            luminance,
+            mean,
+            wrap: [tex.wrap_s, tex.wrap_t],
+        })
+    }
+
+    /// Bilinear luminance at `uv` (texel centres at half-integers, as the GPU's sampler).
+    pub fn sample(&self, uv: glam::Vec2) -> f32 {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let x = uv.x * w as f32 - 0.5;
+        let y = uv.y * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let at = |i: i64, j: i64| {
+            let i = wrap_index(i, w, self.wrap[0]);
+            let j = wrap_index(j, h, self.wrap[1]);
+            self.luminance[(j * w + i) as usize]
+        };
+        let (i, j) = (x0 as i64, y0 as i64);
+        let top = at(i, j) * (1.0 - fx) + at(i + 1, j) * fx;
+        let bottom = at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+}
+
+fn wrap_index(i: i64, n: i64, wrap: hikari_scene::Wrap) -> i64 {
+    match wrap {
+        hikari_scene::Wrap::Repeat => i.rem_euclid(n),
+        hikari_scene::Wrap::ClampToEdge => i.clamp(0, n - 1),
+        hikari_scene::Wrap::MirroredRepeat => {
+            let m = i.rem_euclid(2 * n);
+            if m < n { m } else { 2 * n - 1 - m }
+        }
     }
 }
 

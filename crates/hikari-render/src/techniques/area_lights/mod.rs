@@ -22,7 +22,7 @@ use super::gbuffer::GBuffer;
 use crate::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{BindingSet, FrameGraph, Tex, TextureDesc};
+use crate::graph::{BindingSet, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::shader::ShaderLibrary;
@@ -128,6 +128,7 @@ pub struct AreaLightScene {
     pub lights: PolygonLights,
     light_buffer: wgpu::Buffer,
     triangle_buffer: wgpu::Buffer,
+    uv_buffer: wgpu::Buffer,
 }
 
 /// The instances of `scene` that cast shadows: all but emissive shells around a point or spot
@@ -181,6 +182,10 @@ impl AreaLightScene {
                 "area_lights.triangles",
                 bytemuck::cast_slice(&lights.triangles),
             ),
+            uv_buffer: buffer(
+                "area_lights.triangle_uvs",
+                bytemuck::cast_slice(&lights.uvs),
+            ),
             lights,
         })
     }
@@ -196,6 +201,11 @@ impl AreaLightScene {
             g.import_buffer("area_lights.lights", &self.light_buffer),
             g.import_buffer("area_lights.triangles", &self.triangle_buffer),
         )
+    }
+
+    /// The triangles' UVs in a frame (`area_lights.triangle_uvs`: [`PolygonLights::uvs`]).
+    pub fn import_uvs(&self, g: &mut FrameGraph<'_>) -> crate::graph::Buf {
+        g.import_buffer("area_lights.triangle_uvs", &self.uv_buffer)
     }
 }
 
@@ -255,6 +265,7 @@ impl AreaLights {
         )?;
         let bvh = bvh.binding_set(g);
         let (lights, triangles) = area.import(g);
+        let uvs = area.import_uvs(g);
         g.pass("area_lights.shade")
             .constants(view)
             .constants(params)
@@ -267,6 +278,10 @@ impl AreaLights {
             .read(scene.lights)
             .write(radiance)
             .write(unshadowed)
+            .read(uvs)
+            .read(scene.materials)
+            .read(scene.color_textures)
+            .sampler(SamplerKind::LinearRepeat)
             .set(brdf_tables)
             .set(bvh)
             .dispatch_threads(&self.shade, [w, h, 1])?;

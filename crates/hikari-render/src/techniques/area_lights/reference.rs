@@ -550,7 +550,30 @@ fn shadow_ray(
         return (0.0, 0.0, false);
     }
     let blocked = scene.occluded(origin, dir, dist * (1.0 - 1e-3));
-    (if blocked { 0.0 } else { w }, w, true)
+    let f = texture_factor(
+        lights,
+        i,
+        j,
+        Vec3::new(1.0 - su, su * (1.0 - u.y), su * u.y),
+    );
+    (if blocked { 0.0 } else { w * f }, w, true)
+}
+
+/// shade.wgsl's `texture_factor`: light `i`'s emissive texture luminance at barycentrics `b`
+/// of its triangle `j` over the texture's mean, 1 untextured. The GPU reads the scene's sRGB
+/// array, where the image may be resampled to the array's layer size; this reads the image.
+pub fn texture_factor(lights: &PolygonLights, i: usize, j: usize, b: Vec3) -> f32 {
+    let Some(Some(tex)) = lights.textures.get(i) else {
+        return 1.0;
+    };
+    let k = 2 * (lights.lights[i].range[0] as usize + j);
+    let (Some(a), Some(c)) = (lights.uvs.get(k), lights.uvs.get(k + 1)) else {
+        return 1.0;
+    };
+    let uv = glam::Vec2::new(a[0], a[1]) * b.x
+        + glam::Vec2::new(a[2], a[3]) * b.y
+        + glam::Vec2::new(c[0], c[1]) * b.z;
+    tex.sample(uv) * c[2]
 }
 
 /// Area light `i`'s unshadowed (radiance, lux) at `world`, or `None` where it brings none.

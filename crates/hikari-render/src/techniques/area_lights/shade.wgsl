@@ -19,7 +19,7 @@
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
 #import hikari::brdf::{BrdfMaterial, BrdfView, brdf_view, brdf_light_weights, brdf_apply_weights}
-#import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
+#import hikari::scene_gpu::{LightGpu, MaterialGpu, NO_TEXTURE, light_range, light_attenuation, wrap_uv}
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::tile_bounds::{TileBounds, tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 #import hikari::area_polygon::{AreaLightGpu, AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, area_light_reach, area_triangle_vector_irradiance}
@@ -69,6 +69,12 @@ const TILE_THREADS: u32 = 256u;
 // The same lights unshadowed, in closed form (no noise): the shadow denoiser's visibility is
 // out_radiance over this.
 @group(0) @binding(10) var out_unshadowed: texture_storage_2d<rgba16float, write>;
+// Per area triangle two vec4: its UVs (u0, v0, u1, v1), (u2, v2, 1 / the texture's mean
+// luminance, 0) (PolygonLights::uvs); and what a textured emitter's texture is read from.
+@group(0) @binding(11) var<storage, read> area_uvs: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read> materials: array<MaterialGpu>;
+@group(0) @binding(13) var color_textures: texture_2d_array<f32>;
+@group(0) @binding(14) var texture_sampler: sampler;
 
 // The lights that may reach the tile, in index order (so that the per-pixel selection breaks
 // ties and sums as over all lights): chunks of 256 lights are tested one per invocation into
@@ -290,9 +296,31 @@ fn put4(a: ptr<function, array<vec4<f32>, MAX_PER_PIXEL>>, k: u32, v: vec4<f32>)
     }
 }
 
+// A textured emitter's luminance at barycentrics `b` (of p0, p1, p2) of its triangle `j`,
+// over the texture's mean: the closed forms take the light at its mean colour, and the shadow
+// rays' ratio carries the texture's variation over the light. 1 for an untextured light.
+// Twin: reference::texture_factor.
+fn texture_factor(light: AreaLightGpu, j: u32, b: vec3<f32>) -> f32 {
+    if light.range.w == 0u || 2u * j + 1u >= arrayLength(&area_uvs) || light.range.w > arrayLength(&materials) {
+        return 1.0;
+    }
+    let m = materials[light.range.w - 1u];
+    let layer = m.textures.w;
+    if layer == NO_TEXTURE {
+        return 1.0;
+    }
+    let a = area_uvs[2u * j];
+    let c = area_uvs[2u * j + 1u];
+    let uv = a.xy * b.x + a.zw * b.y + c.xy * b.z;
+    let wrap = (m.more_textures.y >> 12u) & 15u;
+    let t = textureSampleLevel(color_textures, texture_sampler, wrap_uv(uv, wrap, textureDimensions(color_textures)), layer, 0.0).rgb;
+    return luminance(t) * c.z;
+}
+
 // Shadow ray `r` of the pixel towards the light of `key`: (its weight if unblocked, its
 // weight), the ratio estimator's terms. Area lights: a point by area (a triangle by its share,
-// the square-root warp), weighted by the unshadowed integrand cos cos / d^2; point and spot
+// the square-root warp), weighted by the unshadowed integrand cos cos / d^2, the unblocked
+// term also by a textured emitter's texture there (texture_factor); point and spot
 // lights: a point on a disc of the light's radius (its own, else the setting's) facing the
 // surface, weight 1.
 fn shadow_ray(key: u32, r: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32>) -> vec2<f32> {
@@ -348,7 +376,8 @@ fn shadow_ray(key: u32, r: u32, pixel: vec2<u32>, origin: vec3<f32>, n: vec3<f32
         return vec2<f32>(0.0);
     }
     let blocked = bvh_occluded(Ray(origin, 0.0, dir, dist * (1.0 - 1e-3)));
-    return vec2<f32>(select(w, 0.0, blocked), w);
+    let f = texture_factor(light, j, vec3<f32>(1.0 - su, su * (1.0 - u.y), su * u.y));
+    return vec2<f32>(select(w * f, 0.0, blocked), w);
 }
 
 // Stores `v` at entry `k` of `a` through a constant-bound loop (see insert_best).
