@@ -409,6 +409,7 @@ pub fn record<'r>(
             area.light_count(),
             s.settings.area_lights.min_flux_lm,
             s.settings.area_lights.punctual_shadows,
+            s.settings.area_lights.punctual_radius_m,
         );
         let inputs = RtGiInputs {
             gbuffer: &gbuffer,

@@ -115,7 +115,8 @@ pub struct RtGiParams {
     pub sky_zenith: [f32; 4],
     pub sky_horizon: [f32; 4],
     /// Lights at hits: the area lights (a count), their minimum flux (lm), the illuminance (lux)
-    /// below which a local light's shadow ray plays Russian roulette (0: never), 0.
+    /// below which a local light's shadow ray plays Russian roulette (0: never), the radius (m)
+    /// of point and spot lights without their own (`area_lights.punctual_radius_m`).
     pub area: [f32; 4],
     /// The accumulation's firefly clamp ([`reference::FireflyClamp`]): k (0: off), the floor
     /// (SH c0 units), the history length from which it applies; w unused.
@@ -212,10 +213,16 @@ impl RtGiParams {
         area_lights: u32,
         min_flux_lm: f32,
         punctual_shadows: bool,
+        punctual_radius_m: f32,
     ) -> Self {
         self.set_flag(FLAG_AREA, enabled && area_lights > 0);
         self.set_flag(FLAG_PUNCTUAL_SHADOWS, enabled && punctual_shadows);
-        self.area = [area_lights as f32, min_flux_lm, self.area[2], 0.0];
+        self.area = [
+            area_lights as f32,
+            min_flux_lm,
+            self.area[2],
+            punctual_radius_m,
+        ];
         self
     }
 

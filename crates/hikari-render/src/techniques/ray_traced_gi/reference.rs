@@ -349,6 +349,28 @@ pub fn hash(v: u32) -> u32 {
 }
 
 /// Number `k` in [0, 1) of `pixel` in `frame` for the light samples of its hit (white noise).
+/// Where the shade pass aims a hit's shadow ray at point or spot light `light` from `x`: a
+/// point on a disc of the light's radius facing `x` (its own, else `default_radius_m`), from
+/// random numbers 6 and 7 of the pixel and frame.
+pub fn punctual_shadow_target(
+    light: &crate::scene_gpu::LightGpu,
+    x: Vec3,
+    default_radius_m: f32,
+    pixel: [u32; 2],
+    frame: u32,
+) -> Vec3 {
+    let centre = Vec3::from_slice(&light.position_range[..3]);
+    let radius = if light.spot[2] >= 0.0 {
+        light.spot[2]
+    } else {
+        default_radius_m
+    };
+    let (t, b) = basis((centre - x).normalize());
+    let rho = radius * random(pixel, frame, 6).sqrt();
+    let phi = 2.0 * std::f32::consts::PI * random(pixel, frame, 7);
+    centre + t * (rho * phi.cos()) + b * (rho * phi.sin())
+}
+
 pub fn random(pixel: [u32; 2], frame: u32, k: u32) -> f32 {
     let h = hash(pixel[0] ^ hash(pixel[1] ^ hash(frame.wrapping_mul(8).wrapping_add(k))));
     (h >> 8) as f32 / 16_777_216.0

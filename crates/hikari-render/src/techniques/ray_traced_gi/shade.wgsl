@@ -27,7 +27,7 @@
 #import hikari::sky_ambient::sky_ambient_irradiance
 #import hikari::area_polygon::{AreaLightGpu, AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, area_light_reach, area_triangle_vector_irradiance}
 #import hikari::finite::is_finite4
-#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
+#import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_basis, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: RtGiParams;
@@ -420,7 +420,15 @@ fn punctual_irradiance(pixel: vec2<u32>, x: vec3<f32>, n: vec3<f32>) -> vec3<f32
     if rtgi_random(pixel, params.config.x, 5u) >= q {
         return vec3<f32>(0.0);
     }
-    let to_light = lights[chosen].position_range.xyz - x;
+    // A point on a disc of the light's radius facing the hit (its own radius, else the
+    // area-light pass's `punctual_radius_m`), as the direct light's shadows: soft at hits too.
+    // Twin: reference::punctual_shadow_target.
+    let light = lights[chosen];
+    let radius = select(params.area.w, light.spot.z, light.spot.z >= 0.0);
+    let tb = rtgi_basis(normalize(light.position_range.xyz - x));
+    let rho = radius * sqrt(rtgi_random(pixel, params.config.x, 6u));
+    let phi = 2.0 * RTGI_PI * rtgi_random(pixel, params.config.x, 7u);
+    let to_light = light.position_range.xyz + tb[0] * (rho * cos(phi)) + tb[1] * (rho * sin(phi)) - x;
     let dist = length(to_light);
     if bvh_occluded(Ray(x, 0.0, to_light / max(dist, 1e-6), dist * (1.0 - 1e-3))) {
         return vec3<f32>(0.0);
