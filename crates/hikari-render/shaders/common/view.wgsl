@@ -1,5 +1,7 @@
 #define_import_path hikari::view
 
+#import hikari::finite::is_finite3
+
 // The camera of the frame. Reverse-Z with an infinite far plane: depth 1 at the near plane,
 // 0 at infinity (the cleared value, so depth 0 means "sky").
 struct View {
@@ -32,4 +34,22 @@ fn view_ray(view: View, pixel: vec2<u32>) -> vec3<f32> {
     // A point on the near plane, which reverse-Z puts at depth 1.
     let near = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
     return normalize(near.xyz / near.w - view.position.xyz);
+}
+
+// The texel of last frame's images that holds `pixel`'s surface, by the G-buffer's motion
+// (xy in pixels, z the view depth) and the surface's world position: none (-1) where either is
+// not finite or the texel is off screen. The temporal passes' reprojection (nearest texel).
+fn reprojected_texel(pixel: vec2<u32>, motion: vec3<f32>, world: vec3<f32>, size: vec2<u32>) -> vec2<i32> {
+    let prev = vec2<f32>(pixel) + 0.5 + motion.xy;
+    if !is_finite3(motion) || !is_finite3(world) || any(prev < vec2<f32>(0.0)) || any(prev >= vec2<f32>(size)) {
+        return vec2<i32>(-1);
+    }
+    return vec2<i32>(prev);
+}
+
+// Whether a history texel's view depth `hz` is where `world` was seen last frame, within
+// `tolerance` (a fraction of that depth): the temporal passes' disocclusion test. NaN fails.
+fn history_depth_agrees(view: View, world: vec3<f32>, hz: f32, tolerance: f32) -> bool {
+    let expected = (view.prev_view_proj * vec4<f32>(world, 1.0)).w;
+    return abs(hz - expected) <= tolerance * abs(expected);
 }

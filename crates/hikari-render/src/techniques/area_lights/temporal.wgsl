@@ -6,7 +6,7 @@
 // blend is 1 / length. Non-finite input is replaced where it enters (raw_visibility), so it
 // never reaches the history. CPU twin: area_lights::reference::denoise_temporal.
 
-#import hikari::view::{View, world_from_depth}
+#import hikari::view::{View, world_from_depth, reprojected_texel, history_depth_agrees}
 #import hikari::finite::{is_finite_f, is_finite4}
 #import hikari::area_lights_denoise::{ShadowDenoiseParams, SHADOW_DENOISE_RESET, raw_visibility}
 
@@ -47,19 +47,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let motion = textureLoad(gbuffer_motion, pixel, 0).xyz;
     let z = select(0.0, motion.z, is_finite_f(motion.z));
     let world = world_from_depth(view, pixel, d);
-    let prev = vec2<f32>(pixel) + 0.5 + motion.xy;
-    if (params.config.x & SHADOW_DENOISE_RESET) != 0u || !is_finite4(vec4<f32>(motion, 0.0))
-        || !is_finite4(vec4<f32>(world, 0.0)) || any(prev < vec2<f32>(0.0)) || any(prev >= vec2<f32>(size)) {
+    let t = reprojected_texel(pixel, motion, world, size);
+    if (params.config.x & SHADOW_DENOISE_RESET) != 0u || t.x < 0 {
         store(pixel, raw, 1.0, z);
         return;
     }
-    let q = vec2<u32>(prev);
+    let q = vec2<u32>(t);
     let hv = textureLoad(prev_visibility, q, 0);
     let hl = textureLoad(prev_length, q, 0).x;
     let hz = textureLoad(prev_depth, q, 0).x;
-    let expected = (view.prev_view_proj * vec4<f32>(world, 1.0)).w;
     if !is_finite4(hv) || !is_finite_f(hl) || !(hl >= 1.0) || !is_finite_f(hz)
-        || !(abs(hz - expected) <= params.values.x * abs(expected)) {
+        || !history_depth_agrees(view, world, hz, params.values.x) {
         store(pixel, raw, 1.0, z);
         return;
     }

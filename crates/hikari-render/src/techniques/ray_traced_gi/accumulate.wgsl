@@ -6,7 +6,7 @@
 // clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
 // reference::accumulate_pixel.
 
-#import hikari::view::{View, world_from_depth}
+#import hikari::view::{View, world_from_depth, reprojected_texel, history_depth_agrees}
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_ACCUMULATE, RTGI_RESET}
 #import hikari::finite::is_finite4
 
@@ -58,22 +58,19 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let z = select(0.0, motion.z, is_finite4(vec4<f32>(motion.z)));
     let world = world_from_depth(view, pixel, d);
     let flags = params.config.y;
-    let prev = vec2<f32>(pixel) + 0.5 + motion.xy;
-    let sizef = vec2<f32>(size);
-    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || !is_finite4(vec4<f32>(motion, 0.0)) || !is_finite4(vec4<f32>(world, 0.0))
-        || any(prev < vec2<f32>(0.0)) || any(prev >= sizef) {
+    let t = reprojected_texel(pixel, motion, world, size);
+    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || t.x < 0 {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;
     }
-    let q = vec2<u32>(prev);
+    let q = vec2<u32>(t);
     let hy = textureLoad(prev_y, q, 0);
     let hc = textureLoad(prev_cocg, q, 0).xy;
     let ha = textureLoad(prev_ao, q, 0).x;
     let hl = textureLoad(prev_length, q, 0).x;
     let hz = textureLoad(prev_depth, q, 0).x;
-    let expected = (view.prev_view_proj * vec4<f32>(world, 1.0)).w;
     if !is_finite4(hy) || !is_finite4(vec4<f32>(hc, ha, hl)) || !is_finite4(vec4<f32>(hz)) || !(hl >= 1.0)
-        || !(abs(hz - expected) <= params.distances.z * abs(expected)) {
+        || !history_depth_agrees(view, world, hz, params.distances.z) {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;
     }
