@@ -20,7 +20,9 @@ use crate::techniques::direct_lighting::GiLight;
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
-use crate::techniques::gi_denoiser::{DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput};
+use crate::techniques::gi_denoiser::{
+    DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput, RecurrentNames,
+};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::ray_traced_gi::{
@@ -95,6 +97,9 @@ pub struct FrameState {
     pub rtgi_scene: Option<SharedRtGiScene>,
     /// Drop the ray-traced GI history next frame (a camera cut); cleared once used.
     pub rtgi_reset: bool,
+    /// Which denoiser outputs the last frame kept as the accumulation's history
+    /// (`GiDenoiser::recurrent_names`): when that changes, a kept texture may be stale.
+    pub rtgi_recurrent: Option<RecurrentNames>,
     /// Tests only: G-buffer texels overwritten every frame after the G-buffer pass
     /// ([`crate::renderer::Renderer::override_gbuffer_texels`]).
     pub gbuffer_overrides: Vec<GBufferTexel>,
@@ -411,6 +416,12 @@ pub fn record<'r>(
             s.settings.area_lights.punctual_shadows,
             s.settings.area_lights.punctual_radius_m,
         );
+        let recurrent = t
+            .gi_denoiser
+            .as_ref()
+            .map(|_| GiDenoiser::recurrent_names(&s.settings.gi_denoiser));
+        let recurrence_changed = state.rtgi_recurrent != recurrent;
+        state.rtgi_recurrent = recurrent;
         let inputs = RtGiInputs {
             gbuffer: &gbuffer,
             sky: &sky,
@@ -423,10 +434,17 @@ pub fn record<'r>(
             area,
             // Step 14's exposure of the last frame: this frame's is not known yet.
             exposure: Exposure::previous(g)?,
+            denoised_history: match t.gi_denoiser {
+                Some(_) => GiDenoiser::recurrent_history(g, &s.settings.gi_denoiser, size)?,
+                None => Default::default(),
+            },
         };
-        let (frame, rays) =
-            t.ray_traced_gi
-                .record(g, &rt_scene, &inputs, state.rtgi_reset || camera_cut)?;
+        let (frame, rays) = t.ray_traced_gi.record(
+            g,
+            &rt_scene,
+            &inputs,
+            state.rtgi_reset || camera_cut || recurrence_changed,
+        )?;
         state.rtgi_reset = false;
         ray_traced_gi = Some(frame);
         ray_traced_gi_rays = Some(rays);

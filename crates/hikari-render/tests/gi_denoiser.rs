@@ -421,13 +421,20 @@ struct CpuOut {
 fn run_cpu(scene: &Scene, signal: &Signal, gpu: &GpuOut) -> CpuOut {
     let [p1, p2, pao] = &gpu.params;
     let (v, g) = (&scene.view, &scene.geo);
-    let pass1 = gpu
-        .pass1
-        .as_ref()
-        .map(|_| reference::spatial_pass(p1, v, g, &signal.gi, &signal.history, &signal.ao));
+    let pass1 = gpu.pass1.as_ref().map(|_| {
+        reference::spatial_pass(
+            p1,
+            v,
+            g,
+            &signal.gi,
+            &signal.history,
+            &signal.ao,
+            &signal.hit,
+        )
+    });
     let pass2 = gpu.pass2.as_ref().map(|_| {
         let input = gpu.pass1.as_ref().unwrap_or(&signal.gi);
-        reference::spatial_pass(p2, v, g, input, &signal.history, &signal.ao)
+        reference::spatial_pass(p2, v, g, input, &signal.history, &signal.ao, &signal.hit)
     });
     let ao = gpu
         .ao
@@ -547,6 +554,27 @@ fn gpu_passes_match_their_cpu_twin() {
             moved * 4 > free.len(),
             "the AO radius cap moved {moved} of {} texels",
             free.len()
+        );
+        // And the GI passes' cap (which loosens for short histories) acts too.
+        let mut uncapped = out.params[0];
+        uncapped.scales[3] = 0.0;
+        let free = reference::spatial_pass(
+            &uncapped,
+            &scene.view,
+            &scene.geo,
+            &signal.gi,
+            &signal.history,
+            &signal.ao,
+            &signal.hit,
+        );
+        let capped = cpu.pass1.as_ref().unwrap();
+        let moved = (free.y.iter().zip(&capped.y))
+            .filter(|(a, b)| (**a - **b).abs().max_element() > 1e-3 * b.x.abs().max(1.0))
+            .count();
+        assert!(
+            moved * 4 > free.y.len(),
+            "the GI radius cap moved {moved} of {} texels",
+            free.y.len()
         );
     }
 }

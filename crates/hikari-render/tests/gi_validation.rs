@@ -54,6 +54,29 @@ fn cornell_settings(w: u32, h: u32) -> FrameSettings {
     s.settings.sky.sky = false;
     s.settings.direct_lighting.placeholder_ambient = false;
     s.settings.ray_traced_gi.enabled = true;
+    with_overrides(s)
+}
+
+/// `HIKARI_GI_VALIDATION_SET="table.key=value,..."` changes settings for a measurement (what
+/// docs/ray-traced-gi.md's "What separates hikari from Mitsuba" numbers come from); the
+/// tests' own settings win over it.
+fn with_overrides(mut s: FrameSettings) -> FrameSettings {
+    let Ok(list) = std::env::var("HIKARI_GI_VALIDATION_SET") else {
+        return s;
+    };
+    let overrides: Vec<(String, String)> = list
+        .split(',')
+        .filter(|kv| !kv.trim().is_empty())
+        .map(|kv| {
+            let (k, v) = kv
+                .split_once('=')
+                .expect("HIKARI_GI_VALIDATION_SET: key=value");
+            (k.trim().to_string(), v.trim().to_string())
+        })
+        .collect();
+    let mut table = toml::Table::try_from(&s.settings).unwrap();
+    table.remove("preset");
+    s.settings = hikari_render::Settings::from_toml(None, table, &overrides).unwrap();
     s
 }
 

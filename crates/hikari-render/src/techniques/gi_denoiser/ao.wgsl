@@ -10,7 +10,7 @@
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
 #import hikari::finite::{is_finite_f, is_finite4}
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3, hit_radius_cap}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -26,36 +26,6 @@
 const EDGE_NORMAL_COS: f32 = 0.9;
 // The fewest samples a pixel takes, however flat its AO.
 const MIN_SAMPLES: u32 = 8u;
-// A radius cap that caps nothing: no ray of the neighbourhood hit, or the cap is off.
-const NO_CAP: f32 = 1.0e30;
-// The hit distances of (2 HIT_WINDOW + 1)^2 pixels set the cap.
-const HIT_WINDOW: i32 = 2;
-
-// The AO's world radius cap: `scale` times the harmonic mean of the finite, positive hit
-// distances over 5x5 (the split-sphere model of irradiance caching: light and occlusion change
-// over about the harmonic mean distance to the surroundings). NO_CAP without hits or scale.
-fn hit_radius_cap(pixel: vec2<u32>, size: vec2<u32>, scale: f32) -> f32 {
-    var inv_sum = 0.0;
-    var count = 0.0;
-    for (var dy = -HIT_WINDOW; dy <= HIT_WINDOW; dy++) {
-        for (var dx = -HIT_WINDOW; dx <= HIT_WINDOW; dx++) {
-            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
-            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
-                continue;
-            }
-            let d = textureLoad(hit_distance_tex, q, 0).x;
-            if d > 0.0 && is_finite_f(d) {
-                inv_sum += 1.0 / d;
-                count += 1.0;
-            }
-        }
-    }
-    if !(scale > 0.0) || !(count > 0.0) {
-        return NO_CAP;
-    }
-    return scale * count / inv_sum;
-}
-
 struct AoPixel {
     surface: Surface,
     // Input AO, 1 (open) where the input was not finite.
@@ -81,10 +51,11 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     p.ao_ok = is_finite_f(raw);
     p.ao = select(1.0, raw, p.ao_ok);
     let raw_history = textureLoad(history_tex, pixel, 0).x;
-    p.keep = combine_weight(select(1.0, raw_history, is_finite_f(raw_history)), params.scales);
+    let history = select(1.0, raw_history, is_finite_f(raw_history));
+    p.keep = combine_weight(history, params.scales);
     let moments = moments_3x3(ao_tex, pixel, size);
     p.variance_scale = radius_scale_variance(moments.x, moments.y, params.scales);
-    p.radius_cap = hit_radius_cap(pixel, size, params.scales.w);
+    p.radius_cap = hit_radius_cap(hit_distance_tex, pixel, size, params.scales.w, history);
     return p;
 }
 

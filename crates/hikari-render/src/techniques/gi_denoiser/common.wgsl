@@ -121,3 +121,36 @@ fn disk_point(i: u32, e: vec4<f32>, rotation: vec4<f32>) -> vec2<f32> {
     let s = rotation.y;
     return vec2<f32>(c * p.x - s * p.y, s * p.x + c * p.y);
 }
+
+// A radius cap that caps nothing: no ray of the neighbourhood hit, or the cap is off.
+const NO_CAP: f32 = 1.0e30;
+// The hit distances of (2 HIT_WINDOW + 1)^2 pixels set the cap.
+const HIT_WINDOW: i32 = 2;
+
+// World radius cap in metres: `scale` times the harmonic mean of the finite, positive hit
+// distances over 5x5 (the split-sphere model of irradiance caching: light and occlusion change
+// over about the harmonic mean distance to the surroundings), over the square root of the
+// history length: the accumulated mean's noise falls as 1 / sqrt(history), so the pixels a
+// kernel must average fall as 1 / history and its radius as 1 / sqrt(history). NO_CAP
+// without hits or scale.
+fn hit_radius_cap(hit_distance: texture_2d<f32>, pixel: vec2<u32>, size: vec2<u32>, scale: f32, history_length: f32) -> f32 {
+    var inv_sum = 0.0;
+    var count = 0.0;
+    for (var dy = -HIT_WINDOW; dy <= HIT_WINDOW; dy++) {
+        for (var dx = -HIT_WINDOW; dx <= HIT_WINDOW; dx++) {
+            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
+            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+                continue;
+            }
+            let d = textureLoad(hit_distance, q, 0).x;
+            if d > 0.0 && is_finite_f(d) {
+                inv_sum += 1.0 / d;
+                count += 1.0;
+            }
+        }
+    }
+    if !(scale > 0.0) || !(count > 0.0) {
+        return NO_CAP;
+    }
+    return scale * count / inv_sum / sqrt(max(history_length, 1.0));
+}

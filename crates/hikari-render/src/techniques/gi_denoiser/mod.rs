@@ -72,6 +72,19 @@ pub struct DenoisedGi {
     pub ao: Tex,
 }
 
+/// [`GiDenoiser::recurrent_names`]: the kept GI textures (Y, CoCg) and the kept AO.
+pub type RecurrentNames = (Option<[&'static str; 2]>, Option<&'static str>);
+
+/// Last frame's denoised output, for a recurrent accumulation (see
+/// [`GiDenoiser::recurrent_history`]): `(textures, valid)`, `None` where that part is not kept.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RecurrentHistory {
+    /// Y (Rgba16Float) and CoCg (Rg16Float).
+    pub gi: Option<([Tex; 2], bool)>,
+    /// R16Float.
+    pub ao: Option<(Tex, bool)>,
+}
+
 pub struct GiDenoiser {
     spatial: ComputePipeline,
     ao: ComputePipeline,
@@ -113,6 +126,51 @@ impl GiDenoiser {
         ]
     }
 
+    /// Names of the textures that hold the denoiser's final output across frames when
+    /// `recurrent` is on: the last enabled GI pass's (`None` with both off) and the AO
+    /// denoiser's (`None` with it off). The temporal accumulation of the next frame blends with
+    /// them instead of with its own last output.
+    pub fn recurrent_names(settings: &GiDenoiserSettings) -> RecurrentNames {
+        if !settings.recurrent {
+            return (None, None);
+        }
+        let gi = if settings.pass2 {
+            Some(["gi_denoiser.pass2_y", "gi_denoiser.pass2_cocg"])
+        } else if settings.pass1 {
+            Some(["gi_denoiser.pass1_y", "gi_denoiser.pass1_cocg"])
+        } else {
+            None
+        };
+        (gi, settings.ao.then_some("gi_denoiser.ao"))
+    }
+
+    /// The history textures of [`GiDenoiser::recurrent_names`] at `size`: last frame's
+    /// denoised GI (Y, CoCg) and AO, for the temporal accumulation to read, and whether each
+    /// holds a real last frame.
+    pub fn recurrent_history(
+        g: &mut FrameGraph<'_>,
+        settings: &GiDenoiserSettings,
+        [width, height]: [u32; 2],
+    ) -> Result<RecurrentHistory> {
+        let (gi, ao) = Self::recurrent_names(settings);
+        let gi = match gi {
+            Some([y, cocg]) => {
+                let y = g.history_texture(y, TextureDesc::d2(width, height, GI_Y_FORMAT))?;
+                let c = g.history_texture(cocg, TextureDesc::d2(width, height, GI_COCG_FORMAT))?;
+                Some(([y.prev, c.prev], y.valid && c.valid))
+            }
+            None => None,
+        };
+        let ao = match ao {
+            Some(name) => {
+                let a = g.history_texture(name, TextureDesc::d2(width, height, AO_FORMAT))?;
+                Some((a.prev, a.valid))
+            }
+            None => None,
+        };
+        Ok(RecurrentHistory { gi, ao })
+    }
+
     /// Adds the enabled passes to the frame (step 10, after the temporal accumulation).
     pub fn record<'r>(
         &'r self,
@@ -131,29 +189,34 @@ impl GiDenoiser {
                 settings.pass1,
                 p1,
                 "gi_denoiser.pass1",
-                "pass1_y",
-                "pass1_cocg",
+                "gi_denoiser.pass1_y",
+                "gi_denoiser.pass1_cocg",
             ),
             (
                 settings.pass2,
                 p2,
                 "gi_denoiser.pass2",
-                "pass2_y",
-                "pass2_cocg",
+                "gi_denoiser.pass2_y",
+                "gi_denoiser.pass2_cocg",
             ),
         ];
+        let (recurrent_gi, recurrent_ao) = Self::recurrent_names(settings);
         for (enabled, p, label, y_name, cocg_name) in passes {
             if !enabled {
                 continue;
             }
-            let out_y = g.texture(
-                &format!("gi_denoiser.{y_name}"),
-                TextureDesc::d2(width, height, GI_Y_FORMAT),
-            )?;
-            let out_cocg = g.texture(
-                &format!("gi_denoiser.{cocg_name}"),
-                TextureDesc::d2(width, height, GI_COCG_FORMAT),
-            )?;
+            // The last pass's output is kept for the next frame's accumulation when recurrent.
+            let kept = recurrent_gi.is_some_and(|[y, _]| y == y_name);
+            let out = |g: &mut FrameGraph<'r>, name: &str, format| {
+                let desc = TextureDesc::d2(width, height, format);
+                if kept {
+                    g.history_texture(name, desc).map(|h| h.cur)
+                } else {
+                    g.texture(name, desc)
+                }
+            };
+            let out_y = out(g, y_name, GI_Y_FORMAT)?;
+            let out_cocg = out(g, cocg_name, GI_COCG_FORMAT)?;
             g.pass(label)
                 .constants(&p)
                 .constants(view)
@@ -165,13 +228,18 @@ impl GiDenoiser {
                 .read(input.ao)
                 .write(out_y)
                 .write(out_cocg)
+                .read(input.hit_distance)
                 .dispatch_threads(&self.spatial, [width, height, 1])?;
             y = out_y;
             cocg = out_cocg;
         }
         let mut ao = input.ao;
         if settings.ao {
-            let out_ao = g.texture("gi_denoiser.ao", TextureDesc::d2(width, height, AO_FORMAT))?;
+            let desc = TextureDesc::d2(width, height, AO_FORMAT);
+            let out_ao = match recurrent_ao {
+                Some(name) => g.history_texture(name, desc)?.cur,
+                None => g.texture("gi_denoiser.ao", desc)?,
+            };
             g.pass("gi_denoiser.ao")
                 .constants(&pao)
                 .constants(view)

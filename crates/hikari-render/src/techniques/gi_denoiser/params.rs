@@ -138,6 +138,7 @@ impl GiDenoiserParams {
         };
         let mut p = common(s, view, frame_index, radius, s.samples, disk);
         p.flags[1] = normal;
+        p.scales[3] = s.gi_hit_distance_scale;
         p
     }
 

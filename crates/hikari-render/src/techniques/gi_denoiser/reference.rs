@@ -137,6 +137,7 @@ fn tap(centre_px: Vec2, offset: Vec2, w: u32, h: u32) -> Option<UVec2> {
 }
 
 /// One GI pass (`spatial.wgsl`): `params.flags[1]` selects the normal weight.
+/// `hit_distance`: this frame's, metres, 0 for no hit (the radius cap, `params.scales[3]`).
 pub fn spatial_pass(
     params: &GiDenoiserParams,
     view: &View,
@@ -144,6 +145,7 @@ pub fn spatial_pass(
     input: &GiImage,
     history_length: &[f32],
     ao: &[f32],
+    hit_distance: &[f32],
 ) -> GiImage {
     let (w, h) = (geo.width, geo.height);
     let n = (w * h) as usize;
@@ -174,7 +176,8 @@ pub fn spatial_pass(
         let scale = radius_scale_z(s.view_z, params.rotation[3])
             * radius_scale_variance(mean, mean_sq, params)
             * a.max(params.scales[1]);
-        let radius = radius_pixels(params.radius[0] * scale, s.view_z, params);
+        let cap = hit_radius_cap(w, h, pixel, hit_distance, params.scales[3], history);
+        let radius = radius_pixels((params.radius[0] * scale).min(cap), s.view_z, params);
         let step = ((params.radius[2] / radius.max(1e-3)).min(64.0) as u32)
             .max(1)
             .min(params.flags[3]);
@@ -249,9 +252,17 @@ pub const NO_RADIUS_CAP: f32 = 1.0e30;
 /// The hit distances of (2 `HIT_WINDOW` + 1)^2 pixels set the AO radius cap (as `ao.wgsl`).
 pub const HIT_WINDOW: i32 = 2;
 
-/// The AO denoiser's world radius cap at `pixel` (`hit_radius_cap` in `ao.wgsl`): `scale`
-/// times the harmonic mean of the finite, positive hit distances over 5x5.
-pub fn hit_radius_cap(w: u32, h: u32, pixel: UVec2, hit_distance: &[f32], scale: f32) -> f32 {
+/// The world radius cap at `pixel` (`hit_radius_cap` in `common.wgsl`): `scale` times the
+/// harmonic mean of the finite, positive hit distances over 5x5, over the square root of the
+/// pixel's history length.
+pub fn hit_radius_cap(
+    w: u32,
+    h: u32,
+    pixel: UVec2,
+    hit_distance: &[f32],
+    scale: f32,
+    history_length: f32,
+) -> f32 {
     let (mut inv_sum, mut count) = (0.0f32, 0.0f32);
     for dy in -HIT_WINDOW..=HIT_WINDOW {
         for dx in -HIT_WINDOW..=HIT_WINDOW {
@@ -269,7 +280,7 @@ pub fn hit_radius_cap(w: u32, h: u32, pixel: UVec2, hit_distance: &[f32], scale:
     if !(scale > 0.0) || !(count > 0.0) {
         return NO_RADIUS_CAP;
     }
-    scale * count / inv_sum
+    scale * count / inv_sum / history_length.max(1.0).sqrt()
 }
 
 fn load_ao_pixel(
@@ -284,13 +295,14 @@ fn load_ao_pixel(
     let (w, h) = (geo.width, geo.height);
     let i = (pixel.y * w + pixel.x) as usize;
     let (mean, mean_sq) = moments_3x3(w, h, pixel, |j| ao[j]);
+    let history = finite_or(history_length[i], 1.0);
     AoPixel {
         surface: make_surface(view, pixel, geo.depth[i], geo.normal_oct[i]),
         ao: finite_or(ao[i], 1.0),
         ao_ok: ao[i].is_finite(),
-        keep: combine_weight(finite_or(history_length[i], 1.0), params),
+        keep: combine_weight(history, params),
         variance_scale: radius_scale_variance(mean, mean_sq, params),
-        radius_cap: hit_radius_cap(w, h, pixel, hit_distance, params.scales[3]),
+        radius_cap: hit_radius_cap(w, h, pixel, hit_distance, params.scales[3], history),
     }
 }
 

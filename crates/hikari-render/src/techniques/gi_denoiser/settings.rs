@@ -13,6 +13,10 @@ pub struct GiDenoiserSettings {
     pub pass2: bool,
     /// The AO denoiser. Off: the accumulated AO goes on unchanged.
     pub ao: bool,
+    /// The talk's recurrent denoiser: the next frame's temporal accumulation blends with this
+    /// frame's denoised output (a mix of the blur's low and the input's high frequencies)
+    /// instead of with its own undenoised output. Off: the history is the undenoised one.
+    pub recurrent: bool,
     /// Base blur radius of the first pass, in metres (the talk: 6 m).
     pub pass1_radius_m: f32,
     /// Base blur radius of the second pass, in metres (the talk: 3 m).
@@ -23,6 +27,10 @@ pub struct GiDenoiserSettings {
     /// the 5x5 neighbourhood's ray hits (AO changes over about the distance to the occluders);
     /// 0 turns the cap off. Unitless.
     pub ao_hit_distance_scale: f32,
+    /// Cap on the GI passes' world radius at a fresh pixel, as a multiple of the 5x5
+    /// neighbourhood's harmonic mean hit distance; the cap shrinks as 1 / sqrt(history length).
+    /// 0 turns the cap off. Unitless.
+    pub gi_hit_distance_scale: f32,
     /// Poisson-disk samples a GI pass takes at most (the talk: up to 32).
     pub samples: u32,
     /// Poisson-disk samples the AO denoiser takes at most (the talk: up to 64).
@@ -53,10 +61,12 @@ impl Default for GiDenoiserSettings {
             pass1: true,
             pass2: true,
             ao: true,
+            recurrent: false,
             pass1_radius_m: 6.0,
             pass2_radius_m: 3.0,
             ao_radius_m: 2.0,
-            ao_hit_distance_scale: 0.1,
+            ao_hit_distance_scale: 0.4,
+            gi_hit_distance_scale: 0.5,
             samples: 32,
             ao_samples: 64,
             min_radius_px: 2.0,
@@ -88,6 +98,10 @@ impl TechniqueSettings for GiDenoiserSettings {
             },
             Field {
                 key: "ao_hit_distance_scale",
+                range: Range::Float { lo: 0.0, hi: 100.0 },
+            },
+            Field {
+                key: "gi_hit_distance_scale",
                 range: Range::Float { lo: 0.0, hi: 100.0 },
             },
             Field {

@@ -9,7 +9,7 @@
 #import hikari::view::{View, world_from_depth}
 #import hikari::octahedral::oct_decode
 #import hikari::finite::{is_finite_f, is_finite4}
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3, hit_radius_cap}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -21,6 +21,7 @@
 @group(0) @binding(7) var ao_tex: texture_2d<f32>;
 @group(0) @binding(8) var out_y: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(9) var out_cocg: texture_storage_2d<rg16float, write>;
+@group(0) @binding(10) var hit_distance_tex: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -58,7 +59,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let scale = radius_scale_z(s.view_z, params.rotation.w)
         * radius_scale_variance(moments.x, moments.y, params.scales)
         * max(ao, params.scales.y);
-    let radius = radius_pixels(params.radius.x * scale, s.view_z, params.radius, params.rotation);
+    let radius_m = min(params.radius.x * scale, hit_radius_cap(hit_distance_tex, pixel, size, params.scales.w, history));
+    let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
     // Small radius, bigger step: fewer taps where the kernel covers fewer pixels.
     let step = min(max(u32(min(params.radius.z / max(radius, 1e-3), 64.0)), 1u), params.flags.w);
 

@@ -37,6 +37,7 @@ use super::direct_lighting::{
 };
 use super::exposure::PreviousExposure;
 use super::gbuffer::GBuffer;
+use super::gi_denoiser::RecurrentHistory;
 use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
 use crate::bvh_trace::BvhBuffers;
@@ -458,6 +459,9 @@ pub struct RtGiInputs<'a> {
     pub area: &'a AreaLightScene,
     /// Last frame's exposure, which caps each sample's radiance (`hit_radiance_cap`).
     pub exposure: PreviousExposure,
+    /// Last frame's denoised output where the denoiser is recurrent: the accumulation's
+    /// history (`RecurrentHistory::default()`: its own).
+    pub denoised_history: RecurrentHistory,
 }
 
 /// The raw (unaccumulated) signal of a frame.
@@ -529,15 +533,13 @@ impl RayTracedGi {
             params.set_flag(FLAG_RESET, true);
         }
         let gb = inputs.gbuffer;
-        let frame = self.record_accumulate(
+        let frame = self.record_accumulate_onto(
             g,
             inputs.view,
             &params,
-            gb.depth,
-            gb.motion,
-            raw.y,
-            raw.cocg_ao,
-            raw.hit_distance,
+            [gb.depth, gb.motion],
+            [raw.y, raw.cocg_ao, raw.hit_distance],
+            &inputs.denoised_history,
         )?;
         Ok((frame, raw.rays))
     }
@@ -700,6 +702,27 @@ impl RayTracedGi {
         raw_cocg_ao: Tex,
         hit_distance: Tex,
     ) -> Result<RtGiFrame> {
+        self.record_accumulate_onto(
+            g,
+            view,
+            params,
+            [depth, motion],
+            [raw_y, raw_cocg_ao, hit_distance],
+            &RecurrentHistory::default(),
+        )
+    }
+
+    /// [`RayTracedGi::record_accumulate`] whose history is, where `denoised` has it, last
+    /// frame's denoised output (the recurrent denoiser) instead of the accumulation's own.
+    pub fn record_accumulate_onto<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        view: &View,
+        params: &RtGiParams,
+        [depth, motion]: [Tex; 2],
+        [raw_y, raw_cocg_ao, hit_distance]: [Tex; 3],
+        denoised: &RecurrentHistory,
+    ) -> Result<RtGiFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let hist = |g: &mut FrameGraph<'r>, name: &str, format| {
             g.history_texture(name, TextureDesc::d2(w, h, format))
@@ -709,7 +732,11 @@ impl RayTracedGi {
         let ao = hist(g, "ray_traced_gi.ao", SCALAR_FORMAT)?;
         let len = hist(g, "ray_traced_gi.history_length", SCALAR_FORMAT)?;
         let vz = hist(g, "ray_traced_gi.view_depth", VIEW_DEPTH_FORMAT)?;
-        let valid = y.valid && cocg.valid && ao.valid && len.valid && vz.valid;
+        let ([y_prev, cocg_prev], gi_valid) = denoised
+            .gi
+            .unwrap_or(([y.prev, cocg.prev], y.valid && cocg.valid));
+        let (ao_prev, ao_valid) = denoised.ao.unwrap_or((ao.prev, ao.valid));
+        let valid = gi_valid && ao_valid && len.valid && vz.valid;
         let mut params = *params;
         if !valid {
             params.set_flag(FLAG_RESET, true);
@@ -723,9 +750,9 @@ impl RayTracedGi {
             .read(motion)
             .read(raw_y)
             .read(raw_cocg_ao)
-            .read(y.prev)
-            .read(cocg.prev)
-            .read(ao.prev)
+            .read(y_prev)
+            .read(cocg_prev)
+            .read(ao_prev)
             .read(len.prev)
             .read(vz.prev)
             .write(y.cur)
