@@ -263,6 +263,8 @@ fn constant_sh(y: f32) -> ShL1YCoCg {
 
 /// What the GPU passes wrote, read back by their dump names.
 struct GpuOut {
+    /// `gi_denoiser.hit_mean`: the 5x5 harmonic mean hit distance.
+    hit_mean: Vec<f32>,
     pass1: Option<GiImage>,
     pass2: Option<GiImage>,
     ao: Option<Vec<f32>>,
@@ -367,7 +369,7 @@ fn run_gpu(
     } = inputs(ctx, scene, signal);
 
     let mut rt = GraphRuntime::new();
-    let mut dumps = Vec::new();
+    let mut dumps = vec!["gi_denoiser.hit_mean"];
     if settings.pass1 {
         dumps.extend(["gi_denoiser.pass1_y", "gi_denoiser.pass1_cocg"]);
     }
@@ -399,6 +401,12 @@ fn run_gpu(
         let r = g.execute().unwrap();
         let img = |name: &str| r.image(name).cloned();
         out = Some(GpuOut {
+            hit_mean: img("gi_denoiser.hit_mean")
+                .unwrap()
+                .rgba
+                .iter()
+                .map(|p| p[0])
+                .collect(),
             pass1: img("gi_denoiser.pass1_y")
                 .map(|y| gi_image(&y, &img("gi_denoiser.pass1_cocg").unwrap())),
             pass2: img("gi_denoiser.pass2_y")
@@ -413,6 +421,7 @@ fn run_gpu(
 /// The CPU twin of the enabled passes, each fed what its GPU pass read (the second pass reads
 /// the GPU's first-pass output, so each comparison holds one pass).
 struct CpuOut {
+    hit_mean: Vec<f32>,
     pass1: Option<GiImage>,
     pass2: Option<GiImage>,
     ao: Option<Vec<f32>>,
@@ -421,26 +430,24 @@ struct CpuOut {
 fn run_cpu(scene: &Scene, signal: &Signal, gpu: &GpuOut) -> CpuOut {
     let [p1, p2, pao] = &gpu.params;
     let (v, g) = (&scene.view, &scene.geo);
+    let hit_mean = reference::hit_mean(g.width, g.height, &signal.hit);
     let pass1 = gpu.pass1.as_ref().map(|_| {
-        reference::spatial_pass(
-            p1,
-            v,
-            g,
-            &signal.gi,
-            &signal.history,
-            &signal.ao,
-            &signal.hit,
-        )
+        reference::spatial_pass(p1, v, g, &signal.gi, &signal.history, &signal.ao, &hit_mean)
     });
     let pass2 = gpu.pass2.as_ref().map(|_| {
         let input = gpu.pass1.as_ref().unwrap_or(&signal.gi);
-        reference::spatial_pass(p2, v, g, input, &signal.history, &signal.ao, &signal.hit)
+        reference::spatial_pass(p2, v, g, input, &signal.history, &signal.ao, &hit_mean)
     });
     let ao = gpu
         .ao
         .as_ref()
-        .map(|_| reference::ao_pass(pao, v, g, &signal.ao, &signal.history, &signal.hit));
-    CpuOut { pass1, pass2, ao }
+        .map(|_| reference::ao_pass(pao, v, g, &signal.ao, &signal.history, &hit_mean));
+    CpuOut {
+        hit_mean,
+        pass1,
+        pass2,
+        ao,
+    }
 }
 
 /// Channels of a GI image as flat lists: c0..c3 of Y, then Co and Cg.
@@ -484,6 +491,13 @@ fn assert_close(what: &str, gpu: &[f32], cpu: &[f32], abs: f32) {
 }
 
 fn compare(what: &str, gpu: &GpuOut, cpu: &CpuOut, scale: f32) {
+    // The same reciprocals summed in the same order: f32 rounding only.
+    for (i, (g, c)) in gpu.hit_mean.iter().zip(&cpu.hit_mean).enumerate() {
+        assert!(
+            (g - c).abs() <= 1e-5 * c.abs(),
+            "{what} hit mean at {i}: GPU {g}, twin {c}"
+        );
+    }
     for (name, g, c) in [
         ("pass 1", &gpu.pass1, &cpu.pass1),
         ("pass 2", &gpu.pass2, &cpu.pass2),
@@ -543,7 +557,7 @@ fn gpu_passes_match_their_cpu_twin() {
             &scene.geo,
             &signal.ao,
             &signal.history,
-            &signal.hit,
+            &cpu.hit_mean,
         );
         let moved = free
             .iter()
@@ -565,7 +579,7 @@ fn gpu_passes_match_their_cpu_twin() {
             &signal.gi,
             &signal.history,
             &signal.ao,
-            &signal.hit,
+            &cpu.hit_mean,
         );
         let capped = cpu.pass1.as_ref().unwrap();
         let moved = (free.y.iter().zip(&capped.y))

@@ -346,6 +346,7 @@ fn denoised_gi_is_unbiased_against_the_estimator_mean() {
     let mut s = common::small_frame_settings(&scene, N, N);
     s.settings.ray_traced_gi.enabled = true;
     s.settings.ray_traced_gi.reuse_lit = false;
+    let s = with_overrides(s);
     let denoised = read(&s, 64, true);
     let mut fresh = s.clone();
     fresh.settings.ray_traced_gi.accumulate = false;

@@ -18,8 +18,8 @@
 @group(0) @binding(3) var normal_tex: texture_2d<f32>;
 @group(0) @binding(4) var ao_tex: texture_2d<f32>;
 @group(0) @binding(5) var history_tex: texture_2d<f32>;
-// This frame's hit distance in metres (0: a miss or no ray).
-@group(0) @binding(6) var hit_distance_tex: texture_2d<f32>;
+// The 5x5 harmonic mean hit distance in metres (hit_mean.wgsl; 0: no hit).
+@group(0) @binding(6) var hit_mean_tex: texture_2d<f32>;
 @group(0) @binding(7) var out_ao: texture_storage_2d<r16float, write>;
 
 // Two pixels whose normals differ by more than about 25 degrees do not share samples.
@@ -55,7 +55,7 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     p.keep = combine_weight(history, params.scales);
     let moments = moments_3x3(ao_tex, pixel, size);
     p.variance_scale = radius_scale_variance(moments.x, moments.y, params.scales);
-    p.radius_cap = hit_radius_cap(hit_distance_tex, pixel, size, params.scales.w, history);
+    p.radius_cap = hit_radius_cap(textureLoad(hit_mean_tex, pixel, 0).x, params.scales.w, history, params.flags);
     return p;
 }
 

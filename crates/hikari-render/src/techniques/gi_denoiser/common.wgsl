@@ -18,7 +18,8 @@ struct GiDenoiserParams {
     // F(AO); z: largest accumulation speed; w: AO radius cap over the harmonic mean hit
     // distance (0: no cap).
     scales: vec4<f32>,
-    // x: samples at most; y: 1 = normal weight; z: 1 = step geometry falloff; w: largest step.
+    // x: samples at most; y: 1 = normal weight; z: bit 0 step geometry falloff, bit 1
+    // recurrent history (FLAG_RECURRENT); w: largest step.
     flags: vec4<u32>,
     // Poisson-disk points in the unit disk, two an entry (xy, zw).
     disk: array<vec4<f32>, 32>,
@@ -107,7 +108,7 @@ fn combine_weight(history_length: f32, scales: vec4<f32>) -> f32 {
 fn geometry_weight(centre: Surface, p: vec3<f32>, radius: vec4<f32>, flags: vec4<u32>) -> f32 {
     let d = abs(dot(centre.normal, p - centre.position));
     let tolerance = max(radius.w * centre.view_z, 1e-6);
-    if flags.z != 0u {
+    if (flags.z & 1u) != 0u {
         return select(0.0, 1.0, d < tolerance);
     }
     return max(1.0 - d / tolerance, 0.0);
@@ -124,33 +125,22 @@ fn disk_point(i: u32, e: vec4<f32>, rotation: vec4<f32>) -> vec2<f32> {
 
 // A radius cap that caps nothing: no ray of the neighbourhood hit, or the cap is off.
 const NO_CAP: f32 = 1.0e30;
-// The hit distances of (2 HIT_WINDOW + 1)^2 pixels set the cap.
-const HIT_WINDOW: i32 = 2;
 
-// World radius cap in metres: `scale` times the harmonic mean of the finite, positive hit
-// distances over 5x5 (the split-sphere model of irradiance caching: light and occlusion change
-// over about the harmonic mean distance to the surroundings), over the square root of the
-// history length: the accumulated mean's noise falls as 1 / sqrt(history), so the pixels a
-// kernel must average fall as 1 / history and its radius as 1 / sqrt(history). NO_CAP
-// without hits or scale.
-fn hit_radius_cap(hit_distance: texture_2d<f32>, pixel: vec2<u32>, size: vec2<u32>, scale: f32, history_length: f32) -> f32 {
-    var inv_sum = 0.0;
-    var count = 0.0;
-    for (var dy = -HIT_WINDOW; dy <= HIT_WINDOW; dy++) {
-        for (var dx = -HIT_WINDOW; dx <= HIT_WINDOW; dx++) {
-            let q = vec2<i32>(pixel) + vec2<i32>(dx, dy);
-            if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
-                continue;
-            }
-            let d = textureLoad(hit_distance, q, 0).x;
-            if d > 0.0 && is_finite_f(d) {
-                inv_sum += 1.0 / d;
-                count += 1.0;
-            }
-        }
-    }
-    if !(scale > 0.0) || !(count > 0.0) {
+// GiDenoiserParams::flags.z: the history is last frame's denoised output.
+const FLAG_RECURRENT: u32 = 2u;
+
+// World radius cap in metres: `scale` times `hit_mean`, the harmonic mean of the 5x5
+// neighbourhood's hit distances (hit_mean.wgsl; the split-sphere model of irradiance caching:
+// light and occlusion change over about the harmonic mean distance to the surroundings), over
+// a power of the history length L. Over sqrt(L): the accumulated mean's noise falls as
+// 1 / sqrt(L), so the pixels a kernel must average fall as 1 / L and its radius as 1 / sqrt(L).
+// Over L when the history is recurrent: each frame blurs the last one's output again, and
+// the blurs' variances add up, which stays bounded only if they fall faster than 1 / L.
+// NO_CAP without hits or scale.
+fn hit_radius_cap(hit_mean: f32, scale: f32, history_length: f32, flags: vec4<u32>) -> f32 {
+    if !(scale > 0.0) || !(hit_mean > 0.0) || !is_finite_f(hit_mean) {
         return NO_CAP;
     }
-    return scale * count / inv_sum / sqrt(max(history_length, 1.0));
+    let l = max(history_length, 1.0);
+    return scale * hit_mean / select(sqrt(l), l, (flags.z & FLAG_RECURRENT) != 0u);
 }

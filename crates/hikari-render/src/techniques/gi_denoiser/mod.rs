@@ -4,7 +4,8 @@
 //! and the AO denoiser (adaptive sampling, two pixels a thread). How and why:
 //! docs/ray-traced-gi.md. CPU twin: [`reference`].
 //!
-//! Dumps: `gi_denoiser.pass1_y`, `gi_denoiser.pass1_cocg` (after the first pass),
+//! Dumps: `gi_denoiser.hit_mean` (the 5x5 harmonic mean hit distance the radius caps read),
+//! `gi_denoiser.pass1_y`, `gi_denoiser.pass1_cocg` (after the first pass),
 //! `gi_denoiser.pass2_y`, `gi_denoiser.pass2_cocg` (after the second), `gi_denoiser.ao`. A pass
 //! that is switched off writes nothing: its input goes on, and its dump names do not exist.
 
@@ -28,6 +29,8 @@ pub use settings::GiDenoiserSettings;
 pub const GI_Y_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const GI_COCG_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg16Float;
 pub const AO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R16Float;
+/// The 5x5 harmonic mean hit distance (`gi_denoiser.hit_mean`), in f32 as the twin has it.
+pub const HIT_MEAN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// The accumulated GI signal the denoiser reads: the shape of `ray_traced_gi::RtGiFrame`
 /// (all full resolution), kept local so that this technique does not depend on the tracer.
@@ -86,6 +89,7 @@ pub struct RecurrentHistory {
 }
 
 pub struct GiDenoiser {
+    hit_mean: ComputePipeline,
     spatial: ComputePipeline,
     ao: ComputePipeline,
     gi_disk: Vec<Vec2>,
@@ -104,6 +108,7 @@ impl GiDenoiser {
             ));
         }
         Ok(Self {
+            hit_mean: ComputePipeline::new(ctx, lib, "gi_denoiser/hit_mean.wgsl", "main", &[])?,
             spatial: ComputePipeline::new(ctx, lib, "gi_denoiser/spatial.wgsl", "main", &[])?,
             ao: ComputePipeline::new(ctx, lib, "gi_denoiser/ao.wgsl", "main", &[])?,
             gi_disk: params::poisson_points(params::GI_DISK_POINTS, 0x6d65_7472_6f31)?,
@@ -201,6 +206,15 @@ impl GiDenoiser {
             ),
         ];
         let (recurrent_gi, recurrent_ao) = Self::recurrent_names(settings);
+        // Both denoisers' radius caps read the 5x5 harmonic mean hit distance, made once.
+        let hit_mean = g.texture(
+            "gi_denoiser.hit_mean",
+            TextureDesc::d2(width, height, HIT_MEAN_FORMAT),
+        )?;
+        g.pass("gi_denoiser.hit_mean")
+            .read(input.hit_distance)
+            .write(hit_mean)
+            .dispatch(&self.hit_mean, [width.div_ceil(16), height.div_ceil(16), 1])?;
         for (enabled, p, label, y_name, cocg_name) in passes {
             if !enabled {
                 continue;
@@ -228,7 +242,7 @@ impl GiDenoiser {
                 .read(input.ao)
                 .write(out_y)
                 .write(out_cocg)
-                .read(input.hit_distance)
+                .read(hit_mean)
                 .dispatch_threads(&self.spatial, [width, height, 1])?;
             y = out_y;
             cocg = out_cocg;
@@ -247,7 +261,7 @@ impl GiDenoiser {
                 .read(geometry.normal)
                 .read(input.ao)
                 .read(input.history_length)
-                .read(input.hit_distance)
+                .read(hit_mean)
                 .write(out_ao)
                 .dispatch_threads(&self.ao, [width.div_ceil(2), height, 1])?;
             ao = out_ao;

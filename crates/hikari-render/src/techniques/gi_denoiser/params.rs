@@ -14,6 +14,9 @@ pub const MAX_DISK_POINTS: usize = 64;
 pub const GI_DISK_POINTS: usize = 32;
 /// Largest step between the Poisson samples a GI pass takes: at least 4 of 32 are kept.
 pub const MAX_STEP: u32 = 8;
+/// `GiDenoiserParams::flags[2]`: the history is last frame's denoised output (the radius
+/// caps then fall as 1 / history rather than 1 / sqrt(history)); bit 0 is the step falloff.
+pub const FLAG_RECURRENT: u32 = 2;
 
 /// Which GI pass a set of constants is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,7 +119,7 @@ fn common(
         flags: [
             samples.min(disk.len() as u32),
             0,
-            u32::from(s.step_falloff),
+            u32::from(s.step_falloff) | if s.recurrent { FLAG_RECURRENT } else { 0 },
             MAX_STEP,
         ],
         disk: pack_disk(disk),

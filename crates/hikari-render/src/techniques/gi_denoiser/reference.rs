@@ -6,7 +6,7 @@
 
 use glam::{Mat4, UVec2, Vec2, Vec3, Vec4};
 
-use super::params::GiDenoiserParams;
+use super::params::{FLAG_RECURRENT, GiDenoiserParams};
 use crate::reference::octahedral;
 use crate::view::View;
 
@@ -99,7 +99,7 @@ pub fn combine_weight(history_length: f32, p: &GiDenoiserParams) -> f32 {
 pub fn geometry_weight(centre: &Surface, p: Vec3, params: &GiDenoiserParams) -> f32 {
     let d = centre.normal.dot(p - centre.position).abs();
     let tolerance = (params.radius[3] * centre.view_z).max(1e-6);
-    if params.flags[2] != 0 {
+    if params.flags[2] & 1 != 0 {
         return if d < tolerance { 1.0 } else { 0.0 };
     }
     (1.0 - d / tolerance).max(0.0)
@@ -137,7 +137,7 @@ fn tap(centre_px: Vec2, offset: Vec2, w: u32, h: u32) -> Option<UVec2> {
 }
 
 /// One GI pass (`spatial.wgsl`): `params.flags[1]` selects the normal weight.
-/// `hit_distance`: this frame's, metres, 0 for no hit (the radius cap, `params.scales[3]`).
+/// `hit_mean`: [`hit_mean`] of this frame's hit distances (the radius cap, `params.scales[3]`).
 pub fn spatial_pass(
     params: &GiDenoiserParams,
     view: &View,
@@ -145,7 +145,7 @@ pub fn spatial_pass(
     input: &GiImage,
     history_length: &[f32],
     ao: &[f32],
-    hit_distance: &[f32],
+    hit_mean: &[f32],
 ) -> GiImage {
     let (w, h) = (geo.width, geo.height);
     let n = (w * h) as usize;
@@ -176,7 +176,7 @@ pub fn spatial_pass(
         let scale = radius_scale_z(s.view_z, params.rotation[3])
             * radius_scale_variance(mean, mean_sq, params)
             * a.max(params.scales[1]);
-        let cap = hit_radius_cap(w, h, pixel, hit_distance, params.scales[3], history);
+        let cap = hit_radius_cap(hit_mean[i], params.scales[3], history, params.flags);
         let radius = radius_pixels((params.radius[0] * scale).min(cap), s.view_z, params);
         let step = ((params.radius[2] / radius.max(1e-3)).min(64.0) as u32)
             .max(1)
@@ -252,35 +252,54 @@ pub const NO_RADIUS_CAP: f32 = 1.0e30;
 /// The hit distances of (2 `HIT_WINDOW` + 1)^2 pixels set the AO radius cap (as `ao.wgsl`).
 pub const HIT_WINDOW: i32 = 2;
 
-/// The world radius cap at `pixel` (`hit_radius_cap` in `common.wgsl`): `scale` times the
-/// harmonic mean of the finite, positive hit distances over 5x5, over the square root of the
-/// pixel's history length.
-pub fn hit_radius_cap(
-    w: u32,
-    h: u32,
-    pixel: UVec2,
-    hit_distance: &[f32],
-    scale: f32,
-    history_length: f32,
-) -> f32 {
-    let (mut inv_sum, mut count) = (0.0f32, 0.0f32);
-    for dy in -HIT_WINDOW..=HIT_WINDOW {
-        for dx in -HIT_WINDOW..=HIT_WINDOW {
-            let (x, y) = (pixel.x as i32 + dx, pixel.y as i32 + dy);
-            if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
-                continue;
+/// The harmonic mean of the finite, positive hit distances over each pixel's 5x5
+/// neighbourhood, 0 where none hit (`hit_mean.wgsl`).
+pub fn hit_mean(w: u32, h: u32, hit_distance: &[f32]) -> Vec<f32> {
+    let reciprocal = |x: i32, y: i32| {
+        if x < 0 || y < 0 || x >= w as i32 || y >= h as i32 {
+            return Vec2::ZERO;
+        }
+        let d = hit_distance[(y as u32 * w + x as u32) as usize];
+        if d > 0.0 && d.is_finite() {
+            Vec2::new(1.0 / d, 1.0)
+        } else {
+            Vec2::ZERO
+        }
+    };
+    let mut out = vec![0.0; (w * h) as usize];
+    for py in 0..h as i32 {
+        for px in 0..w as i32 {
+            // Five along each row, then the five rows: the shader's order.
+            let mut sum = Vec2::ZERO;
+            for y in py - HIT_WINDOW..=py + HIT_WINDOW {
+                let mut row = Vec2::ZERO;
+                for x in px - HIT_WINDOW..=px + HIT_WINDOW {
+                    row += reciprocal(x, y);
+                }
+                sum += row;
             }
-            let d = hit_distance[(y as u32 * w + x as u32) as usize];
-            if d > 0.0 && d.is_finite() {
-                inv_sum += 1.0 / d;
-                count += 1.0;
+            if sum.y > 0.0 {
+                out[(py as u32 * w + px as u32) as usize] = sum.y / sum.x;
             }
         }
     }
-    if !(scale > 0.0) || !(count > 0.0) {
+    out
+}
+
+/// The world radius cap (`hit_radius_cap` in `common.wgsl`): `scale` times the pixel's
+/// [`hit_mean`], over the square root of its history length, or over the length itself with
+/// [`FLAG_RECURRENT`] in `flags[2]`; [`NO_RADIUS_CAP`] without a hit or a scale.
+pub fn hit_radius_cap(hit_mean: f32, scale: f32, history_length: f32, flags: [u32; 4]) -> f32 {
+    if !(scale > 0.0) || !(hit_mean > 0.0) || !hit_mean.is_finite() {
         return NO_RADIUS_CAP;
     }
-    scale * count / inv_sum / history_length.max(1.0).sqrt()
+    let l = history_length.max(1.0);
+    scale * hit_mean
+        / if flags[2] & FLAG_RECURRENT != 0 {
+            l
+        } else {
+            l.sqrt()
+        }
 }
 
 fn load_ao_pixel(
@@ -289,7 +308,7 @@ fn load_ao_pixel(
     geo: &GeometryImage,
     ao: &[f32],
     history_length: &[f32],
-    hit_distance: &[f32],
+    hit_mean: &[f32],
     pixel: UVec2,
 ) -> AoPixel {
     let (w, h) = (geo.width, geo.height);
@@ -302,7 +321,7 @@ fn load_ao_pixel(
         ao_ok: ao[i].is_finite(),
         keep: combine_weight(history, params),
         variance_scale: radius_scale_variance(mean, mean_sq, params),
-        radius_cap: hit_radius_cap(w, h, pixel, hit_distance, params.scales[3], history),
+        radius_cap: hit_radius_cap(hit_mean[i], params.scales[3], history, params.flags),
     }
 }
 
@@ -371,14 +390,14 @@ fn centre_acc(p: &AoPixel) -> Vec2 {
 }
 
 /// The AO denoiser (`ao.wgsl`): pixel pairs (2x, y), (2x + 1, y) share one set of samples
-/// where no edge lies between them. `hit_distance`: this frame's, metres, 0 for no hit.
+/// where no edge lies between them. `hit_mean`: [`hit_mean`] of this frame's hit distances.
 pub fn ao_pass(
     params: &GiDenoiserParams,
     view: &View,
     geo: &GeometryImage,
     ao: &[f32],
     history_length: &[f32],
-    hit_distance: &[f32],
+    hit_mean: &[f32],
 ) -> Vec<f32> {
     let (w, h) = (geo.width, geo.height);
     let mut out = vec![0.0; (w * h) as usize];
@@ -387,7 +406,7 @@ pub fn ao_pass(
             let pa = UVec2::new(x, y);
             let pb = UVec2::new(x + 1, y);
             let has_b = pb.x < w;
-            let load = |p| load_ao_pixel(params, view, geo, ao, history_length, hit_distance, p);
+            let load = |p| load_ao_pixel(params, view, geo, ao, history_length, hit_mean, p);
             let a = load(pa);
             let b = has_b.then(|| load(pb));
             let ia = (y * w + x) as usize;

@@ -21,7 +21,8 @@
 @group(0) @binding(7) var ao_tex: texture_2d<f32>;
 @group(0) @binding(8) var out_y: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(9) var out_cocg: texture_storage_2d<rg16float, write>;
-@group(0) @binding(10) var hit_distance_tex: texture_2d<f32>;
+// The 5x5 harmonic mean hit distance in metres (hit_mean.wgsl; 0: no hit).
+@group(0) @binding(10) var hit_mean_tex: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -59,7 +60,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let scale = radius_scale_z(s.view_z, params.rotation.w)
         * radius_scale_variance(moments.x, moments.y, params.scales)
         * max(ao, params.scales.y);
-    let radius_m = min(params.radius.x * scale, hit_radius_cap(hit_distance_tex, pixel, size, params.scales.w, history));
+    let radius_m = min(params.radius.x * scale, hit_radius_cap(textureLoad(hit_mean_tex, pixel, 0).x, params.scales.w, history, params.flags));
     let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
     // Small radius, bigger step: fewer taps where the kernel covers fewer pixels.
     let step = min(max(u32(min(params.radius.z / max(radius, 1e-3), 64.0)), 1u), params.flags.w);
