@@ -300,6 +300,19 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
                 if x == 63 && frame == 3 {
                     m[0] = 4.0; // off screen
                 }
+                // Bilinear reprojection: a fractional motion; one towards the sky corner, where
+                // some taps have no history and the rest are renormalised; one within the snap.
+                if (8..16).contains(&x) && (40..48).contains(&y) && frame >= 3 {
+                    m[0] = 1.25;
+                    m[1] = -0.625;
+                }
+                if (6..10).contains(&(x + y)) && frame == 4 {
+                    m[0] = -0.75;
+                    m[1] = -0.5;
+                }
+                if (50..56).contains(&x) && (50..56).contains(&y) && frame == 4 {
+                    m[0] = 0.0078125;
+                }
                 motion[i] = m;
                 let c: [f32; 6] = std::array::from_fn(|_| f16(rng.random_range(-2.0..5.0)));
                 raw_y[i] = [c[0], c[1], c[2], c[3]];

@@ -36,15 +36,45 @@ fn view_ray(view: View, pixel: vec2<u32>) -> vec3<f32> {
     return normalize(near.xyz / near.w - view.position.xyz);
 }
 
-// The texel of last frame's images that holds `pixel`'s surface, by the G-buffer's motion
-// (xy in pixels, z the view depth) and the surface's world position: none (-1) where either is
-// not finite or the texel is off screen. The temporal passes' reprojection (nearest texel).
-fn reprojected_texel(pixel: vec2<u32>, motion: vec3<f32>, world: vec3<f32>, size: vec2<u32>) -> vec2<i32> {
+// The smallest summed weight of the valid bilinear taps that a reprojected history needs.
+const REPROJECTION_MIN_WEIGHT: f32 = 0.01;
+// A bilinear fraction within this of 0 or 1 (pixels) snaps to it: a still camera's motion
+// vectors carry rounding (of the order of 1e-3 pixel), which would otherwise blend a little
+// of each neighbour into the history every frame.
+const REPROJECTION_SNAP: f32 = 0.015625;
+
+// Last frame's images at `pixel`'s surface, bilinearly: the 2x2 texels about
+// `pixel + 0.5 + motion.xy` from `base` (texel base + (k & 1, k >> 1) has weight
+// `bilinear_weight(frac, k)`); `valid` false where the motion or the point is not finite, or
+// the position is off screen. A still camera (motion 0) has one tap of weight 1.
+struct Reprojection {
+    base: vec2<i32>,
+    frac: vec2<f32>,
+    // The texel nearest the position.
+    nearest: vec2<i32>,
+    valid: bool,
+}
+
+fn reprojection(pixel: vec2<u32>, motion: vec3<f32>, world: vec3<f32>, size: vec2<u32>) -> Reprojection {
+    var r: Reprojection;
     let prev = vec2<f32>(pixel) + 0.5 + motion.xy;
-    if !is_finite3(motion) || !is_finite3(world) || any(prev < vec2<f32>(0.0)) || any(prev >= vec2<f32>(size)) {
-        return vec2<i32>(-1);
+    r.valid = is_finite3(motion) && is_finite3(world) && all(prev >= vec2<f32>(0.0)) && all(prev < vec2<f32>(size));
+    if !r.valid {
+        return r;
     }
-    return vec2<i32>(prev);
+    let b = floor(prev - 0.5);
+    r.base = vec2<i32>(b);
+    let f = prev - 0.5 - b;
+    r.frac = select(f, round(f), abs(f - round(f)) < vec2<f32>(REPROJECTION_SNAP));
+    r.nearest = vec2<i32>(prev);
+    return r;
+}
+
+// Weight of tap k (0 to 3) of a Reprojection with fraction `frac`.
+fn bilinear_weight(frac: vec2<f32>, k: u32) -> f32 {
+    let wx = select(1.0 - frac.x, frac.x, (k & 1u) != 0u);
+    let wy = select(1.0 - frac.y, frac.y, (k & 2u) != 0u);
+    return wx * wy;
 }
 
 // Whether a history texel's view depth `hz` is where `world` was seen last frame, within

@@ -640,6 +640,7 @@ fn area_light_share(
 use super::denoise::{MAX_VISIBILITY, SHADOW_DENOISE_RESET, ShadowDenoiseParams, VISIBILITY_EPS};
 use crate::techniques::gi_denoiser::GiDenoiserParams;
 use crate::techniques::gi_denoiser::reference as gi;
+use crate::techniques::ray_traced_gi::reference::{REPROJECTION_MIN_WEIGHT, bilinear_taps};
 use crate::view::View;
 
 /// One frame of the denoiser's inputs: row-major images of `width` x `height` texels.
@@ -720,14 +721,30 @@ pub fn denoise_temporal(
                 {
                     break 'px (r, 1.0, z);
                 }
-                let j = (py as u32 * w + px as u32) as usize;
-                let (hv, hl, hz) = (prev.visibility[j], prev.length[j], prev.view_depth[j]);
                 let expected = (prev_vp * world.extend(1.0)).w;
-                // Written so that NaN rejects.
-                let depth_ok = (hz - expected).abs() <= p.values[0] * expected.abs();
-                if !finite4(hv) || !hl.is_finite() || hl < 1.0 || !hz.is_finite() || !depth_ok {
+                let (mut hv, mut hl, mut weight) = ([0f32; 4], 0f32, 0f32);
+                for ([tx, ty], wt) in bilinear_taps(glam::Vec2::new(px, py)) {
+                    if !(wt > 0.0) || tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
+                        continue;
+                    }
+                    let j = (ty as u32 * w + tx as u32) as usize;
+                    let (tv, tl, tz) = (prev.visibility[j], prev.length[j], prev.view_depth[j]);
+                    // Written so that NaN rejects.
+                    let depth_ok = (tz - expected).abs() <= p.values[0] * expected.abs();
+                    if !finite4(tv) || !tl.is_finite() || tl < 1.0 || !tz.is_finite() || !depth_ok {
+                        continue;
+                    }
+                    for c in 0..4 {
+                        hv[c] += wt * tv[c];
+                    }
+                    hl += wt * tl;
+                    weight += wt;
+                }
+                if weight < REPROJECTION_MIN_WEIGHT {
                     break 'px (r, 1.0, z);
                 }
+                let hv: [f32; 4] = std::array::from_fn(|c| hv[c] / weight);
+                let hl = hl / weight;
                 let len = (hl + 1.0).min(p.config[1].max(1) as f32);
                 let k = 1.0 / len;
                 (std::array::from_fn(|c| hv[c] + (r[c] - hv[c]) * k), len, z)

@@ -1,12 +1,13 @@
 // Shadow denoiser, temporal pass: this frame's visibility (the area-light pass's shadowed light
 // over its unshadowed light, per channel) blended into its history reprojected by the
-// G-buffer's motion vector (nearest texel). The history is dropped off screen, where it is not
-// finite, where its view depth differs from where this point was seen last frame by more than
-// the tolerance, and on a reset; its length grows while it stays valid, up to the cap, and the
+// G-buffer's motion vector, bilinearly (hikari::view's reprojection: each of the 2x2 taps
+// counts where it is on screen, finite, has history and its view depth agrees with where this
+// point was seen last frame within the tolerance; the valid weights renormalised). The history
+// is dropped where no tap counts enough, and on a reset; its length grows while it stays valid, up to the cap, and the
 // blend is 1 / length. Non-finite input is replaced where it enters (raw_visibility), so it
 // never reaches the history. CPU twin: area_lights::reference::denoise_temporal.
 
-#import hikari::view::{View, world_from_depth, reprojected_texel, history_depth_agrees}
+#import hikari::view::{View, world_from_depth, reprojection, bilinear_weight, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
 #import hikari::finite::{is_finite_f, is_finite4}
 #import hikari::area_lights_denoise::{ShadowDenoiseParams, SHADOW_DENOISE_RESET, raw_visibility}
 
@@ -47,20 +48,38 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let motion = textureLoad(gbuffer_motion, pixel, 0).xyz;
     let z = select(0.0, motion.z, is_finite_f(motion.z));
     let world = world_from_depth(view, pixel, d);
-    let t = reprojected_texel(pixel, motion, world, size);
-    if (params.config.x & SHADOW_DENOISE_RESET) != 0u || t.x < 0 {
+    let r = reprojection(pixel, motion, world, size);
+    if (params.config.x & SHADOW_DENOISE_RESET) != 0u || !r.valid {
         store(pixel, raw, 1.0, z);
         return;
     }
-    let q = vec2<u32>(t);
-    let hv = textureLoad(prev_visibility, q, 0);
-    let hl = textureLoad(prev_length, q, 0).x;
-    let hz = textureLoad(prev_depth, q, 0).x;
-    if !is_finite4(hv) || !is_finite_f(hl) || !(hl >= 1.0) || !is_finite_f(hz)
-        || !history_depth_agrees(view, world, hz, params.values.x) {
+    var hv = vec4<f32>(0.0);
+    var hl = 0.0;
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let w = bilinear_weight(r.frac, k);
+        let t = r.base + vec2<i32>(i32(k & 1u), i32(k >> 1u));
+        if !(w > 0.0) || any(t < vec2<i32>(0)) || any(t >= vec2<i32>(size)) {
+            continue;
+        }
+        let q = vec2<u32>(t);
+        let tv = textureLoad(prev_visibility, q, 0);
+        let tl = textureLoad(prev_length, q, 0).x;
+        let tz = textureLoad(prev_depth, q, 0).x;
+        if !is_finite4(tv) || !is_finite_f(tl) || !(tl >= 1.0) || !is_finite_f(tz)
+            || !history_depth_agrees(view, world, tz, params.values.x) {
+            continue;
+        }
+        hv += w * tv;
+        hl += w * tl;
+        weight += w;
+    }
+    if weight < REPROJECTION_MIN_WEIGHT {
         store(pixel, raw, 1.0, z);
         return;
     }
+    hv /= weight;
+    hl /= weight;
     let len = min(hl + 1.0, f32(max(params.config.y, 1u)));
     store(pixel, mix(hv, raw, 1.0 / len), len, z);
 }

@@ -1,12 +1,13 @@
 // Temporal accumulation of the raw GI and AO before denoising: the history is reprojected by
-// the G-buffer's motion vector (nearest texel), rejected off screen, where not finite, or
-// where its view depth differs from where this point was seen last frame by more than the
-// tolerance; the speed is 1 / length, the length growing while the history stays valid, up to
+// the G-buffer's motion vector, bilinearly over the 2x2 texels about the position; a tap counts
+// where it is on screen, finite, has history and its view depth agrees with where this point
+// was seen last frame within the tolerance, the valid taps' weights renormalised, and the
+// history is dropped where they sum to under REPROJECTION_MIN_WEIGHT; the speed is 1 / length, the length growing while the history stays valid, up to
 // a cap. A sample far brighter than the history it joins is scaled down first (the firefly
 // clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
 // reference::accumulate_pixel.
 
-#import hikari::view::{View, world_from_depth, reprojected_texel, history_depth_agrees}
+#import hikari::view::{View, world_from_depth, reprojection, bilinear_weight, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_ACCUMULATE, RTGI_RESET}
 #import hikari::finite::is_finite4
 
@@ -58,22 +59,46 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let z = select(0.0, motion.z, is_finite4(vec4<f32>(motion.z)));
     let world = world_from_depth(view, pixel, d);
     let flags = params.config.y;
-    let t = reprojected_texel(pixel, motion, world, size);
-    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || t.x < 0 {
+    let r = reprojection(pixel, motion, world, size);
+    if (flags & RTGI_ACCUMULATE) == 0u || (flags & RTGI_RESET) != 0u || !r.valid {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;
     }
-    let q = vec2<u32>(t);
-    let hy = textureLoad(prev_y, q, 0);
-    let hc = textureLoad(prev_cocg, q, 0).xy;
-    let ha = textureLoad(prev_ao, q, 0).x;
-    let hl = textureLoad(prev_length, q, 0).x;
-    let hz = textureLoad(prev_depth, q, 0).x;
-    if !is_finite4(hy) || !is_finite4(vec4<f32>(hc, ha, hl)) || !is_finite4(vec4<f32>(hz)) || !(hl >= 1.0)
-        || !history_depth_agrees(view, world, hz, params.distances.z) {
+    var hy = vec4<f32>(0.0);
+    var hc = vec2<f32>(0.0);
+    var ha = 0.0;
+    var hl = 0.0;
+    var weight = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let w = bilinear_weight(r.frac, k);
+        let t = r.base + vec2<i32>(i32(k & 1u), i32(k >> 1u));
+        if !(w > 0.0) || any(t < vec2<i32>(0)) || any(t >= vec2<i32>(size)) {
+            continue;
+        }
+        let q = vec2<u32>(t);
+        let ty = textureLoad(prev_y, q, 0);
+        let tc = textureLoad(prev_cocg, q, 0).xy;
+        let ta = textureLoad(prev_ao, q, 0).x;
+        let tl = textureLoad(prev_length, q, 0).x;
+        let tz = textureLoad(prev_depth, q, 0).x;
+        if !is_finite4(ty) || !is_finite4(vec4<f32>(tc, ta, tl)) || !is_finite4(vec4<f32>(tz)) || !(tl >= 1.0)
+            || !history_depth_agrees(view, world, tz, params.distances.z) {
+            continue;
+        }
+        hy += w * ty;
+        hc += w * tc;
+        ha += w * ta;
+        hl += w * tl;
+        weight += w;
+    }
+    if weight < REPROJECTION_MIN_WEIGHT {
         store(pixel, y, cocg_ao.xy, ao, 1.0, z);
         return;
     }
+    hy /= weight;
+    hc /= weight;
+    ha /= weight;
+    hl /= weight;
     // Firefly clamp: the whole sample scaled so that its c0 stays within k times the
     // history's local scale (the brightest c0 of its 3x3: a pixel whose few samples all came
     // out dark must not cut what its neighbours see) plus the floor; chroma and direction
@@ -82,7 +107,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ff = params.firefly;
     if ff.x > 0.0 && hl >= ff.z {
         var scale = max(hy.x, 0.0);
-        let qi = vec2<i32>(q);
+        let qi = r.nearest;
         for (var dy = -1; dy <= 1; dy++) {
             for (var dx = -1; dx <= 1; dx++) {
                 let t = clamp(qi + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(size) - 1);

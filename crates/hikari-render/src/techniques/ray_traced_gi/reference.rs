@@ -628,12 +628,46 @@ pub fn firefly_scale(
     scale
 }
 
-/// Temporal accumulation of one pixel: reprojects by the motion vector to the nearest texel
-/// of the history, accepts it if inside the image, finite, with history, and its view depth
-/// within `depth_tolerance` (relative) of where this surface point was seen last frame
-/// (`prev_view_proj · world`, w); then blends with speed 1 / length, length growing to
-/// `max_history`, the raw sample held by `firefly` against the history it joins. Non-finite
-/// raw values count as a zero sample (AO: open).
+/// The smallest summed weight of the valid bilinear taps that a reprojected history needs
+/// (`REPROJECTION_MIN_WEIGHT` of `hikari::view`).
+pub const REPROJECTION_MIN_WEIGHT: f32 = 0.01;
+/// A bilinear fraction within this of 0 or 1 snaps to it (`REPROJECTION_SNAP`): a still
+/// camera's motion vectors carry rounding.
+pub const REPROJECTION_SNAP: f32 = 1.0 / 64.0;
+
+/// The bilinear taps about `prev`, a position in last frame's pixels (`hikari::view`'s
+/// `reprojection` and `bilinear_weight`): texel and weight of each of the 2x2, fractions within
+/// [`REPROJECTION_SNAP`] of 0 or 1 snapped. Taps may lie off the image; the caller skips them.
+pub fn bilinear_taps(prev: Vec2) -> [([i64; 2], f32); 4] {
+    let base = (prev - 0.5).floor();
+    let snap = |f: f32| {
+        if (f - f.round()).abs() < REPROJECTION_SNAP {
+            f.round()
+        } else {
+            f
+        }
+    };
+    let f = prev - 0.5 - base;
+    let frac = Vec2::new(snap(f.x), snap(f.y));
+    std::array::from_fn(|k| {
+        let wx = if k & 1 != 0 { frac.x } else { 1.0 - frac.x };
+        let wy = if k & 2 != 0 { frac.y } else { 1.0 - frac.y };
+        let t = [
+            base.x as i64 + (k & 1) as i64,
+            base.y as i64 + (k >> 1) as i64,
+        ];
+        (t, wx * wy)
+    })
+}
+
+/// Temporal accumulation of one pixel: reprojects by the motion vector, bilinearly over the
+/// 2x2 history texels about `pixel + 0.5 + motion`; a tap counts if inside the image, finite,
+/// with history, and its view depth within `depth_tolerance` (relative) of where this surface
+/// point was seen last frame (`prev_view_proj · world`, w); the valid taps' weights are
+/// renormalised (the history is dropped under [`REPROJECTION_MIN_WEIGHT`]); then blends with
+/// speed 1 / length, length growing to `max_history`, the raw sample held by `firefly`
+/// against the history it joins (its 3x3 about the nearest texel). Non-finite raw values
+/// count as a zero sample (AO: open).
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate_pixel(
     pixel: [u32; 2],
@@ -682,15 +716,34 @@ pub fn accumulate_pixel(
     if prev.x < 0.0 || prev.y < 0.0 || prev.x >= size[0] as f32 || prev.y >= size[1] as f32 {
         return fresh;
     }
-    let q = [prev.x as u32, prev.y as u32];
-    let h = history(q);
     let expected = (prev_view_proj * world.extend(1.0)).w;
-    if !h.finite()
-        || h.length < 1.0
-        || (h.view_depth - expected).abs() > depth_tolerance * expected.abs()
-    {
+    let (mut gi, mut ao, mut length, mut weight) = (ShL1YCoCg::default(), 0.0, 0.0, 0.0);
+    for ([tx, ty], w) in bilinear_taps(prev) {
+        if !(w > 0.0) || tx < 0 || ty < 0 || tx >= size[0] as i64 || ty >= size[1] as i64 {
+            continue;
+        }
+        let h = history([tx as u32, ty as u32]);
+        if !h.finite()
+            || h.length < 1.0
+            || (h.view_depth - expected).abs() > depth_tolerance * expected.abs()
+        {
+            continue;
+        }
+        gi = gi.add(&h.gi.scale(w));
+        ao += w * h.ao;
+        length += w * h.length;
+        weight += w;
+    }
+    if weight < REPROJECTION_MIN_WEIGHT {
         return fresh;
     }
+    let h = Accumulated {
+        gi: gi.scale(1.0 / weight),
+        ao: ao / weight,
+        length: length / weight,
+        view_depth,
+    };
+    let q = [prev.x as u32, prev.y as u32];
     let raw = if firefly.k > 0.0 && h.length >= firefly.min_history {
         firefly.apply(raw, firefly_scale(history, q, size), h.length)
     } else {
