@@ -724,7 +724,7 @@ pub fn denoise_temporal(
                 let expected = (prev_vp * world.extend(1.0)).w;
                 let (mut hv, mut hl, mut weight) = ([0f32; 4], 0f32, 0f32);
                 for ([tx, ty], wt) in bilinear_taps(glam::Vec2::new(px, py)) {
-                    if !(wt > 0.0) || tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
+                    if wt <= 0.0 || tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
                         continue;
                     }
                     let j = (ty as u32 * w + tx as u32) as usize;

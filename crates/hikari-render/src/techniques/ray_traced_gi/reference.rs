@@ -719,7 +719,7 @@ pub fn accumulate_pixel(
     let expected = (prev_view_proj * world.extend(1.0)).w;
     let (mut gi, mut ao, mut length, mut weight) = (ShL1YCoCg::default(), 0.0, 0.0, 0.0);
     for ([tx, ty], w) in bilinear_taps(prev) {
-        if !(w > 0.0) || tx < 0 || ty < 0 || tx >= size[0] as i64 || ty >= size[1] as i64 {
+        if w <= 0.0 || tx < 0 || ty < 0 || tx >= size[0] as i64 || ty >= size[1] as i64 {
             continue;
         }
         let h = history([tx as u32, ty as u32]);
