@@ -44,8 +44,7 @@ const REPROJECTION_MIN_WEIGHT: f32 = 0.01;
 const REPROJECTION_SNAP: f32 = 0.015625;
 
 // Last frame's images at `pixel`'s surface, bilinearly: the 2x2 texels about
-// `pixel + 0.5 + motion.xy` from `base` (texel base + (k & 1, k >> 1) has weight
-// `bilinear_weight(frac, k)`); `valid` false where the motion or the point is not finite, or
+// `pixel + 0.5 + motion.xy` from `base` (`reprojection_tap` gives each); `valid` false where the motion or the point is not finite, or
 // the position is off screen. A still camera (motion 0) has one tap of weight 1.
 struct Reprojection {
     base: vec2<i32>,
@@ -70,11 +69,24 @@ fn reprojection(pixel: vec2<u32>, motion: vec3<f32>, world: vec3<f32>, size: vec
     return r;
 }
 
-// Weight of tap k (0 to 3) of a Reprojection with fraction `frac`.
-fn bilinear_weight(frac: vec2<f32>, k: u32) -> f32 {
-    let wx = select(1.0 - frac.x, frac.x, (k & 1u) != 0u);
-    let wy = select(1.0 - frac.y, frac.y, (k & 2u) != 0u);
-    return wx * wy;
+// Tap k (0 to 3) of a valid Reprojection: texel base + (k & 1, k >> 1) and its bilinear
+// weight, 0 where the texel lies off an image of `size`.
+struct ReprojectionTap {
+    texel: vec2<u32>,
+    weight: f32,
+}
+
+fn reprojection_tap(r: Reprojection, k: u32, size: vec2<u32>) -> ReprojectionTap {
+    var tap: ReprojectionTap;
+    let t = r.base + vec2<i32>(i32(k & 1u), i32(k >> 1u));
+    if any(t < vec2<i32>(0)) || any(t >= vec2<i32>(size)) {
+        return tap;
+    }
+    let wx = select(1.0 - r.frac.x, r.frac.x, (k & 1u) != 0u);
+    let wy = select(1.0 - r.frac.y, r.frac.y, (k & 2u) != 0u);
+    tap.texel = vec2<u32>(t);
+    tap.weight = wx * wy;
+    return tap;
 }
 
 // Whether a history texel's view depth `hz` is where `world` was seen last frame, within

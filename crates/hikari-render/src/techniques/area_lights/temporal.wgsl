@@ -7,7 +7,7 @@
 // blend is 1 / length. Non-finite input is replaced where it enters (raw_visibility), so it
 // never reaches the history. CPU twin: area_lights::reference::denoise_temporal.
 
-#import hikari::view::{View, world_from_depth, reprojection, bilinear_weight, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
+#import hikari::view::{View, world_from_depth, reprojection, reprojection_tap, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
 #import hikari::finite::{is_finite_f, is_finite4}
 #import hikari::area_lights_denoise::{ShadowDenoiseParams, SHADOW_DENOISE_RESET, raw_visibility}
 
@@ -57,12 +57,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var hl = 0.0;
     var weight = 0.0;
     for (var k = 0u; k < 4u; k++) {
-        let w = bilinear_weight(r.frac, k);
-        let t = r.base + vec2<i32>(i32(k & 1u), i32(k >> 1u));
-        if !(w > 0.0) || any(t < vec2<i32>(0)) || any(t >= vec2<i32>(size)) {
+        let tap = reprojection_tap(r, k, size);
+        let w = tap.weight;
+        if !(w > 0.0) {
             continue;
         }
-        let q = vec2<u32>(t);
+        let q = tap.texel;
         let tv = textureLoad(prev_visibility, q, 0);
         let tl = textureLoad(prev_length, q, 0).x;
         let tz = textureLoad(prev_depth, q, 0).x;

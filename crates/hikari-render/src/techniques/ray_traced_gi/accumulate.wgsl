@@ -7,7 +7,7 @@
 // clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
 // reference::accumulate_pixel.
 
-#import hikari::view::{View, world_from_depth, reprojection, bilinear_weight, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
+#import hikari::view::{View, world_from_depth, reprojection, reprojection_tap, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_ACCUMULATE, RTGI_RESET}
 #import hikari::finite::is_finite4
 
@@ -70,12 +70,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var hl = 0.0;
     var weight = 0.0;
     for (var k = 0u; k < 4u; k++) {
-        let w = bilinear_weight(r.frac, k);
-        let t = r.base + vec2<i32>(i32(k & 1u), i32(k >> 1u));
-        if !(w > 0.0) || any(t < vec2<i32>(0)) || any(t >= vec2<i32>(size)) {
+        let tap = reprojection_tap(r, k, size);
+        let w = tap.weight;
+        if !(w > 0.0) {
             continue;
         }
-        let q = vec2<u32>(t);
+        let q = tap.texel;
         let ty = textureLoad(prev_y, q, 0);
         let tc = textureLoad(prev_cocg, q, 0).xy;
         let ta = textureLoad(prev_ao, q, 0).x;
