@@ -12,6 +12,11 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 mod interior_mask;
+mod quantization;
+mod texture_transform;
+
+use quantization::Storage;
+pub use texture_transform::UvTransform;
 
 use crate::{
     AlphaMode, Camera, Instance, Light, LightKind, Material, Mesh, Scene, Sun, Texture, TextureRef,
@@ -20,8 +25,12 @@ use crate::{
 
 /// Extensions whose content is read. Others in `extensionsUsed` give a warning; others in
 /// `extensionsRequired` are an error.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_materials_emissive_strength"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    quantization::EXTENSION,
+    texture_transform::EXTENSION,
+];
 
 /// A glTF file that cannot be loaded: the file and what is wrong with it.
 #[derive(Debug, Error)]
@@ -178,6 +187,9 @@ struct Loader<'o> {
     doc: gltf::Document,
     buffers: Vec<gltf::buffer::Data>,
     warnings: std::cell::RefCell<Vec<String>>,
+    /// Whether the file lists KHR_mesh_quantization (used or required), which the attribute
+    /// types it adds need.
+    quantization_declared: bool,
 }
 
 /// Checks a .glb header before `gltf` reads it: its length arithmetic underflows on a
@@ -290,6 +302,28 @@ fn check_before_validation(root: &gltf::json::Root) -> Res<()> {
     Ok(())
 }
 
+/// Refuses an `extensionsRequired` entry that hikari does not read, and takes out of the list
+/// those that hikari reads itself but the `gltf` crate's validation would refuse (it only knows
+/// the extensions it parses). Returns whether the file declares KHR_mesh_quantization.
+fn check_required_extensions(root: &mut gltf::json::Root) -> Res<bool> {
+    for (i, ext) in root.extensions_required.iter().enumerate() {
+        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
+            return Err(format!(
+                "invalid glTF: extensionsRequired[{i}] = \"{ext}\": Unsupported extension (hikari reads {})",
+                SUPPORTED_EXTENSIONS.join(", ")
+            ));
+        }
+    }
+    let declared = root
+        .extensions_required
+        .iter()
+        .chain(&root.extensions_used)
+        .any(|e| e == quantization::EXTENSION);
+    root.extensions_required
+        .retain(|e| e != quantization::EXTENSION && e != texture_transform::EXTENSION);
+    Ok(declared)
+}
+
 fn describe(e: &gltf::Error) -> String {
     match e {
         gltf::Error::Deserialize(e) => format!("bad JSON: {e}"),
@@ -313,8 +347,9 @@ impl<'o> Loader<'o> {
         }
         let gltf::Gltf { document, blob } =
             gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| describe(&e))?;
-        let root = document.into_json();
+        let mut root = document.into_json();
         check_before_validation(&root)?;
+        let quantization_declared = check_required_extensions(&mut root)?;
         let doc = gltf::Document::from_json(root).map_err(|e| describe(&e))?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let mut loader = Loader {
@@ -323,6 +358,7 @@ impl<'o> Loader<'o> {
             doc,
             buffers: Vec::new(),
             warnings: Default::default(),
+            quantization_declared,
         };
         loader.load_buffers(blob)?;
         Ok(loader)
@@ -539,27 +575,35 @@ impl<'o> Loader<'o> {
         Ok(out)
     }
 
-    /// Reads a float attribute of `dims` components; `ints` allows normalised integer types.
+    /// Reads an attribute of `dims` components as floats, stored as one of the types `storage`
+    /// allows (integers dequantized); the types KHR_mesh_quantization adds only where the file
+    /// declares that extension.
     fn read_floats(
         &self,
         acc: &gltf::Accessor,
         label: &str,
         dims: &[Dimensions],
-        ints: bool,
+        storage: Storage,
     ) -> Res<(usize, Vec<f32>)> {
-        let ok_type = acc.data_type() == DataType::F32
-            || (ints
-                && acc.normalized()
-                && matches!(acc.data_type(), DataType::U8 | DataType::U16));
-        if !dims.contains(&acc.dimensions()) || !ok_type {
+        let declared = self.quantization_declared;
+        let allowed = quantization::allowed(storage, acc.data_type(), acc.normalized());
+        if !dims.contains(&acc.dimensions()) || allowed.is_none_or(|ext| ext && !declared) {
             return Err(format!(
-                "{label}: accessor {} is {:?} {:?}{}, expected {:?} of float{}",
+                "{label}: accessor {} is {:?} {:?}{}, expected {:?} of {}{}",
                 acc.index(),
                 acc.dimensions(),
                 acc.data_type(),
                 if acc.normalized() { " normalized" } else { "" },
                 dims,
-                if ints { " or normalized u8/u16" } else { "" }
+                quantization::describe(storage, declared),
+                if allowed == Some(true) && !declared {
+                    format!(
+                        " ({} allows this type, but the file does not list it in extensionsRequired)",
+                        quantization::EXTENSION
+                    )
+                } else {
+                    String::new()
+                }
             ));
         }
         let v = self
@@ -587,8 +631,9 @@ impl<'o> Loader<'o> {
             textures: self.load_textures()?,
             ..Default::default()
         };
-        scene.materials = self.load_materials(scene.textures.len())?;
-        let meshes = self.load_meshes(&mut scene)?;
+        let (materials, uv_transforms) = self.load_materials(scene.textures.len())?;
+        scene.materials = materials;
+        let meshes = self.load_meshes(&mut scene, &uv_transforms)?;
         self.load_nodes(&mut scene, &meshes)?;
         let bounds = scene.bounds();
         if bounds.is_none() {
@@ -669,30 +714,104 @@ impl<'o> Loader<'o> {
         Ok(textures)
     }
 
-    fn load_materials(&self, texture_count: usize) -> Res<Vec<Material>> {
+    /// The materials, and for each the KHR_texture_transform its primitives' UVs get.
+    fn load_materials(&self, texture_count: usize) -> Res<(Vec<Material>, Vec<UvTransform>)> {
         let mut out = Vec::new();
+        let mut transforms = Vec::new();
         let docs: Vec<_> = self.doc.materials().collect();
         for m in docs {
             let name = m.name().map_or_else(
                 || format!("material{}", m.index().unwrap_or(0)),
                 str::to_owned,
             );
-            let tex = |info: Option<(gltf::texture::Texture, u32)>,
-                       what: &str|
-             -> Option<TextureRef> {
-                let (t, set) = info?;
-                if set != 0 {
-                    self.warn(format!(
-                        "material `{name}`: {what} texture uses TEXCOORD_{set}; only TEXCOORD_0 is loaded, so it is used instead"
-                    ));
-                }
-                (t.index() < texture_count).then(|| TextureRef::new(t.index()))
-            };
             let pbr = m.pbr_metallic_roughness();
             let [r, g, b, a] = pbr.base_color_factor();
             let strength = m.emissive_strength().unwrap_or(1.0);
             let normal = m.normal_texture();
             let occlusion = m.occlusion_texture();
+            let ext = texture_transform::EXTENSION;
+            // Per texture slot, in the order that picks the material's UV transform: the glTF
+            // member, its name in messages, the texture, textureInfo.texCoord and the
+            // KHR_texture_transform object.
+            let slots = [
+                pbr.base_color_texture().map(|i| {
+                    let v = i.extension_value(ext).cloned();
+                    (
+                        "baseColorTexture",
+                        "base colour",
+                        i.texture(),
+                        i.tex_coord(),
+                        v,
+                    )
+                }),
+                pbr.metallic_roughness_texture().map(|i| {
+                    let v = i.extension_value(ext).cloned();
+                    (
+                        "metallicRoughnessTexture",
+                        "metallic-roughness",
+                        i.texture(),
+                        i.tex_coord(),
+                        v,
+                    )
+                }),
+                normal.as_ref().map(|i| {
+                    let v = i.extension_value(ext).cloned();
+                    ("normalTexture", "normal", i.texture(), i.tex_coord(), v)
+                }),
+                occlusion.as_ref().map(|i| {
+                    let v = i.extension_value(ext).cloned();
+                    (
+                        "occlusionTexture",
+                        "occlusion",
+                        i.texture(),
+                        i.tex_coord(),
+                        v,
+                    )
+                }),
+                m.emissive_texture().map(|i| {
+                    let v = i.extension_value(ext).cloned();
+                    ("emissiveTexture", "emissive", i.texture(), i.tex_coord(), v)
+                }),
+            ];
+            // hikari's meshes have one UV set, so a material has one transform: the first
+            // textured slot's (the base colour's where it has one); a slot with a different one
+            // is drawn with it anyway, with a warning.
+            let mut chosen: Option<(&str, UvTransform)> = None;
+            let mut refs = [None; 5];
+            for (slot, r) in slots.iter().zip(&mut refs) {
+                let Some((member, what, texture, core_set, transform)) = slot else {
+                    continue;
+                };
+                let (transform, set_override) = texture_transform::parse(transform.as_ref())
+                    .map_err(|e| format!("material `{name}`: {member}: {e}"))?;
+                let set = set_override.unwrap_or(*core_set);
+                if set != 0 {
+                    self.warn(format!(
+                        "material `{name}`: {what} texture uses TEXCOORD_{set}{}; only TEXCOORD_0 is loaded, so it is used instead",
+                        if set_override.is_some() {
+                            format!(" ({ext}.texCoord)")
+                        } else {
+                            String::new()
+                        }
+                    ));
+                }
+                match chosen {
+                    None => chosen = Some((member, transform)),
+                    Some((first, t)) if !t.approx_eq(&transform) => self.warn(format!(
+                        "material `{name}`: {member} has a different {ext} ({transform:?}) from {first} ({t:?}); a mesh has one UV set, so {first}'s is used for every texture of the material"
+                    )),
+                    Some(_) => {}
+                }
+                *r = (texture.index() < texture_count).then(|| TextureRef::new(texture.index()));
+            }
+            transforms.push(chosen.map_or(UvTransform::IDENTITY, |(_, t)| t));
+            let [
+                base_color_texture,
+                metallic_roughness_texture,
+                normal_texture,
+                occlusion_texture,
+                emissive_texture,
+            ] = refs;
             let alpha_mode = match m.alpha_mode() {
                 gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
                 gltf::material::AlphaMode::Mask => {
@@ -722,29 +841,12 @@ impl<'o> Loader<'o> {
                     * strength
                     * self.options.emissive_nits_per_unit,
                 double_sided: m.double_sided(),
-                base_color_texture: tex(
-                    pbr.base_color_texture()
-                        .map(|i| (i.texture(), i.tex_coord())),
-                    "base colour",
-                ),
-                metallic_roughness_texture: tex(
-                    pbr.metallic_roughness_texture()
-                        .map(|i| (i.texture(), i.tex_coord())),
-                    "metallic-roughness",
-                ),
-                normal_texture: tex(
-                    normal.as_ref().map(|i| (i.texture(), i.tex_coord())),
-                    "normal",
-                ),
+                base_color_texture,
+                metallic_roughness_texture,
+                normal_texture,
                 normal_scale: normal.as_ref().map_or(1.0, |n| n.scale()),
-                emissive_texture: tex(
-                    m.emissive_texture().map(|i| (i.texture(), i.tex_coord())),
-                    "emissive",
-                ),
-                occlusion_texture: tex(
-                    occlusion.as_ref().map(|i| (i.texture(), i.tex_coord())),
-                    "occlusion",
-                ),
+                emissive_texture,
+                occlusion_texture,
                 occlusion_strength: occlusion
                     .as_ref()
                     .map_or(1.0, |o| o.strength())
@@ -760,11 +862,17 @@ impl<'o> Loader<'o> {
             };
             out.push(mat);
         }
-        Ok(out)
+        Ok((out, transforms))
     }
 
     /// Loads every primitive; returns, per glTF mesh, its (scene mesh, scene material) pairs.
-    fn load_meshes(&self, scene: &mut Scene) -> Res<Vec<Vec<(usize, usize)>>> {
+    /// `uv_transforms[m]` is material m's KHR_texture_transform (the default material has
+    /// none).
+    fn load_meshes(
+        &self,
+        scene: &mut Scene,
+        uv_transforms: &[UvTransform],
+    ) -> Res<Vec<Vec<(usize, usize)>>> {
         let mut default_material = None;
         let mut out = Vec::new();
         let meshes: Vec<_> = self.doc.meshes().collect();
@@ -799,7 +907,12 @@ impl<'o> Loader<'o> {
                     }),
                 };
                 let wants_tangents = scene.materials[material].normal_texture.is_some();
-                let Some(m) = self.load_primitive(&prim, &label, wants_tangents)? else {
+                let uv_transform = uv_transforms
+                    .get(material)
+                    .copied()
+                    .unwrap_or(UvTransform::IDENTITY);
+                let Some(m) = self.load_primitive(&prim, &label, wants_tangents, &uv_transform)?
+                else {
                     continue;
                 };
                 scene.meshes.push(m);
@@ -815,6 +928,7 @@ impl<'o> Loader<'o> {
         prim: &gltf::Primitive,
         label: &str,
         wants_tangents: bool,
+        uv_transform: &UvTransform,
     ) -> Res<Option<Mesh>> {
         let err = |e: String| format!("{label}: {e}");
         let Some(pos) = prim.get(&gltf::Semantic::Positions) else {
@@ -822,7 +936,7 @@ impl<'o> Loader<'o> {
             return Ok(None);
         };
         let (_, p) = self
-            .read_floats(&pos, "POSITION", &[Dimensions::Vec3], false)
+            .read_floats(&pos, "POSITION", &[Dimensions::Vec3], Storage::Position)
             .map_err(err)?;
         let positions: Vec<Vec3> = p.chunks_exact(3).map(Vec3::from_slice).collect();
         let n = positions.len();
@@ -843,28 +957,50 @@ impl<'o> Loader<'o> {
         };
         if let Some(a) = prim.get(&gltf::Semantic::Normals) {
             let (_, v) = self
-                .read_floats(&a, "NORMAL", &[Dimensions::Vec3], false)
+                .read_floats(&a, "NORMAL", &[Dimensions::Vec3], Storage::Direction)
                 .map_err(err)?;
             mesh.normals = v.chunks_exact(3).map(Vec3::from_slice).collect();
+            if a.data_type() != DataType::F32 {
+                // Quantized normals are not unit length; the extension asks to renormalise.
+                for n in &mut mesh.normals {
+                    *n = n.normalize_or_zero();
+                }
+            }
             per_vertex("NORMAL", mesh.normals.len())?;
         }
         if let Some(a) = prim.get(&gltf::Semantic::Tangents) {
             let (_, v) = self
-                .read_floats(&a, "TANGENT", &[Dimensions::Vec4], false)
+                .read_floats(&a, "TANGENT", &[Dimensions::Vec4], Storage::Direction)
                 .map_err(err)?;
             mesh.tangents = v.chunks_exact(4).map(Vec4::from_slice).collect();
+            if a.data_type() != DataType::F32 {
+                // Renormalise xyz; w is the handedness, +-1, whatever its quantized value.
+                for t in &mut mesh.tangents {
+                    let w = if t.w < 0.0 { -1.0 } else { 1.0 };
+                    *t = t.truncate().normalize_or_zero().extend(w);
+                }
+            }
             per_vertex("TANGENT", mesh.tangents.len())?;
         }
         if let Some(a) = prim.get(&gltf::Semantic::TexCoords(0)) {
             let (_, v) = self
-                .read_floats(&a, "TEXCOORD_0", &[Dimensions::Vec2], true)
+                .read_floats(&a, "TEXCOORD_0", &[Dimensions::Vec2], Storage::TexCoord)
                 .map_err(err)?;
-            mesh.uvs = v.chunks_exact(2).map(Vec2::from_slice).collect();
+            // KHR_texture_transform, before tangents are generated from these UVs.
+            mesh.uvs = v
+                .chunks_exact(2)
+                .map(|uv| uv_transform.apply(Vec2::from_slice(uv)))
+                .collect();
             per_vertex("TEXCOORD_0", mesh.uvs.len())?;
         }
         if let Some(a) = prim.get(&gltf::Semantic::Colors(0)) {
             let (dims, v) = self
-                .read_floats(&a, "COLOR_0", &[Dimensions::Vec3, Dimensions::Vec4], true)
+                .read_floats(
+                    &a,
+                    "COLOR_0",
+                    &[Dimensions::Vec3, Dimensions::Vec4],
+                    Storage::Unorm,
+                )
                 .map_err(err)?;
             let c: Vec<Vec4> = v
                 .chunks_exact(dims)
@@ -881,7 +1017,12 @@ impl<'o> Loader<'o> {
         }
         if let Some(a) = prim.get(&gltf::Semantic::Extras(interior_mask::ATTRIBUTE.into())) {
             let (_, v) = self
-                .read_floats(&a, "_HIKARI_INTERIOR", &[Dimensions::Scalar], true)
+                .read_floats(
+                    &a,
+                    "_HIKARI_INTERIOR",
+                    &[Dimensions::Scalar],
+                    Storage::Unorm,
+                )
                 .map_err(err)?;
             per_vertex("_HIKARI_INTERIOR", v.len())?;
             interior_mask::check_vertices(&v).map_err(err)?;
@@ -925,6 +1066,9 @@ impl<'o> Loader<'o> {
         }
         if mesh.tangents.is_empty() && wants_tangents && !mesh.uvs.is_empty() {
             mesh.tangents = generate_tangents(&mesh);
+        } else if !mesh.tangents.is_empty() && !uv_transform.is_identity() {
+            // The file's tangents follow its UVs; re-express them for the transformed ones.
+            uv_transform.transform_tangents(&mesh.normals, &mut mesh.tangents);
         }
         Ok(Some(mesh))
     }

@@ -43,7 +43,7 @@
 //!   embedded as base64 `data:` URIs, and `.glb` (its BIN chunk); PNG and JPEG images, decoded
 //!   to RGBA8 (16-bit and float images are reduced to 8 bits).
 //! - Meshes: triangle-list primitives, one [`Mesh`] each, with POSITION, NORMAL, TANGENT,
-//!   TEXCOORD_0 (float or normalised u8/u16), COLOR_0 (RGB or RGBA) and u8/u16/u32 indices;
+//!   TEXCOORD_0 (float or normalised u8/u16; more with `KHR_mesh_quantization`), COLOR_0 (RGB or RGBA) and u8/u16/u32 indices;
 //!   sparse accessors. Primitives without normals get flat normals (as the glTF spec asks).
 //!   Missing tangents are generated from the UVs only when the material has a normal map (not
 //!   MikkTSpace; see [`gltf::generate_tangents`]); otherwise they stay absent.
@@ -63,14 +63,26 @@
 //!   product is read as cd/m², which is what that extension says to do where a physical unit
 //!   is needed. Files written for display-referred viewers, where emissive 1 means "white",
 //!   look dim under daylight exposure unless that option is raised.
+//! - `KHR_mesh_quantization`: POSITION as (unsigned) byte or short, normalized or not; NORMAL
+//!   and TANGENT as normalized byte or short (renormalised; tangent w keeps its sign);
+//!   TEXCOORD_0 as any of those. Integers are dequantized with the spec's formulas; the node
+//!   transform that undoes a position quantization applies as usual. Quantized types in a file
+//!   that does not declare the extension, and types the extension does not allow (unsigned
+//!   normals, say), are errors naming the mesh, primitive and attribute.
+//! - `KHR_texture_transform` (`offset`, `rotation`, `scale`, `texCoord`) on any of a
+//!   material's five textures, applied to TEXCOORD_0 at load, before tangents are generated
+//!   (file tangents are re-expressed for the new UVs). A mesh has one UV set, so a material has
+//!   one transform: its base colour texture's (else its first textured slot's); a slot with a
+//!   different one gets a warning naming the material and slot. Malformed values are errors
+//!   naming the material, slot and field. docs/gltf.md.
 //!
 //! Approximated, with a warning: `BLEND` materials, drawn as cut-outs at alpha 0.5.
 //!
 //! Ignored, with a warning in [`gltf::Loaded::warnings`] (also logged with `log::warn!`):
 //! non-triangle primitives (points, lines, strips, fans), orthographic cameras, further
-//! directional lights, animations, skins, morph targets, texture coordinate sets other than 0,
-//! scenes other than the default one, and any
-//! extension other than the two above listed in `extensionsUsed`. An extension in
+//! directional lights, animations, skins, morph targets, texture coordinate sets other than 0
+//! (also where `KHR_texture_transform`'s `texCoord` asks for one), scenes other than the
+//! default one, and any extension other than the four above listed in `extensionsUsed`. An extension in
 //! `extensionsRequired` that is not supported is an error. Also ignored silently: `zfar` and
 //! `aspectRatio` of cameras (the renderer uses an infinite far plane and the image's aspect
 //! ratio), texture filters (the renderer chooses its own), `extras` (but a material's
