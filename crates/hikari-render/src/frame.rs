@@ -23,6 +23,7 @@ use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::gi_denoiser::{
     DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput, RecurrentNames,
 };
+use crate::techniques::haze::{Haze, HazeFrame, HazeInputs, HazeParams};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::ray_traced_gi::{
@@ -235,6 +236,7 @@ pub struct Techniques {
     /// `None` where the adapter cannot write the GI signal's 16-bit formats from compute: the
     /// lighting then resolves the accumulated signal undenoised.
     pub gi_denoiser: Option<GiDenoiser>,
+    pub haze: Haze,
     pub taa: Taa,
     pub exposure: Exposure,
     pub local_tonemap: LocalTonemap,
@@ -259,6 +261,7 @@ impl Techniques {
                 .inspect_err(|e| log::warn!("GI denoiser unavailable: {e}"))
                 .ok(),
             brdf_tables: BrdfTables::new(ctx),
+            haze: Haze::new(ctx, &mut lib)?,
             taa: Taa::new(ctx, &mut lib)?,
             exposure: Exposure::new(ctx, &mut lib)?,
             local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
@@ -294,7 +297,9 @@ pub struct FrameOutputs {
     ///
     /// [`Renderer::render`]: crate::renderer::Renderer::render
     pub hdr: Tex,
-    /// The lit image before TAA.
+    /// The haze's grids and the lit image through it (`None` with the haze off).
+    pub haze: Option<HazeFrame>,
+    /// The lit image before TAA (through the haze when it is on).
     pub lit: Tex,
     /// Lux arriving at each surface pixel, -1 on the sky (R32Float).
     pub illuminance: Tex,
@@ -569,10 +574,44 @@ pub fn record<'r>(
         t.ray_traced_gi.keep_lit(g, lit_frame.radiance, size)?;
     }
 
-    // 12. Haze: its issue adds it here.
+    // 12. Haze: the froxel grid lit by the sun or moon (through the shadow maps), the sky and
+    //     the local lights, integrated front to back and composited over every pixel.
+    let haze = if s.settings.haze.enabled {
+        let metered = s.metered_lux_with_sky(sky.sky_lux);
+        let params = HazeParams::new(
+            &s.settings.haze,
+            if sky.enabled {
+                &s.settings.sky.weather
+            } else {
+                "clear"
+            },
+            s.sun.as_ref().filter(|_| s.settings.direct_lighting.sun),
+            if s.settings.direct_lighting.punctual {
+                scene.light_count
+            } else {
+                0
+            },
+            lighting.cutoff[0],
+            metered,
+        );
+        Some(t.haze.record(
+            g,
+            &params,
+            &view,
+            &HazeInputs {
+                depth: gbuffer.depth,
+                lit: lit_frame.radiance,
+                lights: scene.lights,
+                shadows: shadows.lookup,
+                sky_ambient: sky.ambient,
+            },
+        )?)
+    } else {
+        None
+    };
 
     // 13. TAA.
-    let lit = lit_frame.radiance;
+    let lit = haze.map_or(lit_frame.radiance, |h| h.radiance);
     let hdr = if taa_on {
         t.taa
             .record(g, lit, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
@@ -635,6 +674,7 @@ pub fn record<'r>(
         ray_traced_gi,
         denoised_gi,
         ray_traced_gi_rays,
+        haze,
         hdr,
         lit,
         illuminance: lit_frame.illuminance,

@@ -31,11 +31,25 @@ pub fn all() -> Vec<StructLayout> {
     use crate::raster;
     use crate::scene_gpu;
     use crate::techniques::{
-        direct_lighting, exposure, gi_denoiser, irradiance_probes, local_tonemap, ray_traced_gi,
-        sky, sun_shadows, taa, tonemap,
+        direct_lighting, exposure, gi_denoiser, haze, irradiance_probes, local_tonemap,
+        ray_traced_gi, sky, sun_shadows, taa, tonemap,
     };
     use crate::view;
     vec![
+        gpu_layout!(
+            haze::HazeParams,
+            "haze/light.wgsl",
+            [
+                grid,
+                slicing,
+                exponential,
+                layer,
+                scatter,
+                sun,
+                sun_lux,
+                lights
+            ]
+        ),
         gpu_layout!(
             gi_denoiser::GiDenoiserParams,
             "gi_denoiser/spatial.wgsl",

@@ -15,6 +15,7 @@ pub use crate::techniques::area_lights::settings::AreaLightsSettings;
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::exposure::settings::ExposureSettings;
 pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
+pub use crate::techniques::haze::settings::HazeSettings;
 pub use crate::techniques::irradiance_probes::settings::IrradianceProbesSettings;
 pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
 pub use crate::techniques::ray_traced_gi::settings::RayTracedGiSettings;
@@ -200,6 +201,7 @@ register_settings! {
     taa: TaaSettings,
     gi_denoiser: GiDenoiserSettings,
     area_lights: AreaLightsSettings,
+    haze: HazeSettings,
     irradiance_probes: IrradianceProbesSettings,
     ray_traced_gi: RayTracedGiSettings,
     tonemap: TonemapSettings,

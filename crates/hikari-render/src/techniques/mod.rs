@@ -8,6 +8,7 @@ pub mod direct_lighting;
 pub mod exposure;
 pub mod gbuffer;
 pub mod gi_denoiser;
+pub mod haze;
 pub mod irradiance_probes;
 pub mod local_tonemap;
 pub mod ray_traced_gi;

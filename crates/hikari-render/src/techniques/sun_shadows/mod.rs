@@ -217,6 +217,17 @@ pub struct SunShadowMaps {
     pub lookup: BindingSet,
 }
 
+/// A `sun_shadows` binding set in which every point is lit (no cascades), for passes tested
+/// on their own.
+pub fn unshadowed_lookup(g: &mut FrameGraph<'_>) -> Result<BindingSet> {
+    let map = g.texture("sun_shadows.map", map_desc(1, 1))?;
+    g.pass("sun_shadows.clear")
+        // Never read: no cascades means no lookup. wgpu zeroes the map.
+        .uses(map, true)
+        .encode(|_, _| {})?;
+    Ok(lookup_set(g, &ShadowParams::disabled(), map))
+}
+
 fn lookup_set(g: &mut FrameGraph<'_>, params: &ShadowParams, map: Tex) -> BindingSet {
     g.binding_set("sun_shadows")
         .constants(params)

@@ -1,0 +1,95 @@
+#define_import_path hikari::haze
+
+// Volumetric haze (Ghost of Tsushima): two analytic density layers with their optical depth
+// in closed form, and the froxel grid's slicing. CPU twin: `haze::reference` (same names).
+
+#import hikari::view::View
+
+struct HazeParams {
+    // Froxels across, down, slices; HAZE_* flags.
+    grid: vec4<u32>,
+    // Near depth (m), first slice's thickness (m), growth per slice, ln(growth).
+    slicing: vec4<f32>,
+    // Exponential layer: extinction at its height (1/m), 1 / scale height (1/m), height (m).
+    exponential: vec4<f32>,
+    // Sigmoidal layer: extinction below (d0) and above (d1), middle height (m), half-width (m).
+    layer: vec4<f32>,
+    // Albedo, HG asymmetry, storage scale (grid = radiance * scale), far distance (m).
+    scatter: vec4<f32>,
+    // xyz: unit vector towards the sun or moon; w: the local lights' cut-off illuminance (lux).
+    sun: vec4<f32>,
+    // rgb: the sun's or moon's illuminance (lux), 0 when it does not light the haze.
+    sun_lux: vec4<f32>,
+    // x: point and spot lights to read.
+    lights: vec4<u32>,
+}
+
+const HAZE_SUN_SHADOWS: u32 = 1u;
+const HAZE_SKY: u32 = 2u;
+const HAZE_LOCAL_LIGHTS: u32 = 4u;
+const HAZE_DENSITY_AA: u32 = 8u;
+const HAZE_TRICUBIC: u32 = 16u;
+const HAZE_MAX_HALF: f32 = 65504.0;
+const HAZE_PI: f32 = 3.14159265358979;
+
+fn hg_phase(cos_theta: f32, g: f32) -> f32 {
+    let d = max(1.0 + g * g - 2.0 * g * cos_theta, 1e-6);
+    return (1.0 - g * g) / (4.0 * HAZE_PI * d * sqrt(d));
+}
+
+// (1 - e^-x) / x, accurate near 0.
+fn one_minus_exp_over(x: f32) -> f32 {
+    if abs(x) < 1e-3 {
+        return 1.0 - 0.5 * x + x * x / 6.0;
+    }
+    return (1.0 - exp(-x)) / x;
+}
+
+// 1 - e^-tau, accurate for small tau.
+fn opacity(tau: f32) -> f32 {
+    let t = max(tau, 0.0);
+    if t < 1e-3 {
+        return t * (1.0 - 0.5 * t + t * t / 6.0);
+    }
+    return 1.0 - exp(-t);
+}
+
+// Optical depth from `o` along unit `d` over `len` metres (see the twin for the closed forms).
+fn optical_depth(p: HazeParams, o: vec3<f32>, d: vec3<f32>, len_in: f32) -> f32 {
+    let len = max(len_in, 0.0);
+    let x = clamp(len * d.y * p.exponential.y, -80.0, 80.0);
+    let e0 = p.exponential.x * exp(clamp(-(o.y - p.exponential.z) * p.exponential.y, -80.0, 80.0));
+    let exponential = e0 * len * one_minus_exp_over(x);
+    let z0 = o.y - p.layer.z;
+    let z1 = z0 + len * d.y;
+    let ks2 = p.layer.w * p.layer.w;
+    let s0 = sqrt(z0 * z0 + ks2);
+    let s1 = sqrt(z1 * z1 + ks2);
+    let mean_t = 0.5 + 0.5 * (z0 + z1) / max(s0 + s1, 1e-6);
+    let layer = len * (p.layer.x + (p.layer.y - p.layer.x) * mean_t);
+    return max(exponential + layer, 0.0);
+}
+
+fn slice_depth(p: HazeParams, s: f32) -> f32 {
+    return p.slicing.x + p.slicing.y * (exp(s * p.slicing.w) - 1.0) / (p.slicing.z - 1.0);
+}
+
+fn slice_of_depth(p: HazeParams, z: f32) -> f32 {
+    let x = max((z - p.slicing.x) * (p.slicing.z - 1.0) / p.slicing.y, 0.0);
+    // ln(1 + x), accurate near 0.
+    var l = log(1.0 + x);
+    if x < 1e-3 {
+        l = x * (1.0 - 0.5 * x + x * x / 3.0);
+    }
+    return l / p.slicing.w;
+}
+
+// Unit direction from the camera through the normalised screen position `uv` (y down).
+fn screen_ray(view: View, uv: vec2<f32>) -> vec3<f32> {
+    let near = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
+    return normalize(near.xyz / near.w - view.position.xyz);
+}
+
+fn froxel_ray(p: HazeParams, view: View, c: vec2<u32>) -> vec3<f32> {
+    return screen_ray(view, (vec2<f32>(c) + 0.5) / vec2<f32>(p.grid.xy));
+}

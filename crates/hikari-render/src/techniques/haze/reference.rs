@@ -1,0 +1,356 @@
+//! CPU twin of the haze passes: the analytic density and its optical depth along a ray, the
+//! slice mapping, the froxel lighting (`haze.light`), the front-to-back integration
+//! (`haze.integrate`) and the per-pixel composite with tricubic sampling (`haze.composite`).
+//! Every function here mirrors a WGSL function of the same name in `common.wgsl` or the pass
+//! shaders, in f32 as the GPU computes.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use hikari_math::sh::Sh;
+
+use super::{
+    HAZE_DENSITY_AA, HAZE_LOCAL_LIGHTS, HAZE_SKY, HAZE_SUN_SHADOWS, HAZE_TRICUBIC, HazeParams,
+};
+use crate::scene_gpu::LightGpu;
+use crate::view::View;
+
+const PI: f32 = std::f32::consts::PI;
+
+/// Largest value the f16 grids hold.
+pub const MAX_HALF: f32 = 65504.0;
+
+/// Thickness of the first of `slices` slices from `near` to `far`, each `growth` times as thick
+/// as the one before: the geometric series sums to `far - near`.
+pub fn first_slice_m(near: f32, far: f32, growth: f32, slices: u32) -> f32 {
+    let (near, far, r) = (f64::from(near), f64::from(far), f64::from(growth));
+    ((far - near) * (r - 1.0) / (r.powi(slices as i32) - 1.0)) as f32
+}
+
+/// Henyey-Greenstein phase function, per steradian; `cos_theta` between the light's direction
+/// of travel and the scattered direction (1: straight on).
+pub fn hg_phase(cos_theta: f32, g: f32) -> f32 {
+    let d = (1.0 + g * g - 2.0 * g * cos_theta).max(1e-6);
+    (1.0 - g * g) / (4.0 * PI * d * d.sqrt())
+}
+
+/// Extinction per metre at world height `y`.
+pub fn density(p: &HazeParams, y: f32) -> f32 {
+    let [de, inv_k, h, _] = p.exponential;
+    let [d0, d1, hs, ks] = p.layer;
+    let z = y - hs;
+    let t = 0.5 * z / (z * z + ks * ks).sqrt().max(1e-6) + 0.5;
+    de * (-(y - h) * inv_k).clamp(-80.0, 80.0).exp() + d0 + (d1 - d0) * t
+}
+
+/// (1 - e^-x) / x, accurate near 0.
+fn one_minus_exp_over(x: f32) -> f32 {
+    if x.abs() < 1e-3 {
+        1.0 - 0.5 * x + x * x / 6.0
+    } else {
+        -(-x).exp_m1() / x
+    }
+}
+
+/// 1 - e^-tau, accurate for small tau.
+pub fn opacity(tau: f32) -> f32 {
+    -(-tau.max(0.0)).exp_m1()
+}
+
+/// Optical depth from `o` along the unit direction `d` over `len` metres, in closed form: the
+/// exponential layer integrates to an exponential, the sigmoid z / sqrt(z^2 + k^2) to
+/// sqrt(z^2 + k^2), both written so that level rays lose no precision.
+pub fn optical_depth(p: &HazeParams, o: Vec3, d: Vec3, len: f32) -> f32 {
+    let [de, inv_k, h, _] = p.exponential;
+    let [d0, d1, hs, ks] = p.layer;
+    let len = len.max(0.0);
+    // Exponential: de e^(-(y0 - h)/k) * len * (1 - e^-x) / x with x = len dy / k.
+    let x = (len * d.y * inv_k).clamp(-80.0, 80.0);
+    let e0 = de * (-(o.y - h) * inv_k).clamp(-80.0, 80.0).exp();
+    let exponential = e0 * len * one_minus_exp_over(x);
+    // Sigmoid: the mean of t(z) over the segment is 1/2 + (z0 + z1) / (2 (S0 + S1)).
+    let z0 = o.y - hs;
+    let z1 = z0 + len * d.y;
+    let s0 = (z0 * z0 + ks * ks).sqrt();
+    let s1 = (z1 * z1 + ks * ks).sqrt();
+    let mean_t = 0.5 + 0.5 * (z0 + z1) / (s0 + s1).max(1e-6);
+    let layer = len * (d0 + (d1 - d0) * mean_t);
+    (exponential + layer).max(0.0)
+}
+
+/// Depth (metres along the view's forward axis) of slice boundary `s` (0: near plane,
+/// `slices`: far plane); fractional `s` interpolates the geometric series.
+pub fn slice_depth(p: &HazeParams, s: f32) -> f32 {
+    let [near, first, r, ln_r] = p.slicing;
+    near + first * ((s * ln_r).exp() - 1.0) / (r - 1.0)
+}
+
+/// The inverse of [`slice_depth`]: which boundary (fractional) lies at depth `z`; 0 before the
+/// near plane.
+pub fn slice_of_depth(p: &HazeParams, z: f32) -> f32 {
+    let [near, first, r, ln_r] = p.slicing;
+    let x = ((z - near) * (r - 1.0) / first).max(0.0);
+    x.ln_1p() / ln_r
+}
+
+/// Unit direction from the camera through the normalised screen position `uv` (0..1, y down).
+pub fn screen_ray(view: &View, uv: Vec2) -> Vec3 {
+    let inv = Mat4::from_cols_array_2d(&view.inv_view_proj);
+    let near = inv * Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
+    (near.truncate() / near.w - Vec3::from_slice(&view.position[..3])).normalize()
+}
+
+/// Froxel `(i, j)`'s central ray.
+pub fn froxel_ray(p: &HazeParams, view: &View, i: u32, j: u32) -> Vec3 {
+    let uv = Vec2::new(
+        (i as f32 + 0.5) / p.grid[0] as f32,
+        (j as f32 + 0.5) / p.grid[1] as f32,
+    );
+    screen_ray(view, uv)
+}
+
+/// What lights the haze besides the params: the sky's deringed L2 SH (radiance, nits) and the
+/// sun's visibility at a point (1 without shadows).
+pub struct HazeLightInputs<'a> {
+    pub sky_sh: &'a Sh<Vec3, 9>,
+    pub lights: &'a [LightGpu],
+    pub sun_visibility: &'a dyn Fn(Vec3) -> f32,
+}
+
+/// Light a point scatters towards the camera per unit scattering coefficient, nits: the
+/// integral over the sphere of incoming radiance times the phase function (the talk's L_i).
+/// `v`: unit direction from the camera to the point.
+pub fn inscatter(p: &HazeParams, inputs: &HazeLightInputs, x: Vec3, v: Vec3) -> Vec3 {
+    let g = p.scatter[1];
+    let flags = p.grid[3];
+    let to_sun = Vec3::from_slice(&p.sun[..3]);
+    let sun_rgb = Vec3::from_slice(&p.sun_lux[..3]);
+    let mut l = Vec3::ZERO;
+    if sun_rgb.max_element() > 0.0 {
+        let vis = if flags & HAZE_SUN_SHADOWS != 0 {
+            (inputs.sun_visibility)(x)
+        } else {
+            1.0
+        };
+        l += sun_rgb * vis * hg_phase(to_sun.dot(v), g);
+    }
+    if flags & HAZE_SKY != 0 {
+        // The HG phase's zonal harmonics are g^l: convolving the sky's SH with it scales band
+        // l by g^l (Funk-Hecke).
+        l += inputs
+            .sky_sh
+            .scale_bands([1.0, g, g * g])
+            .eval(v)
+            .max(Vec3::ZERO);
+    }
+    if flags & HAZE_LOCAL_LIGHTS != 0 {
+        let cutoff = p.sun[3];
+        for light in inputs.lights.iter().take(p.lights[0] as usize) {
+            l += local_light(light, cutoff, x, v, g);
+        }
+    }
+    l
+}
+
+/// One point or spot light's share of [`inscatter`], unshadowed (as `light_attenuation` in
+/// `scene_gpu.wgsl`).
+pub fn local_light(light: &LightGpu, cutoff_lux: f32, x: Vec3, v: Vec3, g: f32) -> Vec3 {
+    let intensity = Vec3::from_slice(&light.intensity[..3]);
+    let peak = intensity.max_element();
+    let range = light.position_range[3]
+        .min((peak / cutoff_lux).sqrt())
+        .max(1e-3);
+    let to_light = Vec3::from_slice(&light.position_range[..3]) - x;
+    let d2 = to_light.length_squared().max(1e-8);
+    let xr = d2 / (range * range);
+    if xr >= 1.0 {
+        return Vec3::ZERO;
+    }
+    let l = to_light / d2.sqrt();
+    let window = (1.0 - xr * xr).clamp(0.0, 1.0);
+    let mut a = window * window * (1.0 / d2).min(1e4);
+    if light.direction_kind[3] > 0.5 {
+        let axis = Vec3::from_slice(&light.direction_kind[..3]);
+        let s = ((-l).dot(axis) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
+        a *= s * s;
+    }
+    intensity * a * hg_phase(l.dot(v), g)
+}
+
+/// Index of froxel `(i, j, k)` in the grids (x fastest, then y, then slice).
+pub fn froxel_index(p: &HazeParams, i: u32, j: u32, k: u32) -> usize {
+    ((k * p.grid[1] + j) * p.grid[0] + i) as usize
+}
+
+/// `haze.light`: every froxel's L_i at its slice's middle along its central ray, times the
+/// albedo and the storage scale, as the f16 grid holds it (not rounded to f16 here).
+pub fn light_grid(p: &HazeParams, view: &View, inputs: &HazeLightInputs) -> Vec<Vec3> {
+    let [w, h, n, _] = p.grid;
+    let cam = Vec3::from_slice(&view.position[..3]);
+    let fwd = Vec3::from_slice(&view.forward_near[..3]);
+    let mut out = vec![Vec3::ZERO; (w * h * n) as usize];
+    for k in 0..n {
+        let z = 0.5 * (slice_depth(p, k as f32) + slice_depth(p, k as f32 + 1.0));
+        for j in 0..h {
+            for i in 0..w {
+                let v = froxel_ray(p, view, i, j);
+                let x = cam + v * (z / v.dot(fwd).max(1e-4));
+                let li = inscatter(p, inputs, x, v) * (p.scatter[0] * p.scatter[2]);
+                out[froxel_index(p, i, j, k)] = li.min(Vec3::splat(MAX_HALF));
+            }
+        }
+    }
+    out
+}
+
+/// `haze.integrate`: front to back along each froxel column. With density anti-aliasing the
+/// grid holds L / alpha (rgb) and alpha at each slice's far boundary; without, L and alpha.
+pub fn integrate(p: &HazeParams, view: &View, light: &[Vec3]) -> Vec<Vec4> {
+    let [w, h, n, flags] = p.grid;
+    let cam = Vec3::from_slice(&view.position[..3]);
+    let fwd = Vec3::from_slice(&view.forward_near[..3]);
+    let mut out = vec![Vec4::ZERO; (w * h * n) as usize];
+    for j in 0..h {
+        for i in 0..w {
+            let v = froxel_ray(p, view, i, j);
+            let inv_cos = 1.0 / v.dot(fwd).max(1e-4);
+            let mut transmittance = 1.0f32;
+            let mut weight = 0.0f32;
+            let mut sum = Vec3::ZERO;
+            for k in 0..n {
+                let t0 = slice_depth(p, k as f32) * inv_cos;
+                let t1 = slice_depth(p, k as f32 + 1.0) * inv_cos;
+                let tau = optical_depth(p, cam + v * t0, v, t1 - t0);
+                let a = transmittance * opacity(tau);
+                let li = light[froxel_index(p, i, j, k)];
+                sum += li * a;
+                weight += a;
+                transmittance *= (-tau).exp();
+                let alpha = 1.0 - transmittance;
+                let rgb = if flags & HAZE_DENSITY_AA != 0 {
+                    if weight > 1e-30 { sum / weight } else { li }
+                } else {
+                    sum
+                };
+                out[froxel_index(p, i, j, k)] = rgb.min(Vec3::splat(MAX_HALF)).extend(alpha);
+            }
+        }
+    }
+    out
+}
+
+/// Cubic B-spline weights of the four texels about a sample `f` (0..1) past the second.
+pub fn bspline_weights(f: f32) -> [f32; 4] {
+    let f2 = f * f;
+    let f3 = f2 * f;
+    [
+        (1.0 - f) * (1.0 - f) * (1.0 - f) / 6.0,
+        (3.0 * f3 - 6.0 * f2 + 4.0) / 6.0,
+        (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0) / 6.0,
+        f3 / 6.0,
+    ]
+}
+
+fn texel(p: &HazeParams, grid: &[Vec4], c: [i32; 3]) -> Vec4 {
+    let i = c[0].clamp(0, p.grid[0] as i32 - 1) as u32;
+    let j = c[1].clamp(0, p.grid[1] as i32 - 1) as u32;
+    let k = c[2].clamp(0, p.grid[2] as i32 - 1) as u32;
+    grid[froxel_index(p, i, j, k)]
+}
+
+/// The grid at normalised coordinates `uvw` (texel centres at (i + 0.5) / size, clamped at the
+/// edges): a tricubic B-spline over the 4x4x4 texels about it, or trilinear.
+pub fn sample(p: &HazeParams, grid: &[Vec4], uvw: Vec3, tricubic: bool) -> Vec4 {
+    let size = [p.grid[0], p.grid[1], p.grid[2]];
+    let mut base = [0i32; 3];
+    let mut w = [[0.0f32; 4]; 3];
+    for a in 0..3 {
+        let c = uvw[a] * size[a] as f32 - 0.5;
+        let fl = c.floor();
+        let f = c - fl;
+        base[a] = fl as i32;
+        w[a] = if tricubic {
+            bspline_weights(f)
+        } else {
+            [0.0, 1.0 - f, f, 0.0]
+        };
+    }
+    let mut acc = Vec4::ZERO;
+    for (z, wz) in w[2].iter().enumerate() {
+        for (y, wy) in w[1].iter().enumerate() {
+            for (x, wx) in w[0].iter().enumerate() {
+                let wt = wx * wy * wz;
+                if wt != 0.0 {
+                    let c = [
+                        base[0] + x as i32 - 1,
+                        base[1] + y as i32 - 1,
+                        base[2] + z as i32 - 1,
+                    ];
+                    acc += texel(p, grid, c) * wt;
+                }
+            }
+        }
+    }
+    acc
+}
+
+/// Where a pixel's ray ends: its distance from the camera and its depth along the forward
+/// axis (the far plane's for the sky and for depths that are not finite).
+pub fn pixel_extent(p: &HazeParams, view: &View, pixel: [u32; 2], depth: f32) -> (Vec3, f32, f32) {
+    let cam = Vec3::from_slice(&view.position[..3]);
+    let fwd = Vec3::from_slice(&view.forward_near[..3]);
+    let uv = Vec2::new(
+        (pixel[0] as f32 + 0.5) * view.viewport[2],
+        (pixel[1] as f32 + 0.5) * view.viewport[3],
+    );
+    let v = screen_ray(view, uv);
+    let far = p.scatter[3];
+    if depth.is_finite() && depth > 0.0 {
+        let inv = Mat4::from_cols_array_2d(&view.inv_view_proj);
+        let w = inv * Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+        let world = w.truncate() / w.w;
+        let d = world - cam;
+        let dist = d.length();
+        if dist.is_finite() && dist < far {
+            return (v, dist, d.dot(fwd));
+        }
+    }
+    (v, far, far * v.dot(fwd).max(1e-4))
+}
+
+/// `haze.composite` of one pixel: the surface's (or sky's) radiance `lit` seen through the
+/// haze. `grid`: what [`integrate`] gives (scaled).
+pub fn composite_pixel(
+    p: &HazeParams,
+    view: &View,
+    grid: &[Vec4],
+    pixel: [u32; 2],
+    depth: f32,
+    lit: Vec3,
+) -> Vec3 {
+    let flags = p.grid[3];
+    let cam = Vec3::from_slice(&view.position[..3]);
+    let (v, dist, z) = pixel_extent(p, view, pixel, depth);
+    let uvw = Vec3::new(
+        (pixel[0] as f32 + 0.5) * view.viewport[2],
+        (pixel[1] as f32 + 0.5) * view.viewport[3],
+        (slice_of_depth(p, z) - 0.5) / p.grid[2] as f32,
+    );
+    let s = sample(p, grid, uvw, flags & HAZE_TRICUBIC != 0);
+    let lit = if lit.is_finite() {
+        lit.max(Vec3::ZERO)
+    } else {
+        Vec3::ZERO
+    };
+    let inv_scale = 1.0 / p.scatter[2];
+    let out = if flags & HAZE_DENSITY_AA != 0 {
+        let alpha = opacity(optical_depth(p, cam, v, dist));
+        lit * (1.0 - alpha) + s.truncate() * (alpha * inv_scale)
+    } else {
+        let alpha = s.w.clamp(0.0, 1.0);
+        lit * (1.0 - alpha) + s.truncate() * inv_scale
+    };
+    if out.is_finite() {
+        out.max(Vec3::ZERO)
+    } else {
+        lit
+    }
+}
