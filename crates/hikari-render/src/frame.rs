@@ -16,6 +16,7 @@ use crate::techniques::area_lights::{
     AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,
     ShadowDenoiseParams,
 };
+use crate::techniques::clouds::{CloudParams, Clouds};
 use crate::techniques::direct_lighting::GiLight;
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
@@ -228,6 +229,7 @@ fn override_gbuffer<'r>(
 pub struct Techniques {
     pub raster: Rasterizer,
     pub sky: Sky,
+    pub clouds: Clouds,
     pub irradiance_probes: IrradianceProbes,
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
@@ -252,6 +254,7 @@ impl Techniques {
         Ok(Self {
             raster: Rasterizer::new(ctx, &mut lib)?,
             sky: Sky::new(ctx, &mut lib)?,
+            clouds: Clouds::new(ctx, &mut lib)?,
             irradiance_probes: IrradianceProbes::new(ctx, &mut lib)?,
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
@@ -277,6 +280,7 @@ pub struct FrameOutputs {
     pub gbuffer: GBuffer,
     pub shadows: SunShadowMaps,
     pub sky: SkyFrame,
+    pub clouds: crate::techniques::clouds::CloudsFrame,
     pub probes: ProbesFrame,
     /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`), this
     /// frame's estimate before the shadow denoiser.
@@ -299,7 +303,7 @@ pub struct FrameOutputs {
     pub hdr: Tex,
     /// The haze's grids and the lit image through it (`None` with the haze off).
     pub haze: Option<HazeFrame>,
-    /// The lit image before TAA (through the haze when it is on).
+    /// The deferred lighting's image (`direct_lighting.radiance`), before the haze and TAA.
     pub lit: Tex,
     /// Lux arriving at each surface pixel, -1 on the sky (R32Float).
     pub illuminance: Tex,
@@ -364,7 +368,20 @@ pub fn record<'r>(
         s.camera.position,
     )?;
 
-    // 5. Reflection probes, 6. clouds: their issues add them here.
+    // 5. Reflection probes: their issue adds them here.
+
+    // 6. Clouds: this frame's share of the paraboloid cloud map; the deferred lighting draws
+    //    them over the sky and shadows the sun with them, as the haze does.
+    let clouds = t.clouds.record(
+        g,
+        &s.settings.clouds,
+        CloudParams::new(
+            &s.settings.clouds,
+            &s.settings.sky.weather,
+            s.sun.as_ref(),
+            sky.enabled && s.settings.sky.sky,
+        ),
+    )?;
 
     // 7. Sun shadow maps.
     let shadows = t.sun_shadows.record(
@@ -561,6 +578,7 @@ pub fn record<'r>(
         &gbuffer,
         &shadows,
         &sky,
+        &clouds,
         &probes,
         brdf,
         scene,
@@ -604,6 +622,7 @@ pub fn record<'r>(
                 lights: scene.lights,
                 shadows: shadows.lookup,
                 sky_ambient: sky.ambient,
+                clouds: clouds.lookup,
             },
         )?)
     } else {
@@ -611,13 +630,14 @@ pub fn record<'r>(
     };
 
     // 13. TAA.
-    let lit = haze.map_or(lit_frame.radiance, |h| h.radiance);
+    let lit = lit_frame.radiance;
+    let hazed = haze.map_or(lit, |h| h.radiance);
     let hdr = if taa_on {
         t.taa
-            .record(g, lit, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
+            .record(g, hazed, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
             .output
     } else {
-        lit
+        hazed
     };
 
     // 14. Exposure, metered on the illuminance; the local tonemap's grid; the tonemap: the local
@@ -667,6 +687,7 @@ pub fn record<'r>(
         gbuffer,
         shadows,
         sky,
+        clouds,
         probes,
         area_lights,
         area_lights_unshadowed: area_frame.unshadowed,

@@ -31,11 +31,16 @@ pub fn all() -> Vec<StructLayout> {
     use crate::raster;
     use crate::scene_gpu;
     use crate::techniques::{
-        direct_lighting, exposure, gi_denoiser, haze, irradiance_probes, local_tonemap,
+        clouds, direct_lighting, exposure, gi_denoiser, haze, irradiance_probes, local_tonemap,
         ray_traced_gi, sky, sun_shadows, taa, tonemap,
     };
     use crate::view;
     vec![
+        gpu_layout!(
+            clouds::CloudParams,
+            "clouds/march.wgsl",
+            [layer, shape, offset, sun, phase, march, slice]
+        ),
         gpu_layout!(
             haze::HazeParams,
             "haze/light.wgsl",

@@ -12,6 +12,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 pub use crate::techniques::area_lights::settings::AreaLightsSettings;
+pub use crate::techniques::clouds::settings::CloudsSettings;
 pub use crate::techniques::direct_lighting::settings::DirectLightingSettings;
 pub use crate::techniques::exposure::settings::ExposureSettings;
 pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
@@ -198,6 +199,7 @@ register_settings! {
     exposure: ExposureSettings,
     local_tonemap: LocalTonemapSettings,
     sky: SkySettings,
+    clouds: CloudsSettings,
     taa: TaaSettings,
     gi_denoiser: GiDenoiserSettings,
     area_lights: AreaLightsSettings,

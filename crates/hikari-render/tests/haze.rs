@@ -297,6 +297,7 @@ fn run_gpu(
     let sh = g.import_buffer("sky.sh", &sh_buf);
     let lights = g.import_buffer("scene.lights", &light_buf);
     let shadows = sun_shadows::unshadowed_lookup(&mut g).unwrap();
+    let clouds = hikari_render::techniques::clouds::disabled_lookup(&mut g).unwrap();
     let sky_ambient = g
         .binding_set("sky_ambient")
         .constants(&SkyAmbientParams {
@@ -315,6 +316,7 @@ fn run_gpu(
                 lights,
                 shadows,
                 sky_ambient,
+                clouds,
             },
         )
         .unwrap();

@@ -4,6 +4,7 @@
 //! `tests/sun_shadows.rs`.
 
 pub mod area_lights;
+pub mod clouds;
 pub mod direct_lighting;
 pub mod exposure;
 pub mod gbuffer;

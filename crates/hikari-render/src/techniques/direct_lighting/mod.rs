@@ -10,6 +10,7 @@ use glam::Vec3;
 
 use hikari_scene::Sun;
 
+use super::clouds::CloudsFrame;
 use super::gbuffer::GBuffer;
 use super::irradiance_probes::ProbesFrame;
 use super::sky::SkyFrame;
@@ -180,6 +181,7 @@ impl DirectLighting {
         gb: &GBuffer,
         shadows: &SunShadowMaps,
         sky: &SkyFrame,
+        clouds: &CloudsFrame,
         probes: &ProbesFrame,
         brdf_tables: BindingSet,
         scene: &SceneInFrame,
@@ -216,6 +218,7 @@ impl DirectLighting {
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)
+            .set(clouds.lookup)
             .set(probes.lookup)
             .set(brdf_tables)
             .dispatch_threads(&self.shade, [w, h, 1])?;

@@ -11,7 +11,8 @@
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
 #import hikari::sky::sky_background
-#import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_specular}
+#import hikari::clouds::{clouds_over_sky, cloud_shadow}
+#import hikari::sky_ambient::{sky_ambient_eval, sky_ambient_irradiance, sky_ambient_specular}
 #import hikari::irradiance_probes::probe_irradiance_at
 #import hikari::rtgi_resolve::{rtgi_signal, rtgi_resolve_diffuse, rtgi_resolve_specular}
 #import hikari::tile_bounds::{tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
@@ -146,7 +147,8 @@ fn main(
     if d <= 0.0 {
         radiance = select(vec3<f32>(0.0), sky_placeholder(-v), (flags & LIGHTING_PLACEHOLDER_AMBIENT) != 0u);
         if (flags & LIGHTING_SKY) != 0u {
-            radiance = sky_background(-v);
+            let sun_lux = params.color.rgb * params.direction_lux.w;
+            radiance = clouds_over_sky(-v, sky_background(-v), sun_lux, sky_ambient_eval(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0)));
         }
     } else {
         let nt = textureLoad(gbuffer_normal, pixel, 0);
@@ -167,7 +169,7 @@ fn main(
         illuminance = 0.0;
         if (flags & LIGHTING_SUN) != 0u && params.direction_lux.w > 0.0 {
             let l = params.direction_lux.xyz;
-            let e = params.color.rgb * (params.direction_lux.w * sun_visibility(world, n));
+            let e = params.color.rgb * (params.direction_lux.w * sun_visibility(world, n) * cloud_shadow(world));
             let w = brdf_light_weights(brdf, l);
             sum_a += e * w.x;
             sum_b += e * w.y;

@@ -8,6 +8,7 @@
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
 #import hikari::sky_ambient::sky_ambient_eval
+#import hikari::clouds::cloud_shadow
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: HazeParams;
@@ -31,6 +32,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (flags & HAZE_SUN_SHADOWS) != 0u {
             vis = sun_visibility(x, vec3<f32>(0.0));
         }
+        vis *= cloud_shadow(x);
         l += params.sun_lux.xyz * vis * hg_phase(dot(params.sun.xyz, v), g);
     }
     if (flags & HAZE_SKY) != 0u {

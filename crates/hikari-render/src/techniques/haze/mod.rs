@@ -75,7 +75,8 @@ impl HazeParams {
         .filter(|(on, _)| *on)
         .fold(0, |acc, (_, bit)| acc | bit);
         let k = HazeSettings::weather_factor(weather) * s.weather_scale;
-        let first = reference::first_slice_m(s.near_m, s.far_m, s.slice_growth, s.slices);
+        let first = reference::first_slice_m(s.near_m, s.far_m, s.slice_growth, s.slices)
+            .max((s.far_m - s.near_m) * 1e-6);
         let (to_sun, sun_lux) = match sun {
             Some(sun) if s.sun => (
                 sun.direction.normalize_or(Vec3::Y),
@@ -116,6 +117,8 @@ pub struct HazeInputs {
     pub shadows: BindingSet,
     /// Binding set `sky_ambient` (`SkyFrame::ambient`): the sky's SH.
     pub sky_ambient: BindingSet,
+    /// Binding set `clouds` (`CloudsFrame::lookup`): their shadow on the sun.
+    pub clouds: BindingSet,
 }
 
 /// The haze's textures in a frame.
@@ -164,6 +167,7 @@ impl Haze {
             .write(light)
             .set(inputs.shadows)
             .set(inputs.sky_ambient)
+            .set(inputs.clouds)
             .dispatch_threads(&self.light, [gw, gh, gn])?;
         g.pass("haze.integrate")
             .constants(view)
