@@ -12,14 +12,16 @@
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = params.march.z;
-    if any(id.xy >= vec2<u32>(size)) || (id.y % params.slice.x) != params.slice.y {
+    // This frame's rows: slice, slice + slices, ... (the dispatch covers only them).
+    let texel = vec2<u32>(id.x, id.y * params.slice.x + params.slice.y);
+    if any(texel >= vec2<u32>(size)) {
         return;
     }
-    let uv = (vec2<f32>(id.xy) + 0.5) / f32(size);
+    let uv = (vec2<f32>(texel) + 0.5) / f32(size);
     let q = uv * 2.0 - 1.0;
     if dot(q, q) > 1.0 {
         // Outside the hemisphere's disc: clear sky.
-        textureStore(map_out, id.xy, vec4<f32>(0.0, 0.0, 1.0, 1.0));
+        textureStore(map_out, texel, vec4<f32>(0.0, 0.0, 1.0, 1.0));
         return;
     }
     let d = cloud_map_dir(uv);
@@ -75,5 +77,5 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             break;
         }
     }
-    textureStore(map_out, id.xy, vec4<f32>(mie, ambient, transmittance, 1.0));
+    textureStore(map_out, texel, vec4<f32>(mie, ambient, transmittance, 1.0));
 }

@@ -162,7 +162,7 @@ impl Clouds {
         g.pass("clouds.march")
             .constants(&p)
             .write(map)
-            .dispatch_threads(&self.march, [size, size, 1])?;
+            .dispatch_threads(&self.march, [size, size.div_ceil(p.slice[0]), 1])?;
         let lookup = lookup_set(g, &params, map);
         Ok(CloudsFrame {
             map,
