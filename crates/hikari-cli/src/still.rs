@@ -1,14 +1,14 @@
 //! What the commands that render frames of a view share (`render`, `compare`, `timelapse`):
 //! the GPU, a renderer with the scene's probe bake attached, how many frames a still view
-//! needs, one frame read back with its images and exposure, and the checks on where the
+//! needs, a frame's images and exposure read back, and the checks on where the
 //! images go, made before anything is rendered.
 
 use std::path::Path;
 
 use anyhow::Context;
 
-use hikari_render::graph::{FrameResult, ImageRgba32, Res};
-use hikari_render::{ContextOptions, FrameSettings, GpuContext, Renderer, output};
+use hikari_render::graph::ImageRgba32;
+use hikari_render::{ContextOptions, GpuContext, RenderedFrame, Renderer, output};
 
 use crate::probe_bake;
 use crate::scene_source::ResolvedFrame;
@@ -65,69 +65,32 @@ pub fn default_frames(s: &hikari_render::Settings) -> u32 {
     gi_frames.max(cycle).div_ceil(cycle) * cycle
 }
 
-/// One rendered frame: its result (timings, anything else read back), the images when they
-/// were asked for, and the exposure it was shown at.
-pub struct Frame {
-    pub result: FrameResult,
-    /// Linear radiance in nits, alpha 1.
-    pub hdr: Option<ImageRgba32>,
-    /// Display-encoded, as the PNG stores it.
-    pub ldr: Option<ImageRgba32>,
-    /// The EV100 of the frame's exposure (`exposure.value`'s second number): metered, or fixed
-    /// by `exposure.ev100`.
-    pub ev100: f32,
+/// The exposure's buffer, `vec4<f32>(scale, ev100, metered lux, highlight)`: a renderer
+/// whose runtime dumps it ([`read_exposure`]) reads it back every frame.
+const EXPOSURE_VALUE: &str = "exposure.value";
+
+/// Has `renderer` read back each frame's exposure, for [`ev100`].
+pub fn read_exposure(renderer: &mut Renderer) {
+    renderer.runtime.set_dumps(vec![EXPOSURE_VALUE.into()]);
 }
 
-/// Renders one frame of `settings`, reading back its exposure, and the HDR and LDR images
-/// when `images`.
-pub fn render(
-    renderer: &mut Renderer,
-    settings: &FrameSettings,
-    images: bool,
-) -> anyhow::Result<Frame> {
-    let mut picked = None;
-    let mut result = renderer.render_reading(settings, |out| {
-        picked = Some((out.hdr, out.ldr));
-        let mut read: Vec<Res> = vec![out.exposure.value.into()];
-        if images {
-            read.extend([Res::from(out.hdr), Res::from(out.ldr)]);
-        }
-        read
-    })?;
-    let ev100 = result
-        .buffer("exposure.value")
+/// The EV100 `frame` was shown at (metered, or fixed by `exposure.ev100`), from a renderer
+/// set up with [`read_exposure`].
+pub fn ev100(frame: &RenderedFrame) -> anyhow::Result<f32> {
+    frame
+        .result
+        .buffer(EXPOSURE_VALUE)
         .filter(|b| b.len() >= 8)
         .map(|b| f32::from_le_bytes([b[4], b[5], b[6], b[7]]))
-        .context("the frame's exposure was not read back")?;
-    let (hdr, ldr) = match (images, picked) {
-        (true, Some((hdr, ldr))) => (
-            // TAA's history is the HDR output; its alpha counts frames, the EXR's is 1.
-            result.take_image_of(hdr).map(|mut img| {
-                img.rgba.iter_mut().for_each(|p| p[3] = 1.0);
-                img
-            }),
-            result.take_image_of(ldr),
-        ),
-        _ => (None, None),
-    };
-    Ok(Frame {
-        result,
-        hdr,
-        ldr,
-        ev100,
-    })
+        .context("the frame's exposure was not read back")
 }
 
-impl Frame {
-    /// The display image; an error if it was not read back.
-    pub fn ldr(&self) -> anyhow::Result<&ImageRgba32> {
-        self.ldr.as_ref().context("no LDR image")
-    }
-
-    /// The linear image; an error if it was not read back.
-    pub fn hdr(&self) -> anyhow::Result<&ImageRgba32> {
-        self.hdr.as_ref().context("no HDR image")
-    }
+/// The linear (nits) and the display images of a frame rendered with its images read back.
+pub fn images(frame: &RenderedFrame) -> anyhow::Result<(&ImageRgba32, &ImageRgba32)> {
+    Ok((
+        frame.hdr.as_ref().context("no HDR image")?,
+        frame.ldr.as_ref().context("no LDR image")?,
+    ))
 }
 
 /// Checks, before anything is rendered, that `file` (named by `flag`) can be written: its
@@ -165,10 +128,11 @@ pub fn output_folder(flag: &str, dir: &Path) -> anyhow::Result<()> {
 
 /// Writes the display image as a PNG and, unless `exr` is `None`, the linear image as an
 /// EXR, each atomically (hikari-render's `output`).
-pub fn write_images(png: &Path, exr: Option<&Path>, frame: &Frame) -> anyhow::Result<()> {
-    output::write_png(png, frame.ldr()?)?;
+pub fn write_images(png: &Path, exr: Option<&Path>, frame: &RenderedFrame) -> anyhow::Result<()> {
+    let (hdr, ldr) = images(frame)?;
+    output::write_png(png, ldr)?;
     if let Some(exr) = exr {
-        output::write_exr(exr, frame.hdr()?)?;
+        output::write_exr(exr, hdr)?;
     }
     Ok(())
 }

@@ -18,7 +18,7 @@ use clap::Args;
 use serde_json::json;
 
 use hikari_render::graph::ImageRgba32;
-use hikari_render::{FrameSettings, output};
+use hikari_render::{FrameSettings, RenderedFrame, output};
 
 use crate::args::{FrameArgs, JsonArgs};
 use crate::scene_source::{self, ResolvedFrame};
@@ -79,17 +79,22 @@ pub fn toggles() -> Vec<String> {
         .collect()
 }
 
-/// Every `table.key` (nested keys dotted) whose value differs between `a` and `b`, with the
-/// two values (`None`: absent, an option not set).
-pub fn differences(
-    a: &hikari_render::Settings,
-    b: &hikari_render::Settings,
-) -> Vec<(String, Option<toml::Value>, Option<toml::Value>)> {
+/// A setting that differs between A and B: `table.key` and the two values (`None`: absent,
+/// an option not set).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Difference {
+    pub key: String,
+    pub a: Option<toml::Value>,
+    pub b: Option<toml::Value>,
+}
+
+/// Every `table.key` (nested keys dotted) whose value differs between `a` and `b`.
+pub fn differences(a: &hikari_render::Settings, b: &hikari_render::Settings) -> Vec<Difference> {
     fn walk(
         prefix: &str,
         a: Option<&toml::Value>,
         b: Option<&toml::Value>,
-        out: &mut Vec<(String, Option<toml::Value>, Option<toml::Value>)>,
+        out: &mut Vec<Difference>,
     ) {
         match (a, b) {
             (Some(toml::Value::Table(ta)), Some(toml::Value::Table(tb))) => {
@@ -105,7 +110,11 @@ pub fn differences(
                     walk(&path, ta.get(k), tb.get(k), out);
                 }
             }
-            (a, b) if a != b => out.push((prefix.to_string(), a.cloned(), b.cloned())),
+            (a, b) if a != b => out.push(Difference {
+                key: prefix.to_string(),
+                a: a.cloned(),
+                b: b.cloned(),
+            }),
             _ => {}
         }
     }
@@ -180,18 +189,22 @@ fn side_by_side(a: &ImageRgba32, b: &ImageRgba32, map: &nv_flip::FlipImageRgb8) 
     }
 }
 
-/// `frames` frames of `settings` on a renderer of its own; the last one read back.
+/// `frames` frames of `settings` on a renderer of its own; the last one read back, and the
+/// EV100 it was shown at.
 fn render_view(
     view: &ResolvedFrame,
     settings: &FrameSettings,
     frames: u32,
     bake: Option<&std::path::Path>,
-) -> anyhow::Result<still::Frame> {
+) -> anyhow::Result<(RenderedFrame, f32)> {
     let mut renderer = still::renderer(view, bake)?;
+    still::read_exposure(&mut renderer);
     for _ in 1..frames {
         renderer.render(settings, false)?;
     }
-    still::render(&mut renderer, settings, true)
+    let frame = renderer.render(settings, true)?;
+    let ev100 = still::ev100(&frame)?;
+    Ok((frame, ev100))
 }
 
 fn show(v: &Option<toml::Value>) -> String {
@@ -238,7 +251,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     });
     let bake = args.bake.as_deref();
 
-    let (a_frame, b_frame) = if args.own_exposure {
+    let ((a_frame, ev_a), (b_frame, ev_b)) = if args.own_exposure {
         (
             render_view(&a, &a.settings, frames, bake)?,
             render_view(&b, &b.settings, frames, bake)?,
@@ -247,7 +260,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         // A's EV100: fixed by its settings, else metered on a first run of A.
         let ev100 = match a.settings.settings.exposure.ev100 {
             Some(ev) => ev,
-            None => render_view(&a, &a.settings, frames, bake)?.ev100,
+            None => render_view(&a, &a.settings, frames, bake)?.1,
         };
         if b.settings
             .settings
@@ -268,30 +281,30 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         )
     };
 
-    let (a_ldr, b_ldr) = (a_frame.ldr()?, b_frame.ldr()?);
+    let ((a_hdr, a_ldr), (b_hdr, b_ldr)) = (still::images(&a_frame)?, still::images(&b_frame)?);
     let errors = flip(a_ldr, b_ldr);
     let (mean, p95) = flip_stats(&errors.to_vec());
     let map = errors.apply_color_lut(&nv_flip::magma_lut());
     output::write_png(&args.output, &side_by_side(a_ldr, b_ldr, &map))?;
-    for (p, f) in [(&args.exr_a, &a_frame), (&args.exr_b, &b_frame)] {
+    for (p, hdr) in [(&args.exr_a, a_hdr), (&args.exr_b, b_hdr)] {
         if let Some(p) = p {
-            output::write_exr(p, f.hdr()?)?;
+            output::write_exr(p, hdr)?;
         }
     }
-    let (lum_a, lum_b) = (
-        mean_luminance(a_frame.hdr()?),
-        mean_luminance(b_frame.hdr()?),
-    );
+    let (lum_a, lum_b) = (mean_luminance(a_hdr), mean_luminance(b_hdr));
     let ratio = lum_b / lum_a;
     let exposure = if args.own_exposure { "own" } else { "A's" };
 
     if args.json.json {
-        let settings = |pick: fn(
-            &(String, Option<toml::Value>, Option<toml::Value>),
-        ) -> &Option<toml::Value>| {
+        let settings = |pick: fn(&Difference) -> &Option<toml::Value>| {
             serde_json::Value::Object(
                 diff.iter()
-                    .map(|d| (d.0.clone(), json!(pick(d).as_ref().map(|v| v.to_string()))))
+                    .map(|d| {
+                        (
+                            d.key.clone(),
+                            json!(pick(d).as_ref().map(|v| v.to_string())),
+                        )
+                    })
                     .collect(),
             )
         };
@@ -300,13 +313,13 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             "frames": frames,
             "exposure": if args.own_exposure { "own" } else { "a" },
             "a": {
-                "settings": settings(|d| &d.1),
-                "ev100": a_frame.ev100,
+                "settings": settings(|d| &d.a),
+                "ev100": ev_a,
                 "mean_luminance_nits": lum_a,
             },
             "b": {
-                "settings": settings(|d| &d.2),
-                "ev100": b_frame.ev100,
+                "settings": settings(|d| &d.b),
+                "ev100": ev_b,
                 "mean_luminance_nits": lum_b,
             },
             "flip": { "mean": mean, "p95": p95 },
@@ -322,12 +335,12 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     if diff.is_empty() {
         println!("A and B: the same settings");
     }
-    for (key, va, vb) in &diff {
-        println!("  {key}: A {}, B {}", show(va), show(vb));
+    for d in &diff {
+        println!("  {}: A {}, B {}", d.key, show(&d.a), show(&d.b));
     }
     println!(
         "EV100: A {:.3}, B {:.3} (B at {exposure} exposure)",
-        a_frame.ev100, b_frame.ev100
+        ev_a, ev_b
     );
     println!("FLIP: mean {mean:.4}, 95th percentile {p95:.4}");
     println!("mean luminance B/A: {ratio:.4} (A {lum_a:.4} nits, B {lum_b:.4} nits)");
@@ -359,10 +372,10 @@ mod tests {
         b.taa.enabled = !a.taa.enabled;
         b.exposure.ev100 = Some(12.0);
         let d = differences(&a, &b);
-        let keys: Vec<&str> = d.iter().map(|d| d.0.as_str()).collect();
+        let keys: Vec<&str> = d.iter().map(|d| d.key.as_str()).collect();
         assert_eq!(keys, ["exposure.ev100", "taa.enabled"]);
-        assert_eq!(d[0].1, None);
-        assert_eq!(d[1].2, Some(toml::Value::Boolean(b.taa.enabled)));
+        assert_eq!(d[0].a, None);
+        assert_eq!(d[1].b, Some(toml::Value::Boolean(b.taa.enabled)));
     }
 
     #[test]

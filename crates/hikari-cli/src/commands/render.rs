@@ -112,10 +112,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             renderer.render(&settings, false)?;
         }
     }
-    let frame = still::render(&mut renderer, &settings, true)?;
+    let frame = renderer.render(&settings, true)?;
 
     let png = &args.output;
-    let ldr = frame.ldr()?;
+    let (hdr, ldr) = still::images(&frame)?;
     match &strip_lut {
         Some(lut) => {
             let shot = lut_strip::embed(ldr, lut).context("the LUT strip does not fit")?;
@@ -129,7 +129,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             .exr
             .clone()
             .unwrap_or_else(|| png.with_extension("exr"));
-        output::write_exr(&exr, frame.hdr()?)?;
+        output::write_exr(&exr, hdr)?;
         println!("wrote {}", exr.display());
     }
     let dump_dir = args

@@ -128,7 +128,7 @@ pub fn run(args: TimelapseArgs) -> anyhow::Result<()> {
         settings.sun = hikari_render::techniques::sky::lights::directional_light(sky)
             .map_err(|e| anyhow::anyhow!("{e}"))
             .with_context(|| format!("the sun at {now}"))?;
-        let frame = still::render(&mut renderer, &settings, written.is_some())?;
+        let frame = renderer.render(&settings, written.is_some())?;
         if let Some(k) = written {
             let png = args.output.join(format!("frame_{k:0digits$}.png"));
             let exr = png.with_extension("exr");
