@@ -83,11 +83,12 @@ pub fn parse(text: &str) -> anyhow::Result<ConfigFile> {
     })
 }
 
-/// Parses `table.key=value` as `--set` takes it.
+/// Parses `table.key=value` as `--set` (and `compare`'s `--a`, `--b`) takes it; clap's error
+/// names the flag.
 pub fn parse_override(s: &str) -> anyhow::Result<(String, String)> {
     let (k, v) = s
         .split_once('=')
-        .with_context(|| format!("--set {s:?}: expected table.key=value"))?;
+        .with_context(|| format!("{s:?}: expected table.key=value"))?;
     Ok((k.trim().to_string(), v.trim().to_string()))
 }
 

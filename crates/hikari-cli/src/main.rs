@@ -6,14 +6,15 @@ mod config;
 mod probe_bake;
 mod report;
 mod scene_source;
+mod still;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 use commands::{
-    bake, bench_frame, bench_overhead, bench_probes, bench_rays, constants, info, lut, probes,
-    render, sky,
+    bake, bench_frame, bench_overhead, bench_probes, bench_rays, compare, constants, info, lut,
+    probes, render, sky, timelapse,
 };
 
 #[derive(Parser)]
@@ -31,6 +32,12 @@ struct Cli {
 enum Command {
     /// Render a scene to a PNG (display) and a linear EXR (radiance in nits).
     Render(Box<render::RenderArgs>),
+    /// Render a time-lapse: one view from --from to --to, the clock moving every frame,
+    /// --count frames written as numbered PNGs and EXRs.
+    Timelapse(Box<timelapse::TimelapseArgs>),
+    /// Render one view twice, A and B, differing by settings; write A | B | FLIP error map and
+    /// print the FLIP error, both exposures and the luminance ratio.
+    Compare(Box<compare::CompareArgs>),
     /// Write the sky of a date, time, place and weather as an equirectangular EXR (nits) and
     /// print its L2 SH and the sun and moon.
     Sky(sky::SkyCommandArgs),
@@ -83,6 +90,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(*args),
+        Command::Timelapse(args) => timelapse::run(*args),
+        Command::Compare(args) => compare::run(*args),
         Command::Sky(args) => sky::run(args),
         Command::Bake(args) => bake::run(args),
         Command::Probes(args) => probes::run(args),

@@ -6,13 +6,13 @@ use anyhow::Context;
 use clap::Args;
 
 use hikari_render::graph::TimestampMode;
+use hikari_render::output;
 use hikari_render::techniques::tonemap::{self, cube::CubeLut, lut_strip, lut_strip::StripLayout};
-use hikari_render::{ContextOptions, GpuContext, Renderer, output};
 
 use crate::args::FrameArgs;
-use crate::probe_bake;
 use crate::report;
-use crate::scene_source::{self, ResolvedFrame};
+use crate::scene_source;
+use crate::still;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -65,12 +65,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "--dolly {} is outside -100 to 100 metres a frame",
         args.dolly
     );
-    let ResolvedFrame {
-        scene,
-        mut settings,
-        description,
-    } = scene_source::resolve(&args.frame)?;
-    log::info!("{}", description.line());
+    let resolved = scene_source::resolve(&args.frame)?;
+    log::info!("{}", resolved.description.line());
+    still::check_output_file("-o", &args.output)?;
+    if let Some(exr) = args.exr.as_ref().filter(|_| !args.no_exr) {
+        still::check_output_file("--exr", exr)?;
+    }
+    let mut settings = resolved.settings.clone();
     let strip_lut = if args.lut_screenshot {
         if StripLayout::for_width(settings.width).is_none() {
             anyhow::bail!(
@@ -87,16 +88,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         None
     };
-    let ctx = GpuContext::new(&ContextOptions::from_env())?;
-    log::info!("adapter: {}", ctx.describe());
-    let mut renderer = Renderer::new(ctx, &scene)?;
-    probe_bake::attach(
-        &mut renderer,
-        &scene,
-        &description.source,
-        &settings,
-        args.bake.as_deref(),
-    )?;
+    let mut renderer = still::renderer(&resolved, args.bake.as_deref())?;
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
     renderer.runtime.set_timestamps(if args.timings {
@@ -106,7 +98,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     });
     let frames = args
         .frames
-        .unwrap_or_else(|| default_frames(&settings.settings));
+        .unwrap_or_else(|| still::default_frames(&settings.settings));
     let view = settings.camera.clone();
     let forward = view.forward();
     for f in 1..=frames {
@@ -123,7 +115,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let frame = renderer.render(&settings, true)?;
 
     let png = &args.output;
-    let ldr = frame.ldr.as_ref().context("no LDR image")?;
+    let (hdr, ldr) = still::images(&frame)?;
     match &strip_lut {
         Some(lut) => {
             let shot = lut_strip::embed(ldr, lut).context("the LUT strip does not fit")?;
@@ -137,7 +129,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             .exr
             .clone()
             .unwrap_or_else(|| png.with_extension("exr"));
-        output::write_exr(&exr, frame.hdr.as_ref().context("no HDR image")?)?;
+        output::write_exr(&exr, hdr)?;
         println!("wrote {}", exr.display());
     }
     let dump_dir = args
@@ -164,81 +156,4 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         report::print_single_frame(&frame.result);
     }
     Ok(())
-}
-
-/// Frames `render` draws of a still view when `--frames` is not given: the larger of what TAA
-/// and the ray-traced GI need, in whole jitter cycles of TAA.
-///
-/// * TAA: one jitter cycle (`taa.jitter_samples`), after which its history is the mean of every
-///   sub-pixel position.
-/// * GI: the denoiser's combiner keeps `0.5 x speed` of the accumulated signal, where speed =
-///   min(1 - 1 / history, `gi_denoiser.max_accumulation_speed`); the frames until speed reaches
-///   that cap (history >= 1 / (1 - cap): 15 for the talk's 0.93), at most the accumulation's
-///   `max_history`. Before then the image is mostly the spatially denoised single frames.
-pub fn default_frames(s: &hikari_render::Settings) -> u32 {
-    let cycle = if s.taa.enabled {
-        s.taa.jitter_samples.max(1)
-    } else {
-        1
-    };
-    let gi = &s.ray_traced_gi;
-    let gi_frames = if gi.enabled && gi.accumulate {
-        let cap = s.gi_denoiser.max_accumulation_speed as f64;
-        // Less a hair, so that a cap such as 0.8 (0.800000012 in f32) settles at 5, not 6.
-        let history = if cap < 1.0 {
-            (1.0 / (1.0 - cap) - 1e-4).ceil() as u32
-        } else {
-            u32::MAX
-        };
-        history.min(gi.max_history.max(1))
-    } else {
-        1
-    };
-    gi_frames.max(cycle).div_ceil(cycle) * cycle
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The history length at which the combiner's speed, min(1 - 1/h, cap), first equals
-    /// the cap: stepped frame by frame as the accumulation counts.
-    fn combiner_settles(cap: f32, max_history: u32) -> u32 {
-        (1..=max_history)
-            .find(|&h| (1.0 - 1.0 / h as f32).min(cap) >= cap)
-            .unwrap_or(max_history)
-    }
-
-    #[test]
-    fn default_frames_cover_taa_cycles_and_the_gi_combiners_settling() {
-        let mut s = hikari_render::Settings::default();
-        let settle = combiner_settles(
-            s.gi_denoiser.max_accumulation_speed,
-            s.ray_traced_gi.max_history,
-        );
-        assert_eq!(
-            settle, 15,
-            "the talk's 0.93 settles at 15 frames of history"
-        );
-        // 15 frames, rounded up to whole 8-frame jitter cycles.
-        assert_eq!(default_frames(&s), 16);
-        s.taa.enabled = false;
-        assert_eq!(default_frames(&s), settle);
-        s.ray_traced_gi.enabled = false;
-        assert_eq!(default_frames(&s), 1);
-        s.taa.enabled = true;
-        assert_eq!(default_frames(&s), s.taa.jitter_samples);
-        s.ray_traced_gi.enabled = true;
-        s.ray_traced_gi.accumulate = false;
-        assert_eq!(default_frames(&s), s.taa.jitter_samples);
-        s.ray_traced_gi.accumulate = true;
-        for cap in [0.0, 0.5, 0.8, 0.9, 0.95, 0.99, 1.0] {
-            s.gi_denoiser.max_accumulation_speed = cap;
-            s.taa.enabled = false;
-            let want = combiner_settles(cap, s.ray_traced_gi.max_history);
-            assert_eq!(default_frames(&s), want, "cap {cap}");
-            s.taa.enabled = true;
-            assert_eq!(default_frames(&s), want.max(8).div_ceil(8) * 8, "cap {cap}");
-        }
-    }
 }

@@ -37,6 +37,7 @@
 //! # Ok::<(), hikari_math::astro::AstroError>(())
 //! ```
 
+pub mod calendar;
 pub mod illuminance;
 mod moon;
 mod moon_data;
