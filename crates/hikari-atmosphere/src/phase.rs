@@ -14,3 +14,9 @@ pub fn cornette_shanks(nu: f64, g: f64) -> f64 {
     let k = 3.0 / (8.0 * PI) * (1.0 - g * g) / (2.0 + g * g);
     k * (1.0 + nu * nu) / (1.0 + g * g - 2.0 * g * nu).max(1e-12).powf(1.5)
 }
+
+/// Henyey-Greenstein (1941): `(1 - g²) / (4π (1 + g² - 2gν)^1.5)`, mean cosine `g`; the haze's
+/// and the clouds' phase in Ghost of Tsushima.
+pub fn henyey_greenstein(nu: f64, g: f64) -> f64 {
+    (1.0 - g * g) / (4.0 * PI * (1.0 + g * g - 2.0 * g * nu).max(1e-12).powf(1.5))
+}

@@ -2,6 +2,9 @@
 //! with errors naming the material, and read from glTF material `extras`
 //! `{"hikari": {"gi_albedo": [r, g, b]}}`.
 
+mod common;
+use common::base64;
+
 use std::path::PathBuf;
 
 use glam::Vec3;
@@ -57,24 +60,6 @@ fn a_bad_override_is_an_error_naming_the_material() {
             "{bad}: {e}"
         );
     }
-}
-
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for i in 0..4 {
-            if i <= c.len() {
-                out.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }
 
 /// A one-triangle glTF (buffer as a data URI) drawn with material 0 of `materials`, written

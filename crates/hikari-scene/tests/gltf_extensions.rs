@@ -5,6 +5,9 @@
 //! `uv' = T * R * S * uv` with R's rows `[cos r, sin r]`, `[-sin r, cos r]`), never taken from
 //! a run of the loader.
 
+mod common;
+use common::base64;
+
 use std::f32::consts::{FRAC_1_SQRT_2, FRAC_PI_2};
 use std::path::PathBuf;
 
@@ -18,24 +21,6 @@ const SHORT: u32 = 5122;
 const UNSIGNED_SHORT: u32 = 5123;
 const UNSIGNED_INT: u32 = 5125;
 const FLOAT: u32 = 5126;
-
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for i in 0..4 {
-            if i <= c.len() {
-                out.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
 
 fn png_1x1() -> Vec<u8> {
     let mut out = Vec::new();

@@ -2,30 +2,15 @@
 //! files, .glb), loaded, and compared with what was written: node transforms, materials and
 //! textures, cameras, punctual lights, emissive strength, automatic framing and default sun.
 
+mod common;
+use common::base64;
+
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 use hikari_scene::gltf::{GltfOptions, load, load_with};
 use hikari_scene::{LightKind, Sun, Wrap};
 use serde_json::{Value, json};
-
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16
-            | (*c.get(1).unwrap_or(&0) as u32) << 8
-            | *c.get(2).unwrap_or(&0) as u32;
-        for i in 0..4 {
-            if i <= c.len() {
-                out.push(T[(n >> (18 - 6 * i) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
 
 fn dir(test: &str) -> PathBuf {
     let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))

@@ -27,7 +27,6 @@ const CLOUDS_ON: u32 = 1u;
 const CLOUDS_SHADOWS: u32 = 2u;
 const CLOUDS_DENSITY_AA: u32 = 4u;
 const CLOUD_OCTAVES: u32 = 4u;
-const CLOUD_PI: f32 = 3.14159265358979;
 
 fn cloud_hash(c: vec3<i32>) -> f32 {
     let u = bitcast<vec3<u32>>(c);
@@ -105,11 +104,6 @@ fn cloud_map_dir(uv: vec2<f32>) -> vec3<f32> {
     let q = uv * 2.0 - 1.0;
     let r2 = dot(q, q);
     return normalize(vec3<f32>(2.0 * q.x, 1.0 - r2, 2.0 * q.y) / (1.0 + r2));
-}
-
-fn cloud_hg(cos_theta: f32, g: f32) -> f32 {
-    let d = max(1.0 + g * g - 2.0 * g * cos_theta, 1e-6);
-    return (1.0 - g * g) / (4.0 * CLOUD_PI * d * sqrt(d));
 }
 
 // Distance along unit `d` from a point `r0` metres from the Earth's centre at zenith cosine

@@ -4,7 +4,8 @@
 // light's and the segment's transmittance), g = light scattered per unit ambient sky radiance,
 // b = transmittance. Twin: `clouds::reference::march_texel`.
 
-#import hikari::cloud_density::{CloudParams, cloud_density, cloud_map_dir, cloud_hg, cloud_sphere_exit}
+#import hikari::cloud_density::{CloudParams, cloud_density, cloud_map_dir, cloud_sphere_exit}
+#import hikari::phase::hg_phase
 
 @group(0) @binding(0) var<uniform> params: CloudParams;
 @group(0) @binding(1) var map_out: texture_storage_2d<rgba16float, write>;
@@ -37,8 +38,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let s = params.sun.xyz;
     let cos_theta = dot(d, s);
     let albedo = params.shape.w;
-    let fwd = cloud_hg(cos_theta, params.phase.x);
-    let back = cloud_hg(cos_theta, params.phase.y) * params.phase.z;
+    let fwd = hg_phase(cos_theta, params.phase.x);
+    let back = hg_phase(cos_theta, params.phase.y) * params.phase.z;
     var transmittance = 1.0;
     var mie = 0.0;
     var ambient = 0.0;

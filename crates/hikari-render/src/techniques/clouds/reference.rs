@@ -4,6 +4,8 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::techniques::haze::reference::hg_phase;
+
 use super::{CLOUDS_DENSITY_AA, CLOUDS_ON, CLOUDS_SHADOWS, CloudParams};
 
 const OCTAVES: u32 = 4;
@@ -73,11 +75,6 @@ pub fn cloud_map_dir(uv: Vec2) -> Vec3 {
     (Vec3::new(2.0 * q.x, 1.0 - r2, 2.0 * q.y) / (1.0 + r2)).normalize()
 }
 
-pub fn cloud_hg(cos_theta: f32, g: f32) -> f32 {
-    let d = (1.0 + g * g - 2.0 * g * cos_theta).max(1e-6);
-    (1.0 - g * g) / (4.0 * std::f32::consts::PI * d * d.sqrt())
-}
-
 pub fn cloud_sphere_exit(r0: f32, mu: f32, r: f32) -> f32 {
     let b = r0 * mu;
     let disc = b * b - r0 * r0 + r * r;
@@ -102,8 +99,8 @@ pub fn march_texel(p: &CloudParams, x: u32, y: u32) -> Vec4 {
     let texel_angle = (1.0 + d.y) * 2.0 / size as f32;
     let s = Vec3::from_slice(&p.sun[..3]);
     let cos_theta = d.dot(s);
-    let fwd = cloud_hg(cos_theta, p.phase[0]);
-    let back = cloud_hg(cos_theta, p.phase[1]) * p.phase[2];
+    let fwd = hg_phase(cos_theta, p.phase[0]);
+    let back = hg_phase(cos_theta, p.phase[1]) * p.phase[2];
     let (mut transmittance, mut mie, mut ambient) = (1.0f32, 0.0f32, 0.0f32);
     for i in 0..steps {
         let t = t_in + (i as f32 + 0.5) * dt;

@@ -4,6 +4,7 @@
 // in closed form, and the froxel grid's slicing. CPU twin: `haze::reference` (same names).
 
 #import hikari::view::View
+#import hikari::phase::hg_phase
 
 struct HazeParams {
     // Froxels across, down, slices; HAZE_* flags.
@@ -30,12 +31,6 @@ const HAZE_LOCAL_LIGHTS: u32 = 4u;
 const HAZE_DENSITY_AA: u32 = 8u;
 const HAZE_TRICUBIC: u32 = 16u;
 const HAZE_MAX_HALF: f32 = 65504.0;
-const HAZE_PI: f32 = 3.14159265358979;
-
-fn hg_phase(cos_theta: f32, g: f32) -> f32 {
-    let d = max(1.0 + g * g - 2.0 * g * cos_theta, 1e-6);
-    return (1.0 - g * g) / (4.0 * HAZE_PI * d * sqrt(d));
-}
 
 // (1 - e^-x) / x, accurate near 0.
 fn one_minus_exp_over(x: f32) -> f32 {

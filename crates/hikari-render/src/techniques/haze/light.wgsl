@@ -4,7 +4,8 @@
 // the storage scale. Twin: `haze::reference::light_grid`.
 
 #import hikari::view::View
-#import hikari::haze::{HazeParams, HAZE_SUN_SHADOWS, HAZE_SKY, HAZE_LOCAL_LIGHTS, HAZE_MAX_HALF, hg_phase, slice_depth, froxel_ray}
+#import hikari::haze::{HazeParams, HAZE_SUN_SHADOWS, HAZE_SKY, HAZE_LOCAL_LIGHTS, HAZE_MAX_HALF, slice_depth, froxel_ray}
+#import hikari::phase::hg_phase
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
 #import hikari::sky_ambient::sky_ambient_eval

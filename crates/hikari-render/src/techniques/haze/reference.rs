@@ -25,11 +25,10 @@ pub fn first_slice_m(near: f32, far: f32, growth: f32, slices: u32) -> f32 {
     ((far - near) * (r - 1.0) / (r.powi(slices as i32) - 1.0)) as f32
 }
 
-/// Henyey-Greenstein phase function, per steradian; `cos_theta` between the light's direction
-/// of travel and the scattered direction (1: straight on).
+/// Henyey-Greenstein phase function, per steradian (`hikari::phase::hg_phase`); `cos_theta`
+/// between the light's direction of travel and the scattered direction (1: straight on).
 pub fn hg_phase(cos_theta: f32, g: f32) -> f32 {
-    let d = (1.0 + g * g - 2.0 * g * cos_theta).max(1e-6);
-    (1.0 - g * g) / (4.0 * PI * d * d.sqrt())
+    hikari_atmosphere::phase::henyey_greenstein(f64::from(cos_theta), f64::from(g)) as f32
 }
 
 /// Extinction per metre at world height `y`.
