@@ -379,6 +379,10 @@ pub fn record<'r>(
             &s.settings.clouds,
             &s.settings.sky.weather,
             s.sun.as_ref(),
+            s.settings
+                .sky
+                .date_time()
+                .map_or(0.0, |t| f64::from(t.seconds_of_day())),
             sky.enabled && s.settings.sky.sky,
         ),
     )?;

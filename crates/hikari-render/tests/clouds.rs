@@ -107,7 +107,7 @@ fn uniform_slab(steps: u32) -> CloudParams {
         light_steps: 4,
         ..CloudsSettings::default()
     };
-    CloudParams::new(&s, "clear", Some(&sun()), true)
+    CloudParams::new(&s, "clear", Some(&sun()), 0.0, true)
 }
 
 #[test]
@@ -131,14 +131,14 @@ fn cloud_shadow_follows_coverage() {
         coverage: 1.0,
         ..CloudsSettings::default()
     };
-    let p = CloudParams::new(&s, "clear", Some(&sun()), true);
+    let p = CloudParams::new(&s, "clear", Some(&sun()), 0.0, true);
     let shadow = twin::cloud_shadow_at(&p, Vec3::ZERO);
     // Full cover: the layer's optical depth is hundreds; the sun is blocked.
     assert!(shadow < 1e-3, "{shadow}");
     let mut none = p;
     none.shape[0] = 0.0;
     assert_eq!(twin::cloud_shadow_at(&none, Vec3::ZERO), 1.0);
-    let off = CloudParams::new(&s, "clear", Some(&sun()), false);
+    let off = CloudParams::new(&s, "clear", Some(&sun()), 0.0, false);
     assert_eq!(off.march[3] & CLOUDS_ON, 0);
     assert_eq!(twin::cloud_shadow_at(&off, Vec3::ZERO), 1.0);
 }
@@ -170,7 +170,7 @@ fn gpu_march_matches_its_cpu_twin() {
         light_steps: 4,
         ..CloudsSettings::default()
     };
-    let p = CloudParams::new(&s, "clear", Some(&sun()), true);
+    let p = CloudParams::new(&s, "clear", Some(&sun()), 0.0, true);
     let got = gpu_map(&ctx, &s, p);
     let want = twin::march_map(&p);
     let mut bad = 0;
@@ -244,7 +244,8 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
                 offset_x_m: o,
                 ..CloudsSettings::default()
             };
-            let p = CloudParams::new(&c, "clear", Some(&sun0), true);
+            // The frame's clock: 10:00, the wind's offset included.
+            let p = CloudParams::new(&c, "clear", Some(&sun0), 36_000.0, true);
             let t = twin::cloud_shadow_at(&p, Vec3::ZERO);
             t > 0.2 && t < 0.8
         })
@@ -299,7 +300,7 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
     let (lit_off, lux_off, _, _, _) = run(&frame(false, true));
     let (_, lux_dark, _, _, _) = run(&frame(true, false));
     let sun = on.sun.clone().unwrap();
-    let params = CloudParams::new(&on.settings.clouds, "clear", Some(&sun), true);
+    let params = CloudParams::new(&on.settings.clouds, "clear", Some(&sun), 36_000.0, true);
     let map: Vec<Vec4> = map.rgba.iter().map(|v| Vec4::from_array(*v)).collect();
     // The sky's mean radiance: band 0 of the deringed SH times Y00.
     let mean = Vec3::from_slice(&sh[9][..3]) * 0.282_094_8;
@@ -363,4 +364,31 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
         shaded > 20,
         "{shaded} of {ground} sunlit pixels under cloud"
     );
+}
+
+#[test]
+fn the_wind_carries_the_clouds() {
+    // 8 m/s towards the east (-X): after 10 minutes what lay at x lies 4800 m further east.
+    let s = CloudsSettings {
+        wind_mps: 8.0,
+        wind_towards_deg: 90.0,
+        ..CloudsSettings::default()
+    };
+    let p0 = CloudParams::new(&s, "clear", Some(&sun()), 0.0, true);
+    let p1 = CloudParams::new(&s, "clear", Some(&sun()), 600.0, true);
+    let mut differs = 0;
+    for i in 0..200 {
+        let xz = Vec2::new(i as f32 * 97.0 - 9000.0, (i % 17) as f32 * 311.0);
+        let h = 1500.0 + (i % 23) as f32 * 100.0;
+        let before = twin::cloud_density(&p0, xz, h, 1.0);
+        let after = twin::cloud_density(&p1, xz + Vec2::new(-4800.0, 0.0), h, 1.0);
+        assert!(
+            (before - after).abs() < 1e-3 * s.density,
+            "{xz}: {before} then {after}"
+        );
+        if (twin::cloud_density(&p1, xz, h, 1.0) - before).abs() > 1e-3 {
+            differs += 1;
+        }
+    }
+    assert!(differs > 20, "the clouds moved: {differs} points changed");
 }

@@ -51,9 +51,15 @@ pub struct CloudParams {
 }
 
 impl CloudParams {
-    /// The parameters of `s` in `weather`, lit by `sun` (none: unlit). `on` false gives
-    /// parameters that draw nothing and shadow nothing.
-    pub fn new(s: &CloudsSettings, weather: &str, sun: Option<&Sun>, on: bool) -> Self {
+    /// The parameters of `s` in `weather`, lit by `sun` (none: unlit), `seconds` into the day
+    /// (the wind's offset). `on` false gives parameters that draw nothing and shadow nothing.
+    pub fn new(
+        s: &CloudsSettings,
+        weather: &str,
+        sun: Option<&Sun>,
+        seconds: f64,
+        on: bool,
+    ) -> Self {
         let flags = [
             (on && s.enabled, CLOUDS_ON),
             (s.shadows, CLOUDS_SHADOWS),
@@ -74,7 +80,10 @@ impl CloudParams {
                 1.0 / s.feature_m,
                 s.albedo,
             ],
-            offset: [s.offset_x_m, s.offset_z_m, s.max_march_m, 0.0],
+            offset: {
+                let [x, z] = s.offset_at(seconds);
+                [x, z, s.max_march_m, 0.0]
+            },
             sun: dir.extend(lit).to_array(),
             phase: [s.forward_g, s.backward_g, s.backward_scale, 0.0],
             march: [s.steps, s.light_steps, s.map_size, flags],

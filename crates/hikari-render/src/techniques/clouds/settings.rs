@@ -23,6 +23,11 @@ pub struct CloudsSettings {
     /// clouds).
     pub offset_x_m: f32,
     pub offset_z_m: f32,
+    /// Wind speed at the clouds, m/s: the noise moves this far every second of the day (the
+    /// sky's clock), so a time-lapse shows the clouds drift.
+    pub wind_mps: f32,
+    /// Where the wind blows towards, degrees clockwise from north (+Z; east is -X).
+    pub wind_towards_deg: f32,
     /// Single-scattering albedo of the droplets.
     pub albedo: f32,
     /// The talk's phase: HG with `forward_g` where light passes mostly unscattered, with
@@ -58,6 +63,8 @@ impl Default for CloudsSettings {
             feature_m: 6000.0,
             offset_x_m: 0.0,
             offset_z_m: 0.0,
+            wind_mps: 8.0,
+            wind_towards_deg: 70.0,
             albedo: 0.9,
             forward_g: 0.85,
             backward_g: -0.15,
@@ -74,6 +81,16 @@ impl Default for CloudsSettings {
 }
 
 impl CloudsSettings {
+    /// Where the noise's origin lies `seconds` into the day: the offset moved by the wind.
+    pub fn offset_at(&self, seconds: f64) -> [f32; 2] {
+        let a = f64::from(self.wind_towards_deg).to_radians();
+        let d = f64::from(self.wind_mps) * seconds;
+        [
+            (f64::from(self.offset_x_m) - a.sin() * d) as f32,
+            (f64::from(self.offset_z_m) + a.cos() * d) as f32,
+        ]
+    }
+
     /// Coverage in a weather preset.
     pub fn coverage_in(&self, weather: &str) -> f32 {
         let extra = match weather {
@@ -124,6 +141,14 @@ impl TechniqueSettings for CloudsSettings {
             Field {
                 key: "offset_z_m",
                 range: Range::Float { lo: -1e7, hi: 1e7 },
+            },
+            Field {
+                key: "wind_mps",
+                range: Range::Float { lo: 0.0, hi: 100.0 },
+            },
+            Field {
+                key: "wind_towards_deg",
+                range: Range::Float { lo: 0.0, hi: 360.0 },
             },
             Field {
                 key: "albedo",
