@@ -597,16 +597,13 @@ pub fn record<'r>(
     }
 
     // 12. Haze: the froxel grid lit by the sun or moon (through the shadow maps), the sky and
-    //     the local lights, integrated front to back and composited over every pixel.
-    let haze = if s.settings.haze.enabled {
+    //     the local lights, integrated front to back and composited over every pixel. It needs
+    //     the atmosphere: the placeholder sky has no SH to light it.
+    let haze = if s.settings.haze.enabled && sky.enabled {
         let metered = s.metered_lux_with_sky(sky.sky_lux);
         let params = HazeParams::new(
             &s.settings.haze,
-            if sky.enabled {
-                &s.settings.sky.weather
-            } else {
-                "clear"
-            },
+            &s.settings.sky.weather,
             s.sun.as_ref().filter(|_| s.settings.direct_lighting.sun),
             if s.settings.direct_lighting.punctual {
                 scene.light_count

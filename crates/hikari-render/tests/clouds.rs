@@ -370,6 +370,7 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
 fn the_wind_carries_the_clouds() {
     // 8 m/s towards the east (-X): after 10 minutes what lay at x lies 4800 m further east.
     let s = CloudsSettings {
+        coverage: 0.7,
         wind_mps: 8.0,
         wind_towards_deg: 90.0,
         ..CloudsSettings::default()

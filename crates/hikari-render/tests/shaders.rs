@@ -122,6 +122,7 @@ fn shared_modules_bind_in_groups_of_their_own() {
         lib.binding_sets("direct_lighting/shade.wgsl"),
         [
             "brdf_tables",
+            "clouds",
             "irradiance_probes",
             "sky",
             "sky_ambient",
@@ -136,8 +137,8 @@ fn shared_modules_bind_in_groups_of_their_own() {
         &lib.binding_sets("direct_lighting/shade.wgsl"),
     )
     .unwrap();
-    assert_eq!(groups.len(), 6);
-    let names: Vec<&str> = groups[5]
+    assert_eq!(groups.len(), 7);
+    let names: Vec<&str> = groups[6]
         .iter()
         .map(|s| shader::undecorated(&s.name))
         .collect();

@@ -84,6 +84,10 @@ pub fn small_frame_settings(
     // Ray-traced GI has its own tests (tests/ray_traced_gi.rs, gi_validation.rs): here the
     // frame's other techniques are checked against their twins, which leave it out.
     settings.ray_traced_gi.enabled = false;
+    // The haze and the clouds have their own tests (tests/haze.rs, clouds.rs), which hold the
+    // frame with them to their twins; here they would add light the other twins leave out.
+    settings.haze.enabled = false;
+    settings.clouds.enabled = false;
     hikari_render::FrameSettings {
         width: w,
         height: h,

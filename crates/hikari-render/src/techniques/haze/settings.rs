@@ -8,6 +8,8 @@ use crate::settings::{Field, Preset, Range, SettingError, TechniqueSettings};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct HazeSettings {
+    /// The haze needs the atmosphere (`sky.enabled`): the placeholder sky has no SH to light
+    /// it, and a haze lit by the sun alone would darken that sky.
     pub enabled: bool,
     /// Extinction of the exponential layer at `height_m`, per metre (1e-4: a visibility of
     /// about 40 km at that height).
