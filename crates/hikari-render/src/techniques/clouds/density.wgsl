@@ -26,7 +26,9 @@ struct CloudParams {
 const CLOUDS_ON: u32 = 1u;
 const CLOUDS_SHADOWS: u32 = 2u;
 const CLOUDS_DENSITY_AA: u32 = 4u;
+const CLOUDS_MULTIPLE: u32 = 8u;
 const CLOUD_OCTAVES: u32 = 4u;
+const CLOUD_PI: f32 = 3.14159265358979;
 
 fn cloud_hash(c: vec3<i32>) -> f32 {
     let u = bitcast<vec3<u32>>(c);

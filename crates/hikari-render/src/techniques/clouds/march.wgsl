@@ -4,7 +4,7 @@
 // light's and the segment's transmittance), g = light scattered per unit ambient sky radiance,
 // b = transmittance. Twin: `clouds::reference::march_texel`.
 
-#import hikari::cloud_density::{CloudParams, cloud_density, cloud_map_dir, cloud_sphere_exit}
+#import hikari::cloud_density::{CloudParams, CLOUDS_MULTIPLE, CLOUD_PI, cloud_density, cloud_map_dir, cloud_sphere_exit}
 #import hikari::phase::hg_phase
 
 @group(0) @binding(0) var<uniform> params: CloudParams;
@@ -54,12 +54,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         let seg = exp(-sigma * dt);
         var light = 0.0;
+        var tau_l = 0.0;
         if params.sun.w > 0.0 {
             // To the light: up to the layer's top along the sun, in light_steps samples.
             let up = dot(pos, s) / r;
             let l_len = min(max(cloud_sphere_exit(r, up, re + params.layer.y), 0.0), 4.0 * (params.layer.y - params.layer.x));
             let dl = l_len / f32(light_steps);
-            var tau_l = 0.0;
             for (var j = 0u; j < light_steps; j++) {
                 let lp = pos + s * ((f32(j) + 0.5) * dl);
                 tau_l += cloud_density(params, lp.xz, length(lp) - re, dl) * dl;
@@ -69,7 +69,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let phase = mix(back, fwd, light * seg);
         // Each segment's scattering integrated against its own extinction (1 - seg) / sigma.
         let weight = transmittance * albedo * (1.0 - seg);
-        mie += weight * light * phase;
+        var sun = light * phase;
+        if (params.march.w & CLOUDS_MULTIPLE) != 0u && params.sun.w > 0.0 {
+            // Light scattered more than once, as octaves of ever weaker extinction (Wrenninge
+            // 2013, as Hillaire 2016): 1/2 e^(-tau/4) + 1/4 e^(-tau/16), isotropic.
+            sun += (0.5 * exp(-0.25 * tau_l) + 0.25 * exp(-0.0625 * tau_l)) / (4.0 * CLOUD_PI);
+        }
+        mie += weight * sun;
         let h = clamp((height - params.layer.x) / (params.layer.y - params.layer.x), 0.0, 1.0);
         // Sky light reaches the tops more than the bases.
         ambient += weight * mix(0.3, 1.0, h);

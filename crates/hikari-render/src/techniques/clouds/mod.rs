@@ -31,6 +31,7 @@ use settings::CloudsSettings;
 pub const CLOUDS_ON: u32 = 1;
 pub const CLOUDS_SHADOWS: u32 = 2;
 pub const CLOUDS_DENSITY_AA: u32 = 4;
+pub const CLOUDS_MULTIPLE: u32 = 8;
 
 /// Mean Earth radius, metres (as hikari-atmosphere's default ground radius).
 pub const EARTH_RADIUS_M: f32 = 6_360_000.0;
@@ -64,6 +65,7 @@ impl CloudParams {
             (on && s.enabled, CLOUDS_ON),
             (s.shadows, CLOUDS_SHADOWS),
             (s.density_aa, CLOUDS_DENSITY_AA),
+            (s.multiple_scattering, CLOUDS_MULTIPLE),
         ]
         .iter()
         .filter(|(b, _)| *b)

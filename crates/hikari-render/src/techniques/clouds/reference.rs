@@ -6,7 +6,7 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::techniques::haze::reference::hg_phase;
 
-use super::{CLOUDS_DENSITY_AA, CLOUDS_ON, CLOUDS_SHADOWS, CloudParams};
+use super::{CLOUDS_DENSITY_AA, CLOUDS_MULTIPLE, CLOUDS_ON, CLOUDS_SHADOWS, CloudParams};
 
 const OCTAVES: u32 = 4;
 
@@ -118,13 +118,13 @@ pub fn march_texel(p: &CloudParams, x: u32, y: u32) -> Vec4 {
         }
         let seg = (-sigma * dt).exp();
         let mut light = 0.0;
+        let mut tau = 0.0f32;
         if p.sun[3] > 0.0 {
             let up = pos.dot(s) / r;
             let l_len = cloud_sphere_exit(r, up, re + p.layer[1])
                 .max(0.0)
                 .min(4.0 * (p.layer[1] - p.layer[0]));
             let dl = l_len / light_steps as f32;
-            let mut tau = 0.0;
             for j in 0..light_steps {
                 let lp = pos + s * ((j as f32 + 0.5) * dl);
                 tau += cloud_density(p, Vec2::new(lp.x, lp.z), lp.length() - re, dl) * dl;
@@ -133,7 +133,12 @@ pub fn march_texel(p: &CloudParams, x: u32, y: u32) -> Vec4 {
         }
         let phase = back + (fwd - back) * (light * seg);
         let weight = transmittance * p.shape[3] * (1.0 - seg);
-        mie += weight * light * phase;
+        let mut sun = light * phase;
+        if p.march[3] & CLOUDS_MULTIPLE != 0 && p.sun[3] > 0.0 {
+            sun += (0.5 * (-0.25 * tau).exp() + 0.25 * (-0.0625 * tau).exp())
+                / (4.0 * std::f32::consts::PI);
+        }
+        mie += weight * sun;
         let h = ((height - p.layer[0]) / (p.layer[1] - p.layer[0])).clamp(0.0, 1.0);
         ambient += weight * (0.3 + 0.7 * h);
         transmittance *= seg;

@@ -35,6 +35,9 @@ pub struct CloudsSettings {
     pub forward_g: f32,
     pub backward_g: f32,
     pub backward_scale: f32,
+    /// Add light scattered more than once as octaves of weaker extinction (Wrenninge 2013), so
+    /// that the bases of thick clouds are not black; off, the talk's phase alone.
+    pub multiple_scattering: bool,
     /// Shadow the sun's light on the ground and in the haze.
     pub shadows: bool,
     /// Fade the noise octaves a map texel's footprint would alias (the talk's cloud density
@@ -57,7 +60,7 @@ impl Default for CloudsSettings {
         Self {
             enabled: true,
             coverage: 0.35,
-            density: 0.02,
+            density: 0.005,
             bottom_m: 1500.0,
             thickness_m: 2500.0,
             feature_m: 6000.0,
@@ -69,6 +72,7 @@ impl Default for CloudsSettings {
             forward_g: 0.85,
             backward_g: -0.15,
             backward_scale: 2.16,
+            multiple_scattering: true,
             shadows: true,
             density_aa: true,
             map_size: 768,
