@@ -13,7 +13,6 @@ use super::{
 use crate::scene_gpu::LightGpu;
 use crate::view::View;
 
-
 /// Largest value the f16 grids hold.
 pub const MAX_HALF: f32 = 65504.0;
 
