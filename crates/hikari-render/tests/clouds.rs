@@ -10,6 +10,7 @@ use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::clouds::reference as twin;
 use hikari_render::techniques::clouds::settings::CloudsSettings;
 use hikari_render::techniques::clouds::{CLOUDS_ON, CloudParams, Clouds};
+use hikari_render::techniques::gbuffer;
 use hikari_scene::Sun;
 
 fn sun() -> Sun {
@@ -305,16 +306,14 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
     // The sky's mean radiance: band 0 of the deringed SH times Y00.
     let mean = Vec3::from_slice(&sh[9][..3]) * 0.282_094_8;
     let view = hikari_render::view::View::new(&on.camera, 64, 48);
+    let inv = glam::Mat4::from_cols_array_2d(&view.inv_view_proj);
     let (mut sky_px, mut clouded, mut ground, mut shaded) = (0, 0, 0, 0);
     for y in 0..48u32 {
         for x in 0..64u32 {
             let i = (y * 64 + x) as usize;
             let d = depth.rgba[i][0];
             if d == 0.0 {
-                let dir = hikari_render::techniques::haze::reference::screen_ray(
-                    &view,
-                    glam::Vec2::new((x as f32 + 0.5) / 64.0, (y as f32 + 0.5) / 48.0),
-                );
+                let dir = gbuffer::reference::pixel_ray(inv, on.camera.position, [x, y], [64, 48]);
                 let back = Vec3::from_slice(&lit_off.rgba[i][..3]);
                 let sun_lux = sun.color * sun.illuminance_lux;
                 let want = twin::clouds_over_sky(&params, &map, dir, back, sun_lux, mean);
@@ -333,15 +332,7 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
                 let sun_on = lux_off.rgba[i][0] - lux_dark.rgba[i][0];
                 let sun_clouded = lux_on.rgba[i][0] - lux_dark.rgba[i][0];
                 if sun_on > 1000.0 {
-                    let inv = glam::Mat4::from_cols_array_2d(&view.inv_view_proj);
-                    let ndc = glam::Vec4::new(
-                        (x as f32 + 0.5) / 32.0 - 1.0,
-                        1.0 - (y as f32 + 0.5) / 24.0,
-                        d,
-                        1.0,
-                    );
-                    let w = inv * ndc;
-                    let world = w.truncate() / w.w;
+                    let world = gbuffer::reference::world_from_depth(inv, [x, y], [64, 48], d);
                     let want = sun_on * twin::cloud_shadow_at(&params, world);
                     ground += 1;
                     if want < 0.9 * sun_on {

@@ -30,7 +30,11 @@ fn world_from_depth(view: View, pixel: vec2<u32>, depth: f32) -> vec3<f32> {
 
 // Unit direction from the camera through the pixel centre (valid at depth 0 too).
 fn view_ray(view: View, pixel: vec2<u32>) -> vec3<f32> {
-    let uv = (vec2<f32>(pixel) + 0.5) * view.viewport.zw;
+    return view_ray_uv(view, (vec2<f32>(pixel) + 0.5) * view.viewport.zw);
+}
+
+// Unit direction from the camera through the normalised screen position `uv` (0..1, y down).
+fn view_ray_uv(view: View, uv: vec2<f32>) -> vec3<f32> {
     // A point on the near plane, which reverse-Z puts at depth 1.
     let near = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
     return normalize(near.xyz / near.w - view.position.xyz);

@@ -22,6 +22,12 @@ pub fn decode_id(scene: &SceneCpu, id: u32, mesh_first_triangle: u32) -> Option<
 pub fn pixel_ray(inv_view_proj: Mat4, eye: Vec3, pixel: [u32; 2], size: [u32; 2]) -> Vec3 {
     let uv = (Vec2::new(pixel[0] as f32, pixel[1] as f32) + 0.5)
         / Vec2::new(size[0] as f32, size[1] as f32);
+    uv_ray(inv_view_proj, eye, uv)
+}
+
+/// Unit direction of the camera ray through the normalised screen position `uv` (0..1, y
+/// down), as `view_ray_uv` in WGSL.
+pub fn uv_ray(inv_view_proj: Mat4, eye: Vec3, uv: Vec2) -> Vec3 {
     let near = inv_view_proj * Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
     (near.truncate() / near.w - eye).normalize()
 }

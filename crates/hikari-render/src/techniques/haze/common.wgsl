@@ -3,7 +3,7 @@
 // Volumetric haze (Ghost of Tsushima): two analytic density layers with their optical depth
 // in closed form, and the froxel grid's slicing. CPU twin: `haze::reference` (same names).
 
-#import hikari::view::View
+#import hikari::view::{View, view_ray_uv}
 #import hikari::phase::hg_phase
 
 struct HazeParams {
@@ -79,12 +79,6 @@ fn slice_of_depth(p: HazeParams, z: f32) -> f32 {
     return l / p.slicing.w;
 }
 
-// Unit direction from the camera through the normalised screen position `uv` (y down).
-fn screen_ray(view: View, uv: vec2<f32>) -> vec3<f32> {
-    let near = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
-    return normalize(near.xyz / near.w - view.position.xyz);
-}
-
 fn froxel_ray(p: HazeParams, view: View, c: vec2<u32>) -> vec3<f32> {
-    return screen_ray(view, (vec2<f32>(c) + 0.5) / vec2<f32>(p.grid.xy));
+    return view_ray_uv(view, (vec2<f32>(c) + 0.5) / vec2<f32>(p.grid.xy));
 }

@@ -3,8 +3,8 @@
 // L / alpha; the grid is read with a tricubic B-spline as 8 trilinear taps (Sigg and Hadwiger
 // 2005). Twin: `haze::reference::composite_pixel`.
 
-#import hikari::view::View
-#import hikari::haze::{HazeParams, HAZE_DENSITY_AA, HAZE_TRICUBIC, optical_depth, opacity, slice_of_depth, screen_ray}
+#import hikari::view::{View, view_ray, world_from_depth}
+#import hikari::haze::{HazeParams, HAZE_DENSITY_AA, HAZE_TRICUBIC, optical_depth, opacity, slice_of_depth}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: HazeParams;
@@ -68,7 +68,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let uv = (vec2<f32>(id.xy) + 0.5) * view.viewport.zw;
-    let v = screen_ray(view, uv);
+    let v = view_ray(view, id.xy);
     let cam = view.position.xyz;
     let fwd = view.forward_near.xyz;
     let far = params.scatter.w;
@@ -77,8 +77,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let depth = textureLoad(depth_tex, id.xy, 0).r;
     // NaN fails the comparison: such a pixel is taken as the sky.
     if depth > 0.0 && depth <= 3.0e38 {
-        let w = view.inv_view_proj * vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
-        let d = w.xyz / w.w - cam;
+        let d = world_from_depth(view, id.xy, depth) - cam;
         let l = length(d);
         if l < far {
             dist = l;

@@ -11,6 +11,7 @@ use super::{
     HAZE_DENSITY_AA, HAZE_LOCAL_LIGHTS, HAZE_SKY, HAZE_SUN_SHADOWS, HAZE_TRICUBIC, HazeParams,
 };
 use crate::scene_gpu::LightGpu;
+use crate::techniques::gbuffer;
 use crate::view::View;
 
 /// Largest value the f16 grids hold.
@@ -88,11 +89,12 @@ pub fn slice_of_depth(p: &HazeParams, z: f32) -> f32 {
     x.ln_1p() / ln_r
 }
 
-/// Unit direction from the camera through the normalised screen position `uv` (0..1, y down).
-pub fn screen_ray(view: &View, uv: Vec2) -> Vec3 {
-    let inv = Mat4::from_cols_array_2d(&view.inv_view_proj);
-    let near = inv * Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, 1.0, 1.0);
-    (near.truncate() / near.w - Vec3::from_slice(&view.position[..3])).normalize()
+fn inv_view_proj(view: &View) -> Mat4 {
+    Mat4::from_cols_array_2d(&view.inv_view_proj)
+}
+
+fn eye(view: &View) -> Vec3 {
+    Vec3::from_slice(&view.position[..3])
 }
 
 /// Froxel `(i, j)`'s central ray.
@@ -101,7 +103,7 @@ pub fn froxel_ray(p: &HazeParams, view: &View, i: u32, j: u32) -> Vec3 {
         (i as f32 + 0.5) / p.grid[0] as f32,
         (j as f32 + 0.5) / p.grid[1] as f32,
     );
-    screen_ray(view, uv)
+    gbuffer::reference::uv_ray(inv_view_proj(view), eye(view), uv)
 }
 
 /// What lights the haze besides the params: the sky's deringed L2 SH (radiance, nits) and the
@@ -294,16 +296,11 @@ pub fn sample(p: &HazeParams, grid: &[Vec4], uvw: Vec3, tricubic: bool) -> Vec4 
 pub fn pixel_extent(p: &HazeParams, view: &View, pixel: [u32; 2], depth: f32) -> (Vec3, f32, f32) {
     let cam = Vec3::from_slice(&view.position[..3]);
     let fwd = Vec3::from_slice(&view.forward_near[..3]);
-    let uv = Vec2::new(
-        (pixel[0] as f32 + 0.5) * view.viewport[2],
-        (pixel[1] as f32 + 0.5) * view.viewport[3],
-    );
-    let v = screen_ray(view, uv);
+    let size = [view.viewport[0] as u32, view.viewport[1] as u32];
+    let v = gbuffer::reference::pixel_ray(inv_view_proj(view), cam, pixel, size);
     let far = p.scatter[3];
     if depth.is_finite() && depth > 0.0 {
-        let inv = Mat4::from_cols_array_2d(&view.inv_view_proj);
-        let w = inv * Vec4::new(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
-        let world = w.truncate() / w.w;
+        let world = gbuffer::reference::world_from_depth(inv_view_proj(view), pixel, size, depth);
         let d = world - cam;
         let dist = d.length();
         if dist.is_finite() && dist < far {
