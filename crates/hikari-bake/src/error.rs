@@ -16,6 +16,8 @@ pub enum BakeError {
     Bvh(#[from] hikari_bvh::BvhError),
     #[error("probe volume `{name}`: {why}")]
     BadVolume { name: String, why: &'static str },
+    #[error("reflection probe `{name}`: {why}")]
+    BadReflectionProbe { name: String, why: &'static str },
     #[error("{}: {what}", path.display())]
     Gltf {
         path: std::path::PathBuf,

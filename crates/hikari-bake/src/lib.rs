@@ -450,3 +450,4 @@ pub fn bake_grid_sky_visibility(
         stats,
     })
 }
+pub mod reflection_probes;

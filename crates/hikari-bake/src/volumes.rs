@@ -156,7 +156,7 @@ pub fn gltf_volumes(path: &Path) -> Result<Vec<ProbeVolume>, BakeError> {
 }
 
 /// The JSON chunk of a `.glb`, or the whole of a `.gltf`.
-fn gltf_json_bytes(bytes: &[u8]) -> Result<&[u8], String> {
+pub(crate) fn gltf_json_bytes(bytes: &[u8]) -> Result<&[u8], String> {
     if !bytes.starts_with(b"glTF") {
         return Ok(bytes);
     }
@@ -235,6 +235,74 @@ fn mesh_bounds(doc: &Value, mesh: usize) -> Option<(Vec3, Vec3)> {
 }
 
 pub(crate) fn volumes_of_document(doc: &Value) -> Result<Vec<ProbeVolume>, String> {
+    let mut out = Vec::new();
+    for node in marked_nodes(doc, "probe_volume")? {
+        let i = node.index;
+        let spacing = match &node.mark {
+            Value::Bool(true) => Some(DEFAULT_VOLUME_SPACING),
+            Value::Bool(false) => None,
+            Value::Object(o) => Some(match o.get("spacing") {
+                None => DEFAULT_VOLUME_SPACING,
+                Some(s) => s
+                    .as_f64()
+                    .map(|s| s as f32)
+                    .filter(|s| s.is_finite() && *s > 0.0)
+                    .ok_or_else(|| {
+                        format!("node {i}: extras.hikari.probe_volume.spacing is not a positive number of metres")
+                    })?,
+            }),
+            _ => {
+                return Err(format!(
+                    "node {i}: extras.hikari.probe_volume is neither true, false nor an object"
+                ));
+            }
+        };
+        if let Some(spacing) = spacing {
+            out.push(ProbeVolume {
+                transform: node_box(doc, &node, "probe volume")?,
+                name: node.name,
+                spacing,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// A node of the default scene whose `extras.hikari` holds a given key.
+pub(crate) struct MarkedNode {
+    pub index: usize,
+    /// Its `name`, else "node {index}".
+    pub name: String,
+    /// Its world transform.
+    pub world: Mat4,
+    pub mesh: Option<usize>,
+    /// The key's value.
+    pub mark: Value,
+}
+
+/// The box a marked node stands for, as the map of the cube [-1, 1]^3 onto it in world space:
+/// its mesh's bounds (the POSITION accessors' `min`/`max`) under its world transform, or the
+/// cube itself under that transform for a node without a mesh (an "empty").
+pub(crate) fn node_box(doc: &Value, node: &MarkedNode, what: &str) -> Result<Mat4, String> {
+    let local_box = match node.mesh {
+        Some(m) => {
+            let (lo, hi) = mesh_bounds(doc, m).ok_or_else(|| {
+                format!(
+                    "node {}: its mesh {m} has no POSITION min/max to bound the {what}",
+                    node.index
+                )
+            })?;
+            Mat4::from_translation(0.5 * (lo + hi))
+                * Mat4::from_scale((0.5 * (hi - lo)).max(Vec3::splat(1e-3)))
+        }
+        None => Mat4::IDENTITY,
+    };
+    Ok(node.world * local_box)
+}
+
+/// The default scene's (else scene 0's) nodes and descendants whose `extras.hikari` holds
+/// `key`, with their world transforms.
+pub(crate) fn marked_nodes(doc: &Value, key: &str) -> Result<Vec<MarkedNode>, String> {
     let nodes = doc
         .get("nodes")
         .and_then(Value::as_array)
@@ -268,49 +336,19 @@ pub(crate) fn volumes_of_document(doc: &Value) -> Result<Vec<ProbeVolume>, Strin
         if let Some(mark) = node
             .get("extras")
             .and_then(|e| e.get("hikari"))
-            .and_then(|h| h.get("probe_volume"))
+            .and_then(|h| h.get(key))
         {
-            let spacing = match mark {
-                Value::Bool(true) => Some(DEFAULT_VOLUME_SPACING),
-                Value::Bool(false) => None,
-                Value::Object(o) => Some(match o.get("spacing") {
-                    None => DEFAULT_VOLUME_SPACING,
-                    Some(s) => s
-                        .as_f64()
-                        .map(|s| s as f32)
-                        .filter(|s| s.is_finite() && *s > 0.0)
-                        .ok_or_else(|| {
-                            format!("node {i}: extras.hikari.probe_volume.spacing is not a positive number of metres")
-                        })?,
-                }),
-                _ => {
-                    return Err(format!(
-                        "node {i}: extras.hikari.probe_volume is neither true, false nor an object"
-                    ));
-                }
-            };
-            if let Some(spacing) = spacing {
-                let local_box = match node.get("mesh").and_then(Value::as_u64) {
-                    Some(m) => {
-                        let (lo, hi) = mesh_bounds(doc, m as usize).ok_or_else(|| {
-                            format!("node {i}: its mesh {m} has no POSITION min/max to bound the probe volume")
-                        })?;
-                        Mat4::from_translation(0.5 * (lo + hi))
-                            * Mat4::from_scale((0.5 * (hi - lo)).max(Vec3::splat(1e-3)))
-                    }
-                    None => Mat4::IDENTITY,
-                };
-                let name = node
+            out.push(MarkedNode {
+                index: i,
+                name: node
                     .get("name")
                     .and_then(Value::as_str)
                     .map(str::to_owned)
-                    .unwrap_or_else(|| format!("node {i}"));
-                out.push(ProbeVolume {
-                    name,
-                    transform: world * local_box,
-                    spacing,
-                });
-            }
+                    .unwrap_or_else(|| format!("node {i}")),
+                world,
+                mesh: node.get("mesh").and_then(Value::as_u64).map(|m| m as usize),
+                mark: mark.clone(),
+            });
         }
         if let Some(children) = node.get("children").and_then(Value::as_array) {
             for c in children.iter().filter_map(Value::as_u64) {

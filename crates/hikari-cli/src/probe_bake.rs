@@ -444,8 +444,26 @@ pub fn for_render(
     Ok(run.bake)
 }
 
-/// Gives `renderer` the scene's bake ([`for_render`]) when the frame's settings use the
-/// probes (they light only what the sky lights); `given` is `--bake`.
+/// The scene's reflection probes: a built-in scene's placements, the probes a glTF file marks
+/// in its nodes' `extras`, else one over the scene's bounds (docs/reflection-probes.md).
+pub fn reflection_probes(
+    scene: &Scene,
+    source: &SceneSource,
+) -> anyhow::Result<Vec<hikari_bake::reflection_probes::ReflectionProbeBox>> {
+    use hikari_bake::reflection_probes as rp;
+    let mut probes = match source {
+        SceneSource::Builtin(name) => rp::builtin_reflection_probes(name),
+        SceneSource::Gltf(path) => rp::gltf_reflection_probes(path)?,
+    };
+    if probes.is_empty() {
+        probes.extend(rp::default_reflection_probe(scene));
+    }
+    Ok(probes)
+}
+
+/// Gives `renderer` the scene's probe data: its irradiance-probe bake ([`for_render`]; `given`
+/// is `--bake`) when the settings use the probes (they light only what the sky lights), and
+/// its reflection probes ([`reflection_probes`]) when those are on.
 pub fn attach(
     renderer: &mut hikari_render::Renderer,
     scene: &Scene,
@@ -462,6 +480,11 @@ pub fn attach(
             "--bake {}: not used, the probes or the sky's light are off",
             path.display()
         );
+    }
+    if s.reflection_probes.enabled && s.sky.enabled {
+        let probes = reflection_probes(scene, source)?;
+        log::info!("reflection probes: {}", probes.len());
+        renderer.set_reflection_probes(&probes)?;
     }
     Ok(())
 }

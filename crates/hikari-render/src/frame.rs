@@ -30,6 +30,9 @@ use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::ray_traced_gi::{
     RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene, SkySource,
 };
+use crate::techniques::reflection_probes::{
+    ReflectionProbeInputs, ReflectionProbes, ReflectionProbesFrame,
+};
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
 use crate::techniques::taa::{self, Taa};
@@ -231,6 +234,7 @@ pub struct Techniques {
     pub sky: Sky,
     pub clouds: Clouds,
     pub irradiance_probes: IrradianceProbes,
+    pub reflection_probes: ReflectionProbes,
     pub sun_shadows: SunShadows,
     pub gbuffer: GBufferPass,
     pub direct_lighting: DirectLighting,
@@ -256,6 +260,7 @@ impl Techniques {
             sky: Sky::new(ctx, &mut lib)?,
             clouds: Clouds::new(ctx, &mut lib)?,
             irradiance_probes: IrradianceProbes::new(ctx, &mut lib)?,
+            reflection_probes: ReflectionProbes::new(ctx, &mut lib)?,
             sun_shadows: SunShadows::new(ctx, &mut lib)?,
             gbuffer: GBufferPass::new(ctx, &mut lib)?,
             direct_lighting: DirectLighting::new(ctx, &mut lib)?,
@@ -282,6 +287,7 @@ pub struct FrameOutputs {
     pub sky: SkyFrame,
     pub clouds: crate::techniques::clouds::CloudsFrame,
     pub probes: ProbesFrame,
+    pub reflection_probes: ReflectionProbesFrame,
     /// Area lights and shadowed point and spot lights, nits (`area_lights.radiance`), this
     /// frame's estimate before the shadow denoiser.
     pub area_lights: Tex,
@@ -368,9 +374,7 @@ pub fn record<'r>(
         s.camera.position,
     )?;
 
-    // 5. Reflection probes: their issue adds them here.
-
-    // 6. Clouds: this frame's share of the paraboloid cloud map; the deferred lighting draws
+    // 5. Clouds: this frame's share of the paraboloid cloud map; the deferred lighting draws
     //    them over the sky and shadows the sun with them, as the haze does.
     let clouds = t.clouds.record(
         g,
@@ -385,6 +389,31 @@ pub fn record<'r>(
                 .map_or(0.0, |t| f64::from(t.seconds_of_day())),
             sky.enabled && s.settings.sky.sky,
         ),
+    )?;
+
+    // 6. Reflection probes (ARCHITECTURE.md's step 5, after the clouds, which shadow and
+    //    cover their sky): captured once, this frame's share relit and prefiltered.
+    let reflection_probes = t.reflection_probes.record(
+        g,
+        &t.gbuffer,
+        &t.raster,
+        scene,
+        &mut state.raster_queues,
+        &s.settings.reflection_probes,
+        &ReflectionProbeInputs {
+            sky: &sky,
+            probes: &probes,
+            clouds: &clouds,
+            lights: scene.lights,
+            light_count: scene.light_count,
+            sun: s.sun.as_ref(),
+            cutoff_lux: crate::techniques::direct_lighting::light_cutoff_lux(
+                s.metered_lux_with_sky(sky.sky_lux),
+            ),
+            weather: &s.settings.sky.weather,
+            relight_all: camera_cut,
+            sky_light: s.settings.sky.sky,
+        },
     )?;
 
     // 7. Sun shadow maps.
@@ -523,6 +552,7 @@ pub fn record<'r>(
         lighting.use_sky(s.settings.sky.sky);
     }
     lighting.use_probes(probes.present);
+    lighting.use_reflection_probes(reflection_probes.radiance.is_some());
     if gi_light.is_some() {
         lighting.use_ray_traced_gi(
             s.settings.ray_traced_gi.near_field_m,
@@ -590,6 +620,7 @@ pub fn record<'r>(
         &lighting,
         area_light_for_lighting,
         gi_light.as_ref(),
+        reflection_probes.lookup,
     )?;
     if ray_traced_gi.is_some() {
         // The lit image lights next frame's GI hits where they were visible.
@@ -690,6 +721,7 @@ pub fn record<'r>(
         sky,
         clouds,
         probes,
+        reflection_probes,
         area_lights,
         area_lights_unshadowed: area_frame.unshadowed,
         area_lights_denoised,

@@ -32,10 +32,35 @@ pub fn all() -> Vec<StructLayout> {
     use crate::scene_gpu;
     use crate::techniques::{
         clouds, direct_lighting, exposure, gi_denoiser, haze, irradiance_probes, local_tonemap,
-        ray_traced_gi, sky, sun_shadows, taa, tonemap,
+        ray_traced_gi, reflection_probes, sky, sun_shadows, taa, tonemap,
     };
     use crate::view;
     vec![
+        gpu_layout!(
+            reflection_probes::ReflectionProbeGpu,
+            "reflection_probes/relight.wgsl",
+            [to_box, capture, half_m]
+        ),
+        gpu_layout!(
+            reflection_probes::ReflectionProbeParams,
+            "direct_lighting/shade.wgsl",
+            [config, values]
+        ),
+        gpu_layout!(
+            reflection_probes::CaptureParams,
+            "reflection_probes/capture.wgsl",
+            [face, capture]
+        ),
+        gpu_layout!(
+            reflection_probes::RelightParams,
+            "reflection_probes/relight.wgsl",
+            [sun, sun_color, probes, config, cutoff]
+        ),
+        gpu_layout!(
+            reflection_probes::PrefilterParams,
+            "reflection_probes/prefilter.wgsl",
+            [level, probes]
+        ),
         gpu_layout!(
             clouds::CloudParams,
             "clouds/march.wgsl",

@@ -67,6 +67,22 @@ impl Renderer {
         self.techniques.irradiance_probes.set_bake(&self.ctx, bake);
     }
 
+    /// Uses `probes` as the relit reflection probes from the next frame on (captured then);
+    /// none: the sky's SH and the GI give the indirect specular light.
+    pub fn set_reflection_probes(
+        &mut self,
+        probes: &[hikari_bake::reflection_probes::ReflectionProbeBox],
+    ) -> Result<()> {
+        self.techniques
+            .reflection_probes
+            .set_probes(&self.ctx, probes)
+    }
+
+    /// The reflection probes in the order the GPU holds them (smallest box first).
+    pub fn reflection_probes(&self) -> Vec<hikari_bake::reflection_probes::ReflectionProbeBox> {
+        self.techniques.reflection_probes.probes()
+    }
+
     /// The irradiance probes (the uploaded bake's layout, the lookup pass's switch, the
     /// relight's timed dispatches), for `hikari bench probes`.
     pub fn irradiance_probes(&self) -> &crate::techniques::irradiance_probes::IrradianceProbes {
@@ -260,8 +276,10 @@ impl Renderer {
                 .grow(&result, binding_limit)?
                 .is_empty();
             if overflowed {
-                // Cascades drawn into an overflowing queue lack triangles: draw them all again.
+                // Cascades and cube maps drawn into an overflowing queue lack triangles: draw
+                // them all again.
                 self.state.shadow_cache = Default::default();
+                self.techniques.reflection_probes.invalidate_capture();
             }
             // Interactive frames (the runtime does not wait for their counts) are shown as drawn.
             if !overflowed || !self.runtime.waits_for_readbacks() {

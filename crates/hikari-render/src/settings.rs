@@ -20,6 +20,7 @@ pub use crate::techniques::haze::settings::HazeSettings;
 pub use crate::techniques::irradiance_probes::settings::IrradianceProbesSettings;
 pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
 pub use crate::techniques::ray_traced_gi::settings::RayTracedGiSettings;
+pub use crate::techniques::reflection_probes::settings::ReflectionProbesSettings;
 pub use crate::techniques::sky::settings::SkySettings;
 pub use crate::techniques::sun_shadows::settings::SunShadowsSettings;
 pub use crate::techniques::taa::settings::TaaSettings;
@@ -205,6 +206,7 @@ register_settings! {
     area_lights: AreaLightsSettings,
     haze: HazeSettings,
     irradiance_probes: IrradianceProbesSettings,
+    reflection_probes: ReflectionProbesSettings,
     ray_traced_gi: RayTracedGiSettings,
     tonemap: TonemapSettings,
     scene_rt: crate::scene_rt::SceneRtSettings,

@@ -216,7 +216,9 @@ pub fn validate(
 /// naga capabilities matching the features a device was given.
 pub fn capabilities_for(features: wgpu::Features) -> naga::valid::Capabilities {
     use naga::valid::Capabilities as C;
-    let mut c = C::empty();
+    // Cube map arrays (the reflection probes) are in every backend wgpu drives natively
+    // (Vulkan, Metal, DX12); only WebGL lacks them.
+    let mut c = C::CUBE_ARRAY_TEXTURES;
     if features.contains(wgpu::Features::SHADER_F16) {
         c |= C::SHADER_FLOAT16;
     }

@@ -313,11 +313,13 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
                 g.motion.into(),
                 g.emissive.into(),
                 g.instance.into(),
+                g.vertex_normal.into(),
             ]
         })
         .unwrap();
     let vis: Vec<u32> = bytemuck::cast_slice(r.buffer("gbuffer.visibility").unwrap()).to_vec();
     let mut img = |n: &str| r.take_image(n).unwrap();
+    let vertex_normal = img("gbuffer.vertex_normal");
     let (normal, albedo, material, motion, emissive, instance) = (
         img("gbuffer.normal"),
         img("gbuffer.albedo"),
@@ -363,6 +365,9 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
             seen[want.instance as usize] += 1;
             let inst = &scene.instances[want.instance as usize];
             let mapped = scene.materials[inst.material].normal_texture.is_some();
+            // The twin's normal before any normal map is the vertex normal (8-bit snorm).
+            let vn = Vec3::from_slice(&vertex_normal.pixel(x, y)[..3]).normalize();
+            let vertex_normal_ok = vn.dot(want.normal) > 1f32.to_radians().cos();
             let nv = normal.pixel(x, y);
             let decode =
                 |a: f32, b: f32| hikari_render::reference::octahedral::decode(Vec2::new(a, b));
@@ -397,6 +402,7 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
                     n.dot(want.normal) > normal_tolerance.to_radians().cos(),
                 ),
                 ("anisotropy direction", aniso_ok),
+                ("vertex normal", vertex_normal_ok),
                 ("albedo r", close(a[0], want.base_color.x, 2.5 / 255.0, 0.0)),
                 ("albedo g", close(a[1], want.base_color.y, 2.5 / 255.0, 0.0)),
                 ("albedo b", close(a[2], want.base_color.z, 2.5 / 255.0, 0.0)),

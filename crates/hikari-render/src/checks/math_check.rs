@@ -53,6 +53,8 @@ pub enum Kernel {
     Purkinje,
     /// The BRDF (anisotropic and isotropic forms, per-light weights) and its albedo tables.
     Brdf,
+    /// The reflection probes' cube and cone math (`hikari::reflection_probe_math`).
+    ReflectionProbe,
 }
 
 impl Kernel {
@@ -69,6 +71,7 @@ impl Kernel {
             Kernel::YCoCg => "math_check/ycocg.wgsl",
             Kernel::Transfer | Kernel::Matrices | Kernel::Purkinje => "math_check/color.wgsl",
             Kernel::Brdf => "math_check/brdf.wgsl",
+            Kernel::ReflectionProbe => "math_check/reflection_probe.wgsl",
         }
     }
 
@@ -86,6 +89,7 @@ impl Kernel {
             Kernel::Matrices => "matrices",
             Kernel::Purkinje => "purkinje",
             Kernel::Brdf => "eval",
+            Kernel::ReflectionProbe => "main",
         }
     }
 
@@ -104,6 +108,7 @@ impl Kernel {
             Kernel::Matrices => 3,
             Kernel::Purkinje => 3,
             Kernel::Brdf => 21,
+            Kernel::ReflectionProbe => 19,
         }
     }
 
@@ -122,6 +127,7 @@ impl Kernel {
             Kernel::Matrices => 31,
             Kernel::Purkinje => 3,
             Kernel::Brdf => 14,
+            Kernel::ReflectionProbe => 8,
         }
     }
 }

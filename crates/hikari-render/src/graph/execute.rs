@@ -431,6 +431,7 @@ fn encode_passes(
                         .view(ViewKey {
                             dimension: wgpu::TextureViewDimension::D2,
                             single_mip: true,
+                            base_mip: 0,
                         })
                 };
                 let color_views: Vec<(wgpu::TextureView, Option<[f64; 4]>)> =

@@ -81,9 +81,14 @@ pub(crate) struct VirtualBuffer {
 
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Binding {
-    Texture(Tex),
+    /// A texture and the one mip level its view covers (`None`: every level when sampled,
+    /// level 0 when a storage texture).
+    Texture(Tex, Option<u32>),
     Buffer(Buf),
-    Constants { offset: u64, size: u64 },
+    Constants {
+        offset: u64,
+        size: u64,
+    },
     Sampler(SamplerKind),
 }
 
@@ -111,6 +116,7 @@ impl PassResources<'_> {
         p.view(resources::ViewKey {
             dimension: p.default_dimension(),
             single_mip: false,
+            base_mip: 0,
         })
     }
 
@@ -516,7 +522,7 @@ impl<'r> FrameGraph<'r> {
         } else {
             for (b, w) in bindings.iter().zip(&expect_write) {
                 match b {
-                    Binding::Texture(t) => touched.push((Res::Tex(*t), *w == Some(true))),
+                    Binding::Texture(t, _) => touched.push((Res::Tex(*t), *w == Some(true))),
                     Binding::Buffer(b) => touched.push((Res::Buf(*b), *w == Some(true))),
                     _ => {}
                 }
@@ -549,7 +555,7 @@ impl<'r> FrameGraph<'r> {
         let mut out = Vec::new();
         for (b, slot) in bindings.iter().zip(slots) {
             let res = match b {
-                Binding::Texture(t) => Res::Tex(*t),
+                Binding::Texture(t, _) => Res::Tex(*t),
                 Binding::Buffer(b) => Res::Buf(*b),
                 _ => continue,
             };
@@ -598,15 +604,32 @@ impl<'r> FrameGraph<'r> {
         for ((b, slot), ew) in bindings.iter().zip(slots).zip(expect_write) {
             let here = format!("@binding({}) `{}` of `{}`", slot.binding, slot.name, label);
             match (b, &slot.kind) {
-                (Binding::Texture(t), BindingKind::SampledTexture { view, .. })
-                | (Binding::Texture(t), BindingKind::StorageTexture { view, .. }) => {
+                (Binding::Texture(t, level), BindingKind::SampledTexture { view, .. })
+                | (Binding::Texture(t, level), BindingKind::StorageTexture { view, .. }) => {
                     let v = &self.textures[t.0 as usize];
+                    if let Some(level) = level
+                        && *level >= v.desc.mip_levels
+                    {
+                        return Err(err(format!(
+                            "{here} binds mip level {level} but `{}` has {}",
+                            v.name, v.desc.mip_levels
+                        )));
+                    }
                     let ok_dim = match view {
                         wgpu::TextureViewDimension::D3 => {
                             v.desc.dimension == wgpu::TextureDimension::D3
                         }
                         wgpu::TextureViewDimension::D1 => {
                             v.desc.dimension == wgpu::TextureDimension::D1
+                        }
+                        // Six square faces a cube.
+                        wgpu::TextureViewDimension::Cube
+                        | wgpu::TextureViewDimension::CubeArray => {
+                            v.desc.dimension == wgpu::TextureDimension::D2
+                                && v.desc.size[0] == v.desc.size[1]
+                                && v.desc.size[2].is_multiple_of(6)
+                                && (v.desc.size[2] == 6
+                                    || *view == wgpu::TextureViewDimension::CubeArray)
                         }
                         _ => v.desc.dimension == wgpu::TextureDimension::D2,
                     };
@@ -690,7 +713,7 @@ impl<'r> PassBuilder<'_, 'r> {
 
     fn res_binding(r: Res) -> Binding {
         match r {
-            Res::Tex(t) => Binding::Texture(t),
+            Res::Tex(t) => Binding::Texture(t, None),
             Res::Buf(b) => Binding::Buffer(b),
         }
     }
@@ -709,6 +732,17 @@ impl<'r> PassBuilder<'_, 'r> {
     /// Binds the next slot to a resource the pass writes (or reads and writes).
     pub fn write(self, r: impl Into<Res>) -> Self {
         self.bind(Self::res_binding(r.into()), Some(true))
+    }
+
+    /// Binds the next slot, a storage texture, to mip level `level` of `t`, which it writes.
+    pub fn write_mip(self, t: Tex, level: u32) -> Self {
+        self.bind(Binding::Texture(t, Some(level)), Some(true))
+    }
+
+    /// Binds the next slot to mip level `level` of `t` alone, which it reads (so that a pass
+    /// can read one level and write the next).
+    pub fn read_mip(self, t: Tex, level: u32) -> Self {
+        self.bind(Binding::Texture(t, Some(level)), Some(false))
     }
 
     /// Binds the next slot to a uniform holding `value`.

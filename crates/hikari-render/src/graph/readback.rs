@@ -32,6 +32,7 @@ pub(crate) fn texel_bytes(format: wgpu::TextureFormat) -> Option<u32> {
         F::Rg8Unorm | F::R16Float | F::R16Uint => 2,
         F::Rgba8Unorm
         | F::Rgba8UnormSrgb
+        | F::Rgba8Snorm
         | F::Bgra8Unorm
         | F::Bgra8UnormSrgb
         | F::R32Float
@@ -104,6 +105,10 @@ fn decode(format: wgpu::TextureFormat, t: &[u8]) -> [f32; 4] {
         }
         F::Bgra8Unorm | F::Bgra8UnormSrgb => {
             [unorm8(t[2]), unorm8(t[1]), unorm8(t[0]), unorm8(t[3])]
+        }
+        F::Rgba8Snorm => {
+            let s = |i: usize| (t[i] as i8 as f32 / 127.0).max(-1.0);
+            [s(0), s(1), s(2), s(3)]
         }
         F::R16Float => [h(0), 0.0, 0.0, 1.0],
         F::R16Uint => [u16_at(0) as f32, 0.0, 0.0, 1.0],

@@ -160,6 +160,8 @@ pub(crate) struct ViewKey {
     pub dimension: wgpu::TextureViewDimension,
     /// Storage and attachment views must cover a single mip level.
     pub single_mip: bool,
+    /// The first mip level the view covers.
+    pub base_mip: u32,
 }
 
 /// A texture that exists on the GPU, with the views made of it so far.
@@ -217,6 +219,7 @@ impl PhysicalTexture {
         }
         let v = self.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(key.dimension),
+            base_mip_level: key.base_mip,
             mip_level_count: key.single_mip.then_some(1),
             ..Default::default()
         });

@@ -344,9 +344,10 @@ impl GraphRuntime {
         key.push(layout_id);
         for (b, slot) in bindings.iter().zip(slots) {
             match b {
-                Binding::Texture(t) => {
+                Binding::Texture(t, level) => {
                     key.push(res.textures[t.0 as usize].physical.as_ref().unwrap().id);
                     key.push(matches!(slot.kind, BindingKind::StorageTexture { .. }) as u64);
+                    key.push(level.map_or(u64::MAX, u64::from));
                 }
                 Binding::Buffer(bf) => {
                     key.push(res.buffers[bf.0 as usize].physical.as_ref().unwrap().id)
@@ -368,18 +369,20 @@ impl GraphRuntime {
         let mut samplers = Vec::new();
         for (b, slot) in bindings.iter().zip(slots) {
             match (b, &slot.kind) {
-                (Binding::Texture(t), BindingKind::SampledTexture { view, .. }) => {
+                (Binding::Texture(t, level), BindingKind::SampledTexture { view, .. }) => {
                     let p = res.textures[t.0 as usize].physical.as_ref().unwrap();
                     views.push(p.view(ViewKey {
                         dimension: *view,
-                        single_mip: false,
+                        single_mip: level.is_some(),
+                        base_mip: level.unwrap_or(0),
                     }));
                 }
-                (Binding::Texture(t), BindingKind::StorageTexture { view, .. }) => {
+                (Binding::Texture(t, level), BindingKind::StorageTexture { view, .. }) => {
                     let p = res.textures[t.0 as usize].physical.as_ref().unwrap();
                     views.push(p.view(ViewKey {
                         dimension: *view,
                         single_mip: true,
+                        base_mip: level.unwrap_or(0),
                     }));
                 }
                 (Binding::Sampler(s), _) => samplers.push(self.sampler(ctx, *s).1),
@@ -393,7 +396,7 @@ impl GraphRuntime {
             .map(|(b, slot)| wgpu::BindGroupEntry {
                 binding: slot.binding,
                 resource: match b {
-                    Binding::Texture(_) => {
+                    Binding::Texture(..) => {
                         vi += 1;
                         wgpu::BindingResource::TextureView(&views[vi - 1])
                     }

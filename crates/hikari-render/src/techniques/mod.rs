@@ -13,6 +13,7 @@ pub mod haze;
 pub mod irradiance_probes;
 pub mod local_tonemap;
 pub mod ray_traced_gi;
+pub mod reflection_probes;
 pub mod sky;
 pub mod sun_shadows;
 pub mod taa;

@@ -37,6 +37,8 @@ pub const LIGHTING_PROBES: u32 = 32;
 /// Ambient light from the ray-traced GI within the near field (`cutoff.y` metres), blended
 /// into the probes' or the sky's over the last `cutoff.z` of it; AO darkens the far field.
 pub const LIGHTING_RTGI: u32 = 64;
+/// Indirect specular from the relit reflection probes where they cover a surface.
+pub const LIGHTING_REFLECTION_PROBES: u32 = 128;
 
 /// The ray-traced GI signal the deferred lighting resolves (denoised, or accumulated when the
 /// denoiser is off): luminance L1 SH (Rgba16Float), CoCg (Rg16Float) and AO (R16Float).
@@ -70,6 +72,11 @@ pub const LIGHT_CUTOFF_FRACTION: f32 = 1e-4;
 /// The least cut-off illuminance: a hundredth of a lux is far below moonlight, so the cut is
 /// invisible at any exposure that shows the scene.
 pub const LIGHT_CUTOFF_LUX: f32 = 0.01;
+
+/// Lux below which a point or spot light is cut off in a frame metered at `metered_lux`.
+pub fn light_cutoff_lux(metered_lux: f32) -> f32 {
+    (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX)
+}
 
 /// Placeholder sky radiance (nits) under the default 100000 lux sun, until the atmosphere
 /// issue: a clear-day blue zenith and a paler horizon, of the order of a real clear sky (a
@@ -105,12 +112,7 @@ impl LightingParams {
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky).extend(0.0).to_array(),
             config: [light_count, flags, 0, 0],
-            cutoff: [
-                (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX),
-                0.0,
-                0.0,
-                0.0,
-            ],
+            cutoff: [light_cutoff_lux(metered_lux), 0.0, 0.0, 0.0],
         }
     }
 }
@@ -135,6 +137,13 @@ impl LightingParams {
         self.config[1] &= !LIGHTING_PLACEHOLDER_AMBIENT;
         if sky_light {
             self.config[1] |= LIGHTING_SKY;
+        }
+    }
+
+    /// Takes the indirect specular light from the reflection probes where they cover a surface.
+    pub fn use_reflection_probes(&mut self, present: bool) {
+        if present {
+            self.config[1] |= LIGHTING_REFLECTION_PROBES;
         }
     }
 
@@ -189,6 +198,7 @@ impl DirectLighting {
         params: &LightingParams,
         area_lights: Tex,
         gi: Option<&GiLight>,
+        reflection_probes: BindingSet,
     ) -> Result<LitFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
@@ -215,12 +225,14 @@ impl DirectLighting {
             .read(gi.map_or(gb.normal, |g| g.y))
             .read(gi.map_or(gb.normal, |g| g.cocg))
             .read(gi.map_or(gb.normal, |g| g.ao))
+            .read(gb.vertex_normal)
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)
             .set(clouds.lookup)
             .set(probes.lookup)
             .set(brdf_tables)
+            .set(reflection_probes)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(LitFrame {
             radiance,

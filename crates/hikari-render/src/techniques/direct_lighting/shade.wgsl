@@ -15,6 +15,7 @@
 #import hikari::sky_ambient::{sky_ambient_eval, sky_ambient_irradiance, sky_ambient_specular}
 #import hikari::irradiance_probes::probe_irradiance_at
 #import hikari::rtgi_resolve::{rtgi_signal, rtgi_resolve_diffuse, rtgi_resolve_specular}
+#import hikari::reflection_probes::reflection_probe_radiance
 #import hikari::tile_bounds::{tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 
 struct LightingParams {
@@ -39,6 +40,7 @@ const LIGHTING_PLACEHOLDER_AMBIENT: u32 = 8u;
 const LIGHTING_SKY: u32 = 16u;
 const LIGHTING_PROBES: u32 = 32u;
 const LIGHTING_RTGI: u32 = 64u;
+const LIGHTING_REFLECTION_PROBES: u32 = 128u;
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: LightingParams;
@@ -59,6 +61,8 @@ const LIGHTING_RTGI: u32 = 64u;
 @group(0) @binding(11) var gi_y: texture_2d<f32>;
 @group(0) @binding(12) var gi_cocg: texture_2d<f32>;
 @group(0) @binding(13) var gi_ao: texture_2d<f32>;
+// The vertex normal before the normal map (the reflection probes' horizon occlusion).
+@group(0) @binding(14) var gbuffer_vertex_normal: texture_2d<f32>;
 
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
@@ -93,6 +97,13 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
     let mean = 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb);
     let env = mix(sky_placeholder(r), mean, m.perceptual_roughness) * select(0.0, 1.0, r.y > 0.0);
     return brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0)) * env;
+}
+
+// Specular occlusion from ambient occlusion (Lagarde and de Rousiers 2014): a smooth lobe
+// looking out of a crease is occluded less than the cosine-weighted AO says.
+fn specular_occlusion(n_dot_v: f32, ao: f32, perceptual_roughness: f32) -> f32 {
+    let alpha = perceptual_roughness * perceptual_roughness;
+    return clamp(pow(n_dot_v + ao, exp2(-16.0 * alpha - 1.0)) - 1.0 + ao, 0.0, 1.0);
 }
 
 @compute @workgroup_size(16, 16, 1)
@@ -216,17 +227,30 @@ fn main(
             let f = brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0));
             ambient_specular += f * sky_ambient_specular(r, m.perceptual_roughness);
         }
+        var ao = 1.0;
         if (flags & LIGHTING_RTGI) != 0u {
             // Near field: the ray-traced GI (whose misses see the sky) replaces the far field's
             // light, which AO darkens where the two blend.
             let far = smoothstep(params.cutoff.y * (1.0 - params.cutoff.z), params.cutoff.y, length(world - view.position.xyz));
-            let ao = textureLoad(gi_ao, pixel, 0).x;
+            ao = textureLoad(gi_ao, pixel, 0).x;
             let signal = rtgi_signal(textureLoad(gi_y, pixel, 0), textureLoad(gi_cocg, pixel, 0).xy);
             let near_e = rtgi_resolve_diffuse(signal, n) * PI;
             let alpha = m.perceptual_roughness * m.perceptual_roughness;
             let near_specular = rtgi_resolve_specular(signal, n, v, brdf_material_f0(m), alpha);
             ambient = mix(near_e, ambient * ao, far);
             ambient_specular = mix(near_specular, ambient_specular * ao, far);
+        }
+        if (flags & LIGHTING_REFLECTION_PROBES) != 0u {
+            // The relit reflection probes where their boxes hold the surface; the GI's SH
+            // specular (near) or the sky's (far) where they do not, and where they fade out.
+            let nv_raw = textureLoad(gbuffer_vertex_normal, pixel, 0).xyz;
+            let nv = select(n, normalize(nv_raw), dot(nv_raw, nv_raw) > 0.25);
+            let probe = reflection_probe_radiance(world, n, nv, v, m.perceptual_roughness, dot(ambient, EXPOSURE_LUMA));
+            if probe.w > 0.0 {
+                let n_dot_v = max(dot(n, v), 0.0);
+                let f = brdf_fresnel_schlick(brdf_material_f0(m), n_dot_v);
+                ambient_specular = mix(ambient_specular, f * probe.rgb * specular_occlusion(n_dot_v, ao, m.perceptual_roughness), probe.w);
+            }
         }
         radiance += (albedo.rgb * (1.0 - m.metalness) / PI * ambient + ambient_specular) * mat.w;
         illuminance += dot(ambient, EXPOSURE_LUMA) * mat.w;

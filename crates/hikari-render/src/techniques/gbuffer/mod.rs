@@ -19,6 +19,7 @@ pub const MATERIAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm
 pub const MOTION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const EMISSIVE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const INSTANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+pub const VERTEX_NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Snorm;
 /// `gbuffer.instance` of sky pixels.
 pub const NO_INSTANCE: u32 = u32::MAX;
 
@@ -41,6 +42,9 @@ pub struct GBuffer {
     pub emissive: Tex,
     /// Scene instance index, [`NO_INSTANCE`] for the sky.
     pub instance: Tex,
+    /// xyz: the interpolated vertex normal before the normal map (facing the camera on
+    /// double-sided surfaces), for the reflection probes' horizon occlusion; 0 on the sky.
+    pub vertex_normal: Tex,
 }
 
 pub struct GBufferPass {
@@ -60,27 +64,50 @@ impl GBufferPass {
         raster: &'r Rasterizer,
         scene: &SceneInFrame,
         view: &View,
-        [width, height]: [u32; 2],
+        size: [u32; 2],
         queues: &mut RasterQueues,
     ) -> Result<GBuffer> {
-        let tex = |g: &mut FrameGraph<'r>, name: &str, format| {
-            g.texture(name, TextureDesc::d2(width, height, format))
+        self.record_as(g, raster, scene, view, size, queues, "gbuffer")
+    }
+
+    /// The G-buffer of another camera (a reflection probe's cube face), its textures and
+    /// passes named `{name}.*` and its rasteriser queues its own.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_as<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        raster: &'r Rasterizer,
+        scene: &SceneInFrame,
+        view: &View,
+        [width, height]: [u32; 2],
+        queues: &mut RasterQueues,
+        name: &str,
+    ) -> Result<GBuffer> {
+        let tex = |g: &mut FrameGraph<'r>, what: &str, format| {
+            g.texture(
+                &format!("{name}.{what}"),
+                TextureDesc::d2(width, height, format),
+            )
         };
         let gb = GBuffer {
-            visibility: g.buffer("gbuffer.visibility", width as u64 * height as u64 * 8)?,
-            depth: tex(g, "gbuffer.depth", DEPTH_FORMAT)?,
-            normal: tex(g, "gbuffer.normal", NORMAL_FORMAT)?,
-            albedo: tex(g, "gbuffer.albedo", ALBEDO_FORMAT)?,
-            material: tex(g, "gbuffer.material", MATERIAL_FORMAT)?,
-            motion: tex(g, "gbuffer.motion", MOTION_FORMAT)?,
-            emissive: tex(g, "gbuffer.emissive", EMISSIVE_FORMAT)?,
-            instance: tex(g, "gbuffer.instance", INSTANCE_FORMAT)?,
+            visibility: g.buffer(
+                &format!("{name}.visibility"),
+                width as u64 * height as u64 * 8,
+            )?,
+            depth: tex(g, "depth", DEPTH_FORMAT)?,
+            normal: tex(g, "normal", NORMAL_FORMAT)?,
+            albedo: tex(g, "albedo", ALBEDO_FORMAT)?,
+            material: tex(g, "material", MATERIAL_FORMAT)?,
+            motion: tex(g, "motion", MOTION_FORMAT)?,
+            emissive: tex(g, "emissive", EMISSIVE_FORMAT)?,
+            instance: tex(g, "instance", INSTANCE_FORMAT)?,
+            vertex_normal: tex(g, "vertex_normal", VERTEX_NORMAL_FORMAT)?,
         };
         raster.record(
             g,
             scene,
             &RasterJob {
-                technique: "gbuffer",
+                technique: name,
                 views: &[RasterView::full(view.view_proj(), 0, [width, height])],
                 size: [width, height],
                 cull_back_faces: true,
@@ -89,7 +116,7 @@ impl GBufferPass {
             gb.visibility,
             queues,
         )?;
-        g.pass("gbuffer.resolve")
+        g.pass(&format!("{name}.resolve"))
             .constants(view)
             .read(gb.visibility)
             .read(scene.positions)
@@ -109,6 +136,7 @@ impl GBufferPass {
             .write(gb.motion)
             .write(gb.emissive)
             .write(gb.instance)
+            .write(gb.vertex_normal)
             .dispatch_threads(&self.resolve, [width, height, 1])?;
         Ok(gb)
     }

@@ -27,6 +27,7 @@
 @group(0) @binding(16) var out_motion: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(17) var out_emissive: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(18) var out_instance: texture_storage_2d<r32uint, write>;
+@group(0) @binding(19) var out_vertex_normal: texture_storage_2d<rgba8snorm, write>;
 
 const NO_INSTANCE: u32 = 0xffffffffu;
 // Largest finite f16 is 65504.
@@ -118,6 +119,7 @@ fn write_sky(px: vec2<u32>) {
     textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre + view.jitter.xy), 0.0, 0.0));
     textureStore(out_emissive, px, vec4<f32>(0.0));
     textureStore(out_instance, px, vec4<u32>(NO_INSTANCE));
+    textureStore(out_vertex_normal, px, vec4<f32>(0.0));
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -187,6 +189,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let facing = select(1.0, -1.0, dot(ng, d) > 0.0 && (inst_flags & INSTANCE_DOUBLE_SIDED) != 0u);
     n *= facing;
     ng *= facing;
+    // Before the normal map: the reflection probes' horizon occlusion compares the two.
+    var n_vertex = n;
+    if !all(n_vertex == n_vertex) || dot(n_vertex, n_vertex) < 0.5 {
+        n_vertex = ng;
+    }
     let model3 = mat3_of(model);
     var t = model3 * (unpack_oct(a0.tangent) * w.x + unpack_oct(a1.tangent) * w.y + unpack_oct(a2.tangent) * w.z);
     t = t - n * dot(n, t);
@@ -262,4 +269,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre + view.jitter.xy), finite_half2(vec2<f32>(view_depth, 0.0))));
     textureStore(out_emissive, px, vec4<f32>(clamp(emissive, vec3<f32>(0.0), vec3<f32>(MAX_HALF)), 0.0));
     textureStore(out_instance, px, vec4<u32>(chunk.instance, 0u, 0u, 0u));
+    textureStore(out_vertex_normal, px, vec4<f32>(n_vertex, 0.0));
 }

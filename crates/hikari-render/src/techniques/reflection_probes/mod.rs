@@ -1,0 +1,559 @@
+//! Relit reflection probes (Ghost of Tsushima): cube maps of albedo, normal and distance
+//! captured at fixed points, relit by today's sun, sky and irradiance probes a few a frame,
+//! prefiltered for GGX roughness, and read by the deferred lighting for its indirect specular.
+//! docs/reflection-probes.md.
+//!
+//! * `reflection_probes.capture.p{i}f{k}.*`: the G-buffer of probe i's face k, drawn by the
+//!   rasteriser with a 90-degree camera, and `reflection_probes.capture`, which keeps what
+//!   relighting needs in the persistent `reflection_probes.albedo`, `.normal_depth` and
+//!   `.emission` (`capture.wgsl`). Done once, when the probes or the resolution change: the
+//!   talk captured offline; on a GPU it takes milliseconds.
+//! * `reflection_probes.relight` (`relight.wgsl`): this frame's probes (the talk: one a frame,
+//!   round robin; all of them when the sun jumps) into level 0 of `reflection_probes.relit`.
+//! * `reflection_probes.downsample`: the relit maps' mip chain.
+//! * `reflection_probes.prefilter` (`prefilter.wgsl`): GGX filtered importance sampling into
+//!   the persistent `reflection_probes.radiance`, one roughness a level.
+//! * `hikari::reflection_probes` (`lookup.wgsl`, binding set `reflection_probes`): the
+//!   reflected radiance at a surface.
+//!
+//! CPU twins: [`reference`].
+
+pub mod reference;
+pub mod settings;
+
+use std::sync::{Arc, Mutex};
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+use hikari_bake::reflection_probes::ReflectionProbeBox;
+use hikari_scene::{Camera, Sun};
+use wgpu::util::DeviceExt;
+
+use super::clouds::CloudsFrame;
+use super::gbuffer::GBufferPass;
+use super::irradiance_probes::ProbesFrame;
+use super::sky::SkyFrame;
+use crate::context::GpuContext;
+use crate::error::{RenderError, Result};
+use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
+use crate::raster::{RasterQueues, Rasterizer};
+use crate::scene_gpu::SceneInFrame;
+use crate::shader::ShaderLibrary;
+use crate::view::View;
+use settings::ReflectionProbesSettings;
+
+pub const ALBEDO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub const NORMAL_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const EMISSION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Near plane of the capture cameras, metres.
+pub const CAPTURE_NEAR_M: f32 = 0.05;
+
+pub const RP_ON: u32 = 1;
+pub const RP_HORIZON: u32 = 2;
+pub const RP_PARALLAX_ROUGHNESS: u32 = 4;
+pub const RP_NORMALIZE: u32 = 8;
+
+pub const RELIGHT_SHADOWS: u32 = 1;
+pub const RELIGHT_SKY: u32 = 2;
+pub const RELIGHT_PROBES: u32 = 4;
+
+/// One probe on the GPU (`hikari::reflection_probe_math::ReflectionProbeGpu`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct ReflectionProbeGpu {
+    pub to_box: [[f32; 4]; 4],
+    pub capture: [f32; 4],
+    pub half_m: [f32; 4],
+}
+
+impl ReflectionProbeGpu {
+    pub fn new(p: &ReflectionProbeBox) -> Self {
+        let half = Vec3::new(
+            p.transform.x_axis.truncate().length(),
+            p.transform.y_axis.truncate().length(),
+            p.transform.z_axis.truncate().length(),
+        );
+        Self {
+            to_box: p.transform.inverse().to_cols_array_2d(),
+            capture: p.capture.extend(p.blend_m.max(0.0)).to_array(),
+            half_m: half.extend(0.0).to_array(),
+        }
+    }
+}
+
+/// The lookup's uniform (`hikari::reflection_probes::ReflectionProbeParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct ReflectionProbeParams {
+    pub config: [u32; 4],
+    pub values: [f32; 4],
+}
+
+impl ReflectionProbeParams {
+    pub fn new(s: &ReflectionProbesSettings, probes: u32, levels: u32, on: bool) -> Self {
+        let flags = [
+            (on, RP_ON),
+            (s.horizon_occlusion, RP_HORIZON),
+            (s.roughness_parallax, RP_PARALLAX_ROUGHNESS),
+            (s.normalization, RP_NORMALIZE),
+        ]
+        .iter()
+        .filter(|(b, _)| *b)
+        .fold(0, |acc, (_, bit)| acc | bit);
+        Self {
+            config: [probes, levels, flags, 0],
+            values: [s.max_normalization, 0.0, 0.0, 0.0],
+        }
+    }
+}
+
+/// `capture.wgsl`'s uniform.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct CaptureParams {
+    pub face: [u32; 4],
+    pub capture: [f32; 4],
+}
+
+/// `relight.wgsl`'s uniform.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct RelightParams {
+    pub sun: [f32; 4],
+    pub sun_color: [f32; 4],
+    pub probes: [u32; 4],
+    pub config: [u32; 4],
+    pub cutoff: [f32; 4],
+}
+
+/// `prefilter.wgsl`'s uniform.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PrefilterParams {
+    pub level: [u32; 4],
+    pub probes: [u32; 4],
+}
+
+/// What the probes are relit with.
+pub struct ReflectionProbeInputs<'a> {
+    pub sky: &'a SkyFrame,
+    pub probes: &'a ProbesFrame,
+    pub clouds: &'a CloudsFrame,
+    pub lights: Buf,
+    pub light_count: u32,
+    pub sun: Option<&'a Sun>,
+    /// Lux below which a point or spot light is cut off.
+    pub cutoff_lux: f32,
+    /// The weather's name: a new weather relights every probe.
+    pub weather: &'a str,
+    /// Relight every probe this frame.
+    pub relight_all: bool,
+    /// The sky lights the probes (`sky.sky`; off: a black sky and no sky light).
+    pub sky_light: bool,
+}
+
+/// The probes of a frame.
+#[derive(Clone, Copy, Debug)]
+pub struct ReflectionProbesFrame {
+    /// Binding set `reflection_probes` of `hikari::reflection_probes`.
+    pub lookup: BindingSet,
+    /// `reflection_probes.radiance` (`None` with the probes off).
+    pub radiance: Option<Tex>,
+    /// The captured cube maps, `None` with the probes off.
+    pub capture: Option<[Tex; 3]>,
+    /// The probes relit this frame: `relit[1]` of them from index `relit[0]` on, round the
+    /// list ([`ReflectionProbes::probes`]'s order).
+    pub relit: [u32; 2],
+    /// Whether the cube maps were captured this frame.
+    pub captured: bool,
+}
+
+/// The cube face cameras: the face's axis and an up that keeps the image square with the face.
+const FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::Y),
+    (Vec3::NEG_X, Vec3::Y),
+    (Vec3::Y, Vec3::NEG_Z),
+    (Vec3::NEG_Y, Vec3::Z),
+    (Vec3::Z, Vec3::Y),
+    (Vec3::NEG_Z, Vec3::Y),
+];
+
+/// The camera that captures `face` of a cube map at `at`.
+pub fn face_camera(at: Vec3, face: usize) -> Camera {
+    let (axis, up) = FACES[face];
+    Camera {
+        name: format!("reflection probe face {face}"),
+        position: at,
+        target: at + axis,
+        vfov_deg: 90.0,
+        near: CAPTURE_NEAR_M,
+        up,
+    }
+}
+
+struct Uploaded {
+    /// Sorted by volume, smallest first (the lookup's nesting order).
+    boxes: Vec<ReflectionProbeBox>,
+    probes: wgpu::Buffer,
+    capture_light: wgpu::Buffer,
+    generation: u64,
+}
+
+#[derive(Default)]
+struct Progress {
+    /// (generation, resolution) the persistent cube maps were captured with.
+    captured: Option<(u64, u32)>,
+    /// The next probe to relight.
+    next: u32,
+    /// The sun's direction and the weather at the last relight of every probe.
+    relit_all_with: Option<(Vec3, String)>,
+}
+
+pub struct ReflectionProbes {
+    capture: ComputePipeline,
+    relight: ComputePipeline,
+    downsample: ComputePipeline,
+    prefilter: ComputePipeline,
+    uploaded: Mutex<Option<Arc<Uploaded>>>,
+    progress: Mutex<Progress>,
+    /// Stand-ins for the lookup with no probes.
+    empty_probe: wgpu::Buffer,
+    empty_light: wgpu::Buffer,
+}
+
+fn buffer(ctx: &GpuContext, label: &str, data: &[u8]) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: data,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+/// Mip levels of a cube map `n` texels a side down to 1 x 1.
+pub fn mip_count(n: u32) -> u32 {
+    32 - n.max(1).leading_zeros()
+}
+
+impl ReflectionProbes {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Ok(Self {
+            capture: ComputePipeline::new(ctx, lib, "reflection_probes/capture.wgsl", "main", &[])?,
+            relight: ComputePipeline::new(ctx, lib, "reflection_probes/relight.wgsl", "main", &[])?,
+            downsample: ComputePipeline::new(
+                ctx,
+                lib,
+                "reflection_probes/downsample.wgsl",
+                "main",
+                &[],
+            )?,
+            prefilter: ComputePipeline::new(
+                ctx,
+                lib,
+                "reflection_probes/prefilter.wgsl",
+                "main",
+                &[],
+            )?,
+            uploaded: Mutex::new(None),
+            progress: Mutex::new(Progress::default()),
+            empty_probe: buffer(
+                ctx,
+                "reflection_probes.empty",
+                bytemuck::bytes_of(&ReflectionProbeGpu::zeroed()),
+            ),
+            empty_light: buffer(ctx, "reflection_probes.empty_light", &[0; 16]),
+        })
+    }
+
+    /// Uses `probes` from the next frame on (captured then). Each is validated; the error
+    /// names the first bad one.
+    pub fn set_probes(&self, ctx: &GpuContext, probes: &[ReflectionProbeBox]) -> Result<()> {
+        for p in probes {
+            p.validate()
+                .map_err(|e| RenderError::Graph(format!("reflection probes: {e}")))?;
+        }
+        let mut guard = self.uploaded.lock().unwrap_or_else(|e| e.into_inner());
+        let generation = guard.as_ref().map_or(1, |u| u.generation + 1);
+        if probes.is_empty() {
+            *guard = None;
+            return Ok(());
+        }
+        let mut boxes = probes.to_vec();
+        boxes.sort_by(|a, b| a.volume().total_cmp(&b.volume()));
+        let gpu: Vec<ReflectionProbeGpu> = boxes.iter().map(ReflectionProbeGpu::new).collect();
+        let limit = ctx.limits.max_texture_array_layers / 6;
+        if boxes.len() as u32 > limit {
+            return Err(RenderError::Limit {
+                what: "reflection probes (six texture layers each)".into(),
+                requested: boxes.len() as u64,
+                limit: u64::from(limit),
+            });
+        }
+        *guard = Some(Arc::new(Uploaded {
+            probes: buffer(ctx, "reflection_probes.probes", bytemuck::cast_slice(&gpu)),
+            capture_light: buffer(
+                ctx,
+                "reflection_probes.capture_light",
+                &vec![0u8; boxes.len() * 16],
+            ),
+            boxes,
+            generation,
+        }));
+        Ok(())
+    }
+
+    /// The probes in the order the GPU holds them (smallest box first).
+    pub fn probes(&self) -> Vec<ReflectionProbeBox> {
+        self.uploaded
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .as_ref()
+            .map_or(Vec::new(), |u| u.boxes.clone())
+    }
+
+    /// Captures the cube maps again next frame (a rasteriser queue overflowed while they were
+    /// drawn).
+    pub fn invalidate_capture(&self) {
+        self.progress
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .captured = None;
+    }
+
+    fn disabled_frame(
+        &self,
+        g: &mut FrameGraph<'_>,
+        s: &ReflectionProbesSettings,
+    ) -> Result<ReflectionProbesFrame> {
+        let radiance = g.texture(
+            "reflection_probes.radiance",
+            TextureDesc::d2_array(1, 1, 6, RADIANCE_FORMAT),
+        )?;
+        g.pass("reflection_probes.clear")
+            // Never sampled with the probes off; wgpu zeroes it.
+            .uses(radiance, true)
+            .encode(|_, _| {})?;
+        let probes = g.import_buffer("reflection_probes.probes", &self.empty_probe);
+        let light = g.import_buffer("reflection_probes.capture_light", &self.empty_light);
+        let lookup = lookup_set(
+            g,
+            &ReflectionProbeParams::new(s, 0, 1, false),
+            probes,
+            radiance,
+            light,
+        );
+        Ok(ReflectionProbesFrame {
+            lookup,
+            radiance: None,
+            capture: None,
+            relit: [0, 0],
+            captured: false,
+        })
+    }
+
+    /// Captures the probes if they are new, relights this frame's share, prefilters it, and
+    /// makes the lookup set. With the probes off (or none, or no atmosphere), a lookup that
+    /// covers nothing.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        gbuffer: &'r GBufferPass,
+        raster: &'r Rasterizer,
+        scene: &SceneInFrame,
+        queues: &mut RasterQueues,
+        s: &ReflectionProbesSettings,
+        inputs: &ReflectionProbeInputs<'_>,
+    ) -> Result<ReflectionProbesFrame> {
+        let uploaded = self
+            .uploaded
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone();
+        let on = s.enabled && inputs.sky.enabled;
+        let Some(u) = uploaded.filter(|_| on) else {
+            return self.disabled_frame(g, s);
+        };
+        let n = s.resolution;
+        let mips = mip_count(n);
+        if s.levels > mips {
+            return Err(RenderError::Graph(format!(
+                "reflection_probes.levels is {} but a {n}-texel cube map has only {mips} mip levels",
+                s.levels
+            )));
+        }
+        let count = u.boxes.len() as u32;
+        let layers = 6 * count;
+        let array = |format| TextureDesc::d2_array(n, n, layers, format);
+        let (albedo, f0) =
+            g.persistent_texture("reflection_probes.albedo", array(ALBEDO_FORMAT))?;
+        let (normal_depth, f1) =
+            g.persistent_texture("reflection_probes.normal_depth", array(NORMAL_DEPTH_FORMAT))?;
+        let (emission, f2) =
+            g.persistent_texture("reflection_probes.emission", array(EMISSION_FORMAT))?;
+        let (radiance, f3) = g.persistent_texture(
+            "reflection_probes.radiance",
+            array(RADIANCE_FORMAT).with_mips(s.levels),
+        )?;
+        let probes = g.import_buffer("reflection_probes.probes", &u.probes);
+        let capture_light = g.import_buffer("reflection_probes.capture_light", &u.capture_light);
+
+        let mut progress = self.progress.lock().unwrap_or_else(|e| e.into_inner());
+        let key = (u.generation, n);
+        let capture = f0 || f1 || f2 || progress.captured != Some(key);
+        if capture {
+            for (i, b) in u.boxes.iter().enumerate() {
+                for face in 0..6 {
+                    let view = View::new(&face_camera(b.capture, face), n, n);
+                    let gb = gbuffer.record_as(
+                        g,
+                        raster,
+                        scene,
+                        &view,
+                        [n, n],
+                        queues,
+                        &format!("reflection_probes.capture.p{i}f{face}"),
+                    )?;
+                    g.pass("reflection_probes.capture")
+                        .constants(&view)
+                        .constants(&CaptureParams {
+                            face: [face as u32, i as u32 * 6 + face as u32, n, 0],
+                            capture: b.capture.extend(0.0).to_array(),
+                        })
+                        .read(gb.depth)
+                        .read(gb.normal)
+                        .read(gb.albedo)
+                        .read(gb.material)
+                        .read(gb.emissive)
+                        .write(albedo)
+                        .write(normal_depth)
+                        .write(emission)
+                        .dispatch_threads(&self.capture, [n, n, 1])?;
+                }
+            }
+            progress.captured = Some(key);
+        }
+
+        // Which probes to relight: all of them after a capture, a new radiance texture, a jump
+        // of the sun or a new weather; else the next `per_frame`, round robin.
+        let sun_dir = inputs.sun.map_or(Vec3::ZERO, |s| s.direction);
+        let moved = match &progress.relit_all_with {
+            Some((d, w)) => {
+                w != inputs.weather
+                    || d.dot(sun_dir).clamp(-1.0, 1.0).acos().to_degrees() > s.relight_all_deg
+                    || (d.length_squared() == 0.0) != (sun_dir.length_squared() == 0.0)
+            }
+            None => true,
+        };
+        let all = capture || f3 || moved || inputs.relight_all;
+        let (first, k) = if all {
+            progress.relit_all_with = Some((sun_dir, inputs.weather.to_owned()));
+            (0, count)
+        } else {
+            (progress.next % count, s.per_frame.min(count))
+        };
+        progress.next = (first + k) % count;
+        drop(progress);
+
+        let relit = g.texture(
+            "reflection_probes.relit",
+            TextureDesc::d2_array(n, n, 6 * k, RADIANCE_FORMAT).with_mips(mips),
+        )?;
+        let (sun, sun_color) = match inputs.sun {
+            Some(sun) if sun.illuminance_lux > 0.0 => (
+                sun.direction
+                    .normalize_or(Vec3::Y)
+                    .extend(sun.illuminance_lux),
+                sun.color.extend(1.0),
+            ),
+            _ => (glam::Vec4::ZERO, glam::Vec4::ZERO),
+        };
+        let flags = [
+            (s.shadow_tracing, RELIGHT_SHADOWS),
+            (inputs.sky_light, RELIGHT_SKY),
+            (inputs.probes.present, RELIGHT_PROBES),
+        ]
+        .iter()
+        .filter(|(b, _)| *b)
+        .fold(0, |acc, (_, bit)| acc | bit);
+        g.pass("reflection_probes.relight")
+            .constants(&RelightParams {
+                sun: sun.to_array(),
+                sun_color: sun_color.to_array(),
+                probes: [first, count, k, flags],
+                config: [inputs.light_count, n, s.shadow_pcf_radius, 0],
+                cutoff: [inputs.cutoff_lux, 0.0, 0.0, 0.0],
+            })
+            .read(probes)
+            .read(albedo)
+            .read(normal_depth)
+            .read(emission)
+            .read(inputs.lights)
+            .write(relit)
+            .write(capture_light)
+            .set(inputs.sky.lookup)
+            .set(inputs.sky.ambient)
+            .set(inputs.probes.lookup)
+            .set(inputs.clouds.lookup)
+            .dispatch_threads(&self.relight, [n, n, 6 * k])?;
+        for m in 0..mips - 1 {
+            let side = (n >> (m + 1)).max(1);
+            g.pass("reflection_probes.downsample")
+                .read_mip(relit, m)
+                .write_mip(relit, m + 1)
+                .dispatch_threads(&self.downsample, [side, side, 6 * k])?;
+        }
+        for level in 0..s.levels {
+            let side = (n >> level).max(1);
+            g.pass("reflection_probes.prefilter")
+                .constants(&PrefilterParams {
+                    level: [level, s.levels, s.samples, n],
+                    probes: [first, count, k, 0],
+                })
+                .read(relit)
+                .sampler(SamplerKind::LinearClamp)
+                .write_mip(radiance, level)
+                .dispatch_threads(&self.prefilter, [side, side, 6 * k])?;
+        }
+        let lookup = lookup_set(
+            g,
+            &ReflectionProbeParams::new(s, count, s.levels, true),
+            probes,
+            radiance,
+            capture_light,
+        );
+        Ok(ReflectionProbesFrame {
+            lookup,
+            radiance: Some(radiance),
+            capture: Some([albedo, normal_depth, emission]),
+            relit: [first, k],
+            captured: capture,
+        })
+    }
+}
+
+fn lookup_set(
+    g: &mut FrameGraph<'_>,
+    params: &ReflectionProbeParams,
+    probes: Buf,
+    radiance: Tex,
+    capture_light: Buf,
+) -> BindingSet {
+    g.binding_set("reflection_probes")
+        .constants(params)
+        .read(probes)
+        .read(radiance)
+        .sampler(SamplerKind::LinearClamp)
+        .read(capture_light)
+        .finish()
+}
+
+/// The box transform of a probe whose box is `lo..hi` (world, axis-aligned).
+pub fn aabb_transform(lo: Vec3, hi: Vec3) -> Mat4 {
+    Mat4::from_translation(0.5 * (lo + hi)) * Mat4::from_scale(0.5 * (hi - lo))
+}
