@@ -554,3 +554,66 @@ fn the_wgsl_cube_and_cone_math_is_its_twin() {
         assert!((Vec3::new(o[5], o[6], o[7]) - d).abs().max_element() < 1e-5);
     }
 }
+
+#[test]
+fn non_finite_input_stays_out_of_the_reflections() {
+    use hikari_render::frame::{GBufferTarget, GBufferTexel};
+    let scene = room(metal_floor(0.3, Vec3::ZERO), &WALLS);
+    let s = settings(&scene, 8);
+    let mut r = Renderer::new(common::gpu_context(), &scene).unwrap();
+    // A probe whose numbers are not finite, or whose capture point lies outside its box, is
+    // refused by name.
+    let mut bad = probe(LO, HI, CAPTURE, 0.0);
+    bad.capture.x = f32::NAN;
+    let e = r.set_reflection_probes(&[bad]).unwrap_err().to_string();
+    assert!(e.contains("room") && e.contains("finite"), "{e}");
+    let outside = probe(LO, HI, HI + Vec3::ONE, 0.0);
+    assert!(r.set_reflection_probes(&[outside]).is_err());
+    r.set_reflection_probes(&[probe(LO - Vec3::Y * 0.01, HI, CAPTURE, 0.0)])
+        .unwrap();
+    // NaN and infinity in floor texels' normals and depths.
+    let f16 = |v: [f32; 4]| -> Vec<u8> {
+        v.iter()
+            .flat_map(|x| half::f16::from_f32(*x).to_le_bytes())
+            .collect()
+    };
+    let floor: Vec<(u32, u32)> = floor_pixels(&scene.cameras[0])
+        .iter()
+        .map(|p| (p.0, p.1))
+        .collect();
+    let at = |k: usize| [floor[k * 37 % floor.len()].0, floor[k * 37 % floor.len()].1];
+    r.override_gbuffer_texels(vec![
+        GBufferTexel {
+            target: GBufferTarget::Normal,
+            pixel: at(1),
+            size: [1, 1],
+            bytes: f16([f32::NAN, 0.2, 0.0, 0.0]),
+        },
+        GBufferTexel {
+            target: GBufferTarget::Normal,
+            pixel: at(2),
+            size: [1, 1],
+            bytes: f16([0.3, f32::INFINITY, 0.0, 0.0]),
+        },
+        GBufferTexel {
+            target: GBufferTarget::Depth,
+            pixel: at(3),
+            size: [1, 1],
+            bytes: f32::NAN.to_le_bytes().to_vec(),
+        },
+        GBufferTexel {
+            target: GBufferTarget::Depth,
+            pixel: at(4),
+            size: [1, 1],
+            bytes: f32::INFINITY.to_le_bytes().to_vec(),
+        },
+    ]);
+    let mut out = r.render_reading(&s, |o| vec![o.lit.into()]).unwrap();
+    let img = out.take_image("direct_lighting.radiance").unwrap();
+    assert!(
+        img.rgba
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite() && *c >= 0.0)),
+        "a non-finite or negative value reached the lit image"
+    );
+}

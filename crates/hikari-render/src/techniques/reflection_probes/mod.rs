@@ -10,9 +10,9 @@
 //!   talk captured offline; on a GPU it takes milliseconds.
 //! * `reflection_probes.relight` (`relight.wgsl`): this frame's probes (the talk: one a frame,
 //!   round robin; all of them when the sun jumps) into level 0 of `reflection_probes.relit`.
-//! * `reflection_probes.downsample`: the relit maps' mip chain.
-//! * `reflection_probes.prefilter` (`prefilter.wgsl`): GGX filtered importance sampling into
-//!   the persistent `reflection_probes.radiance`, one roughness a level.
+//! * `reflection_probes.downsample{m}`: level m of the relit maps' mip chain.
+//! * `reflection_probes.prefilter{k}` (`prefilter.wgsl`): GGX filtered importance sampling
+//!   into level k of the persistent `reflection_probes.radiance`, one roughness a level.
 //! * `hikari::reflection_probes` (`lookup.wgsl`, binding set `reflection_probes`): the
 //!   reflected radiance at a surface.
 //!
@@ -503,14 +503,14 @@ impl ReflectionProbes {
             .dispatch_threads(&self.relight, [n, n, 6 * k])?;
         for m in 0..mips - 1 {
             let side = (n >> (m + 1)).max(1);
-            g.pass("reflection_probes.downsample")
+            g.pass(&format!("reflection_probes.downsample{}", m + 1))
                 .read_mip(relit, m)
                 .write_mip(relit, m + 1)
                 .dispatch_threads(&self.downsample, [side, side, 6 * k])?;
         }
         for level in 0..s.levels {
             let side = (n >> level).max(1);
-            g.pass("reflection_probes.prefilter")
+            g.pass(&format!("reflection_probes.prefilter{level}"))
                 .constants(&PrefilterParams {
                     level: [level, s.levels, s.samples, n],
                     probes: [first, count, k, 0],
