@@ -412,6 +412,7 @@ pub fn record<'r>(
             ),
             weather: &s.settings.sky.weather,
             relight_all: camera_cut,
+            camera: s.camera.position,
             sky_light: s.settings.sky.sky,
         },
     )?;

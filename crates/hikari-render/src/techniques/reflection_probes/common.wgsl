@@ -10,7 +10,8 @@ struct ReflectionProbeGpu {
     to_box: mat4x4<f32>,
     // xyz: capture point (world); w: metres over which the probe fades inside its faces.
     capture: vec4<f32>,
-    // xyz: half the box's size along its axes, metres; w: unused.
+    // xyz: half the box's size along its axes, metres; w: 1 while the probe is resident
+    // (captured and near enough to the camera), else 0.
     half_m: vec4<f32>,
 }
 
@@ -77,8 +78,11 @@ fn rp_box_exit(p: ReflectionProbeGpu, x: vec3<f32>, d: vec3<f32>) -> f32 {
 }
 
 // The probe's weight at x: 1 deeper than `blend` metres inside every face, falling linearly to
-// 0 at the faces; 0 outside.
+// 0 at the faces; 0 outside, and 0 for a probe that is not resident.
 fn rp_box_weight(p: ReflectionProbeGpu, x: vec3<f32>) -> f32 {
+    if p.half_m.w <= 0.0 {
+        return 0.0;
+    }
     let o = (p.to_box * vec4<f32>(x, 1.0)).xyz;
     let inside_m = (1.0 - abs(o)) * p.half_m.xyz;
     let m = min(inside_m.x, min(inside_m.y, inside_m.z));

@@ -79,7 +79,7 @@ impl ReflectionProbeGpu {
         Self {
             to_box: p.transform.inverse().to_cols_array_2d(),
             capture: p.capture.extend(p.blend_m.max(0.0)).to_array(),
-            half_m: half.extend(0.0).to_array(),
+            half_m: half.extend(1.0).to_array(),
         }
     }
 }
@@ -151,6 +151,8 @@ pub struct ReflectionProbeInputs<'a> {
     pub weather: &'a str,
     /// Relight every probe this frame.
     pub relight_all: bool,
+    /// Where the camera is: probes farther than `stream_distance_m` from it are not resident.
+    pub camera: Vec3,
     /// The sky lights the probes (`sky.sky`; off: a black sky and no sky light).
     pub sky_light: bool,
 }
@@ -164,10 +166,9 @@ pub struct ReflectionProbesFrame {
     pub radiance: Option<Tex>,
     /// The captured cube maps, `None` with the probes off.
     pub capture: Option<[Tex; 3]>,
-    /// The probes relit this frame: `relit[1]` of them from index `relit[0]` on, round the
-    /// list ([`ReflectionProbes::probes`]'s order).
-    pub relit: [u32; 2],
-    /// Whether the cube maps were captured this frame.
+    /// How many probes were relit this frame.
+    pub relit: u32,
+    /// Whether any cube map was captured this frame.
     pub captured: bool,
 }
 
@@ -197,19 +198,35 @@ pub fn face_camera(at: Vec3, face: usize) -> Camera {
 struct Uploaded {
     /// Sorted by volume, smallest first (the lookup's nesting order).
     boxes: Vec<ReflectionProbeBox>,
+    /// `probes` as uploaded, every one resident.
+    gpu: Vec<ReflectionProbeGpu>,
     probes: wgpu::Buffer,
     capture_light: wgpu::Buffer,
+    /// The probes relit this frame (`relight.wgsl`, `prefilter.wgsl`).
+    relit_list: wgpu::Buffer,
     generation: u64,
 }
 
 #[derive(Default)]
 struct Progress {
-    /// (generation, resolution) the persistent cube maps were captured with.
-    captured: Option<(u64, u32)>,
+    /// (generation, resolution) the persistent cube maps hold, and which probes they hold.
+    captured_with: Option<(u64, u32)>,
+    captured: Vec<bool>,
+    /// Which probes were resident last frame.
+    resident: Vec<bool>,
     /// The next probe to relight.
     next: u32,
     /// The sun's direction and the weather at the last relight of every probe.
     relit_all_with: Option<(Vec3, String)>,
+}
+
+/// Metres from `p` to the probe's box (0 inside).
+pub fn distance_to_box(b: &ReflectionProbeBox, p: Vec3) -> f32 {
+    let local = b.transform.inverse().transform_point3(p);
+    let nearest = b
+        .transform
+        .transform_point3(local.clamp(Vec3::splat(-1.0), Vec3::ONE));
+    nearest.distance(p)
 }
 
 pub struct ReflectionProbes {
@@ -301,6 +318,12 @@ impl ReflectionProbes {
                 "reflection_probes.capture_light",
                 &vec![0u8; boxes.len() * 16],
             ),
+            relit_list: buffer(
+                ctx,
+                "reflection_probes.relit_list",
+                &vec![0u8; boxes.len() * 4],
+            ),
+            gpu,
             boxes,
             generation,
         }));
@@ -322,7 +345,7 @@ impl ReflectionProbes {
         self.progress
             .lock()
             .unwrap_or_else(|e| e.into_inner())
-            .captured = None;
+            .captured_with = None;
     }
 
     fn disabled_frame(
@@ -351,7 +374,7 @@ impl ReflectionProbes {
             lookup,
             radiance: None,
             capture: None,
-            relit: [0, 0],
+            relit: 0,
             captured: false,
         })
     }
@@ -405,42 +428,68 @@ impl ReflectionProbes {
 
         let mut progress = self.progress.lock().unwrap_or_else(|e| e.into_inner());
         let key = (u.generation, n);
-        let capture = f0 || f1 || f2 || progress.captured != Some(key);
-        if capture {
-            for (i, b) in u.boxes.iter().enumerate() {
-                for face in 0..6 {
-                    let view = View::new(&face_camera(b.capture, face), n, n);
-                    let gb = gbuffer.record_as(
-                        g,
-                        raster,
-                        scene,
-                        &view,
-                        [n, n],
-                        queues,
-                        &format!("reflection_probes.capture.p{i}f{face}"),
-                    )?;
-                    g.pass("reflection_probes.capture")
-                        .constants(&view)
-                        .constants(&CaptureParams {
-                            face: [face as u32, i as u32 * 6 + face as u32, n, 0],
-                            capture: b.capture.extend(0.0).to_array(),
-                        })
-                        .read(gb.depth)
-                        .read(gb.normal)
-                        .read(gb.albedo)
-                        .read(gb.material)
-                        .read(gb.emissive)
-                        .write(albedo)
-                        .write(normal_depth)
-                        .write(emission)
-                        .dispatch_threads(&self.capture, [n, n, 1])?;
-                }
+        if f0 || f1 || f2 || progress.captured_with != Some(key) {
+            progress.captured_with = Some(key);
+            progress.captured = vec![false; count as usize];
+            progress.resident = vec![false; count as usize];
+        }
+        // The talk streamed its probes in on demand; here a probe is resident while the camera
+        // is within `stream_distance_m` of its box (0: always), captured the first frame it is.
+        let resident: Vec<bool> = u
+            .boxes
+            .iter()
+            .map(|b| {
+                s.stream_distance_m <= 0.0
+                    || distance_to_box(b, inputs.camera) <= s.stream_distance_m
+            })
+            .collect();
+        let mut captured_now = false;
+        for (i, b) in u.boxes.iter().enumerate() {
+            if !resident[i] || progress.captured[i] {
+                continue;
             }
-            progress.captured = Some(key);
+            captured_now = true;
+            progress.captured[i] = true;
+            for face in 0..6 {
+                let view = View::new(&face_camera(b.capture, face), n, n);
+                let gb = gbuffer.record_as(
+                    g,
+                    raster,
+                    scene,
+                    &view,
+                    [n, n],
+                    queues,
+                    &format!("reflection_probes.capture.p{i}f{face}"),
+                )?;
+                g.pass("reflection_probes.capture")
+                    .constants(&view)
+                    .constants(&CaptureParams {
+                        face: [face as u32, i as u32 * 6 + face as u32, n, 0],
+                        capture: b.capture.extend(0.0).to_array(),
+                    })
+                    .read(gb.depth)
+                    .read(gb.normal)
+                    .read(gb.albedo)
+                    .read(gb.material)
+                    .read(gb.emissive)
+                    .write(albedo)
+                    .write(normal_depth)
+                    .write(emission)
+                    .dispatch_threads(&self.capture, [n, n, 1])?;
+            }
+        }
+        if !captured_now {
+            // Nothing drawn this frame: the graph must still see the capture written.
+            g.pass("reflection_probes.keep")
+                .uses(albedo, true)
+                .uses(normal_depth, true)
+                .uses(emission, true)
+                .encode(|_, _| {})?;
         }
 
-        // Which probes to relight: all of them after a capture, a new radiance texture, a jump
-        // of the sun or a new weather; else the next `per_frame`, round robin.
+        // Which probes to relight: every resident one after a new radiance texture, a jump of
+        // the sun or a new weather; else those that just became resident and the next
+        // `per_frame` resident ones, round robin.
         let sun_dir = inputs.sun.map_or(Vec3::ZERO, |s| s.direction);
         let moved = match &progress.relit_all_with {
             Some((d, w)) => {
@@ -450,15 +499,59 @@ impl ReflectionProbes {
             }
             None => true,
         };
-        let all = capture || f3 || moved || inputs.relight_all;
-        let (first, k) = if all {
+        let all = f3 || moved || inputs.relight_all;
+        if all {
             progress.relit_all_with = Some((sun_dir, inputs.weather.to_owned()));
-            (0, count)
-        } else {
-            (progress.next % count, s.per_frame.min(count))
-        };
-        progress.next = (first + k) % count;
+        }
+        let mut list: Vec<u32> = (0..count)
+            .filter(|&i| resident[i as usize] && (all || !progress.resident[i as usize]))
+            .collect();
+        let mut budget = if all { 0 } else { s.per_frame };
+        for step in 0..count {
+            if budget == 0 {
+                break;
+            }
+            let i = (progress.next + step) % count;
+            if resident[i as usize] && !list.contains(&i) {
+                list.push(i);
+                budget -= 1;
+                progress.next = (i + 1) % count;
+            }
+        }
+        progress.resident = resident.clone();
         drop(progress);
+        let gpu: Vec<ReflectionProbeGpu> = u
+            .gpu
+            .iter()
+            .zip(&resident)
+            .map(|(p, &r)| ReflectionProbeGpu {
+                half_m: [
+                    p.half_m[0],
+                    p.half_m[1],
+                    p.half_m[2],
+                    f32::from(u8::from(r)),
+                ],
+                ..*p
+            })
+            .collect();
+        let queue = &g.ctx().queue;
+        queue.write_buffer(&u.probes, 0, bytemuck::cast_slice(&gpu));
+        let k = list.len() as u32;
+        if k > 0 {
+            queue.write_buffer(&u.relit_list, 0, bytemuck::cast_slice(&list));
+        }
+        let relit_list = g.import_buffer("reflection_probes.relit_list", &u.relit_list);
+        let lookup_params = ReflectionProbeParams::new(s, count, s.levels, true);
+        if k == 0 {
+            let lookup = lookup_set(g, &lookup_params, probes, radiance, capture_light);
+            return Ok(ReflectionProbesFrame {
+                lookup,
+                radiance: Some(radiance),
+                capture: Some([albedo, normal_depth, emission]),
+                relit: 0,
+                captured: captured_now,
+            });
+        }
 
         let relit = g.texture(
             "reflection_probes.relit",
@@ -485,7 +578,7 @@ impl ReflectionProbes {
             .constants(&RelightParams {
                 sun: sun.to_array(),
                 sun_color: sun_color.to_array(),
-                probes: [first, count, k, flags],
+                probes: [0, count, k, flags],
                 config: [inputs.light_count, n, s.shadow_pcf_radius, 0],
                 cutoff: [inputs.cutoff_lux, 0.0, 0.0, 0.0],
             })
@@ -496,6 +589,7 @@ impl ReflectionProbes {
             .read(inputs.lights)
             .write(relit)
             .write(capture_light)
+            .read(relit_list)
             .set(inputs.sky.lookup)
             .set(inputs.sky.ambient)
             .set(inputs.probes.lookup)
@@ -513,26 +607,21 @@ impl ReflectionProbes {
             g.pass(&format!("reflection_probes.prefilter{level}"))
                 .constants(&PrefilterParams {
                     level: [level, s.levels, s.samples, n],
-                    probes: [first, count, k, 0],
+                    probes: [0, count, k, 0],
                 })
                 .read(relit)
                 .sampler(SamplerKind::LinearClamp)
                 .write_mip(radiance, level)
+                .read(relit_list)
                 .dispatch_threads(&self.prefilter, [side, side, 6 * k])?;
         }
-        let lookup = lookup_set(
-            g,
-            &ReflectionProbeParams::new(s, count, s.levels, true),
-            probes,
-            radiance,
-            capture_light,
-        );
+        let lookup = lookup_set(g, &lookup_params, probes, radiance, capture_light);
         Ok(ReflectionProbesFrame {
             lookup,
             radiance: Some(radiance),
             capture: Some([albedo, normal_depth, emission]),
-            relit: [first, k],
-            captured: capture,
+            relit: k,
+            captured: captured_now,
         })
     }
 }

@@ -9,7 +9,7 @@
 struct PrefilterParams {
     // x: output level; y: levels; z: samples; w: texels a side of relit level 0.
     level: vec4<u32>,
-    // x: first probe relit; y: probes in all; z: probes relit.
+    // x: unused; y: probes in all; z: probes relit (listed in `relit_list`).
     probes: vec4<u32>,
 }
 
@@ -17,6 +17,7 @@ struct PrefilterParams {
 @group(0) @binding(1) var relit: texture_cube_array<f32>;
 @group(0) @binding(2) var relit_sampler: sampler;
 @group(0) @binding(3) var out_level: texture_storage_2d_array<rgba16float, write>;
+@group(0) @binding(4) var<storage, read> relit_list: array<u32>;
 
 const PI: f32 = 3.14159265358979;
 
@@ -37,7 +38,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let face = gid.z % 6u;
     let cube = gid.z / 6u;
-    let probe = (params.probes.x + cube) % count;
+    let probe = min(relit_list[cube], count - 1u);
     let n = rp_texel_direction(face, gid.xy, size);
     let level = params.level.x;
     var value: vec3<f32>;

@@ -71,8 +71,11 @@ pub fn box_exit(p: &ReflectionProbeGpu, x: Vec3, d: Vec3) -> f32 {
 }
 
 /// The probe's weight at x: 1 deeper than its blend distance inside every face, linear to 0
-/// at the faces, 0 outside.
+/// at the faces, 0 outside and for a probe that is not resident.
 pub fn box_weight(p: &ReflectionProbeGpu, x: Vec3) -> f32 {
+    if p.half_m[3] <= 0.0 {
+        return 0.0;
+    }
     let o = to_box(p).transform_point3(x);
     let half = Vec3::from_slice(&p.half_m[..3]);
     let inside = (Vec3::ONE - o.abs()) * half;

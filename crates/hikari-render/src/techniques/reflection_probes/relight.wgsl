@@ -22,7 +22,7 @@ struct RelightParams {
     sun: vec4<f32>,
     // rgb: its colour, luminance 1.
     sun_color: vec4<f32>,
-    // x: first probe relit; y: probes in all; z: probes relit; w: RELIGHT_* flags.
+    // x: unused; y: probes in all; z: probes relit (listed in `relit_list`); w: RELIGHT_* flags.
     probes: vec4<u32>,
     // x: lights; y: texels a side; z: PCF radius in texels; w: unused.
     config: vec4<u32>,
@@ -46,6 +46,8 @@ const MAX_HALF: f32 = 65000.0;
 // Per probe: the luminance of the irradiance at its capture point as an L1 function of the
 // normal (mean, then x, y, z slopes), lux.
 @group(0) @binding(7) var<storage, read_write> capture_light: array<vec4<f32>>;
+// The probes relit this frame.
+@group(0) @binding(8) var<storage, read> relit_list: array<u32>;
 
 const EXPOSURE_LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
 
@@ -97,7 +99,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let face = gid.z % 6u;
-    let probe = (params.probes.x + gid.z / 6u) % count;
+    let probe = min(relit_list[gid.z / 6u], count - 1u);
     let p = probes[probe];
     let layer = probe * 6u + face;
     let flags = params.probes.w;

@@ -21,6 +21,9 @@ pub struct ReflectionProbesSettings {
     pub per_frame: u32,
     /// Degrees the sun (or moon) may move before every probe is relit at once.
     pub relight_all_deg: f32,
+    /// A probe is resident (captured, relit and used) while the camera is within this many
+    /// metres of its box; 0: every probe always.
+    pub stream_distance_m: f32,
     /// GGX samples a texel of the prefilter takes (filtered importance sampling).
     pub samples: u32,
     /// The talk's cube-map shadow tracing (off: the sun lights every captured texel).
@@ -45,6 +48,7 @@ impl Default for ReflectionProbesSettings {
             levels: 6,
             per_frame: 1,
             relight_all_deg: 2.0,
+            stream_distance_m: 60.0,
             samples: 32,
             shadow_tracing: true,
             shadow_pcf_radius: 2,
@@ -74,6 +78,13 @@ impl TechniqueSettings for ReflectionProbesSettings {
             Field {
                 key: "relight_all_deg",
                 range: Range::Float { lo: 0.0, hi: 180.0 },
+            },
+            Field {
+                key: "stream_distance_m",
+                range: Range::Float {
+                    lo: 0.0,
+                    hi: 1_000_000.0,
+                },
             },
             Field {
                 key: "samples",
