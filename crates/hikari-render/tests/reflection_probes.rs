@@ -617,3 +617,77 @@ fn non_finite_input_stays_out_of_the_reflections() {
         "a non-finite or negative value reached the lit image"
     );
 }
+
+#[test]
+fn only_probes_near_the_camera_are_captured_and_relit() {
+    let scene = room(metal_floor(0.0, Vec3::ZERO), &WALLS);
+    let mut s = settings(&scene, 4);
+    s.settings.reflection_probes.stream_distance_m = 100.0;
+    let far = probe(
+        Vec3::new(500.0, 0.0, 0.0),
+        Vec3::new(504.0, 3.0, 4.0),
+        Vec3::new(502.0, 1.0, 2.0),
+        0.0,
+    );
+    let near = probe(LO - Vec3::Y * 0.01, HI, CAPTURE, 0.0);
+    let relit = |s: &FrameSettings, frames: usize| -> Vec<(u32, bool)> {
+        let mut r = Renderer::new(common::gpu_context(), &scene).unwrap();
+        r.set_reflection_probes(&[far.clone(), near.clone()])
+            .unwrap();
+        (0..frames)
+            .map(|_| {
+                let mut seen = None;
+                r.render_reading(s, |o| {
+                    seen = Some((o.reflection_probes.relit, o.reflection_probes.captured));
+                    vec![]
+                })
+                .unwrap();
+                seen.unwrap()
+            })
+            .collect()
+    };
+    // The far probe is 496 m away: only the room's is captured and relit, first whole, then
+    // one a frame (round robin over the one resident probe), and captured only once.
+    assert_eq!(relit(&s, 3), [(1, true), (1, false), (1, false)]);
+    s.settings.reflection_probes.stream_distance_m = 0.0;
+    assert_eq!(relit(&s, 2), [(2, true), (1, false)]);
+    // A sun that moves more than `relight_all_deg` (2) between frames relights every probe;
+    // one that moves less, one a frame.
+    let mut r = Renderer::new(common::gpu_context(), &scene).unwrap();
+    r.set_reflection_probes(&[far.clone(), near.clone()])
+        .unwrap();
+    let counts: Vec<u32> = [30.0f32, 30.5, 36.0]
+        .iter()
+        .map(|deg| {
+            let a = deg.to_radians();
+            let mut f = s.clone();
+            f.sun = Some(hikari_scene::Sun {
+                direction: Vec3::new(a.cos(), a.sin(), 0.0),
+                illuminance_lux: 1000.0,
+                color: Vec3::ONE,
+            });
+            let mut seen = 0;
+            r.render_reading(&f, |o| {
+                seen = o.reflection_probes.relit;
+                vec![]
+            })
+            .unwrap();
+            seen
+        })
+        .collect();
+    assert_eq!(counts, [2, 1, 2], "sun at 30, 30.5 and 36 degrees");
+    // The mirror still shows the walls with the far probe in the list.
+    let mut r = Renderer::new(common::gpu_context(), &scene).unwrap();
+    r.set_reflection_probes(&[far, near]).unwrap();
+    let mut out = r
+        .render_reading(&settings(&scene, 4), |o| vec![o.lit.into()])
+        .unwrap();
+    let img = out.take_image("direct_lighting.radiance").unwrap();
+    let (x, y, p, v) = floor_pixels(&scene.cameras[0])[200];
+    let (wall, _) = wall_hit(p, Vec3::new(-v.x, v.y, -v.z)).unwrap();
+    let got = Vec4::from(img.pixel(x, y)).truncate();
+    assert!(
+        (got - WALLS[wall]).abs().max_element() < 0.05 * WALLS[wall].max_element(),
+        "{got}"
+    );
+}

@@ -493,9 +493,11 @@ impl ReflectionProbes {
         let sun_dir = inputs.sun.map_or(Vec3::ZERO, |s| s.direction);
         let moved = match &progress.relit_all_with {
             Some((d, w)) => {
+                let (had, has) = (d.length_squared() > 0.0, sun_dir.length_squared() > 0.0);
                 w != inputs.weather
-                    || d.dot(sun_dir).clamp(-1.0, 1.0).acos().to_degrees() > s.relight_all_deg
-                    || (d.length_squared() == 0.0) != (sun_dir.length_squared() == 0.0)
+                    || had != has
+                    || (has
+                        && d.dot(sun_dir).clamp(-1.0, 1.0).acos().to_degrees() > s.relight_all_deg)
             }
             None => true,
         };
