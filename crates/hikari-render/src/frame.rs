@@ -553,7 +553,7 @@ pub fn record<'r>(
         lighting.use_sky(s.settings.sky.sky);
     }
     lighting.use_probes(probes.present);
-    lighting.use_reflection_probes(reflection_probes.radiance.is_some());
+    lighting.use_reflection_probes(&reflection_probes.lookup.params);
     if gi_light.is_some() {
         lighting.use_ray_traced_gi(
             s.settings.ray_traced_gi.near_field_m,
@@ -621,7 +621,7 @@ pub fn record<'r>(
         &lighting,
         area_light_for_lighting,
         gi_light.as_ref(),
-        reflection_probes.lookup,
+        &reflection_probes.lookup,
     )?;
     if ray_traced_gi.is_some() {
         // The lit image lights next frame's GI hits where they were visible.

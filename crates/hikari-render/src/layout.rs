@@ -42,11 +42,6 @@ pub fn all() -> Vec<StructLayout> {
             [to_box, capture, half_m]
         ),
         gpu_layout!(
-            reflection_probes::ReflectionProbeParams,
-            "direct_lighting/shade.wgsl",
-            [config, values]
-        ),
-        gpu_layout!(
             reflection_probes::CaptureParams,
             "reflection_probes/capture.wgsl",
             [face, capture]
@@ -147,7 +142,9 @@ pub fn all() -> Vec<StructLayout> {
                 sky_zenith,
                 sky_horizon,
                 config,
-                cutoff
+                cutoff,
+                reflection,
+                reflection_values
             ]
         ),
         gpu_layout!(

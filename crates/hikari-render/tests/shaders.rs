@@ -124,7 +124,6 @@ fn shared_modules_bind_in_groups_of_their_own() {
             "brdf_tables",
             "clouds",
             "irradiance_probes",
-            "reflection_probes",
             "sky",
             "sky_ambient",
             "sun_shadows"
@@ -138,8 +137,8 @@ fn shared_modules_bind_in_groups_of_their_own() {
         &lib.binding_sets("direct_lighting/shade.wgsl"),
     )
     .unwrap();
-    assert_eq!(groups.len(), 8);
-    let names: Vec<&str> = groups[7]
+    assert_eq!(groups.len(), 7);
+    let names: Vec<&str> = groups[6]
         .iter()
         .map(|s| shader::undecorated(&s.name))
         .collect();

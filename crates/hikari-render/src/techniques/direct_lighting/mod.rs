@@ -13,11 +13,12 @@ use hikari_scene::Sun;
 use super::clouds::CloudsFrame;
 use super::gbuffer::GBuffer;
 use super::irradiance_probes::ProbesFrame;
+use super::reflection_probes::{ReflectionLookup, ReflectionProbeParams};
 use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{BindingSet, FrameGraph, Tex, TextureDesc};
+use crate::graph::{BindingSet, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::scene_gpu::SceneInFrame;
 use crate::settings::DirectLightingSettings;
@@ -62,6 +63,10 @@ pub struct LightingParams {
     /// ray-traced GI's near field in metres; z: the fraction of it over which the GI blends
     /// into the far field; w unused.
     pub cutoff: [f32; 4],
+    /// The reflection probes: probes, roughness levels, `RP_*` flags (0: none), 0.
+    pub reflection: [u32; 4],
+    /// x: their normalisation's largest ratio.
+    pub reflection_values: [f32; 4],
 }
 
 /// A punctual light is cut off where its illuminance falls below this fraction of the frame's
@@ -113,6 +118,8 @@ impl LightingParams {
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky).extend(0.0).to_array(),
             config: [light_count, flags, 0, 0],
             cutoff: [light_cutoff_lux(metered_lux), 0.0, 0.0, 0.0],
+            reflection: [0; 4],
+            reflection_values: [0.0; 4],
         }
     }
 }
@@ -140,11 +147,14 @@ impl LightingParams {
         }
     }
 
-    /// Takes the indirect specular light from the reflection probes where they cover a surface.
-    pub fn use_reflection_probes(&mut self, present: bool) {
-        if present {
+    /// Takes the indirect specular light from the reflection probes where they cover a surface
+    /// (`p`'s `RP_ON` flag).
+    pub fn use_reflection_probes(&mut self, p: &ReflectionProbeParams) {
+        if p.config[2] & super::reflection_probes::RP_ON != 0 {
             self.config[1] |= LIGHTING_REFLECTION_PROBES;
         }
+        self.reflection = p.config;
+        self.reflection_values = p.values;
     }
 
     /// Takes the ambient diffuse light from the irradiance probes when `present`.
@@ -198,7 +208,7 @@ impl DirectLighting {
         params: &LightingParams,
         area_lights: Tex,
         gi: Option<&GiLight>,
-        reflection_probes: BindingSet,
+        reflection_probes: &ReflectionLookup,
     ) -> Result<LitFrame> {
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let radiance = g.texture(
@@ -226,13 +236,16 @@ impl DirectLighting {
             .read(gi.map_or(gb.normal, |g| g.cocg))
             .read(gi.map_or(gb.normal, |g| g.ao))
             .read(gb.vertex_normal)
+            .read(reflection_probes.probes)
+            .read(reflection_probes.radiance)
+            .sampler(SamplerKind::LinearClamp)
+            .read(reflection_probes.capture_light)
             .set(shadows.lookup)
             .set(sky.lookup)
             .set(sky.ambient)
             .set(clouds.lookup)
             .set(probes.lookup)
             .set(brdf_tables)
-            .set(reflection_probes)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(LitFrame {
             radiance,

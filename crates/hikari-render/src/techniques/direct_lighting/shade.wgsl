@@ -15,7 +15,7 @@
 #import hikari::sky_ambient::{sky_ambient_eval, sky_ambient_irradiance, sky_ambient_specular}
 #import hikari::irradiance_probes::probe_irradiance_at
 #import hikari::rtgi_resolve::{rtgi_signal, rtgi_resolve_diffuse, rtgi_resolve_specular}
-#import hikari::reflection_probes::reflection_probe_radiance
+#import hikari::reflection_probe_math::{ReflectionProbeGpu, RP_ON, RP_HORIZON, RP_PARALLAX_ROUGHNESS, RP_NORMALIZE, rp_box_weight, rp_lookup_direction, rp_normalization, rp_horizon_occlusion}
 #import hikari::tile_bounds::{tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 
 struct LightingParams {
@@ -31,6 +31,10 @@ struct LightingParams {
     config: vec4<u32>,
     // x: illuminance in lux below which a punctual light is cut off this frame.
     cutoff: vec4<f32>,
+    // The reflection probes: x probes, y roughness levels, z RP_* flags.
+    reflection: vec4<u32>,
+    // x: their normalisation's largest ratio.
+    reflection_values: vec4<f32>,
 }
 
 const LIGHTING_SUN: u32 = 1u;
@@ -63,6 +67,15 @@ const LIGHTING_REFLECTION_PROBES: u32 = 128u;
 @group(0) @binding(13) var gi_ao: texture_2d<f32>;
 // The vertex normal before the normal map (the reflection probes' horizon occlusion).
 @group(0) @binding(14) var gbuffer_vertex_normal: texture_2d<f32>;
+// The relit reflection probes (`ReflectionProbesFrame::lookup`), in this pass's own group and
+// uniform: a binding set of their own would be its eighth uniform buffer, one more than
+// lavapipe takes in a stage without corrupting its heap.
+// Sorted by the boxes' volume, smallest first.
+@group(0) @binding(15) var<storage, read> rp_probes: array<ReflectionProbeGpu>;
+@group(0) @binding(16) var rp_radiance: texture_cube_array<f32>;
+@group(0) @binding(17) var rp_sampler: sampler;
+// Per probe: luminance of the irradiance at its capture point, mean and x, y, z slopes (lux).
+@group(0) @binding(18) var<storage, read> rp_capture_light: array<vec4<f32>>;
 
 const PI: f32 = 3.14159265358979;
 // Largest finite f16 is 65504; stay below it so no pixel turns into infinity.
@@ -97,6 +110,46 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
     let mean = 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb);
     let env = mix(sky_placeholder(r), mean, m.perceptual_roughness) * select(0.0, 1.0, r.y > 0.0);
     return brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0)) * env;
+}
+
+// The relit reflection probes' reflected radiance (rgb, nits, before Fresnel) at world point x
+// of mapped normal nm and vertex normal nv, seen from v (towards the eye), perceptual
+// roughness `roughness`, from the probes whose boxes hold x (smallest first, each fading out
+// over its blend distance into the next: the talk's nesting); `e_luma`: the luminance of the
+// irradiance the surface receives (lux), for the normalisation. w: the probes' coverage, 0 to
+// 1. Twin: `reflection_probes::reference::lookup`.
+fn reflection_probe_radiance(x: vec3<f32>, nm: vec3<f32>, nv: vec3<f32>, v: vec3<f32>, roughness: f32, e_luma: f32) -> vec4<f32> {
+    let flags = params.reflection.z;
+    if (flags & RP_ON) == 0u {
+        return vec4<f32>(0.0);
+    }
+    let r = reflect(-v, nm);
+    let alpha = roughness * roughness;
+    let levels = f32(max(params.reflection.y, 1u) - 1u);
+    var sum = vec3<f32>(0.0);
+    var covered = 0.0;
+    for (var i = 0u; i < params.reflection.x; i++) {
+        let p = rp_probes[i];
+        let w = rp_box_weight(p, x);
+        if w <= 0.0 {
+            continue;
+        }
+        let at = rp_lookup_direction(p, x, r, alpha, levels, (flags & RP_PARALLAX_ROUGHNESS) != 0u);
+        var c = textureSampleLevel(rp_radiance, rp_sampler, at.xyz, i, at.w).rgb;
+        if (flags & RP_NORMALIZE) != 0u {
+            c *= rp_normalization(rp_capture_light[i], nm, e_luma, params.reflection_values.x);
+        }
+        let take = (1.0 - covered) * w;
+        sum += c * take;
+        covered += take;
+        if covered >= 0.999 {
+            break;
+        }
+    }
+    if (flags & RP_HORIZON) != 0u {
+        sum *= 1.0 - rp_horizon_occlusion(nm, nv, r, alpha);
+    }
+    return vec4<f32>(sum, covered);
 }
 
 // Specular occlusion from ambient occlusion (Lagarde and de Rousiers 2014): a smooth lobe

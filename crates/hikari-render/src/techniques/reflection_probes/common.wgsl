@@ -15,6 +15,11 @@ struct ReflectionProbeGpu {
     half_m: vec4<f32>,
 }
 
+const RP_ON: u32 = 1u;
+const RP_HORIZON: u32 = 2u;
+const RP_PARALLAX_ROUGHNESS: u32 = 4u;
+const RP_NORMALIZE: u32 = 8u;
+
 const RP_PI: f32 = 3.14159265358979;
 // The fraction of the GGX lobe's energy its reflection cone holds (the talk: 0.95).
 const RP_CONE_ENERGY: f32 = 0.95;
@@ -135,4 +140,24 @@ fn rp_compensated_alpha(alpha: f32, d_eye: f32, d_capture: f32) -> f32 {
 // Van der Corput / Hammersley point i of n.
 fn rp_hammersley(i: u32, n: u32) -> vec2<f32> {
     return vec2<f32>((f32(i) + 0.5) / f32(n), f32(reverseBits(i)) * 2.3283064365386963e-10);
+}
+
+// Where a probe is read for a surface at x reflecting along r (GGX alpha): xyz the direction
+// from its capture point to where r leaves its box (parallax correction), w the level of
+// detail, with the talk's roughness parallax compensation when `compensate`.
+fn rp_lookup_direction(p: ReflectionProbeGpu, x: vec3<f32>, r: vec3<f32>, alpha: f32, levels: f32, compensate: bool) -> vec4<f32> {
+    let t = rp_box_exit(p, x, r);
+    let dir = x + r * t - p.capture.xyz;
+    var a = alpha;
+    if compensate {
+        a = rp_compensated_alpha(alpha, t, length(dir));
+    }
+    return vec4<f32>(dir, sqrt(a) * levels);
+}
+
+// The talk's luminance normalisation: the luminance of the irradiance a surface of normal n
+// receives over that at the probe's capture point (`light`: mean and x, y, z slopes), at most
+// `max_ratio`.
+fn rp_normalization(light: vec4<f32>, n: vec3<f32>, e_luma: f32, max_ratio: f32) -> f32 {
+    return clamp(e_luma / max(light.x + dot(light.yzw, n), 1e-6), 0.0, max_ratio);
 }

@@ -13,8 +13,9 @@
 //! * `reflection_probes.downsample{m}`: level m of the relit maps' mip chain.
 //! * `reflection_probes.prefilter{k}` (`prefilter.wgsl`): GGX filtered importance sampling
 //!   into level k of the persistent `reflection_probes.radiance`, one roughness a level.
-//! * `hikari::reflection_probes` (`lookup.wgsl`, binding set `reflection_probes`): the
-//!   reflected radiance at a surface.
+//! * [`ReflectionLookup`]: what the deferred lighting reads the probes through
+//!   (`direct_lighting/shade.wgsl`'s `reflection_probe_radiance`, with the per-probe math of
+//!   `common.wgsl`).
 //!
 //! CPU twins: [`reference`].
 
@@ -35,7 +36,7 @@ use super::irradiance_probes::ProbesFrame;
 use super::sky::SkyFrame;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
+use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::raster::{RasterQueues, Rasterizer};
 use crate::scene_gpu::SceneInFrame;
@@ -84,9 +85,10 @@ impl ReflectionProbeGpu {
     }
 }
 
-/// The lookup's uniform (`hikari::reflection_probes::ReflectionProbeParams`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+/// The lookup's numbers, which the deferred lighting's uniform carries
+/// (`LightingParams::reflection`): probes, roughness levels, `RP_*` flags; the
+/// normalisation's largest ratio.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReflectionProbeParams {
     pub config: [u32; 4],
     pub values: [f32; 4],
@@ -157,11 +159,23 @@ pub struct ReflectionProbeInputs<'a> {
     pub sky_light: bool,
 }
 
+/// What the deferred lighting binds to read the probes, in this order (the numbers go into
+/// its uniform).
+#[derive(Clone, Copy, Debug)]
+pub struct ReflectionLookup {
+    pub params: ReflectionProbeParams,
+    /// `reflection_probes.probes`: [`ReflectionProbeGpu`] a probe, smallest box first.
+    pub probes: Buf,
+    /// The prefiltered cube maps (a 1 x 1 stand-in with the probes off).
+    pub radiance: Tex,
+    /// `reflection_probes.capture_light`: the light at each capture point.
+    pub capture_light: Buf,
+}
+
 /// The probes of a frame.
 #[derive(Clone, Copy, Debug)]
 pub struct ReflectionProbesFrame {
-    /// Binding set `reflection_probes` of `hikari::reflection_probes`.
-    pub lookup: BindingSet,
+    pub lookup: ReflectionLookup,
     /// `reflection_probes.radiance` (`None` with the probes off).
     pub radiance: Option<Tex>,
     /// The captured cube maps, `None` with the probes off.
@@ -363,13 +377,12 @@ impl ReflectionProbes {
             .encode(|_, _| {})?;
         let probes = g.import_buffer("reflection_probes.probes", &self.empty_probe);
         let light = g.import_buffer("reflection_probes.capture_light", &self.empty_light);
-        let lookup = lookup_set(
-            g,
-            &ReflectionProbeParams::new(s, 0, 1, false),
+        let lookup = ReflectionLookup {
+            params: ReflectionProbeParams::new(s, 0, 1, false),
             probes,
             radiance,
-            light,
-        );
+            capture_light: light,
+        };
         Ok(ReflectionProbesFrame {
             lookup,
             radiance: None,
@@ -545,7 +558,12 @@ impl ReflectionProbes {
         let relit_list = g.import_buffer("reflection_probes.relit_list", &u.relit_list);
         let lookup_params = ReflectionProbeParams::new(s, count, s.levels, true);
         if k == 0 {
-            let lookup = lookup_set(g, &lookup_params, probes, radiance, capture_light);
+            let lookup = ReflectionLookup {
+                params: lookup_params,
+                probes,
+                radiance,
+                capture_light,
+            };
             return Ok(ReflectionProbesFrame {
                 lookup,
                 radiance: Some(radiance),
@@ -617,7 +635,12 @@ impl ReflectionProbes {
                 .read(relit_list)
                 .dispatch_threads(&self.prefilter, [side, side, 6 * k])?;
         }
-        let lookup = lookup_set(g, &lookup_params, probes, radiance, capture_light);
+        let lookup = ReflectionLookup {
+            params: lookup_params,
+            probes,
+            radiance,
+            capture_light,
+        };
         Ok(ReflectionProbesFrame {
             lookup,
             radiance: Some(radiance),
@@ -626,22 +649,6 @@ impl ReflectionProbes {
             captured: captured_now,
         })
     }
-}
-
-fn lookup_set(
-    g: &mut FrameGraph<'_>,
-    params: &ReflectionProbeParams,
-    probes: Buf,
-    radiance: Tex,
-    capture_light: Buf,
-) -> BindingSet {
-    g.binding_set("reflection_probes")
-        .constants(params)
-        .read(probes)
-        .read(radiance)
-        .sampler(SamplerKind::LinearClamp)
-        .read(capture_light)
-        .finish()
 }
 
 /// The box transform of a probe whose box is `lo..hi` (world, axis-aligned).
