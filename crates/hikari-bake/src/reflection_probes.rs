@@ -20,7 +20,7 @@ use hikari_scene::village::{Footprint, VillageLayout};
 use serde_json::Value;
 
 use crate::error::BakeError;
-use crate::volumes::{gltf_json_bytes, marked_nodes, node_box};
+use crate::volumes::{marked_nodes, node_box, read_gltf_json};
 
 /// A relit reflection probe: where its cube map is captured and the box it serves.
 #[derive(Clone, Debug, PartialEq)]
@@ -211,14 +211,7 @@ pub fn default_reflection_probe(scene: &Scene) -> Option<ReflectionProbeBox> {
 /// The reflection probes a glTF file (`.gltf` or `.glb`) marks in its nodes' `extras` (module
 /// documentation), each validated.
 pub fn gltf_reflection_probes(path: &Path) -> Result<Vec<ReflectionProbeBox>, BakeError> {
-    let err = |what: String| BakeError::Gltf {
-        path: path.to_path_buf(),
-        what,
-    };
-    let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read: {e}")))?;
-    let json = gltf_json_bytes(&bytes).map_err(err)?;
-    let doc: Value = serde_json::from_slice(json).map_err(|e| err(format!("bad JSON: {e}")))?;
-    probes_of_document(&doc).map_err(err)
+    read_gltf_json(path, probes_of_document)
 }
 
 pub(crate) fn probes_of_document(doc: &Value) -> Result<Vec<ReflectionProbeBox>, String> {

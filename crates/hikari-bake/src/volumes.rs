@@ -145,6 +145,14 @@ pub fn builtin_volumes(name: &str) -> Vec<ProbeVolume> {
 /// The probe volumes a glTF file (`.gltf` or `.glb`) marks in its nodes' `extras` (module
 /// documentation). Nodes of the file's default scene (else scene 0) and their descendants.
 pub fn gltf_volumes(path: &Path) -> Result<Vec<ProbeVolume>, BakeError> {
+    read_gltf_json(path, volumes_of_document)
+}
+
+/// `read` of a glTF file's JSON document; its errors and the file's name the path.
+pub(crate) fn read_gltf_json<T>(
+    path: &Path,
+    read: impl FnOnce(&Value) -> Result<T, String>,
+) -> Result<T, BakeError> {
     let err = |what: String| BakeError::Gltf {
         path: path.to_path_buf(),
         what,
@@ -152,11 +160,11 @@ pub fn gltf_volumes(path: &Path) -> Result<Vec<ProbeVolume>, BakeError> {
     let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read: {e}")))?;
     let json = gltf_json_bytes(&bytes).map_err(err)?;
     let doc: Value = serde_json::from_slice(json).map_err(|e| err(format!("bad JSON: {e}")))?;
-    volumes_of_document(&doc).map_err(err)
+    read(&doc).map_err(err)
 }
 
 /// The JSON chunk of a `.glb`, or the whole of a `.gltf`.
-pub(crate) fn gltf_json_bytes(bytes: &[u8]) -> Result<&[u8], String> {
+fn gltf_json_bytes(bytes: &[u8]) -> Result<&[u8], String> {
     if !bytes.starts_with(b"glTF") {
         return Ok(bytes);
     }
