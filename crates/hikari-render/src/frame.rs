@@ -1,5 +1,6 @@
 //! One frame, top to bottom. Each numbered step is the step of the same number in
-//! ARCHITECTURE.md; the steps not yet built say which issue brings them.
+//! ARCHITECTURE.md, except 5 and 6: the clouds come before the reflection probes, which they
+//! shadow and whose sky they cover.
 
 use hikari_scene::{Camera, Sun};
 
