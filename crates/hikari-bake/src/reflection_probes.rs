@@ -58,6 +58,15 @@ impl ReflectionProbeBox {
         )
     }
 
+    /// Metres from `p` to the box (0 inside).
+    pub fn distance_to(&self, p: Vec3) -> f32 {
+        let local = self.transform.inverse().transform_point3(p);
+        let nearest = self
+            .transform
+            .transform_point3(local.clamp(Vec3::splat(-1.0), Vec3::ONE));
+        nearest.distance(p)
+    }
+
     /// Checks finite numbers, a box at least 1 cm along each axis whose axes are at right
     /// angles, the capture point inside it, and a blend of 0 or more metres.
     pub fn validate(&self) -> Result<(), BakeError> {

@@ -103,6 +103,11 @@ fn the_default_probe_bounds_every_instance() {
             .max_element()
             < 1e-5
     );
+    // Distances to the box: 0 inside, straight up 3 m over the top is 3, past a corner the
+    // diagonal.
+    assert!(p.distance_to(Vec3::new(0.0, 1.0, 1.0)) < 1e-5);
+    assert!((p.distance_to(Vec3::new(0.0, 5.0, 1.0)) - 3.0).abs() < 1e-5);
+    assert!((p.distance_to(Vec3::new(8.0, 2.0, 8.0)) - 5.0).abs() < 1e-5);
     assert!(default_reflection_probe(&Scene::default()).is_none());
 }
 

@@ -78,11 +78,6 @@ impl Renderer {
             .set_probes(&self.ctx, probes)
     }
 
-    /// The reflection probes in the order the GPU holds them (smallest box first).
-    pub fn reflection_probes(&self) -> Vec<hikari_bake::reflection_probes::ReflectionProbeBox> {
-        self.techniques.reflection_probes.probes()
-    }
-
     /// The irradiance probes (the uploaded bake's layout, the lookup pass's switch, the
     /// relight's timed dispatches), for `hikari bench probes`.
     pub fn irradiance_probes(&self) -> &crate::techniques::irradiance_probes::IrradianceProbes {

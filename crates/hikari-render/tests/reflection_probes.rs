@@ -6,8 +6,8 @@ mod common;
 
 use glam::{Mat4, Quat, Vec3, Vec4};
 use hikari_bake::reflection_probes::ReflectionProbeBox;
+use hikari_render::techniques::reflection_probes::ReflectionProbeGpu;
 use hikari_render::techniques::reflection_probes::reference as twin;
-use hikari_render::techniques::reflection_probes::{ReflectionProbeGpu, aabb_transform};
 use hikari_render::{FrameSettings, Renderer};
 use hikari_scene::{Camera, Instance, Material, Scene, shapes};
 
@@ -37,12 +37,7 @@ fn every_cube_texel_direction_falls_back_on_its_texel() {
 }
 
 fn probe(lo: Vec3, hi: Vec3, capture: Vec3, blend: f32) -> ReflectionProbeBox {
-    ReflectionProbeBox {
-        name: "room".into(),
-        transform: aabb_transform(lo, hi),
-        capture,
-        blend_m: blend,
-    }
+    ReflectionProbeBox::aabb("room", lo, hi, capture, blend)
 }
 
 #[test]

@@ -25,7 +25,7 @@ pub mod settings;
 use std::sync::{Arc, Mutex};
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use hikari_bake::reflection_probes::ReflectionProbeBox;
 use hikari_scene::{Camera, Sun};
 use wgpu::util::DeviceExt;
@@ -72,15 +72,10 @@ pub struct ReflectionProbeGpu {
 
 impl ReflectionProbeGpu {
     pub fn new(p: &ReflectionProbeBox) -> Self {
-        let half = Vec3::new(
-            p.transform.x_axis.truncate().length(),
-            p.transform.y_axis.truncate().length(),
-            p.transform.z_axis.truncate().length(),
-        );
         Self {
             to_box: p.transform.inverse().to_cols_array_2d(),
             capture: p.capture.extend(p.blend_m.max(0.0)).to_array(),
-            half_m: half.extend(1.0).to_array(),
+            half_m: p.half_extents().extend(1.0).to_array(),
         }
     }
 }
@@ -234,15 +229,6 @@ struct Progress {
     relit_all_with: Option<(Vec3, String)>,
 }
 
-/// Metres from `p` to the probe's box (0 inside).
-pub fn distance_to_box(b: &ReflectionProbeBox, p: Vec3) -> f32 {
-    let local = b.transform.inverse().transform_point3(p);
-    let nearest = b
-        .transform
-        .transform_point3(local.clamp(Vec3::splat(-1.0), Vec3::ONE));
-    nearest.distance(p)
-}
-
 pub struct ReflectionProbes {
     capture: ComputePipeline,
     relight: ComputePipeline,
@@ -344,15 +330,6 @@ impl ReflectionProbes {
         Ok(())
     }
 
-    /// The probes in the order the GPU holds them (smallest box first).
-    pub fn probes(&self) -> Vec<ReflectionProbeBox> {
-        self.uploaded
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .as_ref()
-            .map_or(Vec::new(), |u| u.boxes.clone())
-    }
-
     /// Captures the cube maps again next frame (a rasteriser queue overflowed while they were
     /// drawn).
     pub fn invalidate_capture(&self) {
@@ -392,8 +369,8 @@ impl ReflectionProbes {
         })
     }
 
-    /// Captures the probes if they are new, relights this frame's share, prefilters it, and
-    /// makes the lookup set. With the probes off (or none, or no atmosphere), a lookup that
+    /// Captures the probes that became resident, relights this frame's share, prefilters it,
+    /// and gives the lookup's resources. With the probes off (or none, or no atmosphere), a lookup that
     /// covers nothing.
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
@@ -452,8 +429,7 @@ impl ReflectionProbes {
             .boxes
             .iter()
             .map(|b| {
-                s.stream_distance_m <= 0.0
-                    || distance_to_box(b, inputs.camera) <= s.stream_distance_m
+                s.stream_distance_m <= 0.0 || b.distance_to(inputs.camera) <= s.stream_distance_m
             })
             .collect();
         let mut captured_now = false;
@@ -490,14 +466,6 @@ impl ReflectionProbes {
                     .write(emission)
                     .dispatch_threads(&self.capture, [n, n, 1])?;
             }
-        }
-        if !captured_now {
-            // Nothing drawn this frame: the graph must still see the capture written.
-            g.pass("reflection_probes.keep")
-                .uses(albedo, true)
-                .uses(normal_depth, true)
-                .uses(emission, true)
-                .encode(|_, _| {})?;
         }
 
         // Which probes to relight: every resident one after a new radiance texture, a jump of
@@ -649,9 +617,4 @@ impl ReflectionProbes {
             captured: captured_now,
         })
     }
-}
-
-/// The box transform of a probe whose box is `lo..hi` (world, axis-aligned).
-pub fn aabb_transform(lo: Vec3, hi: Vec3) -> Mat4 {
-    Mat4::from_translation(0.5 * (lo + hi)) * Mat4::from_scale(0.5 * (hi - lo))
 }
