@@ -3,7 +3,8 @@
 // G-buffer pixel its direction projects to (whatever the camera's roll, a texel centre lands
 // on a pixel centre) and keeps what relighting needs: the albedo light is reflected with and
 // the interior mask, the normal and the distance from the capture point (0: sky), and the
-// emission. Twin: `reflection_probes::reference::capture_texel`.
+// emission. Checked against the room geometry it captures (tests/reflection_probes.rs: the
+// mirror floor in an emissive room), the G-buffer itself against its own twin.
 
 #import hikari::view::{View, world_from_depth}
 #import hikari::reflection_probe_math::rp_texel_direction

@@ -2,7 +2,8 @@
 // convolved with the GGX lobe (normal = view = reflection) by filtered importance sampling
 // (Krivanek and Colbert 2008): each sample reads the relit mip chain at the level whose texels
 // cover the solid angle the sample stands for. Level 0 is the relit map itself (a mirror).
-// Twin: `reflection_probes::reference::prefilter_texel`.
+// Twin: `reflection_probes::reference::prefilter_integral`, the integral it estimates (the
+// mip chain of `downsample.wgsl` is checked through it).
 
 #import hikari::reflection_probe_math::{rp_texel_direction, rp_hammersley}
 
