@@ -444,7 +444,7 @@ const FURNACE_ROUGHNESS: [f32; 9] = [0.0, 0.02, 0.045, 0.1, 0.25, 0.4, 0.6, 0.8,
 const FURNACE_DEGREES: [f64; 8] = [0.0, 30.0, 60.0, 75.0, 84.0, 86.0, 88.0, 89.0];
 
 /// White furnace of the whole BRDF with a white base colour, dielectric (F0 0.04 + white
-/// Lambert) and metal (F0 1), isotropic, over roughness 0..1 and view angles up to 89°:
+/// Lambert; and with KHR_materials_specular's weight 0.5) and metal (F0 1), isotropic, over roughness 0..1 and view angles up to 89°:
 /// the directional albedo is in [0.97, 1 + tol]. With the compensation it should be 1 up to
 /// the tables' error, so the test also bounds `|E − 1|`.
 ///
@@ -461,7 +461,11 @@ fn white_furnace_full_brdf() {
 fn check_full_furnace(spec_nodes: usize, smooth_nodes: usize, over: f64, off: f64, print: bool) {
     let mut worst_over = f64::NEG_INFINITY;
     let mut worst_under = f64::INFINITY;
-    for (name, metalness) in [("dielectric", 0.0f32), ("metal", 1.0)] {
+    for (name, metalness, specular) in [
+        ("dielectric", 0.0f32, 1.0f32),
+        ("dielectric, specular 0.5", 0.0, 0.5),
+        ("metal", 1.0, 1.0),
+    ] {
         for r in FURNACE_ROUGHNESS {
             for deg in FURNACE_DEGREES {
                 let m = Material {
@@ -469,6 +473,7 @@ fn check_full_furnace(spec_nodes: usize, smooth_nodes: usize, over: f64, off: f6
                     perceptual_roughness: r,
                     metalness,
                     anisotropy: 0.0,
+                    specular,
                 };
                 let v = view(deg.to_radians().cos(), 0.5);
                 let (spec, ms, diff) = full_albedo(&m, v, spec_nodes, smooth_nodes);
@@ -491,6 +496,51 @@ fn check_full_furnace(spec_nodes: usize, smooth_nodes: usize, over: f64, off: f6
         }
     }
     eprintln!("full furnace: albedo − 1 in [{worst_under:.2e}, {worst_over:.2e}]");
+}
+
+/// KHR_materials_specular's weight 0 leaves a dielectric exactly Lambert, `ρ/π n·l`, at any
+/// roughness and direction; in between, the specular lobe (and its multiple scattering) is
+/// the full one times the weight, and the Fresnel at grazing view reaches the weight, not 1.
+#[test]
+fn specular_weight_scales_the_dielectric_lobe() {
+    let mut rng = Rng(0x5bd1_e995_17);
+    for _ in 0..200 {
+        let m = random_material(&mut rng);
+        let base = Material {
+            metalness: 0.0,
+            anisotropy: 0.0,
+            ..m
+        };
+        let v = view(rng.range(0.05, 1.0) as f64, rng.range(0.0, 6.28) as f64);
+        let l = view(rng.range(0.05, 1.0) as f64, rng.range(0.0, 6.28) as f64);
+        let matte = evaluate_lobes_f64(&base.with_specular(0.0), N, T, B, v, l);
+        let lambert =
+            base.base_color.as_dvec3().clamp(DVec3::ZERO, DVec3::ONE) / std::f64::consts::PI * l.z;
+        assert!(
+            (matte.sum() - lambert).abs().max_element() < 1e-12,
+            "{base:?}: {matte:?}"
+        );
+        let full = evaluate_lobes_f64(&base.with_specular(1.0), N, T, B, v, l);
+        let w = rng.f32();
+        let half = evaluate_lobes_f64(&base.with_specular(w), N, T, B, v, l);
+        for (got, want) in [
+            (half.specular, full.specular),
+            (half.multiple, full.multiple),
+        ] {
+            assert!(
+                (got - want * w as f64).abs().max_element() < 1e-12 * (1.0 + want.max_element())
+            );
+        }
+    }
+    let m = Material::dielectric(Vec3::ONE, 0.5).with_specular(0.25);
+    assert!((m.f0() - DVec3::splat(0.01)).abs().max_element() < 1e-12);
+    assert_eq!(m.f90(), 0.25);
+    assert_eq!(
+        Material::metal(Vec3::ONE, 0.5).with_specular(0.0).f90(),
+        1.0
+    );
+    assert_eq!(m.with_specular(f32::NAN).specular_weight(), 1.0);
+    assert_eq!(m.with_specular(7.0).specular_weight(), 1.0);
 }
 
 /// The same on converged quadratures (512 x 1024 and 256 x 512 nodes), printing every albedo.
@@ -521,6 +571,7 @@ fn white_furnace_anisotropic_and_half_metal() {
                             perceptual_roughness: r,
                             metalness,
                             anisotropy: a,
+                            specular: 1.0,
                         };
                         let v = view(deg.to_radians().cos(), phi);
                         let (spec, ms, diff) = full_albedo(&m, v, 48, 32);
@@ -558,6 +609,7 @@ fn compensation_lobe_albedos() {
             perceptual_roughness: r,
             metalness,
             anisotropy: 0.0,
+            specular: 1.0,
         };
         let c = Compensation::new(&m);
         for mu in [1.0, 0.5, 0.1] {
@@ -592,6 +644,11 @@ fn random_material(rng: &mut Rng) -> Material {
         perceptual_roughness: rng.range(0.0, 1.0),
         metalness: rng.f32(),
         anisotropy: rng.range(-1.0, 1.0),
+        specular: if rng.range(0.0, 1.0) < 0.3 {
+            1.0
+        } else {
+            rng.range(0.0, 1.0)
+        },
     }
 }
 
@@ -642,7 +699,8 @@ fn reciprocity() {
     }
 }
 
-/// Anisotropy 0 is the isotropic BRDF, in any tangent frame around `n` (1e-12 relative).
+/// Anisotropy 0 is the isotropic BRDF, in any tangent frame around `n` (1e-11 relative: the
+/// two paths round differently, up to 2e-12 of a sharp highlight's peak).
 #[test]
 fn zero_anisotropy_is_isotropic() {
     let mut rng = Rng(5);
@@ -653,7 +711,7 @@ fn zero_anisotropy_is_isotropic() {
         let aniso = evaluate_f64(&m, n, t, b, v, l);
         let iso = evaluate_isotropic_f64(&m, n, v, l);
         assert!(
-            (aniso - iso).abs().max_element() <= 1e-12 * iso.max_element(),
+            (aniso - iso).abs().max_element() <= 1e-11 * iso.max_element(),
             "{aniso} {iso}"
         );
         // Spin the tangent frame about n: nothing changes.
@@ -1053,6 +1111,7 @@ fn model_albedo_matches_the_independent_reference() {
                     perceptual_roughness: r as f32,
                     metalness: mat["metalness"].as_f64().unwrap() as f32,
                     anisotropy: 0.0,
+                    specular: 1.0,
                 };
                 let c = Compensation::new(&m);
                 let f0 = m.f0();

@@ -113,7 +113,8 @@ pub struct MaterialGpu {
     pub params: [f32; 4],
     /// Occlusion strength, interior mask (negative: none; a mesh's own mask wins over it),
     /// alpha cut-off (0: opaque; else a fragment is drawn where base colour alpha, factor times
-    /// texture A times vertex colour A, is at least it), 0.
+    /// texture A times vertex colour A, is at least it), dielectric specular weight
+    /// (KHR_materials_specular; 1 is the usual interface, 0 matte).
     pub extra: [f32; 4],
     /// Texture layers: base colour and emissive in the sRGB array, metallic-roughness and
     /// normal in the linear array; [`NO_TEXTURE`] where absent.
@@ -373,7 +374,7 @@ impl SceneCpu {
                     m.occlusion_strength,
                     m.interior.unwrap_or(-1.0),
                     alpha_cutoff(m),
-                    0.0,
+                    m.specular,
                 ],
                 textures: [slots[0].0, slots[1].0, slots[2].0, slots[3].0],
                 more_textures: [slots[4].0, wraps, 0, 0],

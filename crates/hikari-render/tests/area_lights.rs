@@ -124,6 +124,8 @@ struct Frame {
     normal: hikari_render::graph::ImageRgba32,
     albedo: hikari_render::graph::ImageRgba32,
     material: hikari_render::graph::ImageRgba32,
+    /// Emission and, in alpha, the specular weight the BRDF reads.
+    emissive: hikari_render::graph::ImageRgba32,
     radiance: hikari_render::graph::ImageRgba32,
     unshadowed: hikari_render::graph::ImageRgba32,
     params: AreaLightParams,
@@ -142,6 +144,7 @@ fn render(scene: &Scene, settings: FrameSettings) -> (Renderer, Frame) {
                 g.normal.into(),
                 g.albedo.into(),
                 g.material.into(),
+                g.emissive.into(),
                 o.area_lights.into(),
                 o.area_lights_unshadowed.into(),
             ]
@@ -160,6 +163,7 @@ fn render(scene: &Scene, settings: FrameSettings) -> (Renderer, Frame) {
         normal: img("gbuffer.normal"),
         albedo: img("gbuffer.albedo"),
         material: img("gbuffer.material"),
+        emissive: img("gbuffer.emissive"),
         radiance: img("area_lights.radiance"),
         unshadowed: img("area_lights.unshadowed"),
         settings,
@@ -219,7 +223,7 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
                 normal: v4(f.normal.pixel(x, y)),
                 albedo: v4(f.albedo.pixel(x, y)),
                 material: v4(f.material.pixel(x, y)),
-                emissive: Vec3::ZERO,
+                emissive: v4(f.emissive.pixel(x, y)),
             };
             want_unshadowed.push(reference::shade_unshadowed(
                 &f.params,
@@ -645,7 +649,7 @@ fn point_lights_cast_ray_traced_shadows() {
                 normal: v4(f.normal.pixel(x, y)),
                 albedo: v4(f.albedo.pixel(x, y)),
                 material: v4(f.material.pixel(x, y)),
-                emissive: Vec3::ZERO,
+                emissive: v4(f.emissive.pixel(x, y)),
             };
             let world = world_at(&f, x, y);
             let want = reference::shade(
@@ -784,7 +788,7 @@ fn texel_at(f: &Frame, x: u32, y: u32) -> direct_lighting::reference::Texel {
         normal: v4(f.normal.pixel(x, y)),
         albedo: v4(f.albedo.pixel(x, y)),
         material: v4(f.material.pixel(x, y)),
-        emissive: Vec3::ZERO,
+        emissive: v4(f.emissive.pixel(x, y)),
     }
 }
 

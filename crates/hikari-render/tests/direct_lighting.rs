@@ -183,7 +183,7 @@ fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> 
                 normal: v4(normal.pixel(x, y)),
                 albedo: v4(albedo.pixel(x, y)),
                 material: v4(material.pixel(x, y)),
-                emissive: v4(emissive.pixel(x, y)).truncate(),
+                emissive: v4(emissive.pixel(x, y)),
             };
             let vis = if d > 0.0 {
                 let n = hikari_render::reference::octahedral::decode(Vec2::new(

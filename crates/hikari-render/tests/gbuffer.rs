@@ -89,6 +89,7 @@ fn textured_scene() -> Scene {
         occlusion_texture: Some(TextureRef::new(0)),
         occlusion_strength: 0.5,
         emissive_nits: Vec3::new(10.0, 20.0, 30.0),
+        specular: 0.375,
         // Under the quad's own per-vertex mask, which wins (`Mesh::interior_at`).
         interior: Some(0.9),
         ..Material::default()
@@ -425,6 +426,7 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
                     "emissive b",
                     close(e[2], want.emissive.z, emissive_tol.z, 2e-3),
                 ),
+                ("specular", close(e[3], want.specular, 0.0, 1e-3)),
                 ("instance", instance.pixel(x, y)[0] == want.instance as f32),
             ];
             for (what, ok) in checks {

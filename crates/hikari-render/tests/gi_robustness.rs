@@ -339,11 +339,13 @@ fn non_finite_gbuffer_texels_stay_out_of_every_gi_output() {
 const WARM_FRAMES: u32 = 4;
 
 /// NaN and infinity in the accumulation's history (Y SH, CoCg, AO, history length, view depth)
-/// and in the lit image kept for the hits, written between two frames of a still camera: the
-/// next frame's GI textures are all finite, each pixel whose history was damaged starts again
-/// (history length 1, then 2 a frame later), and every other surface pixel keeps growing its
-/// history (length `WARM_FRAMES + 1`). A damaged lit image only feeds the hits that see it;
-/// it restarts nothing.
+/// and in the lit image kept for the hits, written between two frames of a still camera over
+/// a 3x3 block of texels each: the next frame's GI textures are all finite; the block's centre,
+/// whose whole 3x3 is damaged, starts again (history length 1, then 2 a frame later); the
+/// block's ring takes the undamaged texels of its own 3x3 (the accumulation's fallback where
+/// its reprojected texel fails) and, as every other surface pixel, keeps growing its history
+/// (length `WARM_FRAMES + 1`). A damaged lit image only feeds the hits that see it; it restarts
+/// nothing.
 #[test]
 fn non_finite_history_texels_restart_their_pixel() {
     damage_history(false);
@@ -387,13 +389,46 @@ fn damage_history(recurrent: bool) {
             .all(|p| p[0] == 0.0 || p[0] == WARM_FRAMES as f32),
         "a still camera grows every surface pixel's history"
     );
-    // Surface pixels, spread over the image, 3 pixels apart.
-    let surfaces: Vec<[u32; 2]> = (0..SIZE * SIZE)
-        .filter(|&i| last.length.rgba[i as usize][0] > 0.0)
+    // Block centres: surface pixels each of whose ring pixels has, outside the block and
+    // within its own 3x3, a surface texel at a view depth within 2 % of its own (the
+    // accumulation's depth test allows 5 %), so that the ring keeps its history; spread over
+    // the image, at least 6 pixels apart, so that no two blocks touch.
+    let view_depth = |x: i64, y: i64| {
+        let inside = (0..SIZE as i64).contains(&x) && (0..SIZE as i64).contains(&y);
+        let i = (y * SIZE as i64 + x) as usize;
+        (inside && last.length.rgba[i][0] > 0.0).then(|| last.view_depth.rgba[i][0])
+    };
+    let ring_keeps_history = |cx: i64, cy: i64, rx: i64, ry: i64| {
+        let Some(z) = view_depth(rx, ry) else {
+            return false;
+        };
+        (-1..=1).any(|dy: i64| {
+            (-1..=1).any(|dx: i64| {
+                let (qx, qy) = (rx + dx, ry + dy);
+                let outside = (qx - cx).abs() > 1 || (qy - cy).abs() > 1;
+                outside && view_depth(qx, qy).is_some_and(|q| (q - z).abs() <= 0.02 * z)
+            })
+        })
+    };
+    let candidates: Vec<[u32; 2]> = (0..SIZE * SIZE)
         .map(|i| [i % SIZE, i / SIZE])
-        .filter(|p| p[0] % 3 == 1 && p[1] % 3 == 1)
+        .filter(|p| {
+            let (x, y) = (p[0] as i64, p[1] as i64);
+            view_depth(x, y).is_some()
+                && (-1..=1).all(|dy| {
+                    (-1..=1)
+                        .all(|dx| (dx, dy) == (0, 0) || ring_keeps_history(x, y, x + dx, y + dy))
+                })
+        })
         .collect();
-    assert!(surfaces.len() > 100);
+    let mut surfaces: Vec<[u32; 2]> = Vec::new();
+    for c in candidates.iter().step_by((candidates.len() / 64).max(1)) {
+        let apart = |p: &[u32; 2]| p[0].abs_diff(c[0]).max(p[1].abs_diff(c[1])) >= 6;
+        if surfaces.iter().all(apart) {
+            surfaces.push(*c);
+        }
+    }
+    assert!(surfaces.len() >= 16, "{} block centres", surfaces.len());
     let mut pick = surfaces.iter().step_by(surfaces.len() / 16).copied();
     let (nan, inf) = (f32::NAN, f32::INFINITY);
     // (history, texel bytes for one value, values): each value at its own pixel.
@@ -425,21 +460,21 @@ fn damage_history(recurrent: bool) {
                 texture: tex,
                 mip_level: 0,
                 origin: wgpu::Origin3d {
-                    x: p[0],
-                    y: p[1],
+                    x: p[0] - 1,
+                    y: p[1] - 1,
                     z: 0,
                 },
                 aspect: wgpu::TextureAspect::All,
             },
-            bytes,
+            &bytes.repeat(9),
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: None,
+                bytes_per_row: Some(3 * bytes.len() as u32),
                 rows_per_image: None,
             },
             wgpu::Extent3d {
-                width: 1,
-                height: 1,
+                width: 3,
+                height: 3,
                 depth_or_array_layers: 1,
             },
         );

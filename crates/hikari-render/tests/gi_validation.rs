@@ -204,14 +204,12 @@ fn render_frames(s: &FrameSettings, frames: u32, keep: &[u32]) -> Rendered {
     }
 }
 
-/// The Cornell box at 128 x 128 with GI on, against Mitsuba 3's `path` integrator with
-/// max_depth 3 (the emitter seen, direct light, and one diffuse bounce; 65536 spp, box filter)
-/// of the same published geometry, camera and light. FLIP (LDR, default 67 pixels per degree)
-/// on both images through `display`; the issue's bounds: at most 0.15 on the first frame and
-/// at most 0.05 after 16 frames.
-#[test]
-#[ignore = "misses issue 18's bounds (frame 1: 0.156, frame 16: 0.108): docs/ray-traced-gi.md, Validation"]
-fn cornell_box_with_gi_matches_mitsuba_direct_plus_one_bounce() {
+/// The Cornell box at 128 x 128 with GI on (its matte surfaces: `Material::specular` 0, as
+/// Mitsuba's Lambertian `diffuse`), against Mitsuba 3's `path` integrator with max_depth 3
+/// (the emitter seen, direct light, and one diffuse bounce; 65536 spp, box filter) of the
+/// same published geometry, camera and light. FLIP (LDR, default 67 pixels per degree) on
+/// both images through `display`. Returns the FLIP of each frame in `frames` (1-based).
+fn cornell_gi_flip(frames: &[u32]) -> Vec<f32> {
     let (w, h, mitsuba) = read_pfm(include_bytes!(
         "fixtures/mitsuba_cornell_one_bounce_128.pfm"
     ));
@@ -222,31 +220,44 @@ fn cornell_box_with_gi_matches_mitsuba_direct_plus_one_bounce() {
     // 1.10 of Mitsuba's luminance after 16 frames); computing every hit's light keeps it to
     // one. The reuse is checked against computed light in `tests/ray_traced_gi.rs`.
     s.settings.ray_traced_gi.reuse_lit = false;
-    let kept = render_frames(&s, 16, &[1, 16]).hdr;
-    dump_pfm("gi_hikari_1", &kept[0], w, h);
-    dump_pfm("gi_hikari_16", &kept[1], w, h);
+    let kept = render_frames(&s, *frames.iter().max().unwrap(), frames).hdr;
     let k = exposure_of(&mitsuba);
     let reference = display(&mitsuba, k);
-    let (d1, d16) = (display(&kept[0], k), display(&kept[1], k));
     dump("gi_mitsuba", &reference, w, h);
-    dump("gi_hikari_1", &d1, w, h);
-    dump("gi_hikari_16", &d16, w, h);
-    let first = mean_flip(&reference, &d1, w, h);
-    let last = mean_flip(&reference, &d16, w, h);
     let mean_lum = |img: &[[f32; 3]]| {
         img.iter()
             .map(luminance)
             .filter(|l| *l < 1000.0)
             .sum::<f32>()
     };
-    println!(
-        "FLIP against Mitsuba direct + one bounce: frame 1 {first:.4}, frame 16 {last:.4}; \
-         surface luminance hikari / Mitsuba {:.4} at frame 1, {:.4} at 16 \
-         (exposure {k:.3e} per nit)",
-        mean_lum(&kept[0]) / mean_lum(&mitsuba),
-        mean_lum(&kept[1]) / mean_lum(&mitsuba)
-    );
+    let mut flips = Vec::new();
+    for (f, img) in frames.iter().zip(&kept) {
+        dump_pfm(&format!("gi_hikari_{f}"), img, w, h);
+        let shown = display(img, k);
+        dump(&format!("gi_hikari_{f}"), &shown, w, h);
+        let flip = mean_flip(&reference, &shown, w, h);
+        println!(
+            "FLIP against Mitsuba direct + one bounce at frame {f}: {flip:.4}; surface \
+             luminance hikari / Mitsuba {:.4} (exposure {k:.3e} per nit)",
+            mean_lum(img) / mean_lum(&mitsuba)
+        );
+        flips.push(flip);
+    }
+    flips
+}
+
+/// The issue's bound on the first frame: FLIP at most 0.15 (measured 0.143).
+#[test]
+fn cornell_box_with_gi_matches_mitsuba_on_the_first_frame() {
+    let first = cornell_gi_flip(&[1])[0];
     assert!(first <= 0.15, "FLIP at frame 1: {first}");
+}
+
+/// The issue's bound after 16 frames: FLIP at most 0.05.
+#[test]
+#[ignore = "misses issue 18's bound (0.092 after 16 frames against 0.05): docs/ray-traced-gi.md, Validation"]
+fn cornell_box_with_gi_matches_mitsuba_after_16_frames() {
+    let last = cornell_gi_flip(&[16])[0];
     assert!(last <= 0.05, "FLIP at frame 16: {last}");
 }
 
@@ -256,7 +267,7 @@ fn cornell_box_with_gi_matches_mitsuba_direct_plus_one_bounce() {
 /// 50 m AO: `tools/mitsuba_cornell.py`). AO is a display value in [0, 1]: both are written as
 /// 8-bit grey without a curve. The issue's bound: FLIP ≤ 0.03.
 #[test]
-#[ignore = "misses issue 18's bound (0.100 against 0.03): docs/ray-traced-gi.md, Validation"]
+#[ignore = "misses issue 18's bound (0.099 against 0.03): docs/ray-traced-gi.md, Validation"]
 fn cornell_box_ao_matches_mitsuba() {
     let (w, h, mitsuba) = read_pfm(include_bytes!("fixtures/mitsuba_cornell_ao50_128.pfm"));
     assert_eq!((w, h), (SIZE, SIZE));
@@ -296,11 +307,15 @@ const NOISE_PERIOD: u32 = 64;
 /// weight included) over its whole period of 64 frames (= over the issue's 4096 frames, see
 /// `NOISE_PERIOD`). Compared: c0 (luminance), Co, Cg as image means, each relative to its own
 /// magnitude, and c0 as means of 8 x 8 blocks (4096 rays each) relative to the image's mean
-/// c0. Bound: image means within 3 % (measured 1.3 %, 2.2 %, 0.2 %). The worst block is
-/// printed, not bounded: at 32 x 32 the denoiser's 6 m and 3 m radii span most of the image, so
-/// a block's difference measures the blur (0.69 of the mean c0 where sky meets ground), not
-/// a bias. The same 64 denoised frames without the firefly clamp (`firefly_clamp = 0`) give
-/// the clamp's own share of the bias, also bounded at 3 % of each mean (measured 0.8 %,
+/// c0. Bound: image means within 3 % (measured 2.3 %, 2.8 %, 0.1 %; 2.4 %, 0.2 %, 0.9 %
+/// before session 16's reprojection fallback, with which silhouette pixels keep history under
+/// TAA's jitter: at 32 x 32 they are many, and their neighbours' history is a pixel away). About
+/// 1 % of it is lavapipe's: its f16 stores truncate, which shrinks every accumulated value (the
+/// plain 64-frame accumulation without jitter, clamp or denoiser: 1.1 % under the estimator).
+/// The worst block is printed, not bounded: at 32 x 32 the denoiser's 6 m and 3 m radii span
+/// most of the image, so a block's difference measures the blur (0.69 of the mean c0 where sky
+/// meets ground), not a bias. The same 64 denoised frames without the firefly clamp (`firefly_clamp = 0`) give
+/// the clamp's own share of the bias, also bounded at 3 % of each mean (measured 1.0 %,
 /// 0.4 %, 0.2 %).
 #[test]
 fn denoised_gi_is_unbiased_against_the_estimator_mean() {

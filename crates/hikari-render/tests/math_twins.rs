@@ -1157,10 +1157,11 @@ fn tolerances_catch_a_wrong_constant() {
 
 // ---- BRDF ----
 
-/// A random shading case for the BRDF kernel: material, frame and directions, with `n·v` and
+/// A random shading case for the BRDF kernel: material (with a specular weight of 1, 0 or in
+/// between), frame and directions, with `n·v` and
 /// `n·l` either clearly above the surface (≥ 0.02, so f32 and f64 agree on the side) or, in one
 /// case of eight, clearly below (≤ −0.02, where both must give exactly 0).
-fn brdf_case(rng: &mut SmallRng) -> ([f32; 6], [Vec3; 5]) {
+fn brdf_case(rng: &mut SmallRng) -> ([f32; 7], [Vec3; 5]) {
     let r = match rng.random_range(0..4) {
         0 => rng.random_range(0.0..0.1),
         _ => rng.random_range(0.0..1.0),
@@ -1181,6 +1182,11 @@ fn brdf_case(rng: &mut SmallRng) -> ([f32; 6], [Vec3; 5]) {
         r,
         metal,
         a,
+        match rng.random_range(0..3) {
+            0 => 1.0,
+            1 => 0.0,
+            _ => rng.random_range(0.0..1.0),
+        },
     ];
     let n = unit(rng);
     let t = unit(rng);
@@ -1225,10 +1231,11 @@ fn brdf_matches_the_cpu() {
     let mut cases = Vec::new();
     for _ in 0..n_cases {
         let (mat, dirs) = brdf_case(&mut rng);
-        input.extend_from_slice(&mat);
+        input.extend_from_slice(&mat[..6]);
         for d in dirs {
             input.extend_from_slice(&d.to_array());
         }
+        input.push(mat[6]);
         cases.push((mat, dirs));
     }
     let Some(out) = run(Kernel::Brdf, &input) else {
@@ -1246,6 +1253,7 @@ fn brdf_matches_the_cpu() {
             perceptual_roughness: mat[3],
             metalness: mat[4],
             anisotropy: mat[5],
+            specular: mat[6],
         };
         let d = |x: Vec3| x.as_dvec3();
         let above = n.dot(*v) > 0.0 && n.dot(*l) > 0.0;
@@ -1272,6 +1280,7 @@ fn brdf_matches_the_cpu() {
             let spec = ggx_ndf_aniso(h, ax, ay) * visibility_aniso(vl, ll, ax, ay) * ll.z;
             let c = Compensation::new(&m);
             let (e_l, _) = c.single_scattering(ll);
+            // The material's F0 and F90 weigh the first two (brdf_apply_weights).
             let want_w = [
                 spec,
                 spec * schlick_weight(vl.dot(h)),

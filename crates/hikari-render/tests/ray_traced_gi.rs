@@ -490,8 +490,10 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
                 accumulated > 3000,
                 "frame {frame}: history kept in {accumulated} pixels"
             );
+            // The wrong-depth block's inside, whose 3x3 is all wrong (its rim takes its
+            // neighbours' history, the fallback): 6 x 5 pixels at least.
             assert!(
-                fresh > 50,
+                fresh >= 30,
                 "frame {frame}: rejected history in only {fresh} pixels"
             );
         }

@@ -254,7 +254,9 @@ fn push_quad(mesh: &mut Mesh, q: [[f32; 3]; 4], facing: Vec3) {
 pub const CORNELL_LIGHT_NITS: f32 = 5000.0;
 
 /// The Cornell box with its published dimensions, in metres (see `cornell_data`), seen from
-/// the published camera. The interior mask is 1 everywhere: it is a closed room.
+/// the published camera. The interior mask is 1 everywhere: it is a closed room. The
+/// surfaces are matte ([`Material::specular`] 0): the published reflectances are those of
+/// Lambertian surfaces, which is also what reference renderers draw.
 ///
 /// Colours: the published data give spectral reflectances (400-700 nm); these are the
 /// approximate linear RGB albedos derived from them that reference renderers commonly use
@@ -272,6 +274,7 @@ pub fn cornell() -> Scene {
     let indoor = |m: Material| Material {
         interior: Some(1.0),
         roughness: 1.0,
+        specular: 0.0,
         ..m
     };
     let materials = vec![

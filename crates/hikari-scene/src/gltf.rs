@@ -28,9 +28,13 @@ use crate::{
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
+    SPECULAR_EXTENSION,
     quantization::EXTENSION,
     texture_transform::EXTENSION,
 ];
+
+/// The material extension whose `specularFactor` becomes [`Material::specular`].
+const SPECULAR_EXTENSION: &str = "KHR_materials_specular";
 
 /// A glTF file that cannot be loaded: the file and what is wrong with it.
 #[derive(Debug, Error)]
@@ -319,8 +323,9 @@ fn check_required_extensions(root: &mut gltf::json::Root) -> Res<bool> {
         .iter()
         .chain(&root.extensions_used)
         .any(|e| e == quantization::EXTENSION);
-    root.extensions_required
-        .retain(|e| e != quantization::EXTENSION && e != texture_transform::EXTENSION);
+    root.extensions_required.retain(|e| {
+        e != quantization::EXTENSION && e != texture_transform::EXTENSION && e != SPECULAR_EXTENSION
+    });
     Ok(declared)
 }
 
@@ -857,12 +862,60 @@ impl<'o> Loader<'o> {
                     .map_err(|e| format!("material `{name}`: {e}"))?,
                 interior: interior_mask::material_interior(m.extras())
                     .map_err(|e| format!("material `{name}`: {e}"))?,
+                specular: self.specular_factor(&m, &name)?,
                 name,
                 ..Default::default()
             };
             out.push(mat);
         }
         Ok((out, transforms))
+    }
+
+    /// KHR_materials_specular's `specularFactor` (1 without the extension). Its textures and
+    /// its specular colour are not read: a warning says so where they would change the
+    /// look.
+    fn specular_factor(&self, m: &gltf::Material, name: &str) -> Res<f32> {
+        let Some(ext) = m.extension_value(SPECULAR_EXTENSION) else {
+            return Ok(1.0);
+        };
+        let here = |what: &str| format!("material `{name}`: {SPECULAR_EXTENSION}.{what}");
+        let Some(obj) = ext.as_object() else {
+            return Err(format!(
+                "material `{name}`: {SPECULAR_EXTENSION} must be an object"
+            ));
+        };
+        let factor = match obj.get("specularFactor") {
+            None => 1.0,
+            Some(v) => match v.as_f64() {
+                Some(f) if (0.0..=1.0).contains(&f) => f as f32,
+                _ => {
+                    return Err(format!(
+                        "{} {v} must be a number in [0, 1]",
+                        here("specularFactor")
+                    ));
+                }
+            },
+        };
+        for key in ["specularTexture", "specularColorTexture"] {
+            if obj.contains_key(key) {
+                self.warn(format!(
+                    "{} is not loaded; the factors alone are used",
+                    here(key)
+                ));
+            }
+        }
+        if let Some(c) = obj.get("specularColorFactor") {
+            let white = c
+                .as_array()
+                .is_some_and(|a| a.len() == 3 && a.iter().all(|x| x.as_f64() == Some(1.0)));
+            if !white {
+                self.warn(format!(
+                    "{} {c} is not supported; the specular reflection stays uncoloured",
+                    here("specularColorFactor")
+                ));
+            }
+        }
+        Ok(factor)
     }
 
     /// Loads every primitive; returns, per glTF mesh, its (scene mesh, scene material) pairs.

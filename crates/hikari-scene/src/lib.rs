@@ -63,6 +63,9 @@
 //!   product is read as cd/m², which is what that extension says to do where a physical unit
 //!   is needed. Files written for display-referred viewers, where emissive 1 means "white",
 //!   look dim under daylight exposure unless that option is raised.
+//! - `KHR_materials_specular`: `specularFactor` becomes [`Material::specular`], the weight of
+//!   a dielectric's specular reflection (0: matte). Its textures and `specularColorFactor`
+//!   are not read (a warning says so).
 //! - `KHR_mesh_quantization`: POSITION as (unsigned) byte or short, normalized or not; NORMAL
 //!   and TANGENT as normalized byte or short (renormalised; tangent w keeps its sign);
 //!   TEXCOORD_0 as any of those. Integers are dequantized with the spec's formulas; the node

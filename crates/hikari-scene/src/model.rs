@@ -201,6 +201,11 @@ pub struct Material {
     /// directions; `None`: measured. glTF material `extras`
     /// `{"hikari": {"gi_albedo": [r, g, b]}}`. docs/ray-traced-gi.md, "Per-instance albedo".
     pub gi_albedo: Option<Vec3>,
+    /// Weight in [0, 1] of the dielectric's specular reflection (glTF KHR_materials_specular
+    /// `specularFactor`): 1 is the usual F0 = 0.04 interface, 0 a matte surface that reflects
+    /// like Lambert's law (a measured matte paint, the published Cornell box). Metals ignore
+    /// it. docs/brdf.md.
+    pub specular: f32,
 }
 
 impl Default for Material {
@@ -225,6 +230,7 @@ impl Default for Material {
             interior: None,
             area_light: None,
             gi_albedo: None,
+            specular: 1.0,
         }
     }
 }
@@ -581,6 +587,7 @@ impl Scene {
                 ("alpha", m.alpha),
                 ("occlusion strength", m.occlusion_strength),
                 ("interior", m.interior.unwrap_or(0.0)),
+                ("specular", m.specular),
                 (
                     "anisotropy strength",
                     m.anisotropy.map_or(0.0, |a| a.strength),
@@ -824,6 +831,20 @@ mod tests {
         };
         let e = scene(tri(), bad_rough).validate().unwrap_err().to_string();
         assert!(e.contains("roughness 1.5"), "{e}");
+        for v in [f32::NAN, -0.5] {
+            let bad_specular = Material {
+                specular: v,
+                ..Default::default()
+            };
+            let e = scene(tri(), bad_specular)
+                .validate()
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(&format!("specular {v} is outside [0, 1]")),
+                "{e}"
+            );
+        }
         let mut s = scene(tri(), Material::default());
         s.textures.push(Texture {
             name: "t".into(),

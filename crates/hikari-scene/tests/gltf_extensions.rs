@@ -834,3 +834,72 @@ fn malformed_texture_transforms_are_errors_naming_material_slot_and_field() {
         );
     }
 }
+
+const SPEC: &str = "KHR_materials_specular";
+
+/// A triangle drawn with `material`, declaring KHR_materials_specular.
+fn specular_doc(material: Value) -> Value {
+    let mut f = File::default();
+    let pos = float_triangle(&mut f);
+    f.doc(json!({"POSITION": pos}), material, json!({}), &[SPEC])
+}
+
+#[test]
+fn khr_materials_specular_sets_the_specular_weight() {
+    let cases = [
+        (
+            json!({"name": "matte", "extensions": {SPEC: {"specularFactor": 0.0}}}),
+            0.0,
+        ),
+        (
+            json!({"name": "half", "extensions": {SPEC: {"specularFactor": 0.5}}}),
+            0.5,
+        ),
+        // The extension's default factor is 1, as is a material without it.
+        (json!({"name": "default", "extensions": {SPEC: {}}}), 1.0),
+        (plain_material(), 1.0),
+    ];
+    for (i, (material, want)) in cases.into_iter().enumerate() {
+        let loaded = load_ok(&format!("specular_{i}"), &specular_doc(material));
+        assert_eq!(loaded.scene.materials[0].specular, want, "case {i}");
+        assert!(
+            loaded.warnings.is_empty(),
+            "case {i}: {:?}",
+            loaded.warnings
+        );
+    }
+}
+
+#[test]
+fn khr_materials_specular_textures_and_colour_warn_and_bad_factors_are_errors() {
+    let material = json!({"name": "tinted", "extensions": {SPEC: {
+        "specularFactor": 0.25,
+        "specularColorFactor": [1.0, 0.5, 0.5],
+        "specularTexture": {"index": 0}
+    }}});
+    let loaded = load_ok("specular_tinted", &specular_doc(material));
+    assert_eq!(loaded.scene.materials[0].specular, 0.25);
+    assert_eq!(loaded.warnings.len(), 2, "{:?}", loaded.warnings);
+    for w in &loaded.warnings {
+        assert!(w.contains("`tinted`") && w.contains(SPEC), "{w}");
+    }
+    // A white specular colour changes nothing and gives no warning.
+    let white =
+        json!({"name": "white", "extensions": {SPEC: {"specularColorFactor": [1.0, 1.0, 1.0]}}});
+    assert!(
+        load_ok("specular_white", &specular_doc(white))
+            .warnings
+            .is_empty()
+    );
+    for (i, bad) in [json!(1.5), json!(-0.1), json!("0.5")]
+        .into_iter()
+        .enumerate()
+    {
+        let material = json!({"name": "bad", "extensions": {SPEC: {"specularFactor": bad}}});
+        load_err(
+            &format!("specular_bad_{i}"),
+            &specular_doc(material),
+            &["`bad`", "KHR_materials_specular.specularFactor", "[0, 1]"],
+        );
+    }
+}

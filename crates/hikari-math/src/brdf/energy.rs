@@ -18,6 +18,11 @@
 //! (glTF 2.0's definition); the single-scattering lobe is linear in F0 and so blends through F0,
 //! the multiple-scattering colour is blended itself.
 //!
+//! A specular weight `s` (KHR_materials_specular's `specularFactor`) scales the dielectric's
+//! whole specular lobe, single and multiple scattering: `E_d` becomes `s E_d` throughout, so
+//! the diffuse lobe keeps what the weaker interface leaves, `ρ (1 − s E_d(μo))`, and a white
+//! dielectric still reflects 1. At `s = 0` the dielectric is exactly Lambert.
+//!
 //! Anisotropic lobes read the tables at [`isotropic_equivalent_roughness`] (the isotropic lobe
 //! with the same peak `D(n)`): the compensation is then that of the isotropic lobe, which is
 //! only approximate for them (docs/brdf.md gives the furnace numbers).
@@ -53,11 +58,13 @@ pub struct Compensation {
     pub roughness: f64,
     /// `E_avg`: average single-scattering albedo with `F = 1`.
     pub e_avg: f64,
-    /// Colour of the multiple-scattering lobe, `(1 − m) F_ms(0.04) + m F_ms(base colour)`.
+    /// Colour of the multiple-scattering lobe, `(1 − m) s F_ms(0.04) + m F_ms(base colour)`.
     pub ms_fresnel: DVec3,
-    /// `F_ms(0.04)`: the dielectric's multiple-scattering colour (grey).
+    /// `F_ms(0.04)`: the dielectric's multiple-scattering colour (grey), unweighted.
     pub dielectric_ms_fresnel: f64,
-    /// `E_d,avg`: average albedo of the dielectric's whole specular lobe.
+    /// The dielectric's specular weight `s` ([`Material::specular_weight`]).
+    pub specular: f64,
+    /// `s E_d,avg`: average albedo of the dielectric's whole specular lobe.
     pub dielectric_avg: f64,
 }
 
@@ -74,13 +81,15 @@ impl Compensation {
             .base_color
             .as_dvec3()
             .clamp(DVec3::ZERO, DVec3::ONE);
-        let ms_fresnel = DVec3::splat(dielectric_ms_fresnel).lerp(fms(base), metal);
-        let dielectric_avg = dielectric_albedo(e_avg, e_w_avg, dielectric_ms_fresnel);
+        let specular = material.specular_weight();
+        let ms_fresnel = DVec3::splat(specular * dielectric_ms_fresnel).lerp(fms(base), metal);
+        let dielectric_avg = specular * dielectric_albedo(e_avg, e_w_avg, dielectric_ms_fresnel);
         Self {
             roughness,
             e_avg,
             ms_fresnel,
             dielectric_ms_fresnel,
+            specular,
             dielectric_avg,
         }
     }
@@ -90,11 +99,11 @@ impl Compensation {
         albedo_tables().lookup(w_local.z, self.roughness)
     }
 
-    /// `E_d(w)`: directional albedo of the dielectric's specular lobe (single + multiple
-    /// scattering, F0 = 0.04) for direction `w_local`.
+    /// `s E_d(w)`: directional albedo of the dielectric's specular lobe (single + multiple
+    /// scattering, F0 = 0.04, weight `s`) for direction `w_local`.
     pub fn dielectric_specular_albedo(&self, w_local: DVec3) -> f64 {
         let (e, e_w) = self.single_scattering(w_local);
-        dielectric_albedo(e, e_w, self.dielectric_ms_fresnel)
+        self.specular * dielectric_albedo(e, e_w, self.dielectric_ms_fresnel)
     }
 
     /// The multiple-scattering lobe `f_ms(v, l)`, sr⁻¹, per channel, for directions in the

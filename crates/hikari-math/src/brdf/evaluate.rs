@@ -2,7 +2,7 @@
 //! irradiance.
 
 use super::energy::Compensation;
-use super::fresnel::fresnel_schlick;
+use super::fresnel::fresnel_schlick_f90;
 use super::ggx::{ggx_ndf, ggx_ndf_aniso};
 use super::material::Material;
 use super::smith::{visibility, visibility_aniso};
@@ -42,7 +42,7 @@ impl Lobes {
 /// surface; a pass whose normal maps face away from the viewer must bend `n` itself.
 ///
 /// Specular: `D · V · F(v·h)` with [`ggx_ndf_aniso`], [`visibility_aniso`] (height-correlated
-/// Smith) and [`fresnel_schlick`], plus the multiple-scattering lobe; diffuse: Lambert scaled
+/// Smith) and Schlick's Fresnel from [`Material::f0`] to [`Material::f90`], plus the multiple-scattering lobe; diffuse: Lambert scaled
 /// by what the specular lobe leaves ([`Compensation`], docs/brdf.md). Computed in `f64`.
 pub fn evaluate(material: &Material, n: Vec3, t: Vec3, b: Vec3, v: Vec3, l: Vec3) -> Vec3 {
     let d = |x: Vec3| x.as_dvec3();
@@ -80,7 +80,7 @@ pub fn evaluate_lobes_f64(
     let f0 = material.f0();
     let spec = ggx_ndf_aniso(h_loc, ax, ay)
         * visibility_aniso(v_loc, l_loc, ax, ay)
-        * fresnel_schlick(f0, v_loc.dot(h_loc));
+        * fresnel_schlick_f90(f0, material.f90(), v_loc.dot(h_loc));
     let comp = Compensation::new(material);
     let ms = comp.multiple_scattering(v_loc, l_loc);
     let diff = comp.diffuse(material.diffuse_albedo(), v_loc, l_loc);
@@ -110,7 +110,7 @@ pub fn evaluate_isotropic_f64(material: &Material, n: DVec3, v: DVec3, l: DVec3)
     let f0 = material.f0();
     let spec = ggx_ndf(n.dot(h), alpha)
         * visibility(n_dot_v, n_dot_l, alpha)
-        * fresnel_schlick(f0, v.dot(h));
+        * fresnel_schlick_f90(f0, material.f90(), v.dot(h));
     let comp = Compensation::new(&material.with_anisotropy(0.0));
     // Isotropic: only the cosines matter; any azimuth will do.
     let (wv, wl) = (polar(n_dot_v), polar(n_dot_l));

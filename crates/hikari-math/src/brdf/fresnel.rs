@@ -15,6 +15,13 @@ pub fn fresnel_schlick(f0: DVec3, cos_theta: f64) -> DVec3 {
     f0 + (DVec3::ONE - f0) * schlick_weight(cos_theta)
 }
 
+/// `F(θ) = F0 + (F90 − F0)(1 − cos θ)⁵` per channel: [`fresnel_schlick`] with the grazing
+/// reflectance `f90` instead of 1, so that a weighted interface (`s` times a Schlick
+/// Fresnel) stays one Schlick form.
+pub fn fresnel_schlick_f90(f0: DVec3, f90: f64, cos_theta: f64) -> DVec3 {
+    f0 + (DVec3::splat(f90) - f0) * schlick_weight(cos_theta)
+}
+
 /// Scalar [`fresnel_schlick`].
 pub fn fresnel_schlick_scalar(f0: f64, cos_theta: f64) -> f64 {
     f0 + (1.0 - f0) * schlick_weight(cos_theta)

@@ -39,6 +39,10 @@ pub struct Material {
     /// Anisotropy in [-1, 1]: positive stretches the highlight along the tangent `t`,
     /// negative along the bitangent `b`, 0 is isotropic.
     pub anisotropy: f32,
+    /// Weight in [0, 1] of the dielectric's specular lobe (glTF's KHR_materials_specular
+    /// `specularFactor`): 1 is the usual F0 = 0.04 interface, 0 a matte surface whose dielectric
+    /// part is pure Lambert. Metals ignore it.
+    pub specular: f32,
 }
 
 impl Material {
@@ -49,6 +53,7 @@ impl Material {
             perceptual_roughness,
             metalness: 0.0,
             anisotropy: 0.0,
+            specular: 1.0,
         }
     }
 
@@ -59,12 +64,18 @@ impl Material {
             perceptual_roughness,
             metalness: 1.0,
             anisotropy: 0.0,
+            specular: 1.0,
         }
     }
 
     /// The same material with `anisotropy` set.
     pub fn with_anisotropy(self, anisotropy: f32) -> Self {
         Self { anisotropy, ..self }
+    }
+
+    /// The same material with the dielectric specular weight `specular` set.
+    pub fn with_specular(self, specular: f32) -> Self {
+        Self { specular, ..self }
     }
 
     fn base(&self) -> DVec3 {
@@ -75,9 +86,25 @@ impl Material {
         (self.metalness as f64).clamp(0.0, 1.0)
     }
 
-    /// Normal-incidence Fresnel reflectance per channel: `lerp(0.04, base_color, metalness)`.
+    /// The dielectric specular weight clamped to [0, 1] (NaN: 1, the glTF default).
+    pub fn specular_weight(&self) -> f64 {
+        let s = self.specular as f64;
+        if s.is_nan() { 1.0 } else { s.clamp(0.0, 1.0) }
+    }
+
+    /// Normal-incidence Fresnel reflectance per channel: `lerp(0.04 s, base_color, metalness)`
+    /// with `s` the [`Material::specular_weight`].
     pub fn f0(&self) -> DVec3 {
-        f0_from_metalness(self.base(), self.metal_fraction())
+        let m = self.metal_fraction();
+        DVec3::splat(DIELECTRIC_F0 * self.specular_weight() * (1.0 - m)) + self.base() * m
+    }
+
+    /// Grazing-incidence Fresnel reflectance: `lerp(s, 1, metalness)`. The specular lobe's
+    /// Fresnel is `F0 + (F90 − F0)(1 − cos θ)⁵`, which is `s` times the dielectric's Schlick
+    /// Fresnel blended with the metal's.
+    pub fn f90(&self) -> f64 {
+        let m = self.metal_fraction();
+        self.specular_weight() * (1.0 - m) + m
     }
 
     /// Albedo of the diffuse lobe before its Fresnel weights: `base_color · (1 − metalness)`.

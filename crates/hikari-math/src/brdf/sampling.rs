@@ -1,7 +1,7 @@
 //! Importance sampling of the specular lobe through its distribution of visible normals
 //! (Heitz 2018), using [`crate::sampling::ggx::sample_vndf`].
 
-use super::fresnel::fresnel_schlick;
+use super::fresnel::fresnel_schlick_f90;
 use super::ggx::ggx_ndf_aniso;
 use super::material::Material;
 use super::smith::{smith_g1_aniso, smith_g2_height_correlated_aniso};
@@ -72,6 +72,6 @@ pub fn sample_specular(
     Some(SpecularSample {
         l: l.normalize().as_vec3(),
         pdf: pdf as f32,
-        weight: (fresnel_schlick(material.f0(), v_dot_h) * g).as_vec3(),
+        weight: (fresnel_schlick_f90(material.f0(), material.f90(), v_dot_h) * g).as_vec3(),
     })
 }

@@ -14,7 +14,9 @@
 // Schlick Fresnel (Schlick 1994) on v.h; plus the multiple-scattering lobe of Kulla & Conty
 // 2017 and Lambert scaled by what the specular lobe leaves, (1 - E_d(n.v)) (1 - E_d(n.l)) /
 // (1 - E_d,avg) (Kelemen & Szirmay-Kalos 2001), from the albedo tables of hikari::brdf_tables,
-// so that a white material reflects what it receives at every roughness and angle.
+// so that a white material reflects what it receives at every roughness and angle. A specular
+// weight s (KHR_materials_specular) scales the dielectric's whole specular lobe: Fresnel from
+// F0 = lerp(0.04 s, base, m) to F90 = lerp(s, 1, m), and E_d becomes s E_d throughout.
 
 #import hikari::brdf_tables::{BRDF_TABLE_SIZE, brdf_table_albedo_filtered, brdf_table_average}
 
@@ -36,6 +38,8 @@ struct BrdfMaterial {
     perceptual_roughness: f32,
     metalness: f32,
     anisotropy: f32,
+    // Weight of the dielectric's specular lobe in [0, 1] (KHR_materials_specular): 0 is matte.
+    specular: f32,
 }
 
 fn brdf_alpha_from_perceptual(perceptual_roughness: f32) -> f32 {
@@ -155,6 +159,11 @@ fn brdf_fresnel_schlick(f0: vec3<f32>, cos_theta: f32) -> vec3<f32> {
     return f0 + (vec3<f32>(1.0) - f0) * brdf_schlick_weight(cos_theta);
 }
 
+// Schlick's Fresnel rising from f0 to f90 at grazing instead of to 1.
+fn brdf_fresnel_schlick_f90(f0: vec3<f32>, f90: f32, cos_theta: f32) -> vec3<f32> {
+    return f0 + (vec3<f32>(f90) - f0) * brdf_schlick_weight(cos_theta);
+}
+
 fn brdf_lambert(albedo: vec3<f32>) -> vec3<f32> {
     return albedo * (1.0 / BRDF_PI);
 }
@@ -221,7 +230,17 @@ fn brdf_dielectric_albedo(e: vec2<f32>, dielectric_ms_fresnel: f32) -> f32 {
 }
 
 fn brdf_material_f0(m: BrdfMaterial) -> vec3<f32> {
-    return brdf_f0_from_metalness(saturate(m.base_color), saturate(m.metalness));
+    let metal = saturate(m.metalness);
+    return vec3<f32>(BRDF_DIELECTRIC_F0 * saturate(m.specular) * (1.0 - metal)) + saturate(m.base_color) * metal;
+}
+
+fn brdf_material_f90(m: BrdfMaterial) -> f32 {
+    return mix(saturate(m.specular), 1.0, saturate(m.metalness));
+}
+
+// The material's Fresnel at cosine `cos_theta`, F0 to F90.
+fn brdf_material_fresnel(m: BrdfMaterial, cos_theta: f32) -> vec3<f32> {
+    return brdf_fresnel_schlick_f90(brdf_material_f0(m), brdf_material_f90(m), cos_theta);
 }
 
 fn brdf_material_diffuse_albedo(m: BrdfMaterial) -> vec3<f32> {
@@ -233,9 +252,13 @@ struct BrdfCompensation {
     // brdf_table_row(r).
     row: vec2<f32>,
     e_avg: f32,
-    // (1 - m) F_ms(0.04) + m F_ms(base colour).
+    // (1 - m) s F_ms(0.04) + m F_ms(base colour).
     ms_fresnel: vec3<f32>,
+    // F_ms(0.04), unweighted.
     dielectric_ms_fresnel: f32,
+    // The specular weight s.
+    specular: f32,
+    // s E_d,avg.
     dielectric_avg: f32,
 }
 
@@ -247,8 +270,9 @@ fn brdf_compensation(m: BrdfMaterial, perceptual_roughness: f32) -> BrdfCompensa
     c.e_avg = avg.x;
     c.dielectric_ms_fresnel = brdf_multiple_scattering_fresnel(brdf_fresnel_schlick_average(vec3<f32>(BRDF_DIELECTRIC_F0)), avg.x).x;
     let metal_fms = brdf_multiple_scattering_fresnel(brdf_fresnel_schlick_average(saturate(m.base_color)), avg.x);
-    c.ms_fresnel = mix(vec3<f32>(c.dielectric_ms_fresnel), metal_fms, saturate(m.metalness));
-    c.dielectric_avg = brdf_dielectric_albedo(avg, c.dielectric_ms_fresnel);
+    c.specular = saturate(m.specular);
+    c.ms_fresnel = mix(vec3<f32>(c.specular * c.dielectric_ms_fresnel), metal_fms, saturate(m.metalness));
+    c.dielectric_avg = c.specular * brdf_dielectric_albedo(avg, c.dielectric_ms_fresnel);
     return c;
 }
 
@@ -260,8 +284,11 @@ struct BrdfView {
     n: vec3<f32>,
     v_local: vec3<f32>,
     alphas: vec2<f32>,
-    // Fresnel reflectance at normal incidence.
+    // Fresnel reflectance at normal incidence and at grazing.
     f_normal: vec3<f32>,
+    f_grazing: f32,
+    // The specular weight s.
+    specular: f32,
     // Albedo-scaled Lambert's view half: rho / pi (1 - E_d(n.v)) / (1 - E_d,avg).
     diffuse: vec3<f32>,
     // Multiple-scattering lobe's view half: F_ms (1 - E(n.v)) / (pi (1 - E_avg)).
@@ -285,10 +312,12 @@ fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<
     p.v_local = vec3<f32>(dot(t, v), dot(b, v), dot(n, v));
     p.alphas = brdf_anisotropic_alphas(m.perceptual_roughness, m.anisotropy);
     p.f_normal = brdf_material_f0(m);
+    p.f_grazing = brdf_material_f90(m);
     let c = brdf_compensation(m, brdf_isotropic_equivalent_roughness(p.alphas));
+    p.specular = c.specular;
     let e_v = brdf_albedo_lookup_row(p.v_local.z, c.row);
     p.diffuse = brdf_lambert(brdf_material_diffuse_albedo(m))
-        * ((1.0 - brdf_dielectric_albedo(e_v, c.dielectric_ms_fresnel)) / max(1.0 - c.dielectric_avg, BRDF_MIN_LOSS));
+        * ((1.0 - c.specular * brdf_dielectric_albedo(e_v, c.dielectric_ms_fresnel)) / max(1.0 - c.dielectric_avg, BRDF_MIN_LOSS));
     p.multiple = c.ms_fresnel * ((1.0 - e_v.x) / (BRDF_PI * max(1.0 - c.e_avg, BRDF_MIN_LOSS)));
     p.row = c.row;
     p.dielectric_ms_fresnel = c.dielectric_ms_fresnel;
@@ -299,8 +328,8 @@ fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<
 }
 
 // The light-dependent factors of brdf_evaluate_view, scalars, such that
-//   brdf_evaluate_view(p, l) = f_normal w.x + (1 - f_normal) w.y + diffuse w.z + multiple w.w:
-// w.x = D V n.l, w.y = D V n.l Schlick(v.h) (from F = f0 + (1 - f0) Schlick),
+//   brdf_evaluate_view(p, l) = f_normal w.x + (f_grazing - f_normal) w.y + diffuse w.z + multiple w.w:
+// w.x = D V n.l, w.y = D V n.l Schlick(v.h) (from F = f0 + (f90 - f0) Schlick),
 // w.z = (1 - E_d(n.l)) n.l, w.w = (1 - E(n.l)) n.l. A caller summing many lights sums their
 // weighted light colours and applies the material's colours once (brdf_apply_weights), rather
 // than four colour products a light.
@@ -317,14 +346,14 @@ fn brdf_light_weights(p: BrdfView, l: vec3<f32>) -> vec4<f32> {
     let vis_den = l_local.z * p.v_stretched + p.v_local.z * length(l_local * vec3<f32>(p.alphas, 1.0));
     let spec = l_local.z * p.spec_scale / (dd * dd * vis_den);
     let e_l = brdf_albedo_lookup_row(l_local.z, p.row);
-    let diffuse = (1.0 - brdf_dielectric_albedo(e_l, p.dielectric_ms_fresnel)) * l_local.z;
+    let diffuse = (1.0 - p.specular * brdf_dielectric_albedo(e_l, p.dielectric_ms_fresnel)) * l_local.z;
     return vec4<f32>(spec, spec * brdf_schlick_weight(dot(p.v_local, h_local)), diffuse, (1.0 - e_l.x) * l_local.z);
 }
 
 // Radiance from light weights summed with their colours: a = sum c w.x, b = sum c w.y,
 // c = sum c w.z, d = sum c w.w (see brdf_light_weights).
 fn brdf_apply_weights(p: BrdfView, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
-    return p.f_normal * a + (vec3<f32>(1.0) - p.f_normal) * b + p.diffuse * c + p.multiple * d;
+    return p.f_normal * a + (vec3<f32>(p.f_grazing) - p.f_normal) * b + p.diffuse * c + p.multiple * d;
 }
 
 // brdf_evaluate for a prepared view: BRDF * n.l, 0 when v or l is at or below the surface.
@@ -351,15 +380,15 @@ fn brdf_evaluate_isotropic(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>, l: vec3<
     let f0 = brdf_material_f0(m);
     let spec = brdf_ggx_ndf(dot(n, h), alpha)
         * brdf_visibility(n_dot_v, n_dot_l, alpha)
-        * brdf_fresnel_schlick(f0, dot(v, h));
+        * brdf_fresnel_schlick_f90(f0, brdf_material_f90(m), dot(v, h));
     let c = brdf_compensation(m, clamp(m.perceptual_roughness, BRDF_MIN_PERCEPTUAL_ROUGHNESS, 1.0));
     let e_v = brdf_albedo_lookup_row(n_dot_v, c.row);
     let e_l = brdf_albedo_lookup_row(n_dot_l, c.row);
     let ms = c.ms_fresnel * ((1.0 - e_v.x) * (1.0 - e_l.x) / (BRDF_PI * max(1.0 - c.e_avg, BRDF_MIN_LOSS)));
     let diff = brdf_albedo_scaled_lambert(
         brdf_material_diffuse_albedo(m),
-        brdf_dielectric_albedo(e_v, c.dielectric_ms_fresnel),
-        brdf_dielectric_albedo(e_l, c.dielectric_ms_fresnel),
+        c.specular * brdf_dielectric_albedo(e_v, c.dielectric_ms_fresnel),
+        c.specular * brdf_dielectric_albedo(e_l, c.dielectric_ms_fresnel),
         c.dielectric_avg,
     );
     return (spec + ms + diff) * n_dot_l;

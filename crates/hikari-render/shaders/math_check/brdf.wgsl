@@ -11,10 +11,11 @@
 
 #import hikari::math_check_io::{params, inputs, outputs, in_vec3, out_vec3}
 
-// In: base colour (3), perceptual roughness, metalness, anisotropy (3), n, t, b, v, l (5 x 3).
+// In: base colour (3), perceptual roughness, metalness, anisotropy (3), n, t, b, v, l (5 x 3),
+// specular weight.
 // Out: brdf_evaluate (3), brdf_evaluate_isotropic (3), brdf_light_weights (4),
 // brdf_albedo_lookup(n.v, isotropic-equivalent roughness) (2), brdf_albedo_average(same) (2).
-const IN_BRDF: u32 = 21u;
+const IN_BRDF: u32 = 22u;
 const OUT_BRDF: u32 = 14u;
 
 @compute @workgroup_size(64, 1, 1)
@@ -24,7 +25,7 @@ fn eval(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let i = id.x * IN_BRDF;
     let o = id.x * OUT_BRDF;
-    let m = BrdfMaterial(in_vec3(i), inputs[i + 3u], inputs[i + 4u], inputs[i + 5u]);
+    let m = BrdfMaterial(in_vec3(i), inputs[i + 3u], inputs[i + 4u], inputs[i + 5u], inputs[i + 21u]);
     let n = in_vec3(i + 6u);
     let t = in_vec3(i + 9u);
     let b = in_vec3(i + 12u);

@@ -107,7 +107,7 @@ impl Kernel {
             Kernel::Transfer => 5,
             Kernel::Matrices => 3,
             Kernel::Purkinje => 3,
-            Kernel::Brdf => 21,
+            Kernel::Brdf => 22,
             Kernel::ReflectionProbe => 19,
         }
     }

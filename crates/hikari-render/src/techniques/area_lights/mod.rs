@@ -282,6 +282,7 @@ impl AreaLights {
             .read(scene.materials)
             .read(scene.color_textures)
             .sampler(SamplerKind::LinearRepeat)
+            .read(gb.emissive)
             .set(brdf_tables)
             .set(bvh)
             .dispatch_threads(&self.shade, [w, h, 1])?;

@@ -200,6 +200,7 @@ fn pixel_frame(texel: &Texel, world: Vec3, eye: Vec3) -> (Frame, Vec3) {
             perceptual_roughness: texel.material.x,
             metalness: texel.material.y,
             anisotropy: texel.material.z,
+            specular: texel.emissive.w,
         },
     };
     let origin = world + n * (1e-3 + 1e-3 * (eye - world).length());

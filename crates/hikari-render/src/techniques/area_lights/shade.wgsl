@@ -75,6 +75,8 @@ const TILE_THREADS: u32 = 256u;
 @group(0) @binding(12) var<storage, read> materials: array<MaterialGpu>;
 @group(0) @binding(13) var color_textures: texture_2d_array<f32>;
 @group(0) @binding(14) var texture_sampler: sampler;
+// Alpha: the dielectric specular weight (KHR_materials_specular) the BRDF reads.
+@group(0) @binding(15) var gbuffer_emissive: texture_2d<f32>;
 
 // The lights that may reach the tile, in index order (so that the per-pixel selection breaks
 // ties and sums as over all lights): chunks of 256 lights are tested one per invocation into
@@ -459,7 +461,7 @@ fn shade(pixel: vec2<u32>, d: f32) -> vec3<f32> {
     let b = cross(n, t);
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     let mat = textureLoad(gbuffer_material, pixel, 0);
-    let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
+    let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z, textureLoad(gbuffer_emissive, pixel, 0).a);
     let brdf = brdf_view(m, n, t, b, v);
     // Off the surface by a thousandth of the distance to the eye (and a millimetre), which the
     // depth buffer's reconstruction error stays well under.

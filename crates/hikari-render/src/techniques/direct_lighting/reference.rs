@@ -74,8 +74,7 @@ impl SkyLight<'_> {
 }
 
 fn fresnel_at(m: &Material, n: Vec3, v: Vec3) -> Vec3 {
-    let f0 = brdf::material::f0_from_metalness(m.base_color.as_dvec3(), m.metalness as f64);
-    brdf::fresnel::fresnel_schlick(f0, n.dot(v).max(0.0) as f64).as_vec3()
+    brdf::fresnel::fresnel_schlick_f90(m.f0(), m.f90(), n.dot(v).max(0.0) as f64).as_vec3()
 }
 
 /// Where the light's illuminance falls to the frame's cutoff, or its own range if nearer.
@@ -108,7 +107,8 @@ pub struct Texel {
     pub normal: Vec4,
     pub albedo: Vec4,
     pub material: Vec4,
-    pub emissive: Vec3,
+    /// Emitted nits (rgb) and the dielectric specular weight (a), as `gbuffer.emissive`.
+    pub emissive: Vec4,
 }
 
 /// Radiance of one pixel. `world` is the surface point, `v` the unit vector to the camera
@@ -159,6 +159,7 @@ pub fn shade_with_sky(
         perceptual_roughness: texel.material.x,
         metalness: texel.material.y,
         anisotropy: texel.material.z,
+        specular: texel.emissive.w,
     };
     let mut radiance = Vec3::ZERO;
     let lux = p.direction_lux[3];
@@ -192,7 +193,7 @@ pub fn shade_with_sky(
         radiance += (diffuse + specular) * texel.material.w;
     }
     if flags & LIGHTING_EMISSIVE != 0 {
-        radiance += texel.emissive;
+        radiance += texel.emissive.truncate();
     }
     clamp(radiance)
 }

@@ -7,7 +7,7 @@
 
 #import hikari::view::{View, view_ray, world_from_depth}
 #import hikari::octahedral::oct_decode
-#import hikari::brdf::{BrdfMaterial, brdf_view, brdf_light_weights, brdf_apply_weights, brdf_fresnel_schlick, brdf_material_f0}
+#import hikari::brdf::{BrdfMaterial, brdf_view, brdf_light_weights, brdf_apply_weights, brdf_material_fresnel, brdf_material_f0, brdf_material_f90}
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
 #import hikari::sky::sky_background
@@ -109,7 +109,7 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
     let r = reflect(-v, n);
     let mean = 0.5 * (params.sky_zenith.rgb + params.sky_horizon.rgb);
     let env = mix(sky_placeholder(r), mean, m.perceptual_roughness) * select(0.0, 1.0, r.y > 0.0);
-    return brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0)) * env;
+    return brdf_material_fresnel(m, max(dot(n, v), 0.0)) * env;
 }
 
 // The relit reflection probes' reflected radiance (rgb, nits, before Fresnel) at world point x
@@ -222,7 +222,8 @@ fn main(
         let b = cross(n, t);
         let albedo = textureLoad(gbuffer_albedo, pixel, 0);
         let mat = textureLoad(gbuffer_material, pixel, 0);
-        let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z);
+        let emissive = textureLoad(gbuffer_emissive, pixel, 0);
+        let m = BrdfMaterial(albedo.rgb, mat.x, mat.y, mat.z, emissive.a);
         let brdf = brdf_view(m, n, t, b, v);
         // Every light's colour times its four BRDF weights, summed; the material's colours
         // are applied once after the loop.
@@ -277,7 +278,7 @@ fn main(
             }
             ambient += sky_e;
             let r = reflect(-v, n);
-            let f = brdf_fresnel_schlick(brdf_material_f0(m), max(dot(n, v), 0.0));
+            let f = brdf_material_fresnel(m, max(dot(n, v), 0.0));
             ambient_specular += f * sky_ambient_specular(r, m.perceptual_roughness);
         }
         var ao = 1.0;
@@ -289,7 +290,9 @@ fn main(
             let signal = rtgi_signal(textureLoad(gi_y, pixel, 0), textureLoad(gi_cocg, pixel, 0).xy);
             let near_e = rtgi_resolve_diffuse(signal, n) * PI;
             let alpha = m.perceptual_roughness * m.perceptual_roughness;
-            let near_specular = rtgi_resolve_specular(signal, n, v, brdf_material_f0(m), alpha);
+            // F0 to F90 is F90 times Schlick's from F0 / F90 to 1.
+            let f90 = brdf_material_f90(m);
+            let near_specular = select(vec3<f32>(0.0), f90 * rtgi_resolve_specular(signal, n, v, brdf_material_f0(m) / max(f90, 1e-6), alpha), f90 > 0.0);
             ambient = mix(near_e, ambient * ao, far);
             ambient_specular = mix(near_specular, ambient_specular * ao, far);
         }
@@ -301,14 +304,14 @@ fn main(
             let probe = reflection_probe_radiance(world, n, nv, v, m.perceptual_roughness, dot(ambient, EXPOSURE_LUMA));
             if probe.w > 0.0 {
                 let n_dot_v = max(dot(n, v), 0.0);
-                let f = brdf_fresnel_schlick(brdf_material_f0(m), n_dot_v);
+                let f = brdf_material_fresnel(m, n_dot_v);
                 ambient_specular = mix(ambient_specular, f * probe.rgb * specular_occlusion(n_dot_v, ao, m.perceptual_roughness), probe.w);
             }
         }
         radiance += (albedo.rgb * (1.0 - m.metalness) / PI * ambient + ambient_specular) * mat.w;
         illuminance += dot(ambient, EXPOSURE_LUMA) * mat.w;
         if (flags & LIGHTING_EMISSIVE) != 0u {
-            radiance += textureLoad(gbuffer_emissive, pixel, 0).rgb;
+            radiance += emissive.rgb;
         }
         let area = textureLoad(area_light_radiance, pixel, 0);
         radiance += area.rgb;

@@ -54,6 +54,8 @@ pub struct ResolvedTexel {
     pub anisotropy: f32,
     pub occlusion: f32,
     pub emissive: Vec3,
+    /// Dielectric specular weight (`gbuffer.emissive` alpha).
+    pub specular: f32,
     /// Previous minus current pixel position.
     pub motion: Vec2,
     pub view_depth: f32,
@@ -257,6 +259,7 @@ pub fn resolve_deformed(
         occlusion: (1.0 + material.occlusion_strength as f64 * (occ_tex - 1.0)).clamp(0.0, 1.0)
             as f32,
         emissive: emissive.as_vec3(),
+        specular: material.specular.clamp(0.0, 1.0),
         // Now is the pixel centre less the jitter: `prev_view_proj` has none.
         motion: (prev - centre + DVec2::new(view.jitter[0] as f64, view.jitter[1] as f64))
             .as_vec2(),

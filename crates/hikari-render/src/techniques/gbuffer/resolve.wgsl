@@ -267,7 +267,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     textureStore(out_albedo, px, vec4<f32>(clamp(base, vec3<f32>(0.0), vec3<f32>(1.0)), clamp(interior, 0.0, 1.0)));
     textureStore(out_material, px, vec4<f32>(roughness, metalness, clamp(mat.params.z, 0.0, 1.0), clamp(occlusion, 0.0, 1.0)));
     textureStore(out_motion, px, vec4<f32>(finite_half2(prev - centre + view.jitter.xy), finite_half2(vec2<f32>(view_depth, 0.0))));
-    textureStore(out_emissive, px, vec4<f32>(clamp(emissive, vec3<f32>(0.0), vec3<f32>(MAX_HALF)), 0.0));
+    // Alpha: the dielectric specular weight (KHR_materials_specular), which the BRDF reads.
+    textureStore(out_emissive, px, vec4<f32>(clamp(emissive, vec3<f32>(0.0), vec3<f32>(MAX_HALF)), clamp(mat.extra.w, 0.0, 1.0)));
     textureStore(out_instance, px, vec4<u32>(chunk.instance, 0u, 0u, 0u));
     textureStore(out_vertex_normal, px, vec4<f32>(n_vertex, 0.0));
 }

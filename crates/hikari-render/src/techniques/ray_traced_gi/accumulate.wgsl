@@ -1,9 +1,12 @@
 // Temporal accumulation of the raw GI and AO before denoising: the history is reprojected by
 // the G-buffer's motion vector, bilinearly over the 2x2 texels about the position; a tap counts
 // where it is on screen, finite, has history and its view depth agrees with where this point
-// was seen last frame within the tolerance, the valid taps' weights renormalised, and the
-// history is dropped where they sum to under REPROJECTION_MIN_WEIGHT; the speed is 1 / length, the length growing while the history stays valid, up to
-// a cap. A sample far brighter than the history it joins is scaled down first (the firefly
+// was seen last frame within the tolerance, the valid taps' weights renormalised. Where they
+// sum to under REPROJECTION_MIN_WEIGHT, the 3x3 texels about the nearest one that pass the
+// same tests stand in, equally weighted (a silhouette under TAA's jitter: the pixel's own texel
+// saw the other surface last frame, its neighbours on this side did not); with none, the
+// history is dropped. The speed is 1 / length, the length growing while the history stays
+// valid, up to a cap. A sample far brighter than the history it joins is scaled down first (the firefly
 // clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
 // reference::accumulate_pixel.
 
@@ -27,6 +30,31 @@
 @group(0) @binding(13) var out_ao: texture_storage_2d<r16float, write>;
 @group(0) @binding(14) var out_length: texture_storage_2d<r16float, write>;
 @group(0) @binding(15) var out_depth: texture_storage_2d<r32float, write>;
+
+struct HistoryTexel {
+    ok: bool,
+    y: vec4<f32>,
+    cocg: vec2<f32>,
+    ao: f32,
+    length: f32,
+}
+
+// Last frame's accumulation at texel `q`, ok where it is inside the image, finite, has
+// history and saw the surface at `world`.
+fn history_texel(q: vec2<i32>, size: vec2<u32>, world: vec3<f32>) -> HistoryTexel {
+    var h: HistoryTexel;
+    if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+        return h;
+    }
+    h.y = textureLoad(prev_y, q, 0);
+    h.cocg = textureLoad(prev_cocg, q, 0).xy;
+    h.ao = textureLoad(prev_ao, q, 0).x;
+    h.length = textureLoad(prev_length, q, 0).x;
+    let z = textureLoad(prev_depth, q, 0).x;
+    h.ok = is_finite4(h.y) && is_finite4(vec4<f32>(h.cocg, h.ao, h.length)) && is_finite4(vec4<f32>(z))
+        && h.length >= 1.0 && history_depth_agrees(view, world, z, params.distances.z);
+    return h;
+}
 
 fn store(p: vec2<u32>, y: vec4<f32>, cocg: vec2<f32>, ao: f32, len: f32, z: f32) {
     textureStore(out_y, p, y);
@@ -75,25 +103,37 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if !(w > 0.0) {
             continue;
         }
-        let q = tap.texel;
-        let ty = textureLoad(prev_y, q, 0);
-        let tc = textureLoad(prev_cocg, q, 0).xy;
-        let ta = textureLoad(prev_ao, q, 0).x;
-        let tl = textureLoad(prev_length, q, 0).x;
-        let tz = textureLoad(prev_depth, q, 0).x;
-        if !is_finite4(ty) || !is_finite4(vec4<f32>(tc, ta, tl)) || !is_finite4(vec4<f32>(tz)) || !(tl >= 1.0)
-            || !history_depth_agrees(view, world, tz, params.distances.z) {
-            continue;
+        let h = history_texel(vec2<i32>(tap.texel), size, world);
+        if h.ok {
+            hy += w * h.y;
+            hc += w * h.cocg;
+            ha += w * h.ao;
+            hl += w * h.length;
+            weight += w;
         }
-        hy += w * ty;
-        hc += w * tc;
-        ha += w * ta;
-        hl += w * tl;
-        weight += w;
     }
     if weight < REPROJECTION_MIN_WEIGHT {
-        store(pixel, y, cocg_ao.xy, ao, 1.0, z);
-        return;
+        hy = vec4<f32>(0.0);
+        hc = vec2<f32>(0.0);
+        ha = 0.0;
+        hl = 0.0;
+        weight = 0.0;
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let h = history_texel(r.nearest + vec2<i32>(dx, dy), size, world);
+                if h.ok {
+                    hy += h.y;
+                    hc += h.cocg;
+                    ha += h.ao;
+                    hl += h.length;
+                    weight += 1.0;
+                }
+            }
+        }
+        if weight == 0.0 {
+            store(pixel, y, cocg_ao.xy, ao, 1.0, z);
+            return;
+        }
     }
     hy /= weight;
     hc /= weight;

@@ -664,7 +664,10 @@ pub fn bilinear_taps(prev: Vec2) -> [([i64; 2], f32); 4] {
 /// 2x2 history texels about `pixel + 0.5 + motion`; a tap counts if inside the image, finite,
 /// with history, and its view depth within `depth_tolerance` (relative) of where this surface
 /// point was seen last frame (`prev_view_proj · world`, w); the valid taps' weights are
-/// renormalised (the history is dropped under [`REPROJECTION_MIN_WEIGHT`]); then blends with
+/// renormalised. Where they weigh under [`REPROJECTION_MIN_WEIGHT`], the texels of the 3x3
+/// about the nearest one that pass the same tests stand in, equally weighted (a silhouette
+/// under TAA's jitter: the pixel's own texel saw the other surface last frame, its neighbours
+/// on this side did not); with none, the history is dropped. Then blends with
 /// speed 1 / length, length growing to `max_history`, the raw sample held by `firefly`
 /// against the history it joins (its 3x3 about the nearest texel). Non-finite raw values
 /// count as a zero sample (AO: open).
@@ -717,25 +720,39 @@ pub fn accumulate_pixel(
         return fresh;
     }
     let expected = (prev_view_proj * world.extend(1.0)).w;
-    let (mut gi, mut ao, mut length, mut weight) = (ShL1YCoCg::default(), 0.0, 0.0, 0.0);
-    for ([tx, ty], w) in bilinear_taps(prev) {
-        if w <= 0.0 || tx < 0 || ty < 0 || tx >= size[0] as i64 || ty >= size[1] as i64 {
-            continue;
+    // The history texel at (tx, ty) where it is inside, finite, has history and saw this
+    // surface.
+    let agreeing = |tx: i64, ty: i64| {
+        if tx < 0 || ty < 0 || tx >= size[0] as i64 || ty >= size[1] as i64 {
+            return None;
         }
         let h = history([tx as u32, ty as u32]);
-        if !h.finite()
-            || h.length < 1.0
-            || (h.view_depth - expected).abs() > depth_tolerance * expected.abs()
-        {
-            continue;
+        (h.finite()
+            && h.length >= 1.0
+            && (h.view_depth - expected).abs() <= depth_tolerance * expected.abs())
+        .then_some(h)
+    };
+    let mut taps: Vec<(Accumulated, f32)> = bilinear_taps(prev)
+        .into_iter()
+        .filter(|(_, w)| *w > 0.0)
+        .filter_map(|([tx, ty], w)| agreeing(tx, ty).map(|h| (h, w)))
+        .collect();
+    if taps.iter().map(|(_, w)| w).sum::<f32>() < REPROJECTION_MIN_WEIGHT {
+        let (qx, qy) = (prev.x as i64, prev.y as i64);
+        taps = (-1..=1)
+            .flat_map(|dy| (-1..=1).map(move |dx| (qx + dx, qy + dy)))
+            .filter_map(|(tx, ty)| agreeing(tx, ty).map(|h| (h, 1.0)))
+            .collect();
+        if taps.is_empty() {
+            return fresh;
         }
+    }
+    let (mut gi, mut ao, mut length, mut weight) = (ShL1YCoCg::default(), 0.0, 0.0, 0.0);
+    for (h, w) in taps {
         gi = gi.add(&h.gi.scale(w));
         ao += w * h.ao;
         length += w * h.length;
         weight += w;
-    }
-    if weight < REPROJECTION_MIN_WEIGHT {
-        return fresh;
     }
     let h = Accumulated {
         gi: gi.scale(1.0 / weight),
