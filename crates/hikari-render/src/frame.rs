@@ -657,6 +657,7 @@ pub fn record<'r>(
                 shadows: shadows.lookup,
                 sky_ambient: sky.ambient,
                 clouds: clouds.lookup,
+                probes: probes.lookup,
             },
         )?)
     } else {

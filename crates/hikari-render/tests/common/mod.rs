@@ -5,6 +5,7 @@
 #![allow(dead_code)]
 
 pub mod cutout;
+pub mod probes;
 
 use hikari_render::{ContextOptions, GpuContext};
 

@@ -21,7 +21,7 @@ struct HazeParams {
     sun: vec4<f32>,
     // rgb: the sun's or moon's illuminance (lux), 0 when it does not light the haze.
     sun_lux: vec4<f32>,
-    // x: point and spot lights to read.
+    // x: point and spot lights to read; y: sky-visibility lookups along a froxel's depth.
     lights: vec4<u32>,
 }
 
@@ -30,6 +30,7 @@ const HAZE_SKY: u32 = 2u;
 const HAZE_LOCAL_LIGHTS: u32 = 4u;
 const HAZE_DENSITY_AA: u32 = 8u;
 const HAZE_TRICUBIC: u32 = 16u;
+const HAZE_SKY_OCCLUSION: u32 = 32u;
 const HAZE_MAX_HALF: f32 = 65504.0;
 
 // (1 - e^-x) / x, accurate near 0.

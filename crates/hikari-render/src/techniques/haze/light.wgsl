@@ -1,20 +1,54 @@
 // haze.light: the light every froxel scatters towards the camera per unit scattering (the
 // talk's L_i) at its slice's middle: the sun or moon through the shadow maps and the HG phase,
-// the sky's SH convolved with the phase, and the point and spot lights, times the albedo and
-// the storage scale. Twin: `haze::reference::light_grid`.
+// the sky's SH convolved with the phase times the sky visibility the irradiance probes give
+// there, and the point and spot lights, times the albedo and the storage scale. Twin:
+// `haze::reference::light_grid`.
 
 #import hikari::view::View
-#import hikari::haze::{HazeParams, HAZE_SUN_SHADOWS, HAZE_SKY, HAZE_LOCAL_LIGHTS, HAZE_MAX_HALF, slice_depth, froxel_ray}
+#import hikari::haze::{HazeParams, HAZE_SUN_SHADOWS, HAZE_SKY, HAZE_SKY_OCCLUSION, HAZE_LOCAL_LIGHTS, HAZE_MAX_HALF, slice_depth, froxel_ray}
 #import hikari::phase::hg_phase
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
-#import hikari::sky_ambient::sky_ambient_eval
+#import hikari::sky_ambient::{sky_ambient_eval, sky_ambient_average_irradiance}
+#import hikari::irradiance_probes::probe_irradiance_at
 #import hikari::clouds::cloud_shadow
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: HazeParams;
 @group(0) @binding(2) var<storage, read> lights: array<LightGpu>;
 @group(0) @binding(3) var light_out: texture_storage_3d<rgba16float, write>;
+
+const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
+// The probes' interior mask for a point in the air: none, each probe weighs by its
+// barycentric or grid weight alone.
+const AIR_INTERIOR_MASK: f32 = 0.5;
+
+// The talk's haze AO: the average sky visibility at x, from the irradiance probes. Their
+// irradiance averaged over every normal (the SH's constant term, n = 0) over the open sky's,
+// by luminance, at most 1; 1 where no probe covers x. Twin: reference::probe_sky_visibility.
+fn sky_visibility_at(x: vec3<f32>) -> f32 {
+    let probe = probe_irradiance_at(x, vec3<f32>(0.0), AIR_INTERIOR_MASK);
+    let open = dot(sky_ambient_average_irradiance(), LUMA);
+    if !(probe.w > 0.0) || !(open > 0.0) {
+        return 1.0;
+    }
+    return clamp(dot(probe.rgb, LUMA) / open, 0.0, 1.0);
+}
+
+// The sky visibility averaged over `params.lights.y` points spread evenly along the depth of
+// froxel slice k on the ray v. Twin: reference::froxel_sky_visibility.
+fn froxel_sky_visibility(v: vec3<f32>, k: f32) -> f32 {
+    let z0 = slice_depth(params, k);
+    let z1 = slice_depth(params, k + 1.0);
+    let inv_cos = 1.0 / max(dot(v, view.forward_near.xyz), 1e-4);
+    let n = max(params.lights.y, 1u);
+    var sum = 0.0;
+    for (var i = 0u; i < n; i++) {
+        let z = mix(z0, z1, (f32(i) + 0.5) / f32(n));
+        sum += sky_visibility_at(view.position.xyz + v * (z * inv_cos));
+    }
+    return sum / f32(n);
+}
 
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -38,7 +72,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     if (flags & HAZE_SKY) != 0u {
         // HG's zonal harmonics are g^l: the phase convolution scales SH band l by g^l.
-        l += max(sky_ambient_eval(v, vec3<f32>(1.0, g, g * g)), vec3<f32>(0.0));
+        var sky = max(sky_ambient_eval(v, vec3<f32>(1.0, g, g * g)), vec3<f32>(0.0));
+        if (flags & HAZE_SKY_OCCLUSION) != 0u {
+            sky *= froxel_sky_visibility(v, k);
+        }
+        l += sky;
     }
     if (flags & HAZE_LOCAL_LIGHTS) != 0u {
         let cutoff = params.sun.w;

@@ -6,7 +6,8 @@
 //! recomputes its own alpha in closed form) and tricubic B-spline sampling.
 //!
 //! * `haze.light`: a thread a froxel; the sun or moon through the sun shadow maps and a
-//!   Henyey-Greenstein phase, the sky's L2 SH convolved with that phase, and the point and
+//!   Henyey-Greenstein phase, the sky's L2 SH convolved with that phase and darkened by the
+//!   sky visibility of the irradiance probes there (the talk's haze AO), and the point and
 //!   spot lights (unshadowed).
 //! * `haze.integrate`: a thread a froxel column, front to back.
 //! * `haze.composite`: a thread a pixel; writes `haze.radiance`, which TAA then reads.
@@ -34,6 +35,7 @@ pub const HAZE_SKY: u32 = 2;
 pub const HAZE_LOCAL_LIGHTS: u32 = 4;
 pub const HAZE_DENSITY_AA: u32 = 8;
 pub const HAZE_TRICUBIC: u32 = 16;
+pub const HAZE_SKY_OCCLUSION: u32 = 32;
 
 pub const GRID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -70,6 +72,7 @@ impl HazeParams {
             (s.local_lights && light_count > 0, HAZE_LOCAL_LIGHTS),
             (s.density_aa, HAZE_DENSITY_AA),
             (s.tricubic, HAZE_TRICUBIC),
+            (s.sky && s.sky_occlusion, HAZE_SKY_OCCLUSION),
         ]
         .iter()
         .filter(|(on, _)| *on)
@@ -99,7 +102,7 @@ impl HazeParams {
             scatter: [s.albedo, s.anisotropy, scale, s.far_m],
             sun: to_sun.extend(cutoff_lux).to_array(),
             sun_lux: sun_lux.extend(0.0).to_array(),
-            lights: [light_count, 0, 0, 0],
+            lights: [light_count, s.sky_occlusion_samples.clamp(1, 16), 0, 0],
         }
     }
 }
@@ -119,6 +122,9 @@ pub struct HazeInputs {
     pub sky_ambient: BindingSet,
     /// Binding set `clouds` (`CloudsFrame::lookup`): their shadow on the sun.
     pub clouds: BindingSet,
+    /// Binding set `irradiance_probes` (`ProbesFrame::lookup`): the sky visibility of the
+    /// sky's light.
+    pub probes: BindingSet,
 }
 
 /// The haze's textures in a frame.
@@ -168,6 +174,7 @@ impl Haze {
             .set(inputs.shadows)
             .set(inputs.sky_ambient)
             .set(inputs.clouds)
+            .set(inputs.probes)
             .dispatch_threads(&self.light, [gw, gh, gn])?;
         g.pass("haze.integrate")
             .constants(view)

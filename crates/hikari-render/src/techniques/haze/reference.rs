@@ -8,7 +8,8 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use hikari_math::sh::Sh;
 
 use super::{
-    HAZE_DENSITY_AA, HAZE_LOCAL_LIGHTS, HAZE_SKY, HAZE_SUN_SHADOWS, HAZE_TRICUBIC, HazeParams,
+    HAZE_DENSITY_AA, HAZE_LOCAL_LIGHTS, HAZE_SKY, HAZE_SKY_OCCLUSION, HAZE_SUN_SHADOWS,
+    HAZE_TRICUBIC, HazeParams,
 };
 use crate::scene_gpu::LightGpu;
 use crate::techniques::gbuffer;
@@ -112,12 +113,71 @@ pub struct HazeLightInputs<'a> {
     pub sky_sh: &'a Sh<Vec3, 9>,
     pub lights: &'a [LightGpu],
     pub sun_visibility: &'a dyn Fn(Vec3) -> f32,
+    /// The sky visibility at a point ([`probe_sky_visibility`] of the probes there), applied
+    /// with [`HAZE_SKY_OCCLUSION`].
+    pub sky_visibility: &'a dyn Fn(Vec3) -> f32,
+}
+
+/// Interior mask of a point in the air for the probe lookup (`light.wgsl`'s
+/// `AIR_INTERIOR_MASK`): none, the probes weigh by their interpolation weights alone.
+pub const AIR_INTERIOR_MASK: f32 = 0.5;
+
+/// The talk's haze AO, `light.wgsl`'s `sky_visibility`: the probes' irradiance averaged over
+/// every normal (`probe_average`, lux, as the lookup gives it at n = 0; `None` where no probe
+/// covers the point) over the open sky's (`sky_sh`'s constant term times π and the diffuse
+/// `balance`), by luminance, in [0, 1]; 1 without probes or sky.
+pub fn probe_sky_visibility(
+    probe_average: Option<Vec3>,
+    sky_sh: &Sh<Vec3, 9>,
+    balance: f32,
+) -> f32 {
+    let luma = Vec3::new(0.2126, 0.7152, 0.0722);
+    let c0 = 0.5 / std::f32::consts::PI.sqrt();
+    let open = (sky_sh.coeffs[0] * (c0 * std::f32::consts::PI)).max(Vec3::ZERO) * balance;
+    match probe_average {
+        Some(e) if open.dot(luma) > 0.0 => (e.dot(luma) / open.dot(luma)).clamp(0.0, 1.0),
+        _ => 1.0,
+    }
+}
+
+/// [`HazeLightInputs::sky_visibility`] averaged over `p.lights[1]` points spread evenly along
+/// the depth of froxel slice `k` on the ray `v` (`light.wgsl`'s `froxel_sky_visibility`).
+pub fn froxel_sky_visibility(
+    p: &HazeParams,
+    view: &View,
+    inputs: &HazeLightInputs,
+    v: Vec3,
+    k: u32,
+) -> f32 {
+    let cam = Vec3::from_slice(&view.position[..3]);
+    let fwd = Vec3::from_slice(&view.forward_near[..3]);
+    let (z0, z1) = (slice_depth(p, k as f32), slice_depth(p, k as f32 + 1.0));
+    let n = p.lights[1].max(1);
+    let sum: f32 = (0..n)
+        .map(|i| {
+            let z = z0 + (z1 - z0) * ((i as f32 + 0.5) / n as f32);
+            (inputs.sky_visibility)(cam + v * (z / v.dot(fwd).max(1e-4)))
+        })
+        .sum();
+    sum / n as f32
 }
 
 /// Light a point scatters towards the camera per unit scattering coefficient, nits: the
 /// integral over the sphere of incoming radiance times the phase function (the talk's L_i).
-/// `v`: unit direction from the camera to the point.
+/// `v`: unit direction from the camera to the point; the sky's share is taken times the sky
+/// visibility at `x`.
 pub fn inscatter(p: &HazeParams, inputs: &HazeLightInputs, x: Vec3, v: Vec3) -> Vec3 {
+    inscatter_seeing(p, inputs, x, v, (inputs.sky_visibility)(x))
+}
+
+/// [`inscatter`] with the sky visibility given (applied with [`HAZE_SKY_OCCLUSION`]).
+pub fn inscatter_seeing(
+    p: &HazeParams,
+    inputs: &HazeLightInputs,
+    x: Vec3,
+    v: Vec3,
+    sky_visibility: f32,
+) -> Vec3 {
     let g = p.scatter[1];
     let flags = p.grid[3];
     let to_sun = Vec3::from_slice(&p.sun[..3]);
@@ -134,11 +194,17 @@ pub fn inscatter(p: &HazeParams, inputs: &HazeLightInputs, x: Vec3, v: Vec3) -> 
     if flags & HAZE_SKY != 0 {
         // The HG phase's zonal harmonics are g^l: convolving the sky's SH with it scales band
         // l by g^l (Funk-Hecke).
-        l += inputs
+        let sky = inputs
             .sky_sh
             .scale_bands([1.0, g, g * g])
             .eval(v)
             .max(Vec3::ZERO);
+        let visibility = if flags & HAZE_SKY_OCCLUSION != 0 {
+            sky_visibility
+        } else {
+            1.0
+        };
+        l += sky * visibility;
     }
     if flags & HAZE_LOCAL_LIGHTS != 0 {
         let cutoff = p.sun[3];
@@ -192,7 +258,13 @@ pub fn light_grid(p: &HazeParams, view: &View, inputs: &HazeLightInputs) -> Vec<
             for i in 0..w {
                 let v = froxel_ray(p, view, i, j);
                 let x = cam + v * (z / v.dot(fwd).max(1e-4));
-                let li = inscatter(p, inputs, x, v) * (p.scatter[0] * p.scatter[2]);
+                let sky_visibility = if p.grid[3] & HAZE_SKY_OCCLUSION != 0 {
+                    froxel_sky_visibility(p, view, inputs, v, k)
+                } else {
+                    1.0
+                };
+                let li = inscatter_seeing(p, inputs, x, v, sky_visibility)
+                    * (p.scatter[0] * p.scatter[2]);
                 out[froxel_index(p, i, j, k)] = li.min(Vec3::splat(MAX_HALF));
             }
         }

@@ -43,6 +43,14 @@ pub struct HazeSettings {
     pub sun_shadows: bool,
     /// Light the haze by the sky (its L2 SH convolved with the phase function).
     pub sky: bool,
+    /// Darken the sky's light by the sky visibility the irradiance probes give at each froxel
+    /// (the talk's haze AO: no skylit haze inside a house); off, or where no probe covers the
+    /// froxel, the haze sees the whole sky.
+    pub sky_occlusion: bool,
+    /// Points along each froxel's depth at which the sky visibility is looked up and averaged:
+    /// the probes' visibility changes over less than a distant slice's thickness, and one
+    /// lookup at the middle draws the slices as bands.
+    pub sky_occlusion_samples: u32,
     /// Light the haze by point and spot lights (unshadowed).
     pub local_lights: bool,
     /// Store inscattered light over opacity (L / alpha) and re-apply each pixel's exact
@@ -83,6 +91,8 @@ impl Default for HazeSettings {
             sun: true,
             sun_shadows: true,
             sky: true,
+            sky_occlusion: true,
+            sky_occlusion_samples: 4,
             local_lights: true,
             density_aa: true,
             tricubic: true,
@@ -176,6 +186,10 @@ impl TechniqueSettings for HazeSettings {
             Field {
                 key: "slices",
                 range: Range::Int { lo: 2, hi: 256 },
+            },
+            Field {
+                key: "sky_occlusion_samples",
+                range: Range::Int { lo: 1, hi: 16 },
             },
             Field {
                 key: "near_m",

@@ -45,12 +45,14 @@ struct ProbeSum {
     plain_w: f32,
 }
 
+// The band-2 zonal term is written 3 z^2 - |n|^2 (equal to 3 z^2 - 1 on the unit sphere), so
+// that n = 0 leaves the constant term alone: the irradiance averaged over every normal.
 fn probe_eval(probe: u32, n: vec3<f32>) -> vec3<f32> {
     let b = probe * 9u;
     return 0.28209479177387814 * probe_irradiance[b].xyz
         + 0.4886025119029199 * (probe_irradiance[b + 1u].xyz * n.y + probe_irradiance[b + 2u].xyz * n.z + probe_irradiance[b + 3u].xyz * n.x)
         + 1.0925484305920792 * (probe_irradiance[b + 4u].xyz * (n.x * n.y) + probe_irradiance[b + 5u].xyz * (n.y * n.z) + probe_irradiance[b + 7u].xyz * (n.x * n.z))
-        + 0.31539156525252005 * probe_irradiance[b + 6u].xyz * (3.0 * n.z * n.z - 1.0)
+        + 0.31539156525252005 * probe_irradiance[b + 6u].xyz * (3.0 * n.z * n.z - dot(n, n))
         + 0.5462742152960396 * probe_irradiance[b + 8u].xyz * (n.x * n.x - n.y * n.y);
 }
 
@@ -173,7 +175,8 @@ fn probe_grid_sum(p: vec3<f32>, n: vec3<f32>, mask: f32, scale: f32, acc: ptr<fu
 }
 
 // Irradiance (lux, rgb) at world position p on a surface with unit normal n and interior mask
-// `interior` (the G-buffer's albedo.a); w: 1 where probes cover p, else 0 (and rgb 0).
+// `interior` (the G-buffer's albedo.a); w: 1 where probes cover p, else 0 (and rgb 0). With
+// n = 0: the irradiance averaged over every normal (reference::average_irradiance_at).
 fn probe_irradiance_at(p: vec3<f32>, n: vec3<f32>, interior: f32) -> vec4<f32> {
     let flags = probe_params.grid_size.w;
     if (flags & PROBES_PRESENT) == 0u {

@@ -374,3 +374,23 @@ impl IrradianceProbes {
         Ok(Some(out))
     }
 }
+
+/// The binding set `irradiance_probes` of a frame without probes (its lookup covers nothing),
+/// for a pass that reads the probes recorded on its own, as tests and benchmarks do.
+pub fn absent_lookup(g: &mut FrameGraph<'_>) -> Result<BindingSet> {
+    let irradiance = g.buffer("irradiance_probes.irradiance", 16)?;
+    let positions = g.buffer("irradiance_probes.positions", 16)?;
+    let topology = g.buffer("irradiance_probes.topology", 16)?;
+    g.pass("irradiance_probes.absent")
+        // Never read: the flags say there are no probes. wgpu zeroes the buffers.
+        .uses(irradiance, true)
+        .uses(positions, true)
+        .uses(topology, true)
+        .encode(|_, _| {})?;
+    Ok(g.binding_set("irradiance_probes")
+        .constants(&ProbeLookupParams::zeroed())
+        .read(irradiance)
+        .read(positions)
+        .read(topology)
+        .finish())
+}

@@ -335,6 +335,36 @@ pub fn blended_weights(data: &ProbeGpuData, p: Vec3, mask: f32) -> Vec<(u32, f32
     out
 }
 
+/// The irradiance at `p` averaged over every normal (each probe's constant term, weighted as
+/// [`irradiance_at`] weighs it), lux, clamped at 0 and times `params.grid.w`; `None` where no
+/// probe covers `p`: what the lookup gives with n = 0.
+pub fn average_irradiance_at(
+    data: &ProbeGpuData,
+    params: &super::gpu_data::ProbeLookupParams,
+    irradiance: &[ShL2Rgb],
+    p: Vec3,
+    mask: f32,
+) -> Option<Vec3> {
+    if params.grid_size[3] & PROBES_PRESENT == 0 {
+        return None;
+    }
+    let mask = if params.grid_size[3] & PROBES_INTERIOR_MASK != 0 {
+        mask
+    } else {
+        0.5
+    };
+    let w = blended_weights(data, p, mask);
+    if w.iter().map(|x| x.1).sum::<f32>() <= 0.0 {
+        return None;
+    }
+    let y00 = 0.5 / std::f32::consts::PI.sqrt();
+    let e: Vec3 = w
+        .iter()
+        .map(|&(k, wk)| irradiance[k as usize].coeffs[0] * (y00 * wk))
+        .sum();
+    Some(e.max(Vec3::ZERO) * params.grid[3])
+}
+
 /// Irradiance at `p` on a surface with normal `n` and interior mask `mask` from the relit
 /// probes (`irradiance`, one SH per probe), lux, clamped at 0 and times `params.grid.w`;
 /// `None` where no probe covers `p`. `params` carries the frame's flags and scale.

@@ -33,6 +33,12 @@ fn sky_ambient_irradiance(n: vec3<f32>) -> vec3<f32> {
     return max(sky_ambient_eval(n, SH_COSINE_BANDS), vec3<f32>(0.0)) * sky_ambient.balance.x;
 }
 
+// The sky's irradiance averaged over every normal (its constant term), lux, times the diffuse
+// balance.
+fn sky_ambient_average_irradiance() -> vec3<f32> {
+    return max(sky_ambient_eval(vec3<f32>(0.0), vec3<f32>(SH_COSINE_BANDS.x, 0.0, 0.0)), vec3<f32>(0.0)) * sky_ambient.balance.x;
+}
+
 // The sky's radiance for a reflection along `r`, blurred towards the cosine-weighted mean with
 // roughness, nits, times the specular balance.
 fn sky_ambient_specular(r: vec3<f32>, perceptual_roughness: f32) -> vec3<f32> {
