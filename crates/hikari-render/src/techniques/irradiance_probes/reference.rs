@@ -345,6 +345,22 @@ pub fn average_irradiance_at(
     p: Vec3,
     mask: f32,
 ) -> Option<Vec3> {
+    let y00 = 0.5 / std::f32::consts::PI.sqrt();
+    weighted_sum(data, params, p, mask, |k| {
+        irradiance[k as usize].coeffs[0] * y00
+    })
+}
+
+/// `Σ w_k value(k)` over the probes that light `p` with interior mask `mask` (the frame's
+/// flags decide whether the mask counts), clamped at 0 and times `params.grid.w`; `None`
+/// without probes or where none covers `p`.
+fn weighted_sum(
+    data: &ProbeGpuData,
+    params: &super::gpu_data::ProbeLookupParams,
+    p: Vec3,
+    mask: f32,
+    value: impl Fn(u32) -> Vec3,
+) -> Option<Vec3> {
     if params.grid_size[3] & PROBES_PRESENT == 0 {
         return None;
     }
@@ -357,11 +373,7 @@ pub fn average_irradiance_at(
     if w.iter().map(|x| x.1).sum::<f32>() <= 0.0 {
         return None;
     }
-    let y00 = 0.5 / std::f32::consts::PI.sqrt();
-    let e: Vec3 = w
-        .iter()
-        .map(|&(k, wk)| irradiance[k as usize].coeffs[0] * (y00 * wk))
-        .sum();
+    let e: Vec3 = w.iter().map(|&(k, wk)| value(k) * wk).sum();
     Some(e.max(Vec3::ZERO) * params.grid[3])
 }
 
@@ -376,21 +388,5 @@ pub fn irradiance_at(
     n: Vec3,
     mask: f32,
 ) -> Option<Vec3> {
-    if params.grid_size[3] & PROBES_PRESENT == 0 {
-        return None;
-    }
-    let mask = if params.grid_size[3] & PROBES_INTERIOR_MASK != 0 {
-        mask
-    } else {
-        0.5
-    };
-    let w = blended_weights(data, p, mask);
-    if w.iter().map(|x| x.1).sum::<f32>() <= 0.0 {
-        return None;
-    }
-    let e: Vec3 = w
-        .iter()
-        .map(|&(k, wk)| irradiance[k as usize].eval(n) * wk)
-        .sum();
-    Some(e.max(Vec3::ZERO) * params.grid[3])
+    weighted_sum(data, params, p, mask, |k| irradiance[k as usize].eval(n))
 }
