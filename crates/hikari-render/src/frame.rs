@@ -1,6 +1,7 @@
 //! One frame, top to bottom. Each numbered step is the step of the same number in
-//! ARCHITECTURE.md, except 5 and 6: the clouds come before the reflection probes, which they
-//! shadow and whose sky they cover.
+//! ARCHITECTURE.md, except 4 to 6: the clouds (ARCHITECTURE.md's 6) come first, then the
+//! irradiance probes (its 4), whose sun bounce they shadow, then the reflection probes (its
+//! 5), which they shadow and whose sky they cover.
 
 use hikari_scene::{Camera, Sun};
 
@@ -366,17 +367,9 @@ pub fn record<'r>(
         s.camera.position.y.max(0.0) / 1000.0,
     )?;
 
-    // 4. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon.
-    let probes = t.irradiance_probes.record(
-        g,
-        &s.settings.irradiance_probes,
-        &sky,
-        s.sun.as_ref(),
-        s.camera.position,
-    )?;
-
-    // 5. Clouds: this frame's share of the paraboloid cloud map; the deferred lighting draws
-    //    them over the sky and shadows the sun with them, as the haze does.
+    // 4. Clouds: this frame's share of the paraboloid cloud map; the deferred lighting draws
+    //    them over the sky and shadows the sun with them, as the haze and the probes' sun
+    //    bounce do.
     let clouds = t.clouds.record(
         g,
         &s.settings.clouds,
@@ -390,6 +383,17 @@ pub fn record<'r>(
                 .map_or(0.0, |t| f64::from(t.seconds_of_day())),
             sky.enabled && s.settings.sky.sky,
         ),
+    )?;
+
+    // 5. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon,
+    //    whose bounce the clouds shadow.
+    let probes = t.irradiance_probes.record(
+        g,
+        &s.settings.irradiance_probes,
+        &sky,
+        clouds.lookup,
+        s.sun.as_ref(),
+        s.camera.position,
     )?;
 
     // 6. Reflection probes (ARCHITECTURE.md's step 5, after the clouds, which shadow and

@@ -15,6 +15,7 @@ use hikari_probes::{Bake, BakeSettings, GridTile, HULL, ProbeSh, SceneKey, TILE_
 use hikari_render::graph::GraphRuntime;
 use hikari_render::pipeline::ComputePipeline;
 use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::techniques::clouds::{self, CloudParams, settings::CloudsSettings};
 use hikari_render::techniques::irradiance_probes::gpu_data::{
     PROBES_INTERIOR_MASK, PROBES_PRESENT, ProbeGpuData, ProbeLookupParams,
 };
@@ -44,6 +45,7 @@ fn run_relight(
     data: &ProbeGpuData,
     sky: &ShL2Rgb,
     params: &RelightParams,
+    clouds: Option<CloudParams>,
 ) -> Vec<[f32; 4]> {
     let all = budget::FrameWork {
         tiles: (0..data.tiles.len()).collect(),
@@ -59,6 +61,7 @@ fn run_relight(
     let chunk_b = buffer(ctx, "chunks", bytemuck::cast_slice(&chunks));
     let probes = buffer(ctx, "probes", bytemuck::cast_slice(&data.probe_data));
     let out = buffer(ctx, "irradiance", &vec![0u8; data.probe_data.len() * 16]);
+    let positions = buffer(ctx, "positions", bytemuck::cast_slice(&data.positions));
     let mut p = *params;
     p.config[0] = chunks.len() as u32;
     let mut rt = GraphRuntime::new();
@@ -68,6 +71,11 @@ fn run_relight(
     let chunk_b = g.import_buffer("chunks", &chunk_b);
     let probes = g.import_buffer("probes", &probes);
     let out = g.import_buffer("irradiance_probes.irradiance", &out);
+    let positions = g.import_buffer("positions", &positions);
+    let clouds = match clouds {
+        Some(c) => clouds::shadow_lookup(&mut g, c).unwrap(),
+        None => clouds::disabled_lookup(&mut g).unwrap(),
+    };
     g.pass("irradiance_probes.relight")
         .constants(&p)
         .read(sky_b)
@@ -75,6 +83,8 @@ fn run_relight(
         .read(chunk_b)
         .read(probes)
         .write(out)
+        .read(positions)
+        .set(clouds)
         .dispatch(pipeline, [chunks.len() as u32, 1, 1])
         .unwrap();
     g.readback(out);
@@ -114,8 +124,32 @@ fn relight_matches_the_cpu_twin() {
         illuminance_lux: 90_000.0,
         color: Vec3::new(1.0, 0.95, 0.85),
     };
+    // Clouds over the probes, whose shadow darkens the sun bounce (twin:
+    // clouds::reference::cloud_shadow_at at each probe).
+    let overcast = CloudParams::new(
+        &CloudsSettings {
+            coverage: 0.7,
+            ..CloudsSettings::default()
+        },
+        "clear",
+        Some(&sun),
+        0.0,
+        true,
+    );
+    let shade = |p: Vec3| clouds::reference::cloud_shadow_at(&overcast, p);
+    let mean_shade = data
+        .positions
+        .iter()
+        .map(|p| shade(Vec3::from_slice(&p[..3])))
+        .sum::<f32>()
+        / data.positions.len() as f32;
+    assert!(
+        mean_shade < 0.9,
+        "the clouds should shadow the probes: {mean_shade}"
+    );
     let cases = [
         ("everything", settings_with(|_| {})),
+        ("everything under clouds", settings_with(|_| {})),
         ("no dering", settings_with(|s| s.dering = false)),
         (
             "no boost, no dering",
@@ -137,8 +171,20 @@ fn relight_matches_the_cpu_twin() {
     for (name, s) in cases {
         let sky = synthetic_sky(&mut rng);
         let params = RelightParams::new(Some(&sun), &s, 0);
-        let gpu = run_relight(&ctx, &pipeline, &data, &sky, &params);
-        let cpu = reference::relight_all(&data, &sky, &params);
+        let clouded = name.ends_with("under clouds");
+        let gpu = run_relight(
+            &ctx,
+            &pipeline,
+            &data,
+            &sky,
+            &params,
+            clouded.then_some(overcast),
+        );
+        let cpu = if clouded {
+            reference::relight_all_shadowed(&data, &sky, &params, &shade)
+        } else {
+            reference::relight_all(&data, &sky, &params)
+        };
         let mut outliers = 0;
         let mut worst = 0.0f32;
         for (p, want) in cpu.iter().enumerate() {

@@ -140,6 +140,12 @@ pub fn disabled_lookup(g: &mut FrameGraph<'_>) -> Result<BindingSet> {
     Ok(disabled_frame(g, CloudParams::zeroed())?.lookup)
 }
 
+/// A `clouds` binding set of `params` whose map is a blank 1x1: their shadow (computed from
+/// the parameters alone) without drawing the map, for passes tested on their own.
+pub fn shadow_lookup(g: &mut FrameGraph<'_>, params: CloudParams) -> Result<BindingSet> {
+    Ok(disabled_frame(g, params)?.lookup)
+}
+
 impl Clouds {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {

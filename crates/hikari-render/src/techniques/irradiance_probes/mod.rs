@@ -250,6 +250,7 @@ impl IrradianceProbes {
         g: &mut FrameGraph<'r>,
         s: &IrradianceProbesSettings,
         sky: &SkyFrame,
+        clouds: BindingSet,
         light: Option<&Sun>,
         camera: Vec3,
     ) -> Result<ProbesFrame> {
@@ -289,6 +290,8 @@ impl IrradianceProbes {
                     .read(chunk_buf)
                     .read(probes)
                     .write(irradiance)
+                    .read(positions)
+                    .set(clouds)
                     .dispatch(&self.relight, [chunks.len() as u32, 1, 1])?;
             }
         } else {
@@ -330,6 +333,8 @@ impl IrradianceProbes {
         let gaunt = g.import_buffer("irradiance_probes.gaunt", &self.gaunt);
         let probes = g.import_buffer("irradiance_probes.bench_probes", &bench.probe_data);
         let irradiance = g.import_buffer("irradiance_probes.bench_irradiance", &bench.irradiance);
+        let positions = g.import_buffer("irradiance_probes.bench_positions", &bench.positions);
+        let clouds = super::clouds::disabled_lookup(g)?;
         for w in &bench.workloads {
             let chunks = g.import_buffer(w.pass, &w.chunks);
             g.pass(w.pass)
@@ -339,6 +344,8 @@ impl IrradianceProbes {
                 .read(chunks)
                 .read(probes)
                 .write(irradiance)
+                .read(positions)
+                .set(clouds)
                 .dispatch(&self.relight, [w.chunk_count, 1, 1])?;
         }
         Ok(irradiance)

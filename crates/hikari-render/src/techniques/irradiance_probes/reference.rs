@@ -93,10 +93,24 @@ pub fn relight_probe(
 
 /// Every probe of `data` relit: 9 RGB coefficients per probe, as the `irradiance` buffer.
 pub fn relight_all(data: &ProbeGpuData, sky: &ShL2Rgb, p: &RelightParams) -> Vec<ShL2Rgb> {
+    relight_all_shadowed(data, sky, p, &|_| 1.0)
+}
+
+/// [`relight_all`] with the sun bounce of each probe times `cloud_shadow` at its position
+/// (`relight.wgsl` reads `hikari::clouds::cloud_shadow` there; twin
+/// `clouds::reference::cloud_shadow_at`).
+pub fn relight_all_shadowed(
+    data: &ProbeGpuData,
+    sky: &ShL2Rgb,
+    p: &RelightParams,
+    cloud_shadow: &dyn Fn(Vec3) -> f32,
+) -> Vec<ShL2Rgb> {
     (0..data.probe_count())
         .map(|i| {
             let (v, b) = data.probe_sh(i);
-            relight_probe(sky, &v, &b, p)
+            let mut shadowed = *p;
+            shadowed.light_rgb[3] *= cloud_shadow(Vec3::from_slice(&data.positions[i][..3]));
+            relight_probe(sky, &v, &b, &shadowed)
         })
         .collect()
 }

@@ -5,9 +5,12 @@
 // Per probe: the sky's radiance SH times the probe's sky visibility (SH product truncated to
 // L2); the bounced sky visibility times the sky's average radiance, plus the sun bounce (the
 // light reflected by an imaginary ground and wall, negated reflected directions as windowed
-// deltas, times the light's irradiance and the probe's mean bounced visibility); each part
-// convolved with the clamped cosine and boosted on its own; their sum deringed.
+// deltas, times the light's irradiance, the probe's mean bounced visibility and the clouds'
+// shadow at the probe: the talk's "after applying cloud shadowing, which is dynamic so isn't
+// captured by the sky visibility"); each part convolved with the clamped cosine and boosted
+// on its own; their sum deringed.
 
+#import hikari::clouds::cloud_shadow
 #import hikari::sh::{ShL2Rgb, SH_C0, SH_COSINE_BANDS, sh_basis_l2, sh_band_of, sh_scale_bands_l2_rgb, sh_directionality_boost_rgb, sh_dering_l2_rgb}
 
 struct RelightParams {
@@ -32,6 +35,8 @@ struct RelightParams {
 @group(0) @binding(4) var<storage, read> probe_data: array<vec4<f32>>;
 // 9 per probe: irradiance SH (rgb; w 0), lux.
 @group(0) @binding(5) var<storage, read_write> irradiance: array<vec4<f32>>;
+// Per probe: position (metres; w: interior), where the clouds' shadow is read.
+@group(0) @binding(6) var<storage, read> positions: array<vec4<f32>>;
 
 const RELIGHT_BOUNCE: u32 = 1u;
 const RELIGHT_SUN_BOUNCE: u32 = 2u;
@@ -69,7 +74,8 @@ fn main(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg: ve
     var lobe_window = LOBE_WINDOW;
     let ground_w = max(l.y, 0.0);
     let wall_w = select(0.0, length(l.xz), l.y > 0.0);
-    let sun = params.light_rgb.xyz * mean_bounce * (2.0 * params.light_rgb.w);
+    let shadow = cloud_shadow(positions[chunk.x + lid].xyz);
+    let sun = params.light_rgb.xyz * mean_bounce * (2.0 * params.light_rgb.w * shadow);
     var direct: ShL2Rgb;
     var bounced: ShL2Rgb;
     for (var k = 0u; k < 9u; k++) {

@@ -74,6 +74,8 @@ pub struct RelightBench {
     pub(super) probe_data: wgpu::Buffer,
     /// The relit output, 9 `vec4` per probe.
     pub(super) irradiance: wgpu::Buffer,
+    /// A position per probe (zeros: the bench casts no cloud shadow).
+    pub(super) positions: wgpu::Buffer,
     /// The sky pass's layout: 9 raw radiance coefficients, then 9 deringed ones (the raw ones
     /// again here; the relight reads only the first 9).
     pub(super) sky_sh: wgpu::Buffer,
@@ -166,6 +168,11 @@ impl RelightBench {
         }
         Ok(Self {
             workloads,
+            positions: storage(
+                ctx,
+                "irradiance_probes.bench_positions",
+                &vec![0u8; probe_data.len() / 9 * 16],
+            ),
             irradiance: storage(
                 ctx,
                 "irradiance_probes.bench_irradiance",
