@@ -444,8 +444,8 @@ const FURNACE_ROUGHNESS: [f32; 9] = [0.0, 0.02, 0.045, 0.1, 0.25, 0.4, 0.6, 0.8,
 const FURNACE_DEGREES: [f64; 8] = [0.0, 30.0, 60.0, 75.0, 84.0, 86.0, 88.0, 89.0];
 
 /// White furnace of the whole BRDF with a white base colour, dielectric (F0 0.04 + white
-/// Lambert; and with KHR_materials_specular's weight 0.5) and metal (F0 1), isotropic, over roughness 0..1 and view angles up to 89°:
-/// the directional albedo is in [0.97, 1 + tol]. With the compensation it should be 1 up to
+/// Lambert; and with KHR_materials_specular's weight 0.5) and metal (F0 1), isotropic, over
+/// roughness 0..1 and view angles up to 89°: the directional albedo is in [0.97, 1 + tol]. With the compensation it should be 1 up to
 /// the tables' error, so the test also bounds `|E − 1|`.
 ///
 /// Tolerance: the quadratures here (64 x 128 nodes for the specular lobe, 48 x 96 for the

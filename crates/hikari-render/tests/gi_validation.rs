@@ -314,9 +314,9 @@ const NOISE_PERIOD: u32 = 64;
 /// plain 64-frame accumulation without jitter, clamp or denoiser: 1.1 % under the estimator).
 /// The worst block is printed, not bounded: at 32 x 32 the denoiser's 6 m and 3 m radii span
 /// most of the image, so a block's difference measures the blur (0.69 of the mean c0 where sky
-/// meets ground), not a bias. The same 64 denoised frames without the firefly clamp (`firefly_clamp = 0`) give
-/// the clamp's own share of the bias, also bounded at 3 % of each mean (measured 1.0 %,
-/// 0.4 %, 0.2 %).
+/// meets ground), not a bias. The same 64 denoised frames without the firefly clamp
+/// (`firefly_clamp = 0`) give the clamp's own share of the bias, also bounded at 3 % of each
+/// mean (measured 1.0 %, 0.4 %, 0.2 %).
 #[test]
 fn denoised_gi_is_unbiased_against_the_estimator_mean() {
     const N: u32 = 32;

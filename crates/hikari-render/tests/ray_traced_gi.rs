@@ -989,9 +989,9 @@ fn hits_are_lit_like_the_twin() {
 }
 
 /// `hikari::rtgi_resolve` against its twin on seeded random signals (each the mean of 2 to 8
-/// encoded samples), normals, view directions, F0 and roughness. Diffuse: a few f32 roundings
-/// of terms as large as the result's luminance scale, 1e-5 of it. Specular: GGX in f32 on the
-/// GPU against f64, where the widened lobe can still be sharp (alpha down to 0.03 here): 1e-3
+/// encoded samples), normals, view directions, F0, F90 (1 or weaker) and roughness. Diffuse: a
+/// few f32 roundings of terms as large as the result's luminance scale, 1e-5 of it. Specular:
+/// GGX in f32 on the GPU against f64, where the widened lobe can still be sharp (alpha down to 0.03 here): 1e-3
 /// relative plus 1e-5 of the luminance scale. A wrong sign, a swapped component or a missing
 /// factor is off by far more.
 #[test]
@@ -1022,15 +1022,21 @@ fn resolve_helpers_match_the_cpu_twin() {
             v = (v + n * (0.05 - v.dot(n) + rng.random_range(0.0..1.0))).normalize();
         }
         let f0 = Vec3::new(rng.random(), rng.random(), rng.random()) * 0.96 + 0.04;
+        // F90: 1 for most cases (the usual interface), a weaker one for the rest.
+        let f90: f32 = if rng.random_bool(0.5) {
+            1.0
+        } else {
+            rng.random_range(0.0..1.0)
+        };
         let alpha: f32 = rng.random_range(0.002..1.0);
         let f = reference::to_floats(&s);
         input.extend_from_slice(&[f[0], f[1], f[2], f[3], f[4], f[5], alpha, 0.0]);
         input.extend_from_slice(&[
-            n.x, n.y, n.z, 0.0, v.x, v.y, v.z, 0.0, f0.x, f0.y, f0.z, 0.0,
+            n.x, n.y, n.z, 0.0, v.x, v.y, v.z, 0.0, f0.x, f0.y, f0.z, f90,
         ]);
         want.push((
             reference::resolve_diffuse(&s, n),
-            reference::resolve_specular(&s, n, v, f0, alpha),
+            reference::resolve_specular(&s, n, v, f0, f90, alpha),
             s.y.coeffs[0] / C0 as f32,
         ));
     }

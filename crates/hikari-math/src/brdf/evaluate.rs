@@ -42,8 +42,9 @@ impl Lobes {
 /// surface; a pass whose normal maps face away from the viewer must bend `n` itself.
 ///
 /// Specular: `D · V · F(v·h)` with [`ggx_ndf_aniso`], [`visibility_aniso`] (height-correlated
-/// Smith) and Schlick's Fresnel from [`Material::f0`] to [`Material::f90`], plus the multiple-scattering lobe; diffuse: Lambert scaled
-/// by what the specular lobe leaves ([`Compensation`], docs/brdf.md). Computed in `f64`.
+/// Smith) and Schlick's Fresnel from [`Material::f0`] to [`Material::f90`], plus the
+/// multiple-scattering lobe; diffuse: Lambert scaled by what the specular lobe leaves
+/// ([`Compensation`], docs/brdf.md). Computed in `f64`.
 pub fn evaluate(material: &Material, n: Vec3, t: Vec3, b: Vec3, v: Vec3, l: Vec3) -> Vec3 {
     let d = |x: Vec3| x.as_dvec3();
     evaluate_f64(material, d(n), d(t), d(b), d(v), d(l)).as_vec3()

@@ -57,10 +57,6 @@ fn brdf_anisotropic_alphas(perceptual_roughness: f32, anisotropy: f32) -> vec2<f
     return max(widths, vec2<f32>(BRDF_MIN_ALPHA));
 }
 
-fn brdf_f0_from_metalness(base_color: vec3<f32>, metalness: f32) -> vec3<f32> {
-    return mix(vec3<f32>(BRDF_DIELECTRIC_F0), base_color, metalness);
-}
-
 // GGX D(h), 1/sr, isotropic, from n.h.
 fn brdf_ggx_ndf(n_dot_h: f32, alpha: f32) -> f32 {
     if n_dot_h <= 0.0 {
@@ -155,11 +151,8 @@ fn brdf_schlick_weight(cos_theta: f32) -> f32 {
     return m2 * m2 * m;
 }
 
-fn brdf_fresnel_schlick(f0: vec3<f32>, cos_theta: f32) -> vec3<f32> {
-    return f0 + (vec3<f32>(1.0) - f0) * brdf_schlick_weight(cos_theta);
-}
-
-// Schlick's Fresnel rising from f0 to f90 at grazing instead of to 1.
+// Schlick's Fresnel rising from f0 at normal incidence to f90 at grazing (1 for the usual
+// interface; a specular weight lowers it).
 fn brdf_fresnel_schlick_f90(f0: vec3<f32>, f90: f32, cos_theta: f32) -> vec3<f32> {
     return f0 + (vec3<f32>(f90) - f0) * brdf_schlick_weight(cos_theta);
 }
@@ -328,7 +321,8 @@ fn brdf_view(m: BrdfMaterial, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, v: vec3<
 }
 
 // The light-dependent factors of brdf_evaluate_view, scalars, such that
-//   brdf_evaluate_view(p, l) = f_normal w.x + (f_grazing - f_normal) w.y + diffuse w.z + multiple w.w:
+//   brdf_evaluate_view(p, l) =
+//     f_normal w.x + (f_grazing - f_normal) w.y + diffuse w.z + multiple w.w:
 // w.x = D V n.l, w.y = D V n.l Schlick(v.h) (from F = f0 + (f90 - f0) Schlick),
 // w.z = (1 - E_d(n.l)) n.l, w.w = (1 - E(n.l)) n.l. A caller summing many lights sums their
 // weighted light colours and applies the material's colours once (brdf_apply_weights), rather

@@ -290,9 +290,7 @@ fn main(
             let signal = rtgi_signal(textureLoad(gi_y, pixel, 0), textureLoad(gi_cocg, pixel, 0).xy);
             let near_e = rtgi_resolve_diffuse(signal, n) * PI;
             let alpha = m.perceptual_roughness * m.perceptual_roughness;
-            // F0 to F90 is F90 times Schlick's from F0 / F90 to 1.
-            let f90 = brdf_material_f90(m);
-            let near_specular = select(vec3<f32>(0.0), f90 * rtgi_resolve_specular(signal, n, v, brdf_material_f0(m) / max(f90, 1e-6), alpha), f90 > 0.0);
+            let near_specular = rtgi_resolve_specular(signal, n, v, brdf_material_f0(m), brdf_material_f90(m), alpha);
             ambient = mix(near_e, ambient * ao, far);
             ambient_specular = mix(near_specular, ambient_specular * ao, far);
         }

@@ -24,11 +24,11 @@ const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
 const AIR_INTERIOR_MASK: f32 = 0.5;
 
 // The talk's haze AO: the average sky visibility at x, from the irradiance probes. Their
-// irradiance averaged over every normal (the SH's constant term, n = 0) over the open sky's,
-// by luminance, at most 1; 1 where no probe covers x. Twin: reference::probe_sky_visibility.
-fn sky_visibility_at(x: vec3<f32>) -> f32 {
+// irradiance averaged over every normal (the SH's constant term, n = 0) over the open sky's
+// (`open`, the luminance of sky_ambient_average_irradiance), by luminance, at most 1; 1 where
+// no probe covers x. Twin: reference::probe_sky_visibility.
+fn sky_visibility_at(x: vec3<f32>, open: f32) -> f32 {
     let probe = probe_irradiance_at(x, vec3<f32>(0.0), AIR_INTERIOR_MASK);
-    let open = dot(sky_ambient_average_irradiance(), LUMA);
     if !(probe.w > 0.0) || !(open > 0.0) {
         return 1.0;
     }
@@ -42,10 +42,11 @@ fn froxel_sky_visibility(v: vec3<f32>, k: f32) -> f32 {
     let z1 = slice_depth(params, k + 1.0);
     let inv_cos = 1.0 / max(dot(v, view.forward_near.xyz), 1e-4);
     let n = max(params.lights.y, 1u);
+    let open = dot(sky_ambient_average_irradiance(), LUMA);
     var sum = 0.0;
     for (var i = 0u; i < n; i++) {
         let z = mix(z0, z1, (f32(i) + 0.5) / f32(n));
-        sum += sky_visibility_at(view.position.xyz + v * (z * inv_cos));
+        sum += sky_visibility_at(view.position.xyz + v * (z * inv_cos), open);
     }
     return sum / f32(n);
 }

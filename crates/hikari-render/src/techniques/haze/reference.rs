@@ -122,7 +122,7 @@ pub struct HazeLightInputs<'a> {
 /// `AIR_INTERIOR_MASK`): none, the probes weigh by their interpolation weights alone.
 pub const AIR_INTERIOR_MASK: f32 = 0.5;
 
-/// The talk's haze AO, `light.wgsl`'s `sky_visibility`: the probes' irradiance averaged over
+/// The talk's haze AO, `light.wgsl`'s `sky_visibility_at`: the probes' irradiance averaged over
 /// every normal (`probe_average`, lux, as the lookup gives it at n = 0; `None` where no probe
 /// covers the point) over the open sky's (`sky_sh`'s constant term times π and the diffuse
 /// `balance`), by luminance, in [0, 1]; 1 without probes or sky.

@@ -6,8 +6,8 @@
 // same tests stand in, equally weighted (a silhouette under TAA's jitter: the pixel's own texel
 // saw the other surface last frame, its neighbours on this side did not); with none, the
 // history is dropped. The speed is 1 / length, the length growing while the history stays
-// valid, up to a cap. A sample far brighter than the history it joins is scaled down first (the firefly
-// clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
+// valid, up to a cap. A sample far brighter than the history it joins is scaled down first
+// (the firefly clamp, reference::FireflyClamp). Non-finite input is replaced where it enters. CPU twin:
 // reference::accumulate_pixel.
 
 #import hikari::view::{View, world_from_depth, reprojection, reprojection_tap, history_depth_agrees, REPROJECTION_MIN_WEIGHT}

@@ -798,10 +798,17 @@ pub fn resolve_diffuse(s: &ShL1YCoCg, n: Vec3) -> Vec3 {
 }
 
 /// `hikari::rtgi_resolve`'s specular: reflected radiance towards `v` of a GGX surface facing
-/// `n` (Fresnel F0 `f0`, GGX alpha `material_alpha`), the SH taken as one light from its
+/// `n` (Fresnel from `f0` to `f90`, GGX alpha `material_alpha`), the SH taken as one light from its
 /// dominant direction (the mirror direction if it has none) with the lobe widened by its loss
 /// of directionality and the irradiance it gives a plane facing that direction.
-pub fn resolve_specular(s: &ShL1YCoCg, n: Vec3, v: Vec3, f0: Vec3, material_alpha: f32) -> Vec3 {
+pub fn resolve_specular(
+    s: &ShL1YCoCg,
+    n: Vec3,
+    v: Vec3,
+    f0: Vec3,
+    f90: f32,
+    material_alpha: f32,
+) -> Vec3 {
     use hikari_math::brdf::{fresnel, ggx, smith};
     let l = s.dominant_direction().unwrap_or_else(|| (-v).reflect(n));
     let alpha = s.specular_alpha(material_alpha) as f64;
@@ -812,7 +819,7 @@ pub fn resolve_specular(s: &ShL1YCoCg, n: Vec3, v: Vec3, f0: Vec3, material_alph
     let e = (std::f32::consts::PI * s.resolve_diffuse(l)).as_dvec3();
     let h = (v + l).normalize();
     let spec = ggx::ggx_ndf(n.dot(h) as f64, alpha) * smith::visibility(n_v, n_l, alpha);
-    let f = fresnel::fresnel_schlick(f0.as_dvec3(), v.dot(h).max(0.0) as f64);
+    let f = fresnel::fresnel_schlick_f90(f0.as_dvec3(), f90 as f64, v.dot(h).max(0.0) as f64);
     (f * spec * e * n_l).as_vec3()
 }
 

@@ -8,7 +8,7 @@
 // Importing hikari::brdf brings the binding set `brdf_tables` with it.
 
 #import hikari::sh::{ShYCoCg, shy_resolve_diffuse, shy_dominant_direction, shy_specular_alpha}
-#import hikari::brdf::{brdf_ggx_ndf, brdf_visibility, brdf_fresnel_schlick}
+#import hikari::brdf::{brdf_ggx_ndf, brdf_visibility, brdf_fresnel_schlick_f90}
 
 const RTGI_RESOLVE_PI: f32 = 3.14159265358979;
 
@@ -25,10 +25,11 @@ fn rtgi_resolve_diffuse(s: ShYCoCg, n: vec3<f32>) -> vec3<f32> {
     return shy_resolve_diffuse(s, n);
 }
 
-// Reflected radiance (nits) towards unit v of a GGX surface with unit normal n, Fresnel F0
-// `f0` and GGX alpha `material_alpha`. Without a direction in the SH (all zero) the light is
-// taken from the mirror direction with the widest lobe.
-fn rtgi_resolve_specular(s: ShYCoCg, n: vec3<f32>, v: vec3<f32>, f0: vec3<f32>, material_alpha: f32) -> vec3<f32> {
+// Reflected radiance (nits) towards unit v of a GGX surface with unit normal n, Fresnel from
+// `f0` to `f90` (brdf_material_f0, brdf_material_f90) and GGX alpha `material_alpha`. Without
+// a direction in the SH (all zero) the light is taken from the mirror direction with the
+// widest lobe.
+fn rtgi_resolve_specular(s: ShYCoCg, n: vec3<f32>, v: vec3<f32>, f0: vec3<f32>, f90: f32, material_alpha: f32) -> vec3<f32> {
     var l = shy_dominant_direction(s);
     if dot(l, l) == 0.0 {
         l = reflect(-v, n);
@@ -42,5 +43,5 @@ fn rtgi_resolve_specular(s: ShYCoCg, n: vec3<f32>, v: vec3<f32>, f0: vec3<f32>, 
     let e = RTGI_RESOLVE_PI * shy_resolve_diffuse(s, l);
     let h = normalize(v + l);
     let spec = brdf_ggx_ndf(dot(n, h), alpha) * brdf_visibility(n_v, n_l, alpha);
-    return brdf_fresnel_schlick(f0, max(dot(v, h), 0.0)) * spec * e * n_l;
+    return brdf_fresnel_schlick_f90(f0, f90, max(dot(v, h), 0.0)) * spec * e * n_l;
 }
