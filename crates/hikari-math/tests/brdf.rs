@@ -971,6 +971,7 @@ fn wgsl_twin_matches_cpu_names_and_constants() {
         "visibility_aniso",
         "schlick_weight",
         "fresnel_schlick",
+        "fresnel_schlick_f90",
         "lambert",
         "albedo_scaled_lambert",
         "fresnel_schlick_average",

@@ -57,6 +57,10 @@ fn brdf_anisotropic_alphas(perceptual_roughness: f32, anisotropy: f32) -> vec2<f
     return max(widths, vec2<f32>(BRDF_MIN_ALPHA));
 }
 
+fn brdf_f0_from_metalness(base_color: vec3<f32>, metalness: f32) -> vec3<f32> {
+    return mix(vec3<f32>(BRDF_DIELECTRIC_F0), base_color, metalness);
+}
+
 // GGX D(h), 1/sr, isotropic, from n.h.
 fn brdf_ggx_ndf(n_dot_h: f32, alpha: f32) -> f32 {
     if n_dot_h <= 0.0 {
@@ -149,6 +153,10 @@ fn brdf_schlick_weight(cos_theta: f32) -> f32 {
     let m = 1.0 - clamp(cos_theta, 0.0, 1.0);
     let m2 = m * m;
     return m2 * m2 * m;
+}
+
+fn brdf_fresnel_schlick(f0: vec3<f32>, cos_theta: f32) -> vec3<f32> {
+    return f0 + (vec3<f32>(1.0) - f0) * brdf_schlick_weight(cos_theta);
 }
 
 // Schlick's Fresnel rising from f0 at normal incidence to f90 at grazing (1 for the usual
