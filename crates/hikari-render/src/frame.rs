@@ -357,6 +357,12 @@ pub fn record<'r>(
     state.last_camera = Some(pose);
     let to_sun = s.sun.as_ref().map_or(glam::Vec3::ZERO, |sun| sun.direction);
     let scene = &scene.import(g);
+    // `direct_lighting.punctual` switches the point and spot lights off in every pass.
+    let punctual_lights = if s.settings.direct_lighting.punctual {
+        scene.light_count
+    } else {
+        0
+    };
 
     // 2. Atmosphere tables (rebuilt when the weather changes) resampled for this frame's sun
     //    and moon, and 3. the sky's deringed SH.
@@ -410,7 +416,7 @@ pub fn record<'r>(
             probes: &probes,
             clouds: &clouds,
             lights: scene.lights,
-            light_count: scene.light_count,
+            light_count: punctual_lights,
             sun: s.sun.as_ref(),
             cutoff_lux: crate::techniques::direct_lighting::light_cutoff_lux(
                 s.metered_lux_with_sky(sky.sky_lux),
@@ -466,7 +472,7 @@ pub fn record<'r>(
             &s.settings.ray_traced_gi,
             g.frame_index(),
             s.sun.as_ref(),
-            scene.light_count,
+            punctual_lights,
             s.metered_lux_with_sky(sky.sky_lux),
             sky_source,
         )
@@ -550,7 +556,7 @@ pub fn record<'r>(
     let brdf = t.brdf_tables.binding_set(g);
     let mut lighting = LightingParams::new(
         s.sun.as_ref(),
-        scene.light_count,
+        punctual_lights,
         s.metered_lux_with_sky(sky.sky_lux),
         &s.settings.direct_lighting,
     );
@@ -567,15 +573,10 @@ pub fn record<'r>(
     }
     // Area lights, and point and spot lights with ray-traced shadows (issue 18), added by the
     // deferred lighting, which then leaves the point and spot lights to them.
-    //    `direct_lighting.punctual` switches point and spot lights off in both passes.
     let area_params = AreaLightParams::new(
         &s.settings.area_lights,
         area.light_count(),
-        if s.settings.direct_lighting.punctual {
-            scene.light_count
-        } else {
-            0
-        },
+        punctual_lights,
         s.metered_lux_with_sky(sky.sky_lux),
         g.frame_index(),
     );
@@ -642,11 +643,7 @@ pub fn record<'r>(
             &s.settings.haze,
             &s.settings.sky.weather,
             s.sun.as_ref().filter(|_| s.settings.direct_lighting.sun),
-            if s.settings.direct_lighting.punctual {
-                scene.light_count
-            } else {
-                0
-            },
+            punctual_lights,
             lighting.cutoff[0],
             metered,
         );

@@ -403,6 +403,73 @@ fn a_rough_metal_reflects_the_ggx_integral_of_the_captured_room() {
 }
 
 #[test]
+fn a_lamp_lit_probe_is_normalised_by_the_lamp_at_the_surface() {
+    // Grey walls lit only by a lamp inside the box (no sun, no sky light): the probe's texels
+    // hold the lamp's light, so the normalisation must count it at the capture point and at
+    // the surface alike. A floor pixel's reflection, with the normalisation over without it, is
+    // then the lamp's unshadowed light on the floor there over the capture light for the
+    // floor's normal, at most `max_normalization`: near the lamp above 1, out of its reach 0
+    // (before, the floor took the lamp-lit room's reflection everywhere at full strength).
+    // The direct light of the lamp on the metal floor is the same in both runs and comes out
+    // with a third run without the probes.
+    let lamp_at = Vec3::new(-1.2, 0.6, 1.0);
+    let mut scene = room(metal_floor(0.5, Vec3::ZERO), &[Vec3::ZERO; 5]);
+    for m in &mut scene.materials[1..] {
+        m.base_color = Vec3::splat(0.6);
+    }
+    let mut lamp = hikari_scene::Light::point("lamp", lamp_at, 4.0, Vec3::ONE);
+    // Out of reach of the far side of the floor, as the village's lanterns are of its fields.
+    lamp.range = Some(2.5);
+    scene.lights.push(lamp);
+    let mut s = settings(&scene, 32);
+    s.settings.reflection_probes.normalization = true;
+    let with = render(&scene, &s);
+    s.settings.reflection_probes.normalization = false;
+    let without = render(&scene, &s);
+    s.settings.reflection_probes.enabled = false;
+    let direct = render(&scene, &s);
+
+    let params = hikari_render::techniques::direct_lighting::LightingParams::new(
+        None,
+        1,
+        s.metered_lux(),
+        &s.settings.direct_lighting,
+    );
+    let light = hikari_render::scene_gpu::LightGpu {
+        position_range: lamp_at.extend(2.5).to_array(),
+        direction_kind: [0.0, 0.0, -1.0, hikari_render::scene_gpu::LIGHT_POINT],
+        intensity: [4.0, 4.0, 4.0, 0.0],
+        spot: [0.0, 1.0, 0.0, 0.0],
+    };
+    let b = ReflectionProbeGpu::new(&probe(LO - Vec3::Y * 0.01, HI, CAPTURE, 0.0));
+    let luma = |e: Vec3| e.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let capture =
+        twin::capture_light(|n| luma(twin::box_light_irradiance(&b, &light, &params, CAPTURE, n)));
+    let max = s.settings.reflection_probes.max_normalization;
+    let (mut checked, mut above, mut below) = (0, 0, 0);
+    for (x, y, p, _) in floor_pixels(&scene.cameras[0]) {
+        let d = Vec4::from(direct.pixel(x, y)).truncate();
+        let on = Vec4::from(with.pixel(x, y)).truncate() - d;
+        let off = Vec4::from(without.pixel(x, y)).truncate() - d;
+        if luma(off) < 0.05 {
+            continue;
+        }
+        let at_floor = luma(twin::box_light_irradiance(&b, &light, &params, p, Vec3::Y));
+        let want = (at_floor / (capture.x + capture.z)).clamp(0.0, max);
+        let got = luma(on) / luma(off);
+        assert!(
+            (got - want).abs() <= 0.03 * want + 0.01,
+            "pixel ({x}, {y}) at {p}: normalised by {got}, the twin says {want}"
+        );
+        checked += 1;
+        above += usize::from(want > 1.2);
+        below += usize::from(want < 0.8);
+    }
+    println!("{checked} pixels: {above} above 1.2, {below} under 0.8");
+    assert!(checked > 150 && above > 20 && below > 20);
+}
+
+#[test]
 fn the_relit_cube_maps_are_the_twins_relighting_of_what_was_captured() {
     // The boxes in the morning sun, a probe round them; the sky's light off (its SH has its own
     // tests), so each texel is its emission plus its albedo lit by the sun through the talk's

@@ -15,7 +15,7 @@
 #import hikari::sky_ambient::{sky_ambient_eval, sky_ambient_irradiance, sky_ambient_specular}
 #import hikari::irradiance_probes::probe_irradiance_at
 #import hikari::rtgi_resolve::{rtgi_signal, rtgi_resolve_diffuse, rtgi_resolve_specular}
-#import hikari::reflection_probe_math::{ReflectionProbeGpu, RP_ON, RP_HORIZON, RP_PARALLAX_ROUGHNESS, RP_NORMALIZE, rp_box_weight, rp_lookup_direction, rp_normalization, rp_horizon_occlusion}
+#import hikari::reflection_probe_math::{ReflectionProbeGpu, RP_ON, RP_HORIZON, RP_PARALLAX_ROUGHNESS, RP_NORMALIZE, rp_box_weight, rp_lookup_direction, rp_normalization, rp_horizon_occlusion, rp_box_light_irradiance}
 #import hikari::tile_bounds::{tile_bounds, tile_bounds_distance2, TILE_BOUNDS_FAR}
 
 struct LightingParams {
@@ -116,9 +116,11 @@ fn specular_placeholder(m: BrdfMaterial, n: vec3<f32>, v: vec3<f32>) -> vec3<f32
 // of mapped normal nm and vertex normal nv, seen from v (towards the eye), perceptual
 // roughness `roughness`, from the probes whose boxes hold x (smallest first, each fading out
 // over its blend distance into the next: the talk's nesting); `e_luma`: the luminance of the
-// irradiance the surface receives (lux), for the normalisation. w: the probes' coverage, 0 to
-// 1. Twin: `reflection_probes::reference::lookup`.
-fn reflection_probe_radiance(x: vec3<f32>, nm: vec3<f32>, nv: vec3<f32>, v: vec3<f32>, roughness: f32, e_luma: f32) -> vec4<f32> {
+// ambient irradiance the surface receives (lux), for the normalisation, to which each probe
+// adds the unshadowed light of the tile's lights inside its box (its texels hold that light,
+// and so does its capture light). w: the probes' coverage, 0 to 1. Twin:
+// `reflection_probes::reference::lookup`.
+fn reflection_probe_radiance(x: vec3<f32>, nm: vec3<f32>, nv: vec3<f32>, v: vec3<f32>, roughness: f32, e_luma: f32, tile_lights_n: u32) -> vec4<f32> {
     let flags = params.reflection.z;
     if (flags & RP_ON) == 0u {
         return vec4<f32>(0.0);
@@ -137,7 +139,11 @@ fn reflection_probe_radiance(x: vec3<f32>, nm: vec3<f32>, nv: vec3<f32>, v: vec3
         let at = rp_lookup_direction(p, x, r, alpha, levels, (flags & RP_PARALLAX_ROUGHNESS) != 0u);
         var c = textureSampleLevel(rp_radiance, rp_sampler, at.xyz, i, at.w).rgb;
         if (flags & RP_NORMALIZE) != 0u {
-            c *= rp_normalization(rp_capture_light[i], nm, e_luma, params.reflection_values.x);
+            var local = vec3<f32>(0.0);
+            for (var k = 0u; k < tile_lights_n; k++) {
+                local += rp_box_light_irradiance(p, lights[tile_lights[k]], params.cutoff.x, x, nm);
+            }
+            c *= rp_normalization(rp_capture_light[i], nm, e_luma + dot(local, EXPOSURE_LUMA), params.reflection_values.x);
         }
         let take = (1.0 - covered) * w;
         sum += c * take;
@@ -184,8 +190,10 @@ fn main(
     }
     let bounds = tile_bounds(lid, lo, hi);
 
-    // Cull the lights against the bounds of the tile's visible surfaces.
-    let light_count = select(0u, params.config.x, (params.config.y & LIGHTING_PUNCTUAL) != 0u);
+    // Cull the lights against the bounds of the tile's visible surfaces: to shade them, and for
+    // the reflection probes' normalisation (whose texels they light).
+    let rp_lights = (params.reflection.z & (RP_ON | RP_NORMALIZE)) == (RP_ON | RP_NORMALIZE);
+    let light_count = select(0u, params.config.x, (params.config.y & LIGHTING_PUNCTUAL) != 0u || rp_lights);
     if bounds.lo.x <= bounds.hi.x {
         for (var i = lid; i < light_count; i += 256u) {
             let range = light_range(lights[i], params.cutoff.x);
@@ -242,7 +250,8 @@ fn main(
             sum_d += e * w.w;
             illuminance += dot(e, EXPOSURE_LUMA) * max(dot(n, l), 0.0);
         }
-        for (var k = 0u; k < tile_lights_n; k++) {
+        let shaded_lights_n = select(0u, tile_lights_n, (flags & LIGHTING_PUNCTUAL) != 0u);
+        for (var k = 0u; k < shaded_lights_n; k++) {
             let light = lights[tile_lights[k]];
             let to_light = light.position_range.xyz - world;
             let d2 = dot(to_light, to_light);
@@ -299,7 +308,7 @@ fn main(
             // specular (near) or the sky's (far) where they do not, and where they fade out.
             let nv_raw = textureLoad(gbuffer_vertex_normal, pixel, 0).xyz;
             let nv = select(n, normalize(nv_raw), dot(nv_raw, nv_raw) > 0.25);
-            let probe = reflection_probe_radiance(world, n, nv, v, m.perceptual_roughness, dot(ambient, EXPOSURE_LUMA));
+            let probe = reflection_probe_radiance(world, n, nv, v, m.perceptual_roughness, dot(ambient, EXPOSURE_LUMA), tile_lights_n);
             if probe.w > 0.0 {
                 let n_dot_v = max(dot(n, v), 0.0);
                 let f = brdf_material_fresnel(m, n_dot_v);

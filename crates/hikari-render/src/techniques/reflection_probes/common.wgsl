@@ -4,6 +4,8 @@
 // CPU twin: `reflection_probes::reference`.
 #define_import_path hikari::reflection_probe_math
 
+#import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
+
 // One probe (`reflection_probes::ReflectionProbeGpu`).
 struct ReflectionProbeGpu {
     // World to the box's cube [-1, 1]^3.
@@ -160,4 +162,20 @@ fn rp_lookup_direction(p: ReflectionProbeGpu, x: vec3<f32>, r: vec3<f32>, alpha:
 // `max_ratio`.
 fn rp_normalization(light: vec4<f32>, n: vec3<f32>, e_luma: f32, max_ratio: f32) -> f32 {
     return clamp(e_luma / max(light.x + dot(light.yzw, n), 1e-6), 0.0, max_ratio);
+}
+
+// Irradiance (lux) from one point or spot light at x of normal n, unshadowed, if the light lies
+// inside probe p's box, else 0: the light the relight gives the probe's texels, so that the
+// lookup's normalisation can count the same light at the capture point and at the surface.
+fn rp_box_light_irradiance(p: ReflectionProbeGpu, light: LightGpu, cutoff_lux: f32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let o = (p.to_box * vec4<f32>(light.position_range.xyz, 1.0)).xyz;
+    if any(abs(o) > vec3<f32>(1.0)) {
+        return vec3<f32>(0.0);
+    }
+    let to_light = light.position_range.xyz - x;
+    let d2 = dot(to_light, to_light);
+    let range = light_range(light, cutoff_lux);
+    let inv_d = inverseSqrt(max(d2, 1e-8));
+    let l = to_light * inv_d;
+    return light.intensity.rgb * (light_attenuation(light, l, inv_d * inv_d, d2 / (range * range)) * max(dot(n, l), 0.0));
 }

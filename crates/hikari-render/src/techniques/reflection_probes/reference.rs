@@ -168,11 +168,50 @@ pub fn prefilter_integral(env: impl Fn(Vec3) -> Vec3, n: Vec3, alpha: f64, steps
     (sum / weight.max(1e-300)).as_vec3()
 }
 
+/// Twin of `rp_box_light_irradiance`: the irradiance (lux) one point or spot light gives x of
+/// normal n, unshadowed, if it lies inside the probe's box, else 0. `cutoff`: the frame's
+/// lighting parameters, whose cut-off shortens the light's range.
+pub fn box_light_irradiance(
+    p: &ReflectionProbeGpu,
+    light: &crate::scene_gpu::LightGpu,
+    cutoff: &crate::techniques::direct_lighting::LightingParams,
+    x: Vec3,
+    n: Vec3,
+) -> Vec3 {
+    use crate::techniques::direct_lighting::reference::light_attenuation;
+    let at = Vec3::from_slice(&light.position_range[..3]);
+    if to_box(p).transform_point3(at).abs().max_element() > 1.0 {
+        return Vec3::ZERO;
+    }
+    let to_light = at - x;
+    let d2 = to_light.length_squared().max(1e-8);
+    let l = to_light / d2.sqrt();
+    Vec3::from_slice(&light.intensity[..3])
+        * (light_attenuation(cutoff, light, l, d2) * n.dot(l).max(0.0))
+}
+
+/// Twin of the relight's capture light: the luminance of the irradiance at the capture point
+/// as an L1 function of the normal (mean, x, y, z slopes) from `e_luma(normal)` along the six
+/// axes, whose mean is an L2 SH's band 0 exactly.
+pub fn capture_light(e_luma: impl Fn(Vec3) -> f32) -> Vec4 {
+    let [xp, xn, yp, yn, zp, zn] =
+        [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z].map(&e_luma);
+    Vec4::new(
+        (xp + xn + yp + yn + zp + zn) / 6.0,
+        0.5 * (xp - xn),
+        0.5 * (yp - yn),
+        0.5 * (zp - zn),
+    )
+}
+
 /// One probe as the lookup sees it.
 pub struct LookupProbe<'a> {
     pub gpu: ReflectionProbeGpu,
-    /// Luminance of the irradiance at its capture point: mean, x, y, z slopes.
+    /// Luminance of the irradiance at its capture point: mean, x, y, z slopes ([`capture_light`]).
     pub capture_light: Vec4,
+    /// Luminance of the irradiance the lights inside its box give the surface, unshadowed
+    /// ([`box_light_irradiance`]), which the normalisation adds to the surface's ambient.
+    pub lights_luma: f32,
     /// Its prefiltered radiance along a direction at a level of detail.
     pub sample: &'a dyn Fn(Vec3, f32) -> Vec3,
 }
@@ -186,7 +225,8 @@ pub struct LookupOptions {
     pub max_normalization: f32,
 }
 
-/// Twin of `reflection_probe_radiance`: rgb, and the probes' coverage in w.
+/// Twin of `reflection_probe_radiance`: rgb, and the probes' coverage in w. `e_luma`: the
+/// luminance of the surface's ambient irradiance.
 #[allow(clippy::too_many_arguments)]
 pub fn lookup(
     probes: &[LookupProbe<'_>],
@@ -219,7 +259,7 @@ pub fn lookup(
         if o.normalize {
             let l = p.capture_light;
             let at_capture = l.x + Vec3::new(l.y, l.z, l.w).dot(nm);
-            c *= (e_luma / at_capture.max(1e-6)).clamp(0.0, o.max_normalization);
+            c *= ((e_luma + p.lights_luma) / at_capture.max(1e-6)).clamp(0.0, o.max_normalization);
         }
         let take = (1.0 - covered) * w;
         sum += c * take;

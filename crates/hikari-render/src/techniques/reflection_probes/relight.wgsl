@@ -7,11 +7,12 @@
 // and E_lights the point and spot lights inside the probe's box, unshadowed. Sky texels take
 // the sky and its clouds, without the sun's disk (the sun's specular is direct light).
 // Thread (0, 0) of a probe's first face also stores the light at its capture point (the
-// lookup's luminance normalisation). Twin: `reflection_probes::reference::relight_texel`.
+// lookup's luminance normalisation): the probes' and the lights' inside the box, as the texels
+// have it. Twin: `reflection_probes::reference::relight_texel`.
 
 #import hikari::octahedral::oct_decode
-#import hikari::reflection_probe_math::{ReflectionProbeGpu, rp_texel_direction, rp_face_uv, rp_box_exit}
-#import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
+#import hikari::reflection_probe_math::{ReflectionProbeGpu, rp_texel_direction, rp_face_uv, rp_box_exit, rp_box_light_irradiance}
+#import hikari::scene_gpu::LightGpu
 #import hikari::sky::sky_background_no_disks
 #import hikari::sky_ambient::{sky_ambient_eval, sky_ambient_irradiance}
 #import hikari::irradiance_probes::probe_irradiance_at
@@ -91,6 +92,22 @@ fn cube_map_shadow(probe: u32, p: ReflectionProbeGpu, x: vec3<f32>, l: vec3<f32>
     return lit / total;
 }
 
+// Irradiance from the point and spot lights inside the probe's box, unshadowed (the box's walls
+// would shadow the others).
+fn box_lights(p: ReflectionProbeGpu, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    for (var i = 0u; i < params.config.x; i++) {
+        e += rp_box_light_irradiance(p, lights[i], params.cutoff.x, x, n);
+    }
+    return e;
+}
+
+// The luminance of the irradiance at the capture point c for normal n: the probes' (or the
+// sky's) and, as in the texels, the lights inside the box.
+fn capture_luma(p: ReflectionProbeGpu, c: vec3<f32>, n: vec3<f32>, mask: f32) -> f32 {
+    return dot(ambient(c, n, mask) + box_lights(p, c, n), EXPOSURE_LUMA);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = params.config.y;
@@ -110,12 +127,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // probe's.
         let mask = textureLoad(capture_albedo, vec2<u32>(n / 2u), probe * 6u + 3u, 0).a;
         let c = p.capture.xyz;
-        let e_xp = dot(ambient(c, vec3<f32>(1.0, 0.0, 0.0), mask), EXPOSURE_LUMA);
-        let e_xn = dot(ambient(c, vec3<f32>(-1.0, 0.0, 0.0), mask), EXPOSURE_LUMA);
-        let e_yp = dot(ambient(c, vec3<f32>(0.0, 1.0, 0.0), mask), EXPOSURE_LUMA);
-        let e_yn = dot(ambient(c, vec3<f32>(0.0, -1.0, 0.0), mask), EXPOSURE_LUMA);
-        let e_zp = dot(ambient(c, vec3<f32>(0.0, 0.0, 1.0), mask), EXPOSURE_LUMA);
-        let e_zn = dot(ambient(c, vec3<f32>(0.0, 0.0, -1.0), mask), EXPOSURE_LUMA);
+        let e_xp = capture_luma(p, c, vec3<f32>(1.0, 0.0, 0.0), mask);
+        let e_xn = capture_luma(p, c, vec3<f32>(-1.0, 0.0, 0.0), mask);
+        let e_yp = capture_luma(p, c, vec3<f32>(0.0, 1.0, 0.0), mask);
+        let e_yn = capture_luma(p, c, vec3<f32>(0.0, -1.0, 0.0), mask);
+        let e_zp = capture_luma(p, c, vec3<f32>(0.0, 0.0, 1.0), mask);
+        let e_zn = capture_luma(p, c, vec3<f32>(0.0, 0.0, -1.0), mask);
         // The six axes' mean is an L2 SH's band 0 exactly (bands 1 and 2 cancel in pairs).
         capture_light[probe] = vec4<f32>((e_xp + e_xn + e_yp + e_yn + e_zp + e_zn) / 6.0, 0.5 * (e_xp - e_xn), 0.5 * (e_yp - e_yn), 0.5 * (e_zp - e_zn));
     }
@@ -144,20 +161,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 e += sun_lux * (cos_l * vis);
             }
         }
-        for (var i = 0u; i < params.config.x; i++) {
-            let light = lights[i];
-            // Only the lights inside the probe's box: its walls would shadow the others.
-            let o = (p.to_box * vec4<f32>(light.position_range.xyz, 1.0)).xyz;
-            if any(abs(o) > vec3<f32>(1.0)) {
-                continue;
-            }
-            let to_light = light.position_range.xyz - x;
-            let d2 = dot(to_light, to_light);
-            let range = light_range(light, params.cutoff.x);
-            let inv_d = inverseSqrt(max(d2, 1e-8));
-            let l = to_light * inv_d;
-            e += light.intensity.rgb * (light_attenuation(light, l, inv_d * inv_d, d2 / (range * range)) * max(dot(nrm, l), 0.0));
-        }
+        e += box_lights(p, x, nrm);
         radiance = a.rgb / PI * e + textureLoad(capture_emission, gid.xy, layer, 0).rgb;
     }
     // NaN fails every comparison: it becomes 0, and nothing exceeds f16.
