@@ -29,6 +29,7 @@ use crate::techniques::gi_denoiser::{
 use crate::techniques::haze::{Haze, HazeFrame, HazeInputs, HazeParams};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
+use crate::techniques::particles::{self, ParticleParams, Particles};
 use crate::techniques::ray_traced_gi::{
     RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene, SkySource,
 };
@@ -245,6 +246,7 @@ pub struct Techniques {
     /// lighting then resolves the accumulated signal undenoised.
     pub gi_denoiser: Option<GiDenoiser>,
     pub haze: Haze,
+    pub particles: Particles,
     pub taa: Taa,
     pub exposure: Exposure,
     pub local_tonemap: LocalTonemap,
@@ -272,6 +274,7 @@ impl Techniques {
                 .ok(),
             brdf_tables: BrdfTables::new(ctx),
             haze: Haze::new(ctx, &mut lib)?,
+            particles: Particles::new(ctx, &mut lib, crate::techniques::haze::RADIANCE_FORMAT)?,
             taa: Taa::new(ctx, &mut lib)?,
             exposure: Exposure::new(ctx, &mut lib)?,
             local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
@@ -356,6 +359,7 @@ pub fn record<'r>(
     let camera_cut = s.prev_camera.is_none() && state.last_camera.is_some_and(|p| p != pose);
     state.last_camera = Some(pose);
     let to_sun = s.sun.as_ref().map_or(glam::Vec3::ZERO, |sun| sun.direction);
+    let emitters = &scene.cpu.particles;
     let scene = &scene.import(g);
     // `direct_lighting.punctual` switches the point and spot lights off in every pass.
     let punctual_lights = if s.settings.direct_lighting.punctual {
@@ -647,7 +651,7 @@ pub fn record<'r>(
             lighting.cutoff[0],
             metered,
         );
-        Some(t.haze.record(
+        let frame = t.haze.record(
             g,
             &params,
             &view,
@@ -660,14 +664,50 @@ pub fn record<'r>(
                 clouds: clouds.lookup,
                 probes: probes.lookup,
             },
-        )?)
+        )?;
+        Some((params, frame))
     } else {
         None
     };
+    let lit = lit_frame.radiance;
+    let hazed = haze.as_ref().map_or(lit, |(_, h)| h.radiance);
+
+    //     Particles: the emitters' sprites at the sky's clock, back to front, blended over the
+    //     hazed image; the haze-lit ones take the haze's froxel light (the talk's "haze
+    //     lighting" for particles).
+    if s.settings.particles.enabled && !emitters.is_empty() {
+        let clock = s
+            .settings
+            .sky
+            .date_time()
+            .map_or(0.0, |t| f64::from(t.seconds_of_day()));
+        let sprites = particles::sprites(emitters, clock, s.camera.position);
+        let sun = s
+            .sun
+            .as_ref()
+            .filter(|_| s.settings.direct_lighting.sun)
+            .map(|sun| (sun.direction, sun.color * sun.illuminance_lux));
+        // A sky of `sky_lux` on the ground and a dark ground: about sky_lux / 2 pi on average
+        // over the sphere.
+        let sky_mean = glam::Vec3::splat(sky.sky_lux / std::f32::consts::TAU);
+        let params = ParticleParams::new(
+            &s.settings.particles,
+            sun,
+            sky_mean,
+            haze.as_ref().map(|(p, _)| p),
+        );
+        t.particles.record(
+            g,
+            &view,
+            &params,
+            &sprites,
+            gbuffer.depth,
+            haze.as_ref().map(|(p, h)| (p, h.light)),
+            hazed,
+        )?;
+    }
 
     // 13. TAA.
-    let lit = lit_frame.radiance;
-    let hazed = haze.map_or(lit, |h| h.radiance);
     let hdr = if taa_on {
         t.taa
             .record(g, hazed, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
@@ -732,7 +772,7 @@ pub fn record<'r>(
         ray_traced_gi,
         denoised_gi,
         ray_traced_gi_rays,
-        haze,
+        haze: haze.map(|(_, h)| h),
         hdr,
         lit,
         illuminance: lit_frame.illuminance,

@@ -584,6 +584,8 @@ pub struct RasterDesc<'a> {
     pub color_formats: &'a [wgpu::TextureFormat],
     pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
     pub cull_mode: Option<wgpu::Face>,
+    /// Blending into every colour target; `None` replaces.
+    pub blend: Option<wgpu::BlendState>,
 }
 
 pub struct RasterPipeline {
@@ -617,7 +619,7 @@ impl RasterPipeline {
             .map(|f| {
                 Some(wgpu::ColorTargetState {
                     format: *f,
-                    blend: None,
+                    blend: desc.blend,
                     write_mask: wgpu::ColorWrites::ALL,
                 })
             })

@@ -172,6 +172,8 @@ pub struct SceneCpu {
     /// Chunks from this one on are alpha-tested (see the module doc).
     pub first_alpha_chunk: u32,
     pub lights: Vec<LightGpu>,
+    /// The scene's particle emitters, whose sprites the frame generates on the CPU.
+    pub particles: Vec<hikari_scene::ParticleEmitter>,
 }
 
 /// The alpha cut-off a material is drawn with: 0 (every fragment kept, as glTF's OPAQUE) or
@@ -237,7 +239,10 @@ pub fn orthonormal_tangent(n: Vec3) -> Vec3 {
 
 impl SceneCpu {
     pub fn build(scene: &Scene, layers: &scene_textures::LayerMap) -> Self {
-        let mut cpu = SceneCpu::default();
+        let mut cpu = SceneCpu {
+            particles: scene.particles.clone(),
+            ..SceneCpu::default()
+        };
         let mut mesh_first_triangle = Vec::new();
         for m in &scene.meshes {
             let base = cpu.positions.len() as u32;

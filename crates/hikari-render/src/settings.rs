@@ -19,6 +19,7 @@ pub use crate::techniques::gi_denoiser::settings::GiDenoiserSettings;
 pub use crate::techniques::haze::settings::HazeSettings;
 pub use crate::techniques::irradiance_probes::settings::IrradianceProbesSettings;
 pub use crate::techniques::local_tonemap::settings::LocalTonemapSettings;
+pub use crate::techniques::particles::settings::ParticlesSettings;
 pub use crate::techniques::ray_traced_gi::settings::RayTracedGiSettings;
 pub use crate::techniques::reflection_probes::settings::ReflectionProbesSettings;
 pub use crate::techniques::sky::settings::SkySettings;
@@ -205,6 +206,7 @@ register_settings! {
     gi_denoiser: GiDenoiserSettings,
     area_lights: AreaLightsSettings,
     haze: HazeSettings,
+    particles: ParticlesSettings,
     irradiance_probes: IrradianceProbesSettings,
     reflection_probes: ReflectionProbesSettings,
     ray_traced_gi: RayTracedGiSettings,

@@ -116,6 +116,7 @@ pub mod builtin;
 pub mod deformation;
 pub mod gltf;
 pub mod model;
+pub mod particles;
 pub mod shapes;
 pub mod validation;
 pub mod village;
@@ -125,3 +126,4 @@ pub use model::{
     AlphaMode, Anisotropy, Camera, DEFAULT_INTERIOR, Instance, Light, LightKind, Material, Mesh,
     Scene, SceneError, Sun, Texture, TextureRef, Wrap,
 };
+pub use particles::{Particle, ParticleEmitter};

@@ -29,6 +29,8 @@ pub enum SceneError {
     Texture { texture: String, what: String },
     #[error("light `{light}`: {what}")]
     Light { light: String, what: String },
+    #[error("particles `{emitter}`: {what}")]
+    Particles { emitter: String, what: String },
     #[error("the scene has no camera named `{wanted}`; it has: {have}")]
     NoSuchCamera { wanted: String, have: String },
 }
@@ -469,6 +471,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Images referenced by [`Material`]s through [`TextureRef`].
     pub textures: Vec<Texture>,
+    /// Fog and smoke sprites (docs/particles.md).
+    pub particles: Vec<crate::ParticleEmitter>,
 }
 
 fn finite(v: Vec3) -> bool {
@@ -629,6 +633,9 @@ impl Scene {
         }
         for l in &self.lights {
             l.validate()?;
+        }
+        for e in &self.particles {
+            e.validate()?;
         }
         for (index, inst) in self.instances.iter().enumerate() {
             let err = |what: String| SceneError::Instance { index, what };

@@ -531,7 +531,11 @@ impl<'r> FrameGraph<'r> {
         touched.extend(uses);
         if let PassKind::Raster { colors, depth, .. } = &kind {
             for (t, clear) in colors {
-                touched.push((Res::Tex(*t), clear.is_some()));
+                // Loaded, it is read (blending) and written.
+                if clear.is_none() {
+                    touched.push((Res::Tex(*t), false));
+                }
+                touched.push((Res::Tex(*t), true));
             }
             if let Some((t, clear)) = depth {
                 touched.push((Res::Tex(*t), clear.is_some()));

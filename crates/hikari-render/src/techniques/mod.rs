@@ -12,6 +12,7 @@ pub mod gi_denoiser;
 pub mod haze;
 pub mod irradiance_probes;
 pub mod local_tonemap;
+pub mod particles;
 pub mod ray_traced_gi;
 pub mod reflection_probes;
 pub mod sky;

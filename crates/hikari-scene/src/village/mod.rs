@@ -187,6 +187,20 @@ pub fn build(seed: u64) -> Village {
 
     b.scene.cameras = cameras::build(&ground, &houses[0], &temple, &pond);
     b.scene.sun = Some(Sun::default());
+    // Mist over the pond: haze-lit fog sprites drifting with the breeze (docs/particles.md).
+    b.scene.particles.push(crate::ParticleEmitter {
+        name: "pond mist".into(),
+        centre: pond.centre + Vec3::new(-1.5, 0.7, 0.0),
+        half_extents: Vec3::new(0.7 * pond.shore_radius, 0.35, 0.7 * pond.shore_radius),
+        count: 48,
+        size_m: [1.6, 2.8],
+        opacity: 0.18,
+        velocity_mps: Vec3::new(0.12, 0.01, 0.04),
+        lifetime_s: 40.0,
+        albedo: Vec3::splat(0.9),
+        haze_lit: true,
+        seed: 7,
+    });
     let layout = VillageLayout {
         seed,
         houses: houses.iter().map(|h| h.footprint.clone()).collect(),

@@ -83,3 +83,32 @@ fn slice_of_depth(p: HazeParams, z: f32) -> f32 {
 fn froxel_ray(p: HazeParams, view: View, c: vec2<u32>) -> vec3<f32> {
     return view_ray_uv(view, (vec2<f32>(c) + 0.5) / vec2<f32>(p.grid.xy));
 }
+
+// A cubic B-spline along one axis as two linear taps (Sigg and Hadwiger 2005): the composite's
+// tricubic grid and the particles' bicubic light read it.
+// The two trilinear positions (normalised) and weights along one axis.
+struct Axis {
+    pos: vec2<f32>,
+    weight: vec2<f32>,
+}
+
+fn bspline_axis(u: f32, size: f32) -> Axis {
+    let c = u * size - 0.5;
+    let i = floor(c);
+    let f = c - i;
+    let f2 = f * f;
+    let f3 = f2 * f;
+    let w0 = (1.0 - f) * (1.0 - f) * (1.0 - f) / 6.0;
+    let w1 = (3.0 * f3 - 6.0 * f2 + 4.0) / 6.0;
+    let w2 = (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0) / 6.0;
+    let w3 = f3 / 6.0;
+    let g0 = w0 + w1;
+    let g1 = w2 + w3;
+    // Texel i - 1 + w1 / g0 blends texels i - 1 and i as w0 : w1; likewise i + 1 and i + 2.
+    let h0 = i - 1.0 + w1 / g0;
+    let h1 = i + 1.0 + w3 / g1;
+    var a: Axis;
+    a.pos = (vec2<f32>(h0, h1) + 0.5) / size;
+    a.weight = vec2<f32>(g0, g1);
+    return a;
+}

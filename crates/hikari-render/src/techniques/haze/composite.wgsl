@@ -4,7 +4,7 @@
 // 2005). Twin: `haze::reference::composite_pixel`.
 
 #import hikari::view::{View, view_ray, world_from_depth}
-#import hikari::haze::{HazeParams, HAZE_DENSITY_AA, HAZE_TRICUBIC, optical_depth, opacity, slice_of_depth}
+#import hikari::haze::{HazeParams, HAZE_DENSITY_AA, HAZE_TRICUBIC, optical_depth, opacity, slice_of_depth, bspline_axis}
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> params: HazeParams;
@@ -13,33 +13,6 @@
 @group(0) @binding(4) var grid: texture_3d<f32>;
 @group(0) @binding(5) var grid_sampler: sampler;
 @group(0) @binding(6) var out_tex: texture_storage_2d<rgba16float, write>;
-
-// The two trilinear positions (normalised) and weights along one axis.
-struct Axis {
-    pos: vec2<f32>,
-    weight: vec2<f32>,
-}
-
-fn bspline_axis(u: f32, size: f32) -> Axis {
-    let c = u * size - 0.5;
-    let i = floor(c);
-    let f = c - i;
-    let f2 = f * f;
-    let f3 = f2 * f;
-    let w0 = (1.0 - f) * (1.0 - f) * (1.0 - f) / 6.0;
-    let w1 = (3.0 * f3 - 6.0 * f2 + 4.0) / 6.0;
-    let w2 = (-3.0 * f3 + 3.0 * f2 + 3.0 * f + 1.0) / 6.0;
-    let w3 = f3 / 6.0;
-    let g0 = w0 + w1;
-    let g1 = w2 + w3;
-    // Texel i - 1 + w1 / g0 blends texels i - 1 and i as w0 : w1; likewise i + 1 and i + 2.
-    let h0 = i - 1.0 + w1 / g0;
-    let h1 = i + 1.0 + w3 / g1;
-    var a: Axis;
-    a.pos = (vec2<f32>(h0, h1) + 0.5) / size;
-    a.weight = vec2<f32>(g0, g1);
-    return a;
-}
 
 fn sample_grid(uvw: vec3<f32>, tricubic: bool) -> vec4<f32> {
     if !tricubic {

@@ -330,6 +330,12 @@ fn texel(p: &HazeParams, grid: &[Vec4], c: [i32; 3]) -> Vec4 {
 /// The grid at normalised coordinates `uvw` (texel centres at (i + 0.5) / size, clamped at the
 /// edges): a tricubic B-spline over the 4x4x4 texels about it, or trilinear.
 pub fn sample(p: &HazeParams, grid: &[Vec4], uvw: Vec3, tricubic: bool) -> Vec4 {
+    sample_axes(p, grid, uvw, [tricubic; 3])
+}
+
+/// [`sample`] with a cubic B-spline along the axes `cubic` names and linear along the others
+/// (the particles read the light bicubic in x and y).
+pub fn sample_axes(p: &HazeParams, grid: &[Vec4], uvw: Vec3, cubic: [bool; 3]) -> Vec4 {
     let size = [p.grid[0], p.grid[1], p.grid[2]];
     let mut base = [0i32; 3];
     let mut w = [[0.0f32; 4]; 3];
@@ -338,7 +344,7 @@ pub fn sample(p: &HazeParams, grid: &[Vec4], uvw: Vec3, tricubic: bool) -> Vec4 
         let fl = c.floor();
         let f = c - fl;
         base[a] = fl as i32;
-        w[a] = if tricubic {
+        w[a] = if cubic[a] {
             bspline_weights(f)
         } else {
             [0.0, 1.0 - f, f, 0.0]
