@@ -1222,6 +1222,18 @@ impl<'o> Loader<'o> {
                     }
                 }
             }
+            if let Some(e) = particle_emitter(node.extras(), world).map_err(|e| {
+                format!(
+                    "node `{}` (nodes[{}]): {e}",
+                    node_name.as_deref().unwrap_or("unnamed"),
+                    node.index()
+                )
+            })? {
+                let name = node_name
+                    .clone()
+                    .unwrap_or_else(|| format!("particles{}", node.index()));
+                scene.particles.push(crate::ParticleEmitter { name, ..e });
+            }
             if let Some(light) = node.light() {
                 let name = light
                     .name()
@@ -1289,6 +1301,78 @@ impl<'o> Loader<'o> {
         }
         Ok(())
     }
+}
+
+/// The node `extras` emitter `{"hikari": {"particles": {...}}}` ([`crate::ParticleEmitter`]):
+/// centred on the node's world position, its box's half extents scaled by the node's scale;
+/// every key optional (the emitter's defaults): `half_extents` [x, y, z], `count`, `size_m`
+/// [birth, death], `opacity`, `velocity_mps` [x, y, z], `lifetime_s`, `albedo` [r, g, b],
+/// `haze_lit`, `seed`. An unknown key or a value of the wrong kind is an error; ranges are
+/// checked with the scene by `Scene::validate`.
+fn particle_emitter(
+    extras: &gltf::json::Extras,
+    world: Mat4,
+) -> Res<Option<crate::ParticleEmitter>> {
+    let Some(raw) = extras else {
+        return Ok(None);
+    };
+    let value: gltf::json::Value = gltf::json::deserialize::from_str(raw.get())
+        .map_err(|e| format!("extras are not JSON: {e}"))?;
+    let Some(p) = value.get("hikari").and_then(|h| h.get("particles")) else {
+        return Ok(None);
+    };
+    let Some(fields) = p.as_object() else {
+        return Err(format!(
+            "extras hikari.particles must be an object, not {p}"
+        ));
+    };
+    let bad = |key: &str, want: &str, v: &gltf::json::Value| {
+        format!("extras hikari.particles.{key} must be {want}, not {v}")
+    };
+    let number = |key: &str, v: &gltf::json::Value| {
+        v.as_f64()
+            .map(|x| x as f32)
+            .ok_or_else(|| bad(key, "a number", v))
+    };
+    let numbers = |key: &str, v: &gltf::json::Value, n: usize| -> Res<Vec<f32>> {
+        match v.as_array() {
+            Some(a) if a.len() == n => a.iter().map(|x| number(key, x)).collect(),
+            _ => Err(bad(key, &format!("an array of {n} numbers"), v)),
+        }
+    };
+    let mut e = crate::ParticleEmitter {
+        centre: world.transform_point3(Vec3::ZERO),
+        ..Default::default()
+    };
+    let (scale, _, _) = world.to_scale_rotation_translation();
+    for (key, v) in fields {
+        match key.as_str() {
+            "half_extents" => e.half_extents = Vec3::from_slice(&numbers(key, v, 3)?) * scale.abs(),
+            "count" => {
+                e.count = v
+                    .as_u64()
+                    .and_then(|c| u32::try_from(c).ok())
+                    .ok_or_else(|| bad(key, "a whole number", v))?
+            }
+            "size_m" => {
+                let s = numbers(key, v, 2)?;
+                e.size_m = [s[0], s[1]];
+            }
+            "opacity" => e.opacity = number(key, v)?,
+            "velocity_mps" => e.velocity_mps = Vec3::from_slice(&numbers(key, v, 3)?),
+            "lifetime_s" => e.lifetime_s = number(key, v)?,
+            "albedo" => e.albedo = Vec3::from_slice(&numbers(key, v, 3)?),
+            "haze_lit" => e.haze_lit = v.as_bool().ok_or_else(|| bad(key, "true or false", v))?,
+            "seed" => {
+                e.seed = v
+                    .as_u64()
+                    .and_then(|c| u32::try_from(c).ok())
+                    .ok_or_else(|| bad(key, "a whole number", v))?
+            }
+            other => return Err(format!("extras hikari.particles has no key `{other}`")),
+        }
+    }
+    Ok(Some(e))
 }
 
 /// The material `extras` flag `{"hikari": {"area_light": true|false}}` ([`Material::area_light`]);
