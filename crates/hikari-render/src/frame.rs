@@ -274,7 +274,7 @@ impl Techniques {
                 .ok(),
             brdf_tables: BrdfTables::new(ctx),
             haze: Haze::new(ctx, &mut lib)?,
-            particles: Particles::new(ctx, &mut lib, crate::techniques::haze::RADIANCE_FORMAT)?,
+            particles: Particles::new(ctx, &mut lib)?,
             taa: Taa::new(ctx, &mut lib)?,
             exposure: Exposure::new(ctx, &mut lib)?,
             local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
@@ -670,10 +670,10 @@ pub fn record<'r>(
         None
     };
     let lit = lit_frame.radiance;
-    let hazed = haze.as_ref().map_or(lit, |(_, h)| h.radiance);
+    let mut hazed = haze.as_ref().map_or(lit, |(_, h)| h.radiance);
 
-    //     Particles: the emitters' sprites at the sky's clock, back to front, blended over the
-    //     hazed image; the haze-lit ones take the haze's froxel light (the talk's "haze
+    //     Particles: the emitters' sprites at the sky's clock, back to front, composited over
+    //     the hazed image; the haze-lit ones take the haze's froxel light (the talk's "haze
     //     lighting" for particles).
     if s.settings.particles.enabled && !emitters.is_empty() {
         let clock = s
@@ -681,7 +681,8 @@ pub fn record<'r>(
             .sky
             .date_time()
             .map_or(0.0, |t| f64::from(t.seconds_of_day()));
-        let sprites = particles::sprites(emitters, clock, s.camera.position);
+        let mut sprites = particles::sprites(emitters, clock, s.camera.position);
+        particles::with_screen_rects(&mut sprites, &view);
         let sun = s
             .sun
             .as_ref()
@@ -696,7 +697,7 @@ pub fn record<'r>(
             sky_mean,
             haze.as_ref().map(|(p, _)| p),
         );
-        t.particles.record(
+        hazed = t.particles.record(
             g,
             &view,
             &params,

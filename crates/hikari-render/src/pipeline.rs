@@ -584,8 +584,6 @@ pub struct RasterDesc<'a> {
     pub color_formats: &'a [wgpu::TextureFormat],
     pub depth: Option<(wgpu::TextureFormat, wgpu::CompareFunction)>,
     pub cull_mode: Option<wgpu::Face>,
-    /// Blending into every colour target; `None` replaces.
-    pub blend: Option<wgpu::BlendState>,
 }
 
 pub struct RasterPipeline {
@@ -619,7 +617,7 @@ impl RasterPipeline {
             .map(|f| {
                 Some(wgpu::ColorTargetState {
                     format: *f,
-                    blend: desc.blend,
+                    blend: None,
                     write_mask: wgpu::ColorWrites::ALL,
                 })
             })

@@ -128,7 +128,8 @@ fn the_draw_pass_matches_its_twin() {
             ..Default::default()
         },
     ];
-    let sprites = particles::sprites(&emitters, 4321.0, cam.position);
+    let mut sprites = particles::sprites(&emitters, 4321.0, cam.position);
+    particles::with_screen_rects(&mut sprites, &view);
     assert!(sprites.len() > 30);
     let s = ParticlesSettings::default();
     let params = ParticleParams::new(
@@ -140,7 +141,7 @@ fn the_draw_pass_matches_its_twin() {
 
     // The GPU.
     let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
-    let pass = Particles::new(ctx, &mut lib, wgpu::TextureFormat::Rgba16Float).unwrap();
+    let pass = Particles::new(ctx, &mut lib).unwrap();
     let depth_tex = common::texture_with_data(
         ctx,
         wgpu::TextureFormat::R32Float,
@@ -178,45 +179,32 @@ fn the_draw_pass_matches_its_twin() {
         .flat_map(|v| v.extend(1.0).to_array())
         .map(f16::from_f32)
         .collect();
-    let target_tex = ctx.device.create_texture_with_data(
-        &ctx.queue,
-        &wgpu::TextureDescriptor {
-            label: Some("test.target"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
+    let image_tex = common::texture_with_data(
+        ctx,
+        wgpu::TextureFormat::Rgba16Float,
+        w,
+        h,
         bytemuck::cast_slice(&bg),
     );
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(ctx);
     let depth_t = g.import_texture("test.depth", &depth_tex);
     let light_t = g.import_texture("haze.light", &light_tex);
-    let target = g.import_texture("test.target", &target_tex);
-    pass.record(
-        &mut g,
-        &view,
-        &params,
-        &sprites,
-        depth_t,
-        Some((&haze, light_t)),
-        target,
-    )
-    .unwrap();
-    g.readback(target);
+    let image = g.import_texture("test.image", &image_tex);
+    let out = pass
+        .record(
+            &mut g,
+            &view,
+            &params,
+            &sprites,
+            depth_t,
+            Some((&haze, light_t)),
+            image,
+        )
+        .unwrap();
+    g.readback(out);
     let r = g.execute().unwrap();
-    let got = &r.image("test.target").unwrap().rgba;
+    let got = &r.image("particles.radiance").unwrap().rgba;
 
     // The twin.
     let inputs = twin::Inputs {

@@ -1,11 +1,12 @@
 //! Particles (Ghost of Tsushima's local fog, "haze lighting" mode for particles; docs/particles.md):
-//! the scene's emitters' sprites at the sky's clock, sorted back to front on the CPU, drawn as
-//! camera-facing quads blended over the hazed image before TAA.
+//! the scene's emitters' sprites at the sky's clock, sorted back to front and bounded on screen
+//! on the CPU, composited over the hazed image before TAA.
 //!
-//! * `particles.draw` (`particles.wgsl`): a raster pass, six vertices a sprite pulled from a
-//!   storage buffer, premultiplied blending. A haze-lit sprite reads the haze's froxel light
-//!   (`haze.light`, its `L_i`) at its fragment and the talk's multiple-scattering scale; a
-//!   standard one is lit by the sun or moon and the sky's mean radiance.
+//! * `particles.draw` (`particles.wgsl`): a thread a pixel; each 16 x 16 tile marks the sprites
+//!   whose screen rectangles overlap it, and each pixel meets their planes back to front. A
+//!   haze-lit sprite reads the haze's froxel light (`haze.light`, its `L_i`) there and the
+//!   talk's multiple-scattering scale; a standard one is lit by the sun or moon and the sky's
+//!   mean radiance. Writes `particles.radiance`.
 
 pub mod reference;
 pub mod settings;
@@ -16,8 +17,8 @@ use hikari_scene::ParticleEmitter;
 
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::graph::{FrameGraph, SamplerKind, Tex};
-use crate::pipeline::{RasterDesc, RasterPipeline};
+use crate::graph::{FrameGraph, SamplerKind, Tex, TextureDesc};
+use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
 use crate::techniques::haze::HazeParams;
 use crate::view::View;
@@ -31,6 +32,8 @@ pub struct ParticleGpu {
     pub position_radius: [f32; 4],
     /// rgb: albedo (standard lighting); a: opacity, negative for a haze-lit sprite.
     pub albedo_opacity: [f32; 4],
+    /// The pixels it may cover, x0, y0, x1, y1 inclusive ([`with_screen_rects`]).
+    pub rect: [f32; 4],
 }
 
 /// `particles.wgsl`'s `ParticleParams` (the shader documents each field).
@@ -41,6 +44,8 @@ pub struct ParticleParams {
     pub sun_dir: [f32; 4],
     pub sky: [f32; 4],
     pub ms: [f32; 4],
+    /// x: sprites (set by [`Particles::record`]).
+    pub count: [u32; 4],
 }
 
 impl ParticleParams {
@@ -84,6 +89,7 @@ impl ParticleParams {
                 inv_scale,
                 if haze.is_some() { 1.0 } else { 0.0 },
             ],
+            count: [0; 4],
         }
     }
 }
@@ -101,6 +107,7 @@ pub fn sprites(emitters: &[ParticleEmitter], time_s: f64, eye: Vec3) -> Vec<Part
                     ParticleGpu {
                         position_radius: p.position.extend(p.radius_m).to_array(),
                         albedo_opacity: e.albedo.extend(sign * p.opacity).to_array(),
+                        rect: [0.0; 4],
                     },
                 )
             })
@@ -110,8 +117,54 @@ pub fn sprites(emitters: &[ParticleEmitter], time_s: f64, eye: Vec3) -> Vec<Part
     out.into_iter().map(|(_, p)| p).collect()
 }
 
+/// Sets each sprite's screen rectangle for `view`: the pixels its camera-facing square (which
+/// holds its disc) covers, a pixel wider each side; the whole screen when a corner lies behind
+/// the camera's near plane; none (x0 > x1 or y0 > y1) when it is off screen.
+pub fn with_screen_rects(sprites: &mut [ParticleGpu], view: &View) {
+    let view_proj = glam::Mat4::from_cols_array_2d(&view.view_proj);
+    let cam = Vec3::from_slice(&view.position[..3]);
+    let fwd = Vec3::from_slice(&view.forward_near[..3]);
+    let [w, h] = [view.viewport[0], view.viewport[1]];
+    for p in sprites {
+        let centre = Vec3::from_slice(&p.position_radius[..3]);
+        let radius = p.position_radius[3];
+        let to_eye = cam - centre;
+        let f = if to_eye.length_squared() > 1e-8 {
+            -to_eye.normalize()
+        } else {
+            fwd
+        };
+        let up_hint = if f.y.abs() > 0.99 { Vec3::X } else { Vec3::Y };
+        let right = f.cross(up_hint).normalize();
+        let up = right.cross(f);
+        let mut lo = glam::Vec2::splat(f32::INFINITY);
+        let mut hi = glam::Vec2::splat(f32::NEG_INFINITY);
+        let mut behind = false;
+        for (x, y) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+            let c = view_proj * (centre + (right * x + up * y) * radius).extend(1.0);
+            if c.w <= 1e-4 {
+                behind = true;
+                break;
+            }
+            let s = glam::Vec2::new((c.x / c.w * 0.5 + 0.5) * w, (0.5 - 0.5 * c.y / c.w) * h);
+            lo = lo.min(s);
+            hi = hi.max(s);
+        }
+        p.rect = if behind || !(lo.is_finite() && hi.is_finite()) {
+            [0.0, 0.0, w - 1.0, h - 1.0]
+        } else {
+            [
+                (lo.x - 1.0).floor().max(0.0),
+                (lo.y - 1.0).floor().max(0.0),
+                (hi.x + 1.0).ceil().min(w - 1.0),
+                (hi.y + 1.0).ceil().min(h - 1.0),
+            ]
+        };
+    }
+}
+
 pub struct Particles {
-    draw: RasterPipeline,
+    draw: ComputePipeline,
     /// The sprites, grown as needed.
     buffer: std::cell::RefCell<Option<wgpu::Buffer>>,
     /// A 1 x 1 x 1 stand-in for the haze's light when there is no haze.
@@ -119,37 +172,8 @@ pub struct Particles {
 }
 
 impl Particles {
-    pub fn new(
-        ctx: &GpuContext,
-        lib: &mut ShaderLibrary,
-        format: wgpu::TextureFormat,
-    ) -> Result<Self> {
-        let draw = RasterPipeline::new(
-            ctx,
-            lib,
-            "particles/particles.wgsl",
-            &RasterDesc {
-                vertex_entry: "vs",
-                fragment_entry: Some("fs"),
-                color_formats: &[format],
-                depth: None,
-                cull_mode: None,
-                blend: Some(wgpu::BlendState {
-                    // Premultiplied colour; the image's alpha is kept.
-                    color: wgpu::BlendComponent {
-                        src_factor: wgpu::BlendFactor::One,
-                        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-                        operation: wgpu::BlendOperation::Add,
-                    },
-                    alpha: wgpu::BlendComponent {
-                        src_factor: wgpu::BlendFactor::Zero,
-                        dst_factor: wgpu::BlendFactor::One,
-                        operation: wgpu::BlendOperation::Add,
-                    },
-                }),
-            },
-            &[],
-        )?;
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        let draw = ComputePipeline::new(ctx, lib, "particles/particles.wgsl", "main", &[])?;
         let no_haze = ctx.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("particles.no_haze"),
             size: wgpu::Extent3d {
@@ -171,8 +195,9 @@ impl Particles {
         })
     }
 
-    /// Draws `sprites` over `target` (the hazed image). `haze`: the haze's parameters and its
-    /// light (`haze.light`), `None` without haze.
+    /// Composites `sprites` (with their screen rectangles) over `image` (the hazed image) into
+    /// `particles.radiance`; returns `image` itself when no sprite is on screen. `haze`: the haze's parameters and its light (`haze.light`), `None`
+    /// without haze.
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
@@ -182,13 +207,16 @@ impl Particles {
         sprites: &[ParticleGpu],
         depth: Tex,
         haze: Option<(&HazeParams, Tex)>,
-        target: Tex,
-    ) -> Result<()> {
-        if sprites.is_empty() {
-            return Ok(());
+        image: Tex,
+    ) -> Result<Tex> {
+        if !sprites
+            .iter()
+            .any(|p| p.rect[0] <= p.rect[2] && p.rect[1] <= p.rect[3])
+        {
+            return Ok(image);
         }
         let ctx = g.ctx();
-        let bytes = std::mem::size_of_val(sprites) as u64;
+        let bytes = std::mem::size_of_val(sprites).max(std::mem::size_of::<ParticleGpu>()) as u64;
         let mut slot = self.buffer.borrow_mut();
         if slot.as_ref().is_none_or(|b| b.size() < bytes) {
             *slot = Some(ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -205,22 +233,32 @@ impl Particles {
         let sprite_buf = g.import_buffer("particles.sprites", &buffer);
         let (haze_params, light) = match haze {
             Some((p, t)) => (*p, t),
-            // No haze: no extinction, and a light no fragment reads.
+            // No haze: no extinction, and a light no pixel reads.
             None => (
                 HazeParams::zeroed(),
                 g.import_texture("particles.no_haze", &self.no_haze),
             ),
         };
-        let n = sprites.len() as u32;
+        let params = ParticleParams {
+            count: [sprites.len() as u32, 0, 0, 0],
+            ..*params
+        };
+        let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
+        let out = g.texture(
+            "particles.radiance",
+            TextureDesc::d2(w, h, crate::techniques::haze::RADIANCE_FORMAT),
+        )?;
         g.pass("particles.draw")
             .constants(view)
-            .constants(params)
+            .constants(&params)
             .constants(&haze_params)
             .read(sprite_buf)
             .read(depth)
             .read(light)
             .sampler(SamplerKind::LinearClamp)
-            .color(target, None)
-            .draw(&self.draw, move |rp, _| rp.draw(0..6, 0..n))
+            .read(image)
+            .write(out)
+            .dispatch_threads(&self.draw, [w, h, 1])?;
+        Ok(out)
     }
 }

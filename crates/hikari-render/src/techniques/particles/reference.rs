@@ -1,6 +1,6 @@
-//! CPU twin of `particles.draw`: each pixel's ray meets each sprite's plane (which is what the
-//! rasteriser's perspective-correct interpolation gives at the pixel's centre), back to front,
-//! blended as the pass blends; and the talk's multiple-scattering ratios.
+//! CPU twin of `particles.draw`: each pixel's ray meets each sprite's plane, back to front,
+//! composited premultiplied; and the talk's multiple-scattering ratios. It ignores the sprites'
+//! screen rectangles, which only spare the GPU work: one too small fails the test.
 
 use glam::{Mat4, Vec3, Vec4};
 
@@ -70,7 +70,7 @@ pub fn fragment(inputs: &Inputs<'_>, p: &ParticleGpu, pixel: [u32; 2]) -> Option
     let dist = d.length();
     let v = d / dist.max(1e-6);
     let depth = inputs.depth[(pixel[1] * size[0] + pixel[0]) as usize];
-    if depth > 0.0 {
+    if depth > 0.0 && depth.is_finite() {
         let surface = gbuffer::reference::world_from_depth(inv, pixel, size, depth).distance(cam);
         alpha *= ((surface - dist) / (params.sky[3] * radius).max(1e-4)).clamp(0.0, 1.0);
     }
@@ -112,13 +112,19 @@ pub fn fragment(inputs: &Inputs<'_>, p: &ParticleGpu, pixel: [u32; 2]) -> Option
     Some(c.extend(alpha))
 }
 
-/// The pass at one pixel: `sprites` (back to front) blended over `background`.
+/// The pass at one pixel: `sprites` (back to front) composited over `background` (0 where it
+/// is not finite).
 pub fn composite_pixel(
     inputs: &Inputs<'_>,
     sprites: &[ParticleGpu],
     pixel: [u32; 2],
     background: Vec3,
 ) -> Vec3 {
+    let background = if background.is_finite() {
+        background.max(Vec3::ZERO)
+    } else {
+        Vec3::ZERO
+    };
     sprites
         .iter()
         .fold(background, |dst, p| match fragment(inputs, p, pixel) {
