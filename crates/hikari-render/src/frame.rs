@@ -653,6 +653,7 @@ pub fn record<'r>(
         );
         let frame = t.haze.record(
             g,
+            &s.settings.haze,
             &params,
             &view,
             &HazeInputs {
@@ -664,6 +665,7 @@ pub fn record<'r>(
                 clouds: clouds.lookup,
                 probes: probes.lookup,
             },
+            !camera_cut,
         )?;
         Some((params, frame))
     } else {

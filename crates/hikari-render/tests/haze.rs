@@ -250,17 +250,47 @@ struct Probes {
 /// off and the given sky SH (9 RGB coefficients), lights and probes (none: no probe covers
 /// anything).
 #[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)]
 fn run_gpu(
     ctx: &hikari_render::GpuContext,
     params: &HazeParams,
     view: &View,
-    [w, h]: [u32; 2],
+    size: [u32; 2],
     depth: &[f32],
     lit: &[[f32; 4]],
     sky_sh: &Sh<Vec3, 9>,
     lights: &[LightGpu],
     probes: Option<&Probes>,
 ) -> GpuRun {
+    let settings = HazeSettings::default();
+    run_gpu_frames(
+        ctx,
+        &settings,
+        &[(view.clone(), *params)],
+        size,
+        depth,
+        lit,
+        sky_sh,
+        lights,
+        probes,
+    )
+    .pop()
+    .unwrap()
+}
+
+/// [`run_gpu`] for one frame a view, the graph's history kept from frame to frame.
+#[allow(clippy::too_many_arguments)]
+fn run_gpu_frames(
+    ctx: &hikari_render::GpuContext,
+    settings: &HazeSettings,
+    frames: &[(View, HazeParams)],
+    [w, h]: [u32; 2],
+    depth: &[f32],
+    lit: &[[f32; 4]],
+    sky_sh: &Sh<Vec3, 9>,
+    lights: &[LightGpu],
+    probes: Option<&Probes>,
+) -> Vec<GpuRun> {
     let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
     let haze = Haze::new(ctx, &mut lib).unwrap();
     let depth_tex = common::texture_with_data(
@@ -323,67 +353,73 @@ fn run_gpu(
         )
     });
     let mut rt = GraphRuntime::new();
-    let mut g = rt.begin_frame(ctx);
-    let probe_set = match (probes, &probe_bufs) {
-        (Some(p), Some((irr, pos, topo))) => {
-            let irr = g.import_buffer("irradiance_probes.irradiance", irr);
-            let pos = g.import_buffer("irradiance_probes.positions", pos);
-            let topo = g.import_buffer("irradiance_probes.topology", topo);
-            g.binding_set("irradiance_probes")
-                .constants(&p.params)
-                .read(irr)
-                .read(pos)
-                .read(topo)
-                .finish()
-        }
-        _ => irradiance_probes::absent_lookup(&mut g).unwrap(),
-    };
-    let depth = g.import_texture("test.depth", &depth_tex);
-    let lit = g.import_texture("test.lit", &lit_tex);
-    let sh = g.import_buffer("sky.sh", &sh_buf);
-    let lights = g.import_buffer("scene.lights", &light_buf);
-    let shadows = sun_shadows::unshadowed_lookup(&mut g).unwrap();
-    let clouds = hikari_render::techniques::clouds::disabled_lookup(&mut g).unwrap();
-    let sky_ambient = g
-        .binding_set("sky_ambient")
-        .constants(&SkyAmbientParams {
-            balance: [1.0, 1.0, 0.0, 0.0],
-        })
-        .read(sh)
-        .finish();
-    let out = haze
-        .record(
-            &mut g,
-            params,
-            view,
-            &HazeInputs {
-                depth,
-                lit,
-                lights,
-                shadows,
-                sky_ambient,
-                clouds,
-                probes: probe_set,
-            },
-        )
-        .unwrap();
-    g.readback(out.light);
-    g.readback(out.grid);
-    g.readback(out.radiance);
-    let r = g.execute().unwrap();
-    let get = |name: &str| -> Vec<Vec4> {
-        r.image(name)
-            .unwrap()
-            .rgba
-            .iter()
-            .map(|v| Vec4::from_array(*v))
-            .collect()
-    };
-    GpuRun {
-        light: get("haze.light"),
-        grid: get("haze.grid"),
-        radiance: get("haze.radiance"),
+    let mut runs = Vec::new();
+    for (view, params) in frames {
+        let mut g = rt.begin_frame(ctx);
+        let probe_set = match (probes, &probe_bufs) {
+            (Some(p), Some((irr, pos, topo))) => {
+                let irr = g.import_buffer("irradiance_probes.irradiance", irr);
+                let pos = g.import_buffer("irradiance_probes.positions", pos);
+                let topo = g.import_buffer("irradiance_probes.topology", topo);
+                g.binding_set("irradiance_probes")
+                    .constants(&p.params)
+                    .read(irr)
+                    .read(pos)
+                    .read(topo)
+                    .finish()
+            }
+            _ => irradiance_probes::absent_lookup(&mut g).unwrap(),
+        };
+        let depth = g.import_texture("test.depth", &depth_tex);
+        let lit = g.import_texture("test.lit", &lit_tex);
+        let sh = g.import_buffer("sky.sh", &sh_buf);
+        let lights = g.import_buffer("scene.lights", &light_buf);
+        let shadows = sun_shadows::unshadowed_lookup(&mut g).unwrap();
+        let clouds = hikari_render::techniques::clouds::disabled_lookup(&mut g).unwrap();
+        let sky_ambient = g
+            .binding_set("sky_ambient")
+            .constants(&SkyAmbientParams {
+                balance: [1.0, 1.0, 0.0, 0.0],
+            })
+            .read(sh)
+            .finish();
+        let out = haze
+            .record(
+                &mut g,
+                settings,
+                params,
+                view,
+                &HazeInputs {
+                    depth,
+                    lit,
+                    lights,
+                    shadows,
+                    sky_ambient,
+                    clouds,
+                    probes: probe_set,
+                },
+                true,
+            )
+            .unwrap();
+        g.readback(out.light);
+        g.readback(out.grid);
+        g.readback(out.radiance);
+        let r = g.execute().unwrap();
+        let get = |name: &str| -> Vec<Vec4> {
+            r.image(name)
+                .unwrap()
+                .rgba
+                .iter()
+                .map(|v| Vec4::from_array(*v))
+                .collect()
+        };
+        runs.push(GpuRun {
+            light: get("haze.light"),
+            grid: get("haze.grid"),
+            radiance: get("haze.radiance"),
+        });
     }
+    runs
 }
 
 fn rel_err(got: Vec3, want: Vec3, floor: f32) -> f32 {
@@ -524,6 +560,143 @@ fn gpu_passes_match_their_cpu_twin() {
         let nan_px = gpu.radiance[5];
         assert!(nan_px.truncate().is_finite() && nan_px.x < 1e5, "{nan_px}");
     }
+}
+
+/// The talk's temporal filtering: the second frame lights each froxel at its jittered point
+/// and blends it with the first frame's grid read where the froxel's centre was, the camera
+/// having moved; the twin does the same from the GPU's first grid.
+#[test]
+fn gpu_temporal_filter_matches_its_twin() {
+    let Some(ctx) = common::gpu() else { return };
+    let (w, h) = (32u32, 24u32);
+    let cam0 = test_camera();
+    let cam1 = Camera {
+        position: cam0.position + Vec3::new(0.4, 0.1, -0.3),
+        ..cam0.clone()
+    };
+    let views = [
+        View::new(&cam0, w, h),
+        View::with_previous(&cam1, &cam0, w, h),
+    ];
+    let sun = Sun {
+        direction: Vec3::new(0.4, 0.5, -0.6).normalize(),
+        illuminance_lux: 90_000.0,
+        color: Vec3::new(1.05, 1.0, 0.93),
+    };
+    let lights = vec![LightGpu {
+        position_range: [1.0, 1.5, 2.0, f32::MAX],
+        direction_kind: [0.0, 0.0, 0.0, 0.0],
+        intensity: [400.0, 300.0, 200.0, 0.0],
+        spot: [0.0, 0.0, -1.0, 0.0],
+    }];
+    let mut sky_sh = Sh::<Vec3, 9>::zero();
+    sky_sh.coeffs[0] = Vec3::new(9000.0, 12000.0, 16000.0);
+    sky_sh.coeffs[2] = Vec3::new(3000.0, 3500.0, 4000.0);
+    let s = HazeSettings {
+        grid_width: 16,
+        grid_height: 10,
+        slices: 24,
+        far_m: 2000.0,
+        slice_growth: 1.25,
+        ..layered()
+    };
+    let mut p0 = params_with(&s, Some(&sun), lights.len() as u32);
+    p0.grid[3] &= !HAZE_SUN_SHADOWS;
+    // The second frame metered at half the light: its grid's storage scale doubles, and the
+    // history must be rescaled to it.
+    let p1 = HazeParams {
+        scatter: [
+            p0.scatter[0],
+            p0.scatter[1],
+            2.0 * p0.scatter[2],
+            p0.scatter[3],
+        ],
+        ..p0
+    };
+    let depth = vec![0.0f32; (w * h) as usize];
+    let lit = vec![[1.0f32, 1.0, 1.0, 1.0]; (w * h) as usize];
+    let frames = [(views[0].clone(), p0), (views[1].clone(), p1)];
+    let run = |s: &HazeSettings| {
+        run_gpu_frames(
+            &ctx,
+            s,
+            &frames,
+            [w, h],
+            &depth,
+            &lit,
+            &sky_sh,
+            &lights,
+            None,
+        )
+    };
+    let gpu = run(&s);
+    // The same with the history weighing nothing: this frame's jittered light alone.
+    let alone = run(&HazeSettings {
+        temporal_blend: 0.0,
+        ..s.clone()
+    });
+    let vis = |_: Vec3| 1.0;
+    let inputs = HazeLightInputs {
+        sky_sh: &sky_sh,
+        lights: &lights,
+        sun_visibility: &vis,
+        sky_visibility: &vis,
+    };
+    let jitter = twin::jitter(1);
+    assert!(jitter.truncate().length() > 0.1 && jitter != twin::jitter(0));
+    let current = twin::light_grid_jittered(&p1, &views[1], &inputs, jitter);
+    let want = twin::temporal(
+        &p1,
+        &views[1],
+        &current,
+        &gpu[0].light,
+        s.temporal_blend,
+        2.0,
+    );
+    let (mut worst, mut blended, mut fresh) = (0f32, 0, 0);
+    let [gw, gh, gn, _] = p1.grid;
+    for k in 0..gn {
+        for j in 0..gh {
+            for i in 0..gw {
+                let at = twin::froxel_index(&p1, i, j, k);
+                let own = alone[1].light[at].truncate();
+                let e = rel_err(own, current[at], 1e-3);
+                assert!(
+                    e < 4e-3,
+                    "froxel ({i}, {j}, {k}) alone: {own} vs {}",
+                    current[at]
+                );
+                let got = gpu[1].light[at].truncate();
+                let e = rel_err(got, want[at], 1e-3);
+                assert!(
+                    e < 1e-2,
+                    "froxel ({i}, {j}, {k}): {got} vs {} (current {})",
+                    want[at],
+                    current[at]
+                );
+                worst = worst.max(e);
+                if twin::reproject(&p1, &views[1], i, j, k).is_some() {
+                    blended += 1;
+                } else {
+                    fresh += 1;
+                }
+            }
+        }
+    }
+    eprintln!(
+        "temporal: worst relative difference {worst}; {blended} froxels blended, {fresh} fresh"
+    );
+    // The move leaves froxels of both kinds, and the blend must matter where it happens.
+    assert!(blended > 1000 && fresh > 50);
+    let moved = current
+        .iter()
+        .zip(&want)
+        .filter(|(c, w)| rel_err(**c, **w, 1e-3) > 0.02)
+        .count();
+    assert!(
+        moved > 500,
+        "only {moved} froxels differ from this frame's own light"
+    );
 }
 
 #[test]

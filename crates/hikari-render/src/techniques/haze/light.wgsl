@@ -1,11 +1,13 @@
 // haze.light: the light every froxel scatters towards the camera per unit scattering (the
-// talk's L_i) at its slice's middle: the sun or moon through the shadow maps and the HG phase,
-// the sky's SH convolved with the phase times the sky visibility the irradiance probes give
-// there, and the point and spot lights, times the albedo and the storage scale. Twin:
-// `haze::reference::light_grid`.
+// talk's L_i): the sun or moon through the shadow maps and the HG phase, the sky's SH convolved
+// with the phase times the sky visibility the irradiance probes give there, and the point and
+// spot lights, times the albedo and the storage scale. Sampled at this frame's jittered point in
+// the froxel (the centre on the cycle's first frame) and blended with last frame's grid read
+// where the froxel's centre was (the talk's temporal filtering of jittered samples). Twin:
+// `haze::reference::light_grid_jittered` and `temporal`.
 
-#import hikari::view::View
-#import hikari::haze::{HazeParams, HAZE_SUN_SHADOWS, HAZE_SKY, HAZE_SKY_OCCLUSION, HAZE_LOCAL_LIGHTS, HAZE_MAX_HALF, slice_depth, froxel_ray}
+#import hikari::view::{View, view_ray_uv}
+#import hikari::haze::{HazeParams, HAZE_SUN_SHADOWS, HAZE_SKY, HAZE_SKY_OCCLUSION, HAZE_LOCAL_LIGHTS, HAZE_MAX_HALF, slice_depth, slice_of_depth, froxel_ray}
 #import hikari::phase::hg_phase
 #import hikari::scene_gpu::{LightGpu, light_range, light_attenuation}
 #import hikari::sun_shadows::sun_visibility
@@ -17,6 +19,16 @@
 @group(0) @binding(1) var<uniform> params: HazeParams;
 @group(0) @binding(2) var<storage, read> lights: array<LightGpu>;
 @group(0) @binding(3) var light_out: texture_storage_3d<rgba16float, write>;
+// xyz: the sample's offset in the froxel (x, y in froxels about its centre, z the fraction of
+// the slice's depth); w: the history's weight (0: none, the first frame or a cut).
+struct HazeTemporal {
+    jitter_blend: vec4<f32>,
+    // x: this frame's storage scale over last frame's.
+    rescale: vec4<f32>,
+}
+@group(0) @binding(4) var<uniform> temporal: HazeTemporal;
+@group(0) @binding(5) var history: texture_3d<f32>;
+@group(0) @binding(6) var history_sampler: sampler;
 
 const LUMA: vec3<f32> = vec3<f32>(0.2126, 0.7152, 0.0722);
 // The probes' interior mask for a point in the air: none, each probe weighs by its
@@ -56,9 +68,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if any(id >= params.grid.xyz) {
         return;
     }
-    let v = froxel_ray(params, view, id.xy);
+    let jitter = temporal.jitter_blend.xyz;
+    let v = view_ray_uv(view, (vec2<f32>(id.xy) + 0.5 + jitter.xy) / vec2<f32>(params.grid.xy));
     let k = f32(id.z);
-    let z = 0.5 * (slice_depth(params, k) + slice_depth(params, k + 1.0));
+    let z = mix(slice_depth(params, k), slice_depth(params, k + 1.0), jitter.z);
     let x = view.position.xyz + v * (z / max(dot(v, view.forward_near.xyz), 1e-4));
     let g = params.scatter.y;
     let flags = params.grid.w;
@@ -97,5 +110,21 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var out = l * (params.scatter.x * params.scatter.z);
     // NaN fails the comparison and becomes 0.
     out = select(vec3<f32>(0.0), min(out, vec3<f32>(HAZE_MAX_HALF)), out >= vec3<f32>(0.0));
+    let blend = temporal.jitter_blend.w;
+    if blend > 0.0 {
+        // The froxel's centre in last frame's grid.
+        let c = froxel_ray(params, view, id.xy);
+        let zc = 0.5 * (slice_depth(params, k) + slice_depth(params, k + 1.0));
+        let xc = view.position.xyz + c * (zc / max(dot(c, view.forward_near.xyz), 1e-4));
+        let clip = view.prev_view_proj * vec4<f32>(xc, 1.0);
+        if clip.w > 1e-4 {
+            let uvw = vec3<f32>(0.5 + 0.5 * clip.x / clip.w, 0.5 - 0.5 * clip.y / clip.w, slice_of_depth(params, clip.w) / f32(params.grid.z));
+            if all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0)) {
+                let old = textureSampleLevel(history, history_sampler, uvw, 0.0).rgb * temporal.rescale.x;
+                let blended = mix(out, old, blend);
+                out = select(out, min(blended, vec3<f32>(HAZE_MAX_HALF)), blended >= vec3<f32>(0.0));
+            }
+        }
+    }
     textureStore(light_out, id, vec4<f32>(out, 0.0));
 }

@@ -138,7 +138,47 @@ pub struct HazeFrame {
     pub radiance: Tex,
 }
 
+/// `light.wgsl`'s temporal parameters: this frame's sample offset in the froxel and the
+/// history's weight, and the rescale of last frame's grid to this frame's storage scale.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
+pub struct HazeTemporal {
+    pub jitter_blend: [f32; 4],
+    pub rescale: [f32; 4],
+}
+
+impl HazeTemporal {
+    /// Frame `frame`'s parameters: with `s.temporal`, the jittered sample and, where
+    /// `history` (last frame's parameters) grids the same froxels, its weight; else the centre
+    /// alone.
+    pub fn new(
+        s: &HazeSettings,
+        frame: u64,
+        params: &HazeParams,
+        history: Option<&HazeParams>,
+    ) -> Self {
+        if !s.temporal {
+            return Self {
+                jitter_blend: reference::jitter(0).extend(0.0).to_array(),
+                rescale: [1.0, 0.0, 0.0, 0.0],
+            };
+        }
+        let same_grid = history
+            .filter(|h| h.grid == params.grid && h.slicing == params.slicing && h.scatter[2] > 0.0);
+        let (blend, rescale) = match same_grid {
+            Some(h) => (s.temporal_blend, params.scatter[2] / h.scatter[2]),
+            None => (0.0, 1.0),
+        };
+        Self {
+            jitter_blend: reference::jitter(frame).extend(blend).to_array(),
+            rescale: [rescale, 0.0, 0.0, 0.0],
+        }
+    }
+}
+
 pub struct Haze {
+    /// Last frame's parameters, for the temporal filter.
+    last: std::cell::Cell<Option<HazeParams>>,
     light: ComputePipeline,
     integrate: ComputePipeline,
     composite: ComputePipeline,
@@ -147,23 +187,35 @@ pub struct Haze {
 impl Haze {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
+            last: std::cell::Cell::new(None),
             light: ComputePipeline::new(ctx, lib, "haze/light.wgsl", "main", &[])?,
             integrate: ComputePipeline::new(ctx, lib, "haze/integrate.wgsl", "main", &[])?,
             composite: ComputePipeline::new(ctx, lib, "haze/composite.wgsl", "main", &[])?,
         })
     }
 
-    /// Lights and integrates the grid, and composites it over `inputs.lit`.
+    /// Lights and integrates the grid, and composites it over `inputs.lit`. `keep_history`
+    /// false (a camera cut) starts the temporal filter afresh.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        s: &HazeSettings,
         params: &HazeParams,
         view: &View,
         inputs: &HazeInputs,
+        keep_history: bool,
     ) -> Result<HazeFrame> {
         let [gw, gh, gn, _] = params.grid;
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
-        let light = g.texture("haze.light", TextureDesc::d3(gw, gh, gn, GRID_FORMAT))?;
+        let history = g.history_texture("haze.light", TextureDesc::d3(gw, gh, gn, GRID_FORMAT))?;
+        let last = self.last.replace(Some(*params));
+        let temporal = HazeTemporal::new(
+            s,
+            g.frame_index(),
+            params,
+            last.as_ref().filter(|_| keep_history && history.valid),
+        );
+        let light = history.cur;
         let grid = g.texture("haze.grid", TextureDesc::d3(gw, gh, gn, GRID_FORMAT))?;
         let radiance = g.texture("haze.radiance", TextureDesc::d2(w, h, RADIANCE_FORMAT))?;
         g.pass("haze.light")
@@ -171,6 +223,9 @@ impl Haze {
             .constants(params)
             .read(inputs.lights)
             .write(light)
+            .constants(&temporal)
+            .read(history.prev)
+            .sampler(SamplerKind::LinearClamp)
             .set(inputs.shadows)
             .set(inputs.sky_ambient)
             .set(inputs.clouds)

@@ -100,11 +100,61 @@ fn eye(view: &View) -> Vec3 {
 
 /// Froxel `(i, j)`'s central ray.
 pub fn froxel_ray(p: &HazeParams, view: &View, i: u32, j: u32) -> Vec3 {
-    let uv = Vec2::new(
-        (i as f32 + 0.5) / p.grid[0] as f32,
-        (j as f32 + 0.5) / p.grid[1] as f32,
-    );
+    froxel_ray_at(p, view, Vec2::new(i as f32 + 0.5, j as f32 + 0.5))
+}
+
+/// The ray through grid position `xy` (froxels; a froxel's centre is its index plus 0.5).
+pub fn froxel_ray_at(p: &HazeParams, view: &View, xy: Vec2) -> Vec3 {
+    let uv = xy / Vec2::new(p.grid[0] as f32, p.grid[1] as f32);
     gbuffer::reference::uv_ray(inv_view_proj(view), eye(view), uv)
+}
+
+/// Frames in the temporal filter's cycle of sample positions.
+pub const JITTER_FRAMES: u64 = 16;
+
+fn radical_inverse(mut i: u64, base: u64) -> f32 {
+    let (mut f, mut r) = (1.0f64, 0.0f64);
+    while i > 0 {
+        f /= base as f64;
+        r += f * (i % base) as f64;
+        i /= base;
+    }
+    r as f32
+}
+
+/// Where frame `frame` samples each froxel: x and y in froxels about its centre (-0.5 to 0.5),
+/// z the fraction of its slice's depth. Frame 0 of each cycle takes the centre, (0, 0, 0.5),
+/// then Halton's bases 2, 3 and 5: the talk's jittered samples, filtered over frames.
+pub fn jitter(frame: u64) -> Vec3 {
+    let i = frame % JITTER_FRAMES;
+    if i == 0 {
+        return Vec3::new(0.0, 0.0, 0.5);
+    }
+    Vec3::new(
+        radical_inverse(i, 2) - 0.5,
+        radical_inverse(i, 3) - 0.5,
+        radical_inverse(i, 5),
+    )
+}
+
+/// The froxel (i, j, k)'s centre in last frame's grid (`view.prev_view_proj`, the same
+/// slicing): normalised coordinates, or `None` off that grid or behind its camera.
+pub fn reproject(p: &HazeParams, view: &View, i: u32, j: u32, k: u32) -> Option<Vec3> {
+    let cam = eye(view);
+    let fwd = Vec3::from_slice(&view.forward_near[..3]);
+    let v = froxel_ray(p, view, i, j);
+    let z = 0.5 * (slice_depth(p, k as f32) + slice_depth(p, k as f32 + 1.0));
+    let x = cam + v * (z / v.dot(fwd).max(1e-4));
+    let c = Mat4::from_cols_array_2d(&view.prev_view_proj) * x.extend(1.0);
+    if c.w <= 1e-4 {
+        return None;
+    }
+    let uvw = Vec3::new(
+        0.5 + 0.5 * c.x / c.w,
+        0.5 - 0.5 * c.y / c.w,
+        slice_of_depth(p, c.w) / p.grid[2] as f32,
+    );
+    (uvw.cmpge(Vec3::ZERO).all() && uvw.cmple(Vec3::ONE).all()).then_some(uvw)
 }
 
 /// What lights the haze besides the params: the sky's deringed L2 SH (radiance, nits) and the
@@ -248,15 +298,27 @@ pub fn froxel_index(p: &HazeParams, i: u32, j: u32, k: u32) -> usize {
 /// `haze.light`: every froxel's L_i at its slice's middle along its central ray, times the
 /// albedo and the storage scale, as the f16 grid holds it (not rounded to f16 here).
 pub fn light_grid(p: &HazeParams, view: &View, inputs: &HazeLightInputs) -> Vec<Vec3> {
+    light_grid_jittered(p, view, inputs, jitter(0))
+}
+
+/// [`light_grid`] sampled at `jitter` in every froxel ([`jitter`]).
+pub fn light_grid_jittered(
+    p: &HazeParams,
+    view: &View,
+    inputs: &HazeLightInputs,
+    jitter: Vec3,
+) -> Vec<Vec3> {
     let [w, h, n, _] = p.grid;
     let cam = Vec3::from_slice(&view.position[..3]);
     let fwd = Vec3::from_slice(&view.forward_near[..3]);
     let mut out = vec![Vec3::ZERO; (w * h * n) as usize];
     for k in 0..n {
-        let z = 0.5 * (slice_depth(p, k as f32) + slice_depth(p, k as f32 + 1.0));
+        let (z0, z1) = (slice_depth(p, k as f32), slice_depth(p, k as f32 + 1.0));
+        let z = z0 + (z1 - z0) * jitter.z;
         for j in 0..h {
             for i in 0..w {
-                let v = froxel_ray(p, view, i, j);
+                let at = Vec2::new(i as f32 + 0.5 + jitter.x, j as f32 + 0.5 + jitter.y);
+                let v = froxel_ray_at(p, view, at);
                 let x = cam + v * (z / v.dot(fwd).max(1e-4));
                 let sky_visibility = if p.grid[3] & HAZE_SKY_OCCLUSION != 0 {
                     froxel_sky_visibility(p, view, inputs, v, k)
@@ -266,6 +328,38 @@ pub fn light_grid(p: &HazeParams, view: &View, inputs: &HazeLightInputs) -> Vec<
                 let li = inscatter_seeing(p, inputs, x, v, sky_visibility)
                     * (p.scatter[0] * p.scatter[2]);
                 out[froxel_index(p, i, j, k)] = li.min(Vec3::splat(MAX_HALF));
+            }
+        }
+    }
+    out
+}
+
+/// The temporal filter of `haze.light`: this frame's grid blended with last frame's (`history`,
+/// as stored, read trilinearly where each froxel's centre was), the history weighing `blend`
+/// and rescaled by `rescale` (this frame's storage scale over last frame's). `blend` 0, or a
+/// froxel that was off last frame's grid, takes this frame's value alone.
+pub fn temporal(
+    p: &HazeParams,
+    view: &View,
+    current: &[Vec3],
+    history: &[Vec4],
+    blend: f32,
+    rescale: f32,
+) -> Vec<Vec3> {
+    let [w, h, n, _] = p.grid;
+    let mut out = current.to_vec();
+    if blend <= 0.0 {
+        return out;
+    }
+    for k in 0..n {
+        for j in 0..h {
+            for i in 0..w {
+                let at = froxel_index(p, i, j, k);
+                if let Some(uvw) = reproject(p, view, i, j, k) {
+                    let old = sample(p, history, uvw, false).truncate() * rescale;
+                    let blended = current[at] + (old - current[at]) * blend;
+                    out[at] = blended.min(Vec3::splat(MAX_HALF));
+                }
             }
         }
     }

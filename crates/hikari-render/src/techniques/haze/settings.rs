@@ -58,6 +58,12 @@ pub struct HazeSettings {
     pub density_aa: bool,
     /// Sample the grid with a tricubic B-spline (8 trilinear taps); off, trilinearly.
     pub tricubic: bool,
+    /// The talk's temporal filtering: each frame lights every froxel at a jittered point
+    /// (Halton, a 16-frame cycle) and blends it with last frame's grid, reprojected; off, at the
+    /// froxel's centre, alone.
+    pub temporal: bool,
+    /// The history's weight in that blend (0 to 0.95).
+    pub temporal_blend: f32,
     /// Froxels across the screen.
     pub grid_width: u32,
     /// Froxels down the screen.
@@ -96,6 +102,8 @@ impl Default for HazeSettings {
             local_lights: true,
             density_aa: true,
             tricubic: true,
+            temporal: true,
+            temporal_blend: 0.9,
             grid_width: 128,
             grid_height: 64,
             slices: 64,
@@ -205,6 +213,10 @@ impl TechniqueSettings for HazeSettings {
                     lo: 1.0,
                     hi: 1_000_000.0,
                 },
+            },
+            Field {
+                key: "temporal_blend",
+                range: Range::Float { lo: 0.0, hi: 0.95 },
             },
             Field {
                 key: "slice_growth",

@@ -49,8 +49,8 @@ impl TechniqueSettings for ParticlesSettings {
             Field {
                 key: "ms_asymmetry",
                 range: Range::Float {
-                    lo: -0.99,
-                    hi: 0.99,
+                    lo: -0.95,
+                    hi: 0.95,
                 },
             },
             Field {
