@@ -92,11 +92,22 @@ fn the_draw_pass_matches_its_twin() {
         .iter()
         .map(|v| Vec4::from_array(v.to_array().map(|x| f16::from_f32(x).to_f32())))
         .collect::<Vec<_>>();
+    // Sky along the top; surfaces 4 to 20 m away (reverse-Z depth near / z, near 0.1 m),
+    // nearer ones (6 to 7.5 m, just behind the sprites) in the left half from row 16 (whole
+    // 16 x 16 tiles), where the tiles cull
+    // by depth: the sprites in front must survive it; a few NaN.
     let depth: Vec<f32> = (0..w * h)
-        .map(|i| match i % 7 {
-            0 => 0.0,
-            1 if i % 5 == 0 => f32::NAN,
-            _ => rng.random_range(0.005..0.025f32),
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if y < h / 4 {
+                0.0
+            } else if i % 37 == 0 {
+                f32::NAN
+            } else if x < w / 2 && y >= 16 {
+                0.1 / rng.random_range(6.0..7.5f32)
+            } else {
+                0.1 / rng.random_range(4.0..20.0f32)
+            }
         })
         .collect();
     let background: Vec<Vec3> = (0..w * h)

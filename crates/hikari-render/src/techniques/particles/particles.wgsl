@@ -1,7 +1,7 @@
 // particles.draw: camera-facing fog sprites composited over the hazed image, back to front
 // (premultiplied: colour alpha L T, then the image times 1 - alpha), a thread a pixel. A
 // 16 x 16 tile first marks, in a bit mask, the sprites whose screen rectangles (from the CPU)
-// overlap it; each pixel then meets the marked sprites' planes in index order, which is back to
+// overlap it and that come nearer than its farthest surface; each pixel then meets the marked sprites' planes in index order, which is back to
 // front. A haze-lit sprite takes the haze's froxel light L_i where the pixel's ray meets it (the
 // talk's "haze lighting" mode: the light the haze pass computed, phase, shadows, sky visibility
 // and local lights included), bicubic in x and y once its opacity passes `bicubic_opacity`,
@@ -55,6 +55,9 @@ const TILE: u32 = 16u;
 const BATCH: u32 = 4096u;
 
 var<workgroup> mask: array<atomic<u32>, 128>;
+// The farthest surface in the tile (metres, as bits: non-negative floats order as integers):
+// a sprite wholly beyond it is hidden in every pixel of the tile.
+var<workgroup> tile_far: atomic<u32>;
 
 // The haze light (L_i times the storage scale and albedo) at screen position uv, slice s:
 // trilinear, or a B-spline in x and y (4 trilinear taps) for opaque sprites.
@@ -155,6 +158,16 @@ fn main(
             surface = length(world_from_depth(view, pixel, depth) - view.position.xyz);
         }
     }
+    if lid == 0u {
+        atomicStore(&tile_far, 0u);
+    }
+    workgroupBarrier();
+    if inside {
+        atomicMax(&tile_far, bitcast<u32>(min(surface, 3.0e38)));
+    }
+    workgroupBarrier();
+    let far = bitcast<f32>(atomicLoad(&tile_far));
+    let cam = view.position.xyz;
     let count = params.count.x;
     for (var base = 0u; base < count; base += BATCH) {
         if lid < 128u {
@@ -163,8 +176,10 @@ fn main(
         workgroupBarrier();
         let n = min(count - base, BATCH);
         for (var i = lid; i < n; i += TILE * TILE) {
-            let r = particles[base + i].rect;
-            if r.x <= tile_hi.x && r.z >= tile_lo.x && r.y <= tile_hi.y && r.w >= tile_lo.y {
+            let p = particles[base + i];
+            let r = p.rect;
+            let near = length(p.position_radius.xyz - cam) - p.position_radius.w;
+            if r.x <= tile_hi.x && r.z >= tile_lo.x && r.y <= tile_hi.y && r.w >= tile_lo.y && near < far {
                 atomicOr(&mask[i / 32u], 1u << (i % 32u));
             }
         }
