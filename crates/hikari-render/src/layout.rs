@@ -32,7 +32,7 @@ pub fn all() -> Vec<StructLayout> {
     use crate::scene_gpu;
     use crate::techniques::{
         clouds, direct_lighting, exposure, gi_denoiser, haze, irradiance_probes, local_tonemap,
-        ray_traced_gi, reflection_probes, sky, sun_shadows, taa, tonemap,
+        particles, ray_traced_gi, reflection_probes, sky, sun_shadows, taa, tonemap,
     };
     use crate::view;
     vec![
@@ -74,6 +74,21 @@ pub fn all() -> Vec<StructLayout> {
                 sun_lux,
                 lights
             ]
+        ),
+        gpu_layout!(
+            haze::HazeTemporal,
+            "haze/light.wgsl",
+            [jitter_blend, rescale]
+        ),
+        gpu_layout!(
+            particles::ParticleGpu,
+            "particles/particles.wgsl",
+            [position_radius, albedo_opacity, rect]
+        ),
+        gpu_layout!(
+            particles::ParticleParams,
+            "particles/particles.wgsl",
+            [sun_lux, sun_dir, sky, ms, count]
         ),
         gpu_layout!(
             gi_denoiser::GiDenoiserParams,
