@@ -29,6 +29,18 @@ fn params_with(s: &HazeSettings, sun: Option<&Sun>, lights: u32) -> HazeParams {
     HazeParams::new(s, "clear", sun, lights, 0.01, 100_000.0)
 }
 
+/// [`layered`] on a grid of 16 x 10 x 24 froxels to 2 km, small enough for the twins.
+fn small_grid() -> HazeSettings {
+    HazeSettings {
+        grid_width: 16,
+        grid_height: 10,
+        slices: 24,
+        far_m: 2000.0,
+        slice_growth: 1.25,
+        ..layered()
+    }
+}
+
 fn layered() -> HazeSettings {
     HazeSettings {
         density: 3e-3,
@@ -461,14 +473,7 @@ fn gpu_passes_match_their_cpu_twin() {
             rng.random_range(-2000.0..2000.0),
         );
     }
-    let s = HazeSettings {
-        grid_width: 16,
-        grid_height: 10,
-        slices: 24,
-        far_m: 2000.0,
-        slice_growth: 1.25,
-        ..layered()
-    };
+    let s = small_grid();
     let mut depth: Vec<f32> = (0..w * h)
         .map(|_| {
             if rng.random_bool(0.15) {
@@ -592,14 +597,7 @@ fn gpu_temporal_filter_matches_its_twin() {
     let mut sky_sh = Sh::<Vec3, 9>::zero();
     sky_sh.coeffs[0] = Vec3::new(9000.0, 12000.0, 16000.0);
     sky_sh.coeffs[2] = Vec3::new(3000.0, 3500.0, 4000.0);
-    let s = HazeSettings {
-        grid_width: 16,
-        grid_height: 10,
-        slices: 24,
-        far_m: 2000.0,
-        slice_growth: 1.25,
-        ..layered()
-    };
+    let s = small_grid();
     let mut p0 = params_with(&s, Some(&sun), lights.len() as u32);
     p0.grid[3] &= !HAZE_SUN_SHADOWS;
     // The second frame metered at half the light: its grid's storage scale doubles, and the

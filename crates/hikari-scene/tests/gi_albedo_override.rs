@@ -95,13 +95,7 @@ fn write_gltf(name: &str, materials: Value) -> PathBuf {
         "scenes": [{"nodes": [0]}],
         "scene": 0
     });
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("gi_albedo_override")
-        .join(name);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.gltf"));
-    std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
-    path
+    common::write_gltf_doc("gi_albedo_override", name, &doc)
 }
 
 #[test]

@@ -2,6 +2,8 @@
 //! validated by `Scene::validate` with errors naming the light, and read from glTF
 //! `KHR_lights_punctual` light `extras` `{"hikari": {"radius": r}}`.
 
+mod common;
+
 use std::path::PathBuf;
 
 use glam::Vec3;
@@ -27,13 +29,7 @@ fn write_gltf(name: &str, lights: Value) -> PathBuf {
         "scenes": [{"nodes": (0..n).collect::<Vec<_>>()}],
         "scene": 0
     });
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("light_radius")
-        .join(name);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.gltf"));
-    std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
-    path
+    common::write_gltf_doc("light_radius", name, &doc)
 }
 
 #[test]

@@ -1,6 +1,8 @@
 //! Particle emitters from glTF node `extras` `{"hikari": {"particles": {...}}}`: placed at the
 //! node, their box scaled with it, bad values errors naming the node.
 
+mod common;
+
 use std::path::PathBuf;
 
 use glam::Vec3;
@@ -16,13 +18,7 @@ fn write_gltf(name: &str, extras: Value) -> PathBuf {
         "scenes": [{"nodes": [0]}],
         "scene": 0
     });
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("particle_emitters")
-        .join(name);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{name}.gltf"));
-    std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
-    path
+    common::write_gltf_doc("particle_emitters", name, &doc)
 }
 
 #[test]

@@ -128,15 +128,7 @@ pub fn with_screen_rects(sprites: &mut [ParticleGpu], view: &View) {
     for p in sprites {
         let centre = Vec3::from_slice(&p.position_radius[..3]);
         let radius = p.position_radius[3];
-        let to_eye = cam - centre;
-        let f = if to_eye.length_squared() > 1e-8 {
-            -to_eye.normalize()
-        } else {
-            fwd
-        };
-        let up_hint = if f.y.abs() > 0.99 { Vec3::X } else { Vec3::Y };
-        let right = f.cross(up_hint).normalize();
-        let up = right.cross(f);
+        let [_, right, up] = reference::sprite_basis(centre, cam, fwd);
         let mut lo = glam::Vec2::splat(f32::INFINITY);
         let mut hi = glam::Vec2::splat(f32::NEG_INFINITY);
         let mut behind = false;

@@ -20,6 +20,20 @@ pub fn multiple_scattering(g: f32, g_back: f32, back_strength: f32) -> (f32, f32
     (1.0 + back_strength * (ratio(-1.0) - 1.0), ratio(1.0))
 }
 
+/// A sprite's plane facing the camera at `cam` (forward axis `fwd`): its normal `f` (the line
+/// of sight through its centre) and the `right` and `up` axes of its square.
+pub fn sprite_basis(centre: Vec3, cam: Vec3, fwd: Vec3) -> [Vec3; 3] {
+    let to_eye = cam - centre;
+    let f = if to_eye.length_squared() > 1e-8 {
+        -to_eye.normalize()
+    } else {
+        fwd
+    };
+    let up_hint = if f.y.abs() > 0.99 { Vec3::X } else { Vec3::Y };
+    let right = f.cross(up_hint).normalize();
+    [f, right, right.cross(f)]
+}
+
 /// What the pass reads besides the sprites.
 pub struct Inputs<'a> {
     pub view: &'a View,
@@ -41,15 +55,7 @@ pub fn fragment(inputs: &Inputs<'_>, p: &ParticleGpu, pixel: [u32; 2]) -> Option
     let fwd = Vec3::from_slice(&view.forward_near[..3]);
     let centre = Vec3::from_slice(&p.position_radius[..3]);
     let radius = p.position_radius[3];
-    let to_eye = cam - centre;
-    let f = if to_eye.length_squared() > 1e-8 {
-        -to_eye.normalize()
-    } else {
-        fwd
-    };
-    let up_hint = if f.y.abs() > 0.99 { Vec3::X } else { Vec3::Y };
-    let right = f.cross(up_hint).normalize();
-    let up = right.cross(f);
+    let [f, right, up] = sprite_basis(centre, cam, fwd);
     // The pixel's ray meets the sprite's plane (normal f through the centre).
     let ray = gbuffer::reference::pixel_ray(inv, cam, pixel, size);
     let denom = ray.dot(f);
