@@ -262,7 +262,6 @@ struct Probes {
 /// off and the given sky SH (9 RGB coefficients), lights and probes (none: no probe covers
 /// anything).
 #[allow(clippy::too_many_arguments)]
-#[allow(clippy::too_many_arguments)]
 fn run_gpu(
     ctx: &hikari_render::GpuContext,
     params: &HazeParams,
@@ -278,7 +277,7 @@ fn run_gpu(
     run_gpu_frames(
         ctx,
         &settings,
-        &[(view.clone(), *params)],
+        &[(*view, *params)],
         size,
         depth,
         lit,
@@ -613,7 +612,7 @@ fn gpu_temporal_filter_matches_its_twin() {
     };
     let depth = vec![0.0f32; (w * h) as usize];
     let lit = vec![[1.0f32, 1.0, 1.0, 1.0]; (w * h) as usize];
-    let frames = [(views[0].clone(), p0), (views[1].clone(), p1)];
+    let frames = [(views[0], p0), (views[1], p1)];
     let run = |s: &HazeSettings| {
         run_gpu_frames(
             &ctx,

@@ -51,7 +51,7 @@ fn node_extras_make_an_emitter_at_the_node() {
     );
     assert_eq!(e.velocity_mps, Vec3::new(0.1, 0.0, 0.0));
     // Nothing in the extras but other tools' data: no emitter.
-    let loaded = load(&write_gltf("none", json!({"tool": "blender"}))).unwrap();
+    let loaded = load(write_gltf("none", json!({"tool": "blender"}))).unwrap();
     assert!(loaded.scene.particles.is_empty());
 }
 
@@ -66,7 +66,7 @@ fn bad_emitter_extras_are_errors_naming_the_node() {
         ("haze_lit_number", json!({"haze_lit": 1})),
     ];
     for (name, p) in cases {
-        let e = load(&write_gltf(name, json!({"hikari": {"particles": p}})))
+        let e = load(write_gltf(name, json!({"hikari": {"particles": p}})))
             .unwrap_err()
             .to_string();
         assert!(
@@ -75,7 +75,7 @@ fn bad_emitter_extras_are_errors_naming_the_node() {
         );
     }
     // Out of range: the loader's validation refuses it with the emitter's name.
-    let e = load(&write_gltf(
+    let e = load(write_gltf(
         "zero_opacity",
         json!({"hikari": {"particles": {"opacity": 0.0}}}),
     ))
