@@ -1411,6 +1411,17 @@ fn shadow_denoiser_passes_match_their_cpu_twins() {
                 }
             }
         }
+        // Frame 1 records a wrong view depth in a few still pixels (as if they saw another
+        // surface): on frame 2 their own texel fails the depth test and the 3x3 about it
+        // stands in (SVGF's fallback), so they keep their history.
+        let damaged: Vec<usize> = (3..6).map(|y| (y * rig.w + 40) as usize).collect();
+        for &i in &damaged {
+            match frame {
+                1 => rig.motion[i][2] *= 3.0,
+                2 => rig.motion[i][2] /= 3.0,
+                _ => {}
+            }
+        }
         let (s, u) = noisy_frame(&rig, &mut rng);
         let out = rig.frame(&params, &s, &u);
         let (s16, u16): (Vec<_>, Vec<_>) = (
@@ -1458,6 +1469,14 @@ fn shadow_denoiser_passes_match_their_cpu_twins() {
             lit > (w * rig.h) as usize / 2,
             "frame {frame}: {lit} pixels of length {expected_len}"
         );
+        if frame == 2 {
+            for &i in &damaged {
+                assert_eq!(
+                    out.history.length[i], 3.0,
+                    "damaged pixel {i} lost its history"
+                );
+            }
+        }
         let (filtered, light) = reference::denoise_spatial(&p, &rig.view, &input, &out.history);
         assert_close4(
             &format!("frame {frame} filtered"),

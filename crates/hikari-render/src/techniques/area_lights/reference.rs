@@ -685,7 +685,9 @@ pub fn raw_visibility(shadowed: [f32; 4], unshadowed: [f32; 4]) -> [f32; 4] {
 }
 
 /// The temporal pass: (this frame's raw visibility, the history after it). `prev`: last
-/// frame's history (`None`: no valid history, as on a reset).
+/// frame's history (`None`: no valid history, as on a reset). Bilinear taps that pass the
+/// tests, or where they weigh under [`REPROJECTION_MIN_WEIGHT`] the 3x3 about the nearest
+/// texel that pass them, equally weighted (SVGF's fallback).
 pub fn denoise_temporal(
     p: &ShadowDenoiseParams,
     view: &View,
@@ -723,26 +725,41 @@ pub fn denoise_temporal(
                     break 'px (r, 1.0, z);
                 }
                 let expected = (prev_vp * world.extend(1.0)).w;
-                let (mut hv, mut hl, mut weight) = ([0f32; 4], 0f32, 0f32);
-                for ([tx, ty], wt) in bilinear_taps(glam::Vec2::new(px, py)) {
-                    if wt <= 0.0 || tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
-                        continue;
+                // The history texel at (tx, ty) where it is inside, finite, has history and saw
+                // this surface (written so that NaN rejects).
+                let agreeing = |tx: i64, ty: i64| {
+                    if tx < 0 || ty < 0 || tx >= w as i64 || ty >= h as i64 {
+                        return None;
                     }
                     let j = (ty as u32 * w + tx as u32) as usize;
                     let (tv, tl, tz) = (prev.visibility[j], prev.length[j], prev.view_depth[j]);
-                    // Written so that NaN rejects.
                     let depth_ok = (tz - expected).abs() <= p.values[0] * expected.abs();
-                    if !finite4(tv) || !tl.is_finite() || tl < 1.0 || !tz.is_finite() || !depth_ok {
-                        continue;
+                    (finite4(tv) && tl.is_finite() && tl >= 1.0 && tz.is_finite() && depth_ok)
+                        .then_some((tv, tl))
+                };
+                let mut taps: Vec<(([f32; 4], f32), f32)> = bilinear_taps(glam::Vec2::new(px, py))
+                    .into_iter()
+                    .filter(|(_, wt)| *wt > 0.0)
+                    .filter_map(|([tx, ty], wt)| agreeing(tx, ty).map(|t| (t, wt)))
+                    .collect();
+                // SVGF's fallback: the 3x3 about the nearest texel, equally weighted.
+                if taps.iter().map(|(_, wt)| wt).sum::<f32>() < REPROJECTION_MIN_WEIGHT {
+                    let (qx, qy) = (px as i64, py as i64);
+                    taps = (-1..=1)
+                        .flat_map(|dy| (-1..=1).map(move |dx| (qx + dx, qy + dy)))
+                        .filter_map(|(tx, ty)| agreeing(tx, ty).map(|t| (t, 1.0)))
+                        .collect();
+                    if taps.is_empty() {
+                        break 'px (r, 1.0, z);
                     }
+                }
+                let (mut hv, mut hl, mut weight) = ([0f32; 4], 0f32, 0f32);
+                for ((tv, tl), wt) in taps {
                     for c in 0..4 {
                         hv[c] += wt * tv[c];
                     }
                     hl += wt * tl;
                     weight += wt;
-                }
-                if weight < REPROJECTION_MIN_WEIGHT {
-                    break 'px (r, 1.0, z);
                 }
                 let hv: [f32; 4] = std::array::from_fn(|c| hv[c] / weight);
                 let hl = hl / weight;

@@ -2,9 +2,12 @@
 // over its unshadowed light, per channel) blended into its history reprojected by the
 // G-buffer's motion vector, bilinearly (hikari::view's reprojection: each of the 2x2 taps
 // counts where it is on screen, finite, has history and its view depth agrees with where this
-// point was seen last frame within the tolerance; the valid weights renormalised). The history
-// is dropped where no tap counts enough, and on a reset; its length grows while it stays valid, up to the cap, and the
-// blend is 1 / length. Non-finite input is replaced where it enters (raw_visibility), so it
+// point was seen last frame within the tolerance; the valid weights renormalised). Where they
+// weigh under REPROJECTION_MIN_WEIGHT, the texels of the 3x3 about the nearest one that pass the
+// same tests stand in, equally weighted (SVGF's fallback, as the GI's accumulation: at a
+// silhouette under TAA's jitter the pixel's own texel saw the other surface); with none, and on
+// a reset, the history is dropped. Its length grows while it stays valid, up to the cap, and
+// the blend is 1 / length. Non-finite input is replaced where it enters (raw_visibility), so it
 // never reaches the history. CPU twin: area_lights::reference::denoise_temporal.
 
 #import hikari::view::{View, world_from_depth, reprojection, reprojection_tap, history_depth_agrees, REPROJECTION_MIN_WEIGHT}
@@ -24,6 +27,31 @@
 @group(0) @binding(10) var out_visibility: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(11) var out_length: texture_storage_2d<r16float, write>;
 @group(0) @binding(12) var out_depth: texture_storage_2d<r32float, write>;
+
+// Last frame's visibility (xyzw) and history length (w of the second) at texel q, where it lies
+// on screen, is finite, has history and saw the surface at `world`; length 0 where not.
+struct HistoryTexel {
+    v: vec4<f32>,
+    len: f32,
+}
+
+fn history_texel(q: vec2<i32>, size: vec2<u32>, world: vec3<f32>) -> HistoryTexel {
+    var h: HistoryTexel;
+    h.len = 0.0;
+    if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+        return h;
+    }
+    let tv = textureLoad(prev_visibility, q, 0);
+    let tl = textureLoad(prev_length, q, 0).x;
+    let tz = textureLoad(prev_depth, q, 0).x;
+    if !is_finite4(tv) || !is_finite_f(tl) || !(tl >= 1.0) || !is_finite_f(tz)
+        || !history_depth_agrees(view, world, tz, params.values.x) {
+        return h;
+    }
+    h.v = tv;
+    h.len = tl;
+    return h;
+}
 
 fn store(p: vec2<u32>, v: vec4<f32>, len: f32, z: f32) {
     textureStore(out_visibility, p, v);
@@ -62,21 +90,31 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if !(w > 0.0) {
             continue;
         }
-        let q = tap.texel;
-        let tv = textureLoad(prev_visibility, q, 0);
-        let tl = textureLoad(prev_length, q, 0).x;
-        let tz = textureLoad(prev_depth, q, 0).x;
-        if !is_finite4(tv) || !is_finite_f(tl) || !(tl >= 1.0) || !is_finite_f(tz)
-            || !history_depth_agrees(view, world, tz, params.values.x) {
-            continue;
+        let h = history_texel(vec2<i32>(tap.texel), size, world);
+        if h.len >= 1.0 {
+            hv += w * h.v;
+            hl += w * h.len;
+            weight += w;
         }
-        hv += w * tv;
-        hl += w * tl;
-        weight += w;
     }
     if weight < REPROJECTION_MIN_WEIGHT {
-        store(pixel, raw, 1.0, z);
-        return;
+        hv = vec4<f32>(0.0);
+        hl = 0.0;
+        weight = 0.0;
+        for (var dy = -1; dy <= 1; dy++) {
+            for (var dx = -1; dx <= 1; dx++) {
+                let h = history_texel(r.nearest + vec2<i32>(dx, dy), size, world);
+                if h.len >= 1.0 {
+                    hv += h.v;
+                    hl += h.len;
+                    weight += 1.0;
+                }
+            }
+        }
+        if weight == 0.0 {
+            store(pixel, raw, 1.0, z);
+            return;
+        }
     }
     hv /= weight;
     hl /= weight;
