@@ -177,8 +177,9 @@ impl HazeTemporal {
 }
 
 pub struct Haze {
-    /// Last frame's parameters, for the temporal filter.
-    last: std::cell::Cell<Option<HazeParams>>,
+    /// The frame index and parameters of the last frame that drew the haze, for the temporal
+    /// filter: only the frame just before counts.
+    last: std::cell::Cell<Option<(u64, HazeParams)>>,
     light: ComputePipeline,
     integrate: ComputePipeline,
     composite: ComputePipeline,
@@ -208,12 +209,15 @@ impl Haze {
         let [gw, gh, gn, _] = params.grid;
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let history = g.history_texture("haze.light", TextureDesc::d3(gw, gh, gn, GRID_FORMAT))?;
-        let last = self.last.replace(Some(*params));
+        let frame = g.frame_index();
+        let last = self.last.replace(Some((frame, *params)));
         let temporal = HazeTemporal::new(
             s,
-            g.frame_index(),
+            frame,
             params,
-            last.as_ref().filter(|_| keep_history && history.valid),
+            last.as_ref()
+                .filter(|(f, _)| keep_history && history.valid && f + 1 == frame)
+                .map(|(_, p)| p),
         );
         let light = history.cur;
         let grid = g.texture("haze.grid", TextureDesc::d3(gw, gh, gn, GRID_FORMAT))?;
