@@ -1,7 +1,8 @@
 //! One frame, top to bottom. Each numbered step is the step of the same number in
 //! ARCHITECTURE.md, except 4 to 6: the clouds (ARCHITECTURE.md's 6) come first, then the
 //! irradiance probes (its 4), whose sun bounce they shadow, then the reflection probes (its
-//! 5), which they shadow and whose sky they cover.
+//! 5), which they shadow and whose sky they cover. Step 12 ends with the haze-lit particles,
+//! which ARCHITECTURE.md does not list: they read the haze's light and go before TAA.
 
 use hikari_scene::{Camera, Sun};
 
