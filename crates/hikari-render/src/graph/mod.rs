@@ -531,11 +531,7 @@ impl<'r> FrameGraph<'r> {
         touched.extend(uses);
         if let PassKind::Raster { colors, depth, .. } = &kind {
             for (t, clear) in colors {
-                // Loaded, it is read (blending) and written.
-                if clear.is_none() {
-                    touched.push((Res::Tex(*t), false));
-                }
-                touched.push((Res::Tex(*t), true));
+                touched.push((Res::Tex(*t), clear.is_some()));
             }
             if let Some((t, clear)) = depth {
                 touched.push((Res::Tex(*t), clear.is_some()));

@@ -3,7 +3,8 @@
 //! on the CPU, composited over the hazed image before TAA.
 //!
 //! * `particles.draw` (`particles.wgsl`): a thread a pixel; each 16 x 16 tile marks the sprites
-//!   whose screen rectangles overlap it, and each pixel meets their planes back to front. A
+//!   whose screen rectangles overlap it and that come nearer than its farthest surface, and
+//!   each pixel meets their planes back to front. A
 //!   haze-lit sprite reads the haze's froxel light (`haze.light`, its `L_i`) there and the
 //!   talk's multiple-scattering scale; a standard one is lit by the sun or moon and the sky's
 //!   mean radiance. Writes `particles.radiance`.
@@ -188,8 +189,8 @@ impl Particles {
     }
 
     /// Composites `sprites` (with their screen rectangles) over `image` (the hazed image) into
-    /// `particles.radiance`; returns `image` itself when no sprite is on screen. `haze`: the haze's parameters and its light (`haze.light`), `None`
-    /// without haze.
+    /// `particles.radiance`; returns `image` itself when no sprite is on screen. `haze`: the
+    /// haze's parameters and its light (`haze.light`), `None` without haze.
     #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
