@@ -7,10 +7,10 @@
 // over about the distance to the occluders). Output:
 // lerp(denoised, input, 0.5 * accumulation speed). CPU twin: gi_denoiser/reference.rs `ao_pass`.
 
-#import hikari::view::{View, world_from_depth}
+#import hikari::view::View
 #import hikari::octahedral::oct_decode
 #import hikari::finite::{is_finite_f, is_finite4}
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3, hit_radius_cap}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3, hit_radius_cap, TangentPlane, tangent_plane, plane_weight}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -59,43 +59,57 @@ fn load_pixel(pixel: vec2<u32>, size: vec2<u32>) -> AoPixel {
     return p;
 }
 
-// Weighted mean AO of the samples around `centre_px` (pixel units) against the surface `s`,
-// starting from the centre sum `acc` and weight `acc_w`.
-fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, radius_cap: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
+// Weighted sum of the AO samples around `centre_px` (pixel units) against the surface `s`,
+// starting from the centre sum `acc_in` and weight `acc_w_in`. `checked`: drop every sample
+// whose texels are not finite (see filter_ao).
+fn gather_ao(centre_px: vec2<f32>, s: Surface, plane: TangentPlane, radius: f32, count: u32, acc_in: f32, acc_w_in: f32, size: vec2<u32>, checked: bool) -> vec2<f32> {
     var acc = acc_in;
     var acc_w = acc_w_in;
-    let radius_m = min(params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale, radius_cap);
-    let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
-    let count = min(
-        max(u32(ceil(f32(params.flags.x) * variance_scale)), min(MIN_SAMPLES, params.flags.x)),
-        params.flags.x
-    );
     for (var i = 0u; i < count; i++) {
         let q = vec2<i32>(floor(centre_px + disk_point(i, params.disk[i / 2u], params.rotation) * radius));
         if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
             continue;
         }
         let depth = textureLoad(depth_tex, q, 0).x;
-        if !(depth > 0.0) || !is_finite_f(depth) {
+        if !(depth > 0.0) || (checked && !is_finite_f(depth)) {
             continue;
         }
-        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params.radius, params.flags);
+        var w = plane_weight(plane, view, q, depth, params.flags);
         if !(w > 0.0) {
             continue;
         }
         let oct = textureLoad(normal_tex, q, 0).xy;
-        if !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
+        if checked && !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
             continue;
         }
         w *= max(dot(s.normal, oct_decode(oct)), 0.0);
         let v = textureLoad(ao_tex, q, 0).x;
-        if !(w > 0.0) || !is_finite_f(v) {
+        if !(w > 0.0) || (checked && !is_finite_f(v)) {
             continue;
         }
         acc += w * v;
         acc_w += w;
     }
     return vec2<f32>(acc, acc_w);
+}
+
+// Weighted mean AO of the samples around `centre_px` against the surface `s`, starting from
+// the centre sum `acc_in` and weight `acc_w_in`. The samples are summed first without finite
+// tests (the loop is bound by arithmetic); only a non-finite sum sums them again dropping
+// each non-finite texel, which with finite texels gives the same sum.
+fn filter_ao(centre_px: vec2<f32>, s: Surface, variance_scale: f32, radius_cap: f32, acc_in: f32, acc_w_in: f32, size: vec2<u32>) -> vec2<f32> {
+    let radius_m = min(params.radius.x * radius_scale_z(s.view_z, params.rotation.w) * variance_scale, radius_cap);
+    let radius = radius_pixels(radius_m, s.view_z, params.radius, params.rotation);
+    let count = min(
+        max(u32(ceil(f32(params.flags.x) * variance_scale)), min(MIN_SAMPLES, params.flags.x)),
+        params.flags.x
+    );
+    let plane = tangent_plane(view, s, params.radius);
+    let sum = gather_ao(centre_px, s, plane, radius, count, acc_in, acc_w_in, size, false);
+    if is_finite4(vec4<f32>(sum, 0.0, 0.0)) {
+        return sum;
+    }
+    return gather_ao(centre_px, s, plane, radius, count, acc_in, acc_w_in, size, true);
 }
 
 fn combine(p: AoPixel, acc: vec2<f32>) -> f32 {

@@ -107,11 +107,48 @@ fn combine_weight(history_length: f32, scales: vec4<f32>) -> f32 {
 // that both sides of a curved surface count): linear falloff or a step.
 fn geometry_weight(centre: Surface, p: vec3<f32>, radius: vec4<f32>, flags: vec4<u32>) -> f32 {
     let d = abs(dot(centre.normal, p - centre.position));
-    let tolerance = max(radius.w * centre.view_z, 1e-6);
+    return plane_falloff(d, max(radius.w * centre.view_z, 1e-6), flags);
+}
+
+// The geometry weight of a distance `d` to the tangent plane: linear falloff to 0 at
+// `tolerance`, or a step there (bit 0 of flags.z).
+fn plane_falloff(d: f32, tolerance: f32, flags: vec4<u32>) -> f32 {
     if (flags.z & 1u) != 0u {
         return select(0.0, 1.0, d < tolerance);
     }
     return max(1.0 - d / tolerance, 0.0);
+}
+
+// The centre's tangent plane in the form the sample loops use. A sample's world position is
+// (R0.x, R1.x, R2.x) / (R3.x), with Ri the rows of the inverse view-projection and
+// x = (ndc.x, ndc.y, depth, 1), so its signed distance to the plane is
+// (n.x R0 + n.y R1 + n.z R2 - (n.c) R3).x / (R3.x): two dot products and a division a sample
+// instead of the matrix product and the subtraction (the loops are bound by arithmetic).
+struct TangentPlane {
+    numerator: vec4<f32>,
+    denominator: vec4<f32>,
+    // Distance in metres at which the weight reaches 0.
+    tolerance: f32,
+}
+
+fn tangent_plane(view: View, centre: Surface, radius: vec4<f32>) -> TangentPlane {
+    let rows = transpose(view.inv_view_proj);
+    let n = centre.normal;
+    return TangentPlane(
+        n.x * rows[0] + n.y * rows[1] + n.z * rows[2] - dot(n, centre.position) * rows[3],
+        rows[3],
+        max(radius.w * centre.view_z, 1e-6)
+    );
+}
+
+// geometry_weight of the sample at pixel `q` with reverse-Z depth `depth`. A non-finite depth
+// gives 0 or NaN, which every caller's `w > 0` test drops.
+fn plane_weight(t: TangentPlane, view: View, q: vec2<i32>, depth: f32, flags: vec4<u32>) -> f32 {
+    let uv = (vec2<f32>(q) + 0.5) * view.viewport.zw;
+    let x = vec4<f32>(uv.x * 2.0 - 1.0, 1.0 - uv.y * 2.0, depth, 1.0);
+    // The distance over the tolerance, with one division.
+    let relative = abs(dot(t.numerator, x)) / (t.tolerance * abs(dot(t.denominator, x)));
+    return plane_falloff(relative, 1.0, flags);
 }
 
 // Poisson point `i` of the packed disk entry `e` (= disk[i / 2]), rotated by this frame's

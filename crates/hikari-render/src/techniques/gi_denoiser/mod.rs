@@ -109,8 +109,20 @@ impl GiDenoiser {
         }
         Ok(Self {
             hit_mean: ComputePipeline::new(ctx, lib, "gi_denoiser/hit_mean.wgsl", "main", &[])?,
-            spatial: ComputePipeline::new(ctx, lib, "gi_denoiser/spatial.wgsl", "main", &[])?,
-            ao: ComputePipeline::new(ctx, lib, "gi_denoiser/ao.wgsl", "main", &[])?,
+            // SAFETY: spatial.wgsl indexes its 32-entry workgroup disk with i < flags.x, which
+            // `GiDenoiserParams::gi_pass` holds to the 32 points of `gi_disk`, and the uniform
+            // disk (32 entries) with local / 2 < 16; its sample loop steps by at least 1
+            // (flags.w = MAX_STEP), so it ends; every texel it loads is tested to lie inside the
+            // image first; it has no integer division by a variable; the workgroup disk is
+            // written before the barrier that precedes every read.
+            spatial: unsafe {
+                ComputePipeline::new_unchecked(ctx, lib, "gi_denoiser/spatial.wgsl", "main", &[])?
+            },
+            // SAFETY: ao.wgsl indexes the uniform disk (MAX_DISK_POINTS / 2 entries) with
+            // i / 2 for i < flags.x, which `params::common` holds to MAX_DISK_POINTS; its loops
+            // count up to fixed or uniform bounds; every texel it loads is tested to lie inside
+            // the image first; it has no integer division by a variable and no workgroup memory.
+            ao: unsafe { ComputePipeline::new_unchecked(ctx, lib, "gi_denoiser/ao.wgsl", "main", &[])? },
             gi_disk: params::poisson_points(params::GI_DISK_POINTS, 0x6d65_7472_6f31)?,
             ao_disk: params::poisson_points(params::MAX_DISK_POINTS, 0x6d65_7472_6f32)?,
         })

@@ -117,7 +117,8 @@ fn common(
             0.0,
         ],
         flags: [
-            samples.min(disk.len() as u32),
+            // The uniform holds MAX_DISK_POINTS; the shaders index it below flags[0].
+            samples.min(disk.len().min(MAX_DISK_POINTS) as u32),
             0,
             u32::from(s.step_falloff) | if s.recurrent { FLAG_RECURRENT } else { 0 },
             MAX_STEP,
@@ -140,6 +141,8 @@ impl GiDenoiserParams {
             GiPass::Second => (s.pass2_radius_m, 1),
         };
         let mut p = common(s, view, frame_index, radius, s.samples, disk);
+        // spatial.wgsl holds at most this many points in workgroup memory.
+        p.flags[0] = p.flags[0].min(GI_DISK_POINTS as u32);
         p.flags[1] = normal;
         p.scales[3] = s.gi_hit_distance_scale;
         p

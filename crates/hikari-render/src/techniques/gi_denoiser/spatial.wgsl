@@ -3,13 +3,16 @@
 // step -> every Nth of up to 32 Poisson-disk samples, rotated once a frame; weights: geometry
 // (distance to the tangent plane), and in the second pass the normal (a plain dot product).
 // Y SH and CoCg share the weights. Output: lerp(denoised, input, 0.5 * accumulation speed).
-// A non-finite input texel is dropped where it is read, so it never reaches the output.
+// A non-finite input texel is dropped where it is read, so it never reaches the output: the
+// samples are summed first without finite tests (the loop is bound by arithmetic, and the
+// tests were a third of it), and only a pixel whose sum came out non-finite sums them again,
+// dropping each non-finite texel; with finite texels both give the same sum.
 // CPU twin: gi_denoiser/reference.rs `spatial_pass`.
 
-#import hikari::view::{View, world_from_depth}
+#import hikari::view::View
 #import hikari::octahedral::oct_decode
 #import hikari::finite::{is_finite_f, is_finite4}
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, geometry_weight, disk_point, moments_3x3, hit_radius_cap}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, disk_point, moments_3x3, hit_radius_cap, TangentPlane, tangent_plane, plane_weight}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -24,8 +27,63 @@
 // The 5x5 harmonic mean hit distance in metres (hit_mean.wgsl; 0: no hit).
 @group(0) @binding(10) var hit_mean_tex: texture_2d<f32>;
 
-@compute @workgroup_size(8, 8, 1)
-fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+// This frame's Poisson points, rotated, for the workgroup: the lanes of a warp take
+// different steps through them, and a uniform buffer indexed differently by each lane is
+// read one address at a time.
+var<workgroup> disk: array<vec2<f32>, 32>;
+
+struct Sums {
+    y: vec4<f32>,
+    c: vec2<f32>,
+    w: f32,
+}
+
+// The weighted sum of the centre's samples, starting from the centre's own. `checked`: drop
+// every sample whose texels are not finite (the GPU then tests each texel it reads).
+fn gather(s: Surface, plane: TangentPlane, centre_px: vec2<f32>, radius: f32, step: u32, centre: Sums, size: vec2<u32>, checked: bool) -> Sums {
+    var sum = centre;
+    for (var i = 0u; i < params.flags.x; i += step) {
+        let q = vec2<i32>(floor(centre_px + disk[i] * radius));
+        if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+            continue;
+        }
+        let depth = textureLoad(depth_tex, q, 0).x;
+        if !(depth > 0.0) || (checked && !is_finite_f(depth)) {
+            continue;
+        }
+        var w = plane_weight(plane, view, q, depth, params.flags);
+        if !(w > 0.0) {
+            continue;
+        }
+        if params.flags.y != 0u {
+            let oct = textureLoad(normal_tex, q, 0).xy;
+            if checked && !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
+                continue;
+            }
+            w *= max(dot(s.normal, oct_decode(oct)), 0.0);
+            if !(w > 0.0) {
+                continue;
+            }
+        }
+        // The heavy data, only for samples that count.
+        let y = textureLoad(in_y, q, 0);
+        let c = textureLoad(in_cocg, q, 0).xy;
+        if checked && (!is_finite4(y) || !is_finite4(vec4<f32>(c, 0.0, 0.0))) {
+            continue;
+        }
+        sum.y += w * y;
+        sum.c += w * c;
+        sum.w += w;
+    }
+    return sum;
+}
+
+@compute @workgroup_size(16, 8, 1)
+fn main(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    if local < 32u {
+        disk[local] = disk_point(local, params.disk[local / 2u], params.rotation);
+    }
+    workgroupBarrier();
     let size = textureDimensions(out_y);
     if any(id.xy >= size) {
         return;
@@ -65,49 +123,19 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // Small radius, bigger step: fewer taps where the kernel covers fewer pixels.
     let step = min(max(u32(min(params.radius.z / max(radius, 1e-3), 64.0)), 1u), params.flags.w);
 
-    var acc_y = centre_y;
-    var acc_c = centre_c;
-    var acc_w = select(0.0, 1.0, centre_ok);
+    let plane = tangent_plane(view, s, params.radius);
+    let centre = Sums(centre_y, centre_c, select(0.0, 1.0, centre_ok));
     let centre_px = vec2<f32>(pixel) + 0.5;
-    for (var i = 0u; i < params.flags.x; i += step) {
-        let q = vec2<i32>(floor(centre_px + disk_point(i, params.disk[i / 2u], params.rotation) * radius));
-        if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
-            continue;
-        }
-        let depth = textureLoad(depth_tex, q, 0).x;
-        if !(depth > 0.0) || !is_finite_f(depth) {
-            continue;
-        }
-        var w = geometry_weight(s, world_from_depth(view, vec2<u32>(q), depth), params.radius, params.flags);
-        if !(w > 0.0) {
-            continue;
-        }
-        if params.flags.y != 0u {
-            let oct = textureLoad(normal_tex, q, 0).xy;
-            if !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
-                continue;
-            }
-            w *= max(dot(s.normal, oct_decode(oct)), 0.0);
-            if !(w > 0.0) {
-                continue;
-            }
-        }
-        // The heavy data, only for samples that count.
-        let y = textureLoad(in_y, q, 0);
-        let c = textureLoad(in_cocg, q, 0).xy;
-        if !is_finite4(y) || !is_finite4(vec4<f32>(c, 0.0, 0.0)) {
-            continue;
-        }
-        acc_y += w * y;
-        acc_c += w * c;
-        acc_w += w;
+    var sum = gather(s, plane, centre_px, radius, step, centre, size, false);
+    if !is_finite4(sum.y) || !is_finite4(vec4<f32>(sum.c, sum.w, 0.0)) {
+        sum = gather(s, plane, centre_px, radius, step, centre, size, true);
     }
     var out_sh = centre_y;
     var out_c = centre_c;
-    if acc_w > 0.0 {
+    if sum.w > 0.0 {
         let k = select(0.0, combine_weight(history, params.scales), centre_ok);
-        out_sh = mix(acc_y / acc_w, centre_y, k);
-        out_c = mix(acc_c / acc_w, centre_c, k);
+        out_sh = mix(sum.y / sum.w, centre_y, k);
+        out_c = mix(sum.c / sum.w, centre_c, k);
     }
     textureStore(out_y, pixel, out_sh);
     textureStore(out_cocg, pixel, vec4<f32>(out_c, 0.0, 0.0));
