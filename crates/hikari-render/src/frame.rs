@@ -498,6 +498,7 @@ pub fn record<'r>(
             gbuffer: &gbuffer,
             sky: &sky,
             shadows: &shadows,
+            clouds: clouds.lookup,
             lights: scene.lights,
             view: &view,
             params: &params,

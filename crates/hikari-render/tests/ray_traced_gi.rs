@@ -5,7 +5,7 @@ mod common;
 
 use glam::{Mat4, Vec2, Vec3};
 use hikari_math::sh::basis::{C0, C1};
-use hikari_math::sh::ycocg::{ShL1YCoCg, rgb_to_ycocg};
+use hikari_math::sh::ycocg::{ShL1YCoCg, rgb_to_ycocg, ycocg_to_rgb};
 use hikari_render::graph::{GraphRuntime, ImageRgba32};
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::direct_lighting::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
@@ -2331,4 +2331,185 @@ fn lamp_shells_do_not_add_their_emission_at_hits() {
             assert_eq!(table[2 * k + 1][3], 0.0, "instance {k}, skipped as {why}");
         }
     }
+}
+
+/// The clouds in the GI: a miss sees them over the sky as the deferred lighting draws them, and
+/// the sun at a hit is shadowed by them. Three frames of the same rays: A with clouds, B without,
+/// C without clouds or the GI's sun. The encoding is linear in the radiance and
+/// `clouds_over_sky` is affine in the sky behind, so per pixel, against the clouds' twin with
+/// the frame's own map: a miss's sample is t · B + encode(clouds' light), with t their
+/// transmittance towards the ray; a hit's is C + (B − C) · `cloud_shadow_at` the hit. A wall
+/// facing the sun beside the floor gives sunlit hits; the clouds are moved until a cloud's edge
+/// lies over it. Tolerance: three f16 samples, 2^-8 of the larger luminance scale, with at most
+/// 1 % of pixels beyond (a hit point 1 mm off the surface, a map texel's rounding). The twin
+/// takes the shade pass's limits: 65000 nits a channel, and f16's largest value in storage.
+#[test]
+fn misses_and_hits_see_the_clouds_like_the_twin() {
+    use hikari_render::techniques::clouds::CloudParams;
+    use hikari_render::techniques::clouds::reference as clouds;
+    use hikari_render::techniques::sky;
+    let sky_settings = hikari_render::settings::SkySettings {
+        time: "10:00".into(),
+        ..Default::default()
+    };
+    let sun = sky::lights::directional_light(&sky_settings)
+        .unwrap()
+        .expect("the sun is up at 10:00");
+    let to_sun = Vec3::new(sun.direction.x, 0.0, sun.direction.z).normalize();
+    let mut scene = floor_scene();
+    // A 6 m wall 3 m from the origin away from the sun, its lit face towards the floor.
+    scene.instances.push(Instance {
+        mesh: 0,
+        material: 0,
+        transform: Mat4::from_translation(-3.0 * to_sun + Vec3::new(0.0, 3.0, 0.0))
+            * Mat4::from_quat(glam::Quat::from_rotation_arc(Vec3::Y, to_sun))
+            * Mat4::from_scale(Vec3::splat(6.0 / 400.0)),
+    });
+    let clouds_settings = |offset: f32| hikari_render::settings::CloudsSettings {
+        enabled: true,
+        coverage: 0.45,
+        feature_m: 1500.0,
+        offset_x_m: offset,
+        map_size: 64,
+        steps: 16,
+        light_steps: 3,
+        ..Default::default()
+    };
+    // The frame's clock: 10:00 (36 000 s), the wind's offset included.
+    let params_of = |c: &hikari_render::settings::CloudsSettings| {
+        CloudParams::new(c, "clear", Some(&sun), 36_000.0, true)
+    };
+    let wall = -3.0 * to_sun + Vec3::new(0.0, 1.5, 0.0);
+    let offset = (0..400)
+        .map(|k| k as f32 * 37.0)
+        .find(|&o| {
+            let t = clouds::cloud_shadow_at(&params_of(&clouds_settings(o)), wall);
+            t > 0.2 && t < 0.8
+        })
+        .expect("some offset puts a cloud's edge over the wall");
+    let (w, h) = (64u32, 48u32);
+    let frame = |clouds_on: bool, gi_sun: bool| {
+        let mut s = twin_settings(&scene, w, h);
+        s.settings.sky = sky_settings.clone();
+        s.settings.sky.enabled = true;
+        s.settings.sky.table_quality = 0;
+        s.settings.area_lights.enabled = false;
+        s.settings.clouds = clouds_settings(offset);
+        s.settings.clouds.enabled = clouds_on;
+        s.settings.ray_traced_gi.sun = gi_sun;
+        s.sun = Some(sun.clone());
+        s
+    };
+    struct Out {
+        y: ImageRgba32,
+        cocg: ImageRgba32,
+        distance: ImageRgba32,
+        depth: Vec<[f32; 4]>,
+        normal: Vec<[f32; 4]>,
+        map: Vec<glam::Vec4>,
+        mean_sky: Vec3,
+    }
+    let run = |s: &FrameSettings| {
+        let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
+        let mut picked = None;
+        let mut r = renderer
+            .render_reading(s, |o| {
+                let f = o.ray_traced_gi.expect("the technique is on");
+                picked = Some((f, o.clouds.map));
+                vec![
+                    f.gi_y.into(),
+                    f.gi_cocg.into(),
+                    f.hit_distance.into(),
+                    o.gbuffer.depth.into(),
+                    o.gbuffer.normal.into(),
+                    o.clouds.map.into(),
+                    o.sky.sh.into(),
+                ]
+            })
+            .unwrap();
+        let (f, map) = picked.unwrap();
+        let sh = bytemuck::cast_slice::<u8, [f32; 4]>(r.buffer("sky.sh").unwrap()).to_vec();
+        Out {
+            y: r.take_image_of(f.gi_y).unwrap(),
+            cocg: r.take_image_of(f.gi_cocg).unwrap(),
+            distance: r.take_image_of(f.hit_distance).unwrap(),
+            depth: r.image("gbuffer.depth").unwrap().rgba.clone(),
+            normal: r.image("gbuffer.normal").unwrap().rgba.clone(),
+            map: r
+                .take_image_of(map)
+                .unwrap()
+                .rgba
+                .iter()
+                .map(|v| glam::Vec4::from_array(*v))
+                .collect(),
+            // The sky's mean radiance: band 0 of its SH times Y00.
+            mean_sky: Vec3::from_slice(&sh[9][..3]) * 0.282_094_8,
+        }
+    };
+    let s = frame(true, true);
+    let a = run(&s);
+    let b = run(&frame(false, true));
+    let c = run(&frame(false, false));
+    let params = params_of(&s.settings.clouds);
+    let sun_lux = sun.color * sun.illuminance_lux;
+    let view = View::new(&s.camera, w, h);
+    let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
+    let (mut misses, mut clouded, mut hits, mut shaded, mut off) = (0, 0, 0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let i = (y * w + x) as usize;
+            let d = a.depth[i][0];
+            assert!(d > 0.0, "pixel ({x}, {y}) sees the floor or the wall");
+            let n = reference::oct_decode(Vec2::new(a.normal[i][0], a.normal[i][1]));
+            let world = reference::world_from_depth(inv_vp, [w, h], [x, y], d);
+            let o = reference::ray_origin(world, n, s.camera.position);
+            let (dir, weight) = reference::ray([x, y], 0, n);
+            let (ga, gb, gc) = (
+                sample_at(&a.y, &a.cocg, i),
+                sample_at(&b.y, &b.cocg, i),
+                sample_at(&c.y, &c.cocg, i),
+            );
+            let t_hit = a.distance.rgba[i][0];
+            let want: [f32; 6] = if t_hit > 0.0 {
+                let t = clouds::cloud_shadow_at(&params, o + dir * t_hit);
+                hits += 1;
+                shaded += (t < 0.9 && gb[0] > 1.2 * gc[0]) as u32;
+                std::array::from_fn(|k| (gc[k] + (gb[k] - gc[k]) * t).clamp(-65504.0, 65504.0))
+            } else {
+                // The sky behind, from B's sample: c0 = C0 Y w, (Co, Cg) w.
+                let back = ycocg_to_rgb(Vec3::new(
+                    gb[0] / (C0 as f32 * weight),
+                    gb[4] / weight,
+                    gb[5] / weight,
+                ));
+                let l = clouds::clouds_over_sky(&params, &a.map, dir, back, sun_lux, a.mean_sky);
+                misses += 1;
+                clouded += ((l - back).length() > 0.1 * back.length()) as u32;
+                // The shade pass's per-channel limit (f16 storage), which bright cloud edges
+                // near the sun reach.
+                let l = l.min(Vec3::splat(65000.0));
+                reference::to_floats(&reference::encode_sample(l, dir, weight))
+                    .map(|v| v.clamp(-65504.0, 65504.0))
+            };
+            let scale = ga[0].abs().max(gb[0].abs()) + 1e-6;
+            if (0..6).any(|k| (ga[k] - want[k]).abs() > scale * 2f32.powi(-8)) {
+                off += 1;
+                if off <= 5 {
+                    eprintln!("pixel ({x}, {y}) (hit {t_hit}): GPU {ga:?}, twin {want:?}");
+                }
+            }
+        }
+    }
+    eprintln!(
+        "{misses} misses ({clouded} under cloud), {hits} hits ({shaded} sunlit under cloud), {off} off"
+    );
+    assert!(
+        clouded > 100 && misses - clouded > 100,
+        "{clouded} of {misses} misses under cloud"
+    );
+    assert!(shaded > 20, "{shaded} of {hits} sunlit hits under cloud");
+    assert!(
+        off <= (w * h) as usize / 100,
+        "{off} pixels differ from the twin"
+    );
 }

@@ -122,7 +122,9 @@ impl GiDenoiser {
             // i / 2 for i < flags.x, which `params::common` holds to MAX_DISK_POINTS; its loops
             // count up to fixed or uniform bounds; every texel it loads is tested to lie inside
             // the image first; it has no integer division by a variable and no workgroup memory.
-            ao: unsafe { ComputePipeline::new_unchecked(ctx, lib, "gi_denoiser/ao.wgsl", "main", &[])? },
+            ao: unsafe {
+                ComputePipeline::new_unchecked(ctx, lib, "gi_denoiser/ao.wgsl", "main", &[])?
+            },
             gi_disk: params::poisson_points(params::GI_DISK_POINTS, 0x6d65_7472_6f31)?,
             ao_disk: params::poisson_points(params::MAX_DISK_POINTS, 0x6d65_7472_6f32)?,
         })

@@ -446,6 +446,9 @@ pub struct RtGiInputs<'a> {
     pub gbuffer: &'a GBuffer,
     pub sky: &'a SkyFrame,
     pub shadows: &'a SunShadowMaps,
+    /// The clouds' binding set (`CloudsFrame::lookup`): misses see them over the sky, and
+    /// they shadow the sun at hits.
+    pub clouds: BindingSet,
     /// `SceneInFrame::lights`.
     pub lights: Buf,
     pub view: &'a View,
@@ -660,6 +663,7 @@ impl RayTracedGi {
             .set(inputs.sky.lookup)
             .set(inputs.sky.ambient)
             .set(inputs.shadows.lookup)
+            .set(inputs.clouds)
             .dispatch_threads(&self.shade, [w, h, 1])?;
         Ok(RtGiRaw {
             y: raw_y,

@@ -1,11 +1,12 @@
 // Lights the GI rays' hits (Metro Exodus's "deferred lighting of hits"): regenerates each
 // pixel's ray from its pixel and frame, reads the hit word, and takes the radiance arriving
 // along the ray. Where the hit was visible last frame: last frame's lit image there. On a
-// miss: the sky in that direction (no sun or moon disk: direct light is the deferred pass's).
+// miss: the sky in that direction (no sun or moon disk: direct light is the deferred pass's),
+// seen through the clouds as the deferred lighting draws them.
 // On a hit: the hit's albedo / π times the irradiance there, on a surface facing the hit's
 // normal (`hit_normals`: the triangle's for BVH hits, the G-buffer's for the pre-trace's,
 // turned to face the ray; -dir without one), from the sun or moon (its shadow maps inside a
-// cascade, else a shadow ray), the sky's ambient light, the point and spot lights and the area
+// cascade, else a shadow ray, and the clouds' shadow), the sky's ambient light, the point and spot lights and the area
 // lights (in closed form), each kind shadowed by one ray to one light picked by its
 // unshadowed light; plus the emission of the hit's instance (its material's, textures
 // averaged) unless it is an area light, whose direct light the area-light pass gives every
@@ -24,7 +25,8 @@
 #import hikari::bvh::{Ray, bvh_occluded}
 #import hikari::sky::sky_background_no_disks
 #import hikari::sun_shadows::{sun_visibility, shadow}
-#import hikari::sky_ambient::sky_ambient_irradiance
+#import hikari::sky_ambient::{sky_ambient_irradiance, sky_ambient_eval}
+#import hikari::clouds::{clouds_over_sky, cloud_shadow}
 #import hikari::area_polygon::{AreaLightGpu, AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, area_light_reach, area_triangle_vector_irradiance}
 #import hikari::finite::is_finite4
 #import hikari::ray_traced_gi::{RtGiParams, RTGI_SUN, RTGI_SKY, RTGI_SKY_AMBIENT, RTGI_SHADOW_MAPS, RTGI_REUSE_LIT, RTGI_PLACEHOLDER_SKY, RTGI_PUNCTUAL, RTGI_PUNCTUAL_SHADOWS, RTGI_AREA, RTGI_PI, RTGI_HIT_NOT_TRACED, RTGI_HIT_UNRESOLVED, rtgi_ray, rtgi_basis, rtgi_ray_origin, rtgi_is_hit, rtgi_hit_distance, rtgi_hit_albedo_of, rtgi_random, rtgi_unpack_normal, RTGI_NO_NORMAL}
@@ -92,7 +94,11 @@ fn sky_placeholder(dir: vec3<f32>) -> vec3<f32> {
 fn miss_radiance(dir: vec3<f32>) -> vec3<f32> {
     let flags = params.config.y;
     if (flags & RTGI_SKY) != 0u {
-        return sky_background_no_disks(dir);
+        // The clouds' light as the deferred lighting draws them over the sky: the sun's
+        // illuminance and the sky's mean radiance (band 0 of its SH).
+        let sun_lux = select(vec3<f32>(0.0), params.sun_color.rgb * params.sun.w, (flags & RTGI_SUN) != 0u);
+        let mean_sky = sky_ambient_eval(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0));
+        return clouds_over_sky(dir, sky_background_no_disks(dir), sun_lux, mean_sky);
     }
     if (flags & RTGI_PLACEHOLDER_SKY) != 0u {
         return sky_placeholder(dir);
@@ -354,7 +360,7 @@ fn irradiance(x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let l = params.sun.xyz;
     let c = dot(n, l);
     if (flags & RTGI_SUN) != 0u && params.sun.w > 0.0 && c > 0.0 {
-        e += params.sun_color.rgb * (params.sun.w * c * sun_visible(x, n));
+        e += params.sun_color.rgb * (params.sun.w * c * sun_visible(x, n) * cloud_shadow(x));
     }
     if (flags & RTGI_SKY_AMBIENT) != 0u {
         if (flags & RTGI_SKY) != 0u {
