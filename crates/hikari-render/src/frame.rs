@@ -394,6 +394,7 @@ pub fn record<'r>(
                 .map_or(0.0, |t| f64::from(t.seconds_of_day())),
             sky.enabled && s.settings.sky.sky,
         ),
+        s.camera.position,
     )?;
 
     // 5. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon,

@@ -59,7 +59,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             clouds::CloudParams,
             "clouds/march.wgsl",
-            [layer, shape, offset, sun, phase, march, slice]
+            [layer, shape, offset, sun, phase, march, slice, shadow]
         ),
         gpu_layout!(
             haze::HazeParams,

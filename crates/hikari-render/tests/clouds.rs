@@ -149,7 +149,7 @@ fn gpu_map(ctx: &hikari_render::GpuContext, s: &CloudsSettings, p: CloudParams) 
     let clouds = Clouds::new(ctx, &mut lib).unwrap();
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(ctx);
-    let f = clouds.record(&mut g, s, p).unwrap();
+    let f = clouds.record(&mut g, s, p, Vec3::ZERO).unwrap();
     g.readback(f.map);
     let r = g.execute().unwrap();
     r.image("clouds.map")
@@ -222,7 +222,9 @@ fn gpu_march_matches_its_cpu_twin() {
 /// The deferred lighting's use of `hikari::clouds`: a frame with clouds against the same frame
 /// without, through the twin. Sky pixels: `clouds_over_sky` of the clouds-off sky with the
 /// frame's map and the sky's mean radiance from its SH. Sunlit ground: the sun's share scaled by
-/// the twin's `cloud_shadow_at` (the illuminance minus what the frame without sun receives).
+/// the twin's `cloud_shadow` (the illuminance minus what the frame without sun receives),
+/// through a 2 x 2 shadow map whose bilinear lookup differs from the march at every such
+/// pixel, so that a frame that marched instead, or looked the map up at the wrong place, fails.
 #[test]
 fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
     use hikari_render::techniques::sky;
@@ -266,6 +268,10 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
         s.settings.clouds.map_size = 64;
         s.settings.clouds.steps = 16;
         s.settings.clouds.light_steps = 3;
+        // The coarsest shadow map (2 x 2 texels 2 km apart), so that its bilinear lookup
+        // differs visibly from the march: the frame must take the map's value where the path
+        // enters it.
+        s.settings.clouds.shadow_map_size = 2;
         s.settings.direct_lighting.sun = sun_on;
         s.sun = sky::lights::directional_light(&s.settings.sky).unwrap();
         // Raise the view so that it holds the sky over the boxes and their ground.
@@ -301,7 +307,14 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
     let (lit_off, lux_off, _, _, _) = run(&frame(false, true));
     let (_, lux_dark, _, _, _) = run(&frame(true, false));
     let sun = on.sun.clone().unwrap();
-    let params = CloudParams::new(&on.settings.clouds, "clear", Some(&sun), 36_000.0, true);
+    let params = CloudParams::new(&on.settings.clouds, "clear", Some(&sun), 36_000.0, true)
+        .with_shadow_map(
+            on.settings.clouds.shadow_map_size,
+            on.settings.clouds.shadow_map_extent_m,
+            on.camera.position,
+        );
+    let shadow_map = twin::shadow_map(&params);
+    let mut map_matters = 0;
     let map: Vec<Vec4> = map.rgba.iter().map(|v| Vec4::from_array(*v)).collect();
     // The sky's mean radiance: band 0 of the deringed SH times Y00.
     let mean = Vec3::from_slice(&sh[9][..3]) * 0.282_094_8;
@@ -333,7 +346,10 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
                 let sun_clouded = lux_on.rgba[i][0] - lux_dark.rgba[i][0];
                 if sun_on > 1000.0 {
                     let world = gbuffer::reference::world_from_depth(inv, [x, y], [64, 48], d);
-                    let want = sun_on * twin::cloud_shadow_at(&params, world);
+                    let t = twin::cloud_shadow(&params, &shadow_map, world);
+                    map_matters +=
+                        ((t - twin::cloud_shadow_at(&params, world)).abs() > 0.05) as u32;
+                    let want = sun_on * t;
                     ground += 1;
                     if want < 0.9 * sun_on {
                         shaded += 1;
@@ -346,7 +362,14 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
             }
         }
     }
-    eprintln!("{sky_px} sky pixels ({clouded} clouded), {ground} sunlit ({shaded} under cloud)");
+    eprintln!(
+        "{sky_px} sky pixels ({clouded} clouded), {ground} sunlit ({shaded} under cloud, \
+         {map_matters} where the map's lookup and the march differ by 0.05)"
+    );
+    assert!(
+        map_matters > 20,
+        "{map_matters}: the map's lookup cannot be told from the march"
+    );
     assert!(
         clouded > 20 && sky_px - clouded > 20,
         "{clouded} of {sky_px} sky pixels clouded"
@@ -383,4 +406,108 @@ fn the_wind_carries_the_clouds() {
         }
     }
     assert!(differs > 20, "the clouds moved: {differs} points changed");
+}
+
+/// The shadow map: on the GPU against the twin's `cloud_shadow_at` at each texel's centre on
+/// the layer's base (a 32² map over 8 km, small features); its lookup against the march at
+/// points below the layer, at the default 4 m texels: within 2e-3 where the path enters the
+/// map (bilinear between exact texel centres), the march itself outside it or above the base.
+/// The map lies where the camera's path to the sun enters the layer, snapped to whole texels.
+#[test]
+fn shadow_map_and_its_lookup_agree_with_the_march() {
+    let s = CloudsSettings {
+        coverage: 0.6,
+        feature_m: 3000.0,
+        map_size: 16,
+        shadow_map_size: 32,
+        shadow_map_extent_m: 8000.0,
+        ..CloudsSettings::default()
+    };
+    let camera = Vec3::new(120.0, 30.0, -40.0);
+    let p = CloudParams::new(&s, "clear", Some(&sun()), 0.0, true).with_shadow_map(
+        s.shadow_map_size,
+        s.shadow_map_extent_m,
+        camera,
+    );
+    let texel = p.shadow[2];
+    assert_eq!((texel, p.shadow[3]), (250.0, 32.0));
+    let entry = hikari_render::techniques::clouds::shadow_entry(&p, camera).unwrap();
+    let centre = Vec2::new(p.shadow[0], p.shadow[1]) + 4000.0;
+    assert!(
+        (centre - entry).abs().max_element() <= 0.5 * texel,
+        "{centre} {entry}"
+    );
+    assert_eq!(p.shadow[0] % texel, 0.0, "snapped to whole texels");
+    let want = twin::shadow_map(&p);
+    assert!(
+        want.iter().any(|&t| t < 0.5) && want.iter().any(|&t| t > 0.9),
+        "the map holds clouds and gaps"
+    );
+
+    if let Some(ctx) = common::gpu() {
+        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+        let clouds = Clouds::new(&ctx, &mut lib).unwrap();
+        let mut rt = GraphRuntime::new();
+        let mut g = rt.begin_frame(&ctx);
+        let f = clouds.record(&mut g, &s, p, camera).unwrap();
+        assert_eq!(f.params.shadow, p.shadow);
+        g.readback(f.shadow_map);
+        let r = g.execute().unwrap();
+        let got = &r.image("clouds.shadow_map").unwrap().rgba;
+        assert_eq!(got.len(), want.len());
+        let off = got
+            .iter()
+            .zip(&want)
+            .filter(|(g, w)| (g[0] - **w).abs() > 0.01 * w.max(0.01))
+            .count();
+        assert!(
+            off <= want.len() / 100,
+            "{off} of {} texels off",
+            want.len()
+        );
+    }
+
+    // The lookup at the default resolution, against the march.
+    let d = CloudsSettings {
+        coverage: 0.6,
+        feature_m: 3000.0,
+        ..CloudsSettings::default()
+    };
+    let p = CloudParams::new(&d, "clear", Some(&sun()), 0.0, true).with_shadow_map(
+        d.shadow_map_size,
+        d.shadow_map_extent_m,
+        Vec3::ZERO,
+    );
+    let map = twin::shadow_map(&p);
+    let mut rng = 0x2545_f491_u32;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 17;
+        rng ^= rng << 5;
+        rng as f32 / u32::MAX as f32
+    };
+    let (mut inside, mut worst) = (0, 0.0f32);
+    for _ in 0..400 {
+        let pos = Vec3::new(
+            (next() - 0.5) * 3000.0,
+            next() * 200.0,
+            (next() - 0.5) * 3000.0,
+        );
+        let marched = twin::cloud_shadow_at(&p, pos);
+        let looked_up = twin::cloud_shadow(&p, &map, pos);
+        worst = worst.max((looked_up - marched).abs());
+        inside += 1;
+    }
+    assert!(worst < 2e-3, "the map's lookup is {worst} off the march");
+    assert_eq!(inside, 400);
+    // Outside the map, and above the base: the march.
+    for pos in [
+        Vec3::new(1.0e5, 10.0, 0.0),
+        Vec3::new(0.0, d.bottom_m + 10.0, 0.0),
+    ] {
+        assert_eq!(
+            twin::cloud_shadow(&p, &map, pos),
+            twin::cloud_shadow_at(&p, pos)
+        );
+    }
 }

@@ -21,6 +21,9 @@ struct CloudParams {
     march: vec4<u32>,
     // Time slices, this frame's slice, 0, 0.
     slice: vec4<u32>,
+    // The shadow map: xy its corner on the layer's base (world x, z, metres), z metres a
+    // texel, w texels a side (0: no map; cloud_shadow_at everywhere).
+    shadow: vec4<f32>,
 }
 
 const CLOUDS_ON: u32 = 1u;

@@ -6,6 +6,9 @@
 //! redrawn a row in `time_slices` per frame, whole when its parameters change.
 //!
 //! * `clouds.march`: the map (`march.wgsl`);
+//! * `clouds.shadow_map`: the sun's transmittance through the layer on a square of its base
+//!   around the camera (`shadow_map.wgsl`), which `cloud_shadow` reads for every point whose
+//!   path to the sun enters the layer there;
 //! * `hikari::clouds` (binding set `clouds`): the clouds over the sky, drawn by the deferred
 //!   lighting where depth is 0, and their shadow on the sun's light, in the deferred lighting
 //!   and the haze.
@@ -37,6 +40,9 @@ pub const CLOUDS_MULTIPLE: u32 = 8;
 pub const EARTH_RADIUS_M: f32 = 6_360_000.0;
 
 pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The shadow map's transmittance, read with four loads and a bilinear blend in f32 (as the
+/// twin; R32Float is not filterable everywhere).
+pub const SHADOW_MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// The clouds' parameters (`density.wgsl` documents each field).
 #[repr(C)]
@@ -49,6 +55,7 @@ pub struct CloudParams {
     pub phase: [f32; 4],
     pub march: [u32; 4],
     pub slice: [u32; 4],
+    pub shadow: [f32; 4],
 }
 
 impl CloudParams {
@@ -90,8 +97,41 @@ impl CloudParams {
             phase: [s.forward_g, s.backward_g, s.backward_scale, 0.0],
             march: [s.steps, s.light_steps, s.map_size, flags],
             slice: [1, 0, 0, 0],
+            shadow: [0.0; 4],
         }
     }
+
+    /// `shadow` for a map of `size` texels a side over `extent_m` metres of the layer's base,
+    /// centred where the path from `camera` to the sun enters the layer, snapped to whole
+    /// texels (so that a moving camera samples the same texel centres). No map (w = 0) without
+    /// shadows, a sun, a camera below the base, or a size.
+    pub fn with_shadow_map(mut self, size: u32, extent_m: f32, camera: Vec3) -> Self {
+        let both = CLOUDS_ON | CLOUDS_SHADOWS;
+        self.shadow = [0.0; 4];
+        if size == 0 || self.march[3] & both != both || self.sun[3] == 0.0 {
+            return self;
+        }
+        let Some(entry) = shadow_entry(&self, camera) else {
+            return self;
+        };
+        let texel = extent_m / size as f32;
+        let corner = ((entry - glam::Vec2::splat(0.5 * extent_m)) / texel).round() * texel;
+        if !corner.is_finite() || !(texel > 0.0) {
+            return self;
+        }
+        self.shadow = [corner.x, corner.y, texel, size as f32];
+        self
+    }
+}
+
+/// Where the path from `pos` towards the sun enters the layer's base (world x, z), as
+/// `cloud_shadow_at` marches it: the sun's elevation is floored at sin 0.05 (about 3°).
+/// None above the base.
+pub fn shadow_entry(p: &CloudParams, pos: Vec3) -> Option<glam::Vec2> {
+    let s = Vec3::from_slice(&p.sun[..3]);
+    let sy = s.y.max(0.05);
+    let t0 = (p.layer[0] - pos.y) / sy;
+    (t0 >= 0.0).then(|| glam::Vec2::new(pos.x + s.x * t0, pos.z + s.z * t0))
 }
 
 /// The clouds of a frame.
@@ -100,6 +140,9 @@ pub struct CloudsFrame {
     /// `clouds.map`: the paraboloid map (r: Mie per lux, g: per unit sky radiance,
     /// b: transmittance).
     pub map: Tex,
+    /// `clouds.shadow_map`: R32Float transmittance on the layer's base (1x1 and unused where
+    /// `params.shadow` has no map).
+    pub shadow_map: Tex,
     pub params: CloudParams,
     /// Binding set `clouds` of `hikari::clouds`.
     pub lookup: BindingSet,
@@ -107,28 +150,43 @@ pub struct CloudsFrame {
 
 pub struct Clouds {
     march: ComputePipeline,
+    shadow_map: ComputePipeline,
     /// The parameters the persistent map was last drawn whole with.
     drawn: Mutex<Option<CloudParams>>,
 }
 
-fn lookup_set(g: &mut FrameGraph<'_>, params: &CloudParams, map: Tex) -> BindingSet {
+fn lookup_set(
+    g: &mut FrameGraph<'_>,
+    params: &CloudParams,
+    map: Tex,
+    shadow_map: Tex,
+) -> BindingSet {
     g.binding_set("clouds")
         .constants(params)
         .read(map)
         .sampler(SamplerKind::LinearClamp)
+        .read(shadow_map)
         .finish()
 }
 
-/// Clouds that draw nothing and cast no shadow: a 1x1 map and `params` (flags off).
-fn disabled_frame(g: &mut FrameGraph<'_>, params: CloudParams) -> Result<CloudsFrame> {
+/// Clouds that draw nothing: a 1x1 map and shadow map, `params` without a shadow map (with the
+/// clouds on and shadows, `cloud_shadow` marches the layer at each point).
+fn disabled_frame(g: &mut FrameGraph<'_>, mut params: CloudParams) -> Result<CloudsFrame> {
+    params.shadow = [0.0; 4];
     let map = g.texture("clouds.map", TextureDesc::d2(1, 1, MAP_FORMAT))?;
+    let shadow_map = g.texture(
+        "clouds.shadow_map",
+        TextureDesc::d2(1, 1, SHADOW_MAP_FORMAT),
+    )?;
     g.pass("clouds.clear")
-        // Never read with the clouds off. wgpu zeroes it.
+        // Never read with the clouds off (or without a shadow map). wgpu zeroes them.
         .uses(map, true)
+        .uses(shadow_map, true)
         .encode(|_, _| {})?;
-    let lookup = lookup_set(g, &params, map);
+    let lookup = lookup_set(g, &params, map, shadow_map);
     Ok(CloudsFrame {
         map,
+        shadow_map,
         params,
         lookup,
     })
@@ -150,21 +208,28 @@ impl Clouds {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
             march: ComputePipeline::new(ctx, lib, "clouds/march.wgsl", "main", &[])?,
+            shadow_map: ComputePipeline::new(ctx, lib, "clouds/shadow_map.wgsl", "main", &[])?,
             drawn: Mutex::new(None),
         })
     }
 
-    /// Draws this frame's share of the map (all of it when `params` changed) and makes the
-    /// lookup set. With the clouds off, a 1x1 map and parameters that draw nothing.
+    /// Draws this frame's share of the map (all of it when `params` changed) and the shadow
+    /// map around `camera`, and makes the lookup set. With the clouds off, a 1x1 map and
+    /// parameters that draw nothing.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         s: &CloudsSettings,
         params: CloudParams,
+        camera: Vec3,
     ) -> Result<CloudsFrame> {
         if params.march[3] & CLOUDS_ON == 0 {
             return disabled_frame(g, params);
         }
+        // The paraboloid map does not depend on the camera: it is compared without the
+        // shadow map's place.
+        let mut params = params;
+        params.shadow = [0.0; 4];
         let size = s.map_size;
         let (map, fresh) =
             g.persistent_texture("clouds.map", TextureDesc::d2(size, size, MAP_FORMAT))?;
@@ -180,9 +245,28 @@ impl Clouds {
             .constants(&p)
             .write(map)
             .dispatch_threads(&self.march, [size, size.div_ceil(p.slice[0]), 1])?;
-        let lookup = lookup_set(g, &params, map);
+        drop(drawn);
+        let params = params.with_shadow_map(s.shadow_map_size, s.shadow_map_extent_m, camera);
+        let n = params.shadow[3] as u32;
+        let shadow_map = g.texture(
+            "clouds.shadow_map",
+            TextureDesc::d2(n.max(1), n.max(1), SHADOW_MAP_FORMAT),
+        )?;
+        if n > 0 {
+            g.pass("clouds.shadow_map")
+                .constants(&params)
+                .write(shadow_map)
+                .dispatch_threads(&self.shadow_map, [n, n, 1])?;
+        } else {
+            g.pass("clouds.shadow_map_clear")
+                // Never read without a shadow map. wgpu zeroes it.
+                .uses(shadow_map, true)
+                .encode(|_, _| {})?;
+        }
+        let lookup = lookup_set(g, &params, map, shadow_map);
         Ok(CloudsFrame {
             map,
+            shadow_map,
             params,
             lookup,
         })

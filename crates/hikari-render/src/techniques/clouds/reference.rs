@@ -178,6 +178,42 @@ pub fn cloud_shadow_at(p: &CloudParams, pos: Vec3) -> f32 {
     (-tau).exp()
 }
 
+/// `clouds.shadow_map`: `cloud_shadow_at` at each texel's centre on the layer's base, row-major
+/// (`p.shadow` places it; empty without a map).
+pub fn shadow_map(p: &CloudParams) -> Vec<f32> {
+    let n = p.shadow[3] as u32;
+    (0..n * n)
+        .map(|i| {
+            let c = Vec2::new((i % n) as f32, (i / n) as f32) + 0.5;
+            let xz = Vec2::new(p.shadow[0], p.shadow[1]) + c * p.shadow[2];
+            cloud_shadow_at(p, Vec3::new(xz.x, p.layer[0], xz.y))
+        })
+        .collect()
+}
+
+/// `cloud_shadow` (lookup.wgsl): the shadow map `map` (of [`shadow_map`]) blended between
+/// the four texel centres around where the path from `pos` to the sun enters the layer, or
+/// [`cloud_shadow_at`] where that is outside the map or there is none.
+pub fn cloud_shadow(p: &CloudParams, map: &[f32], pos: Vec3) -> f32 {
+    let n = p.shadow[3];
+    let both = CLOUDS_ON | CLOUDS_SHADOWS;
+    if n > 0.0 && p.march[3] & both == both && p.sun[3] != 0.0 {
+        let s = Vec3::from_slice(&p.sun[..3]);
+        let t0 = (p.layer[0] - pos.y) / s.y.max(0.05);
+        let entry = Vec2::new(pos.x, pos.z) + Vec2::new(s.x, s.z) * t0;
+        let c = (entry - Vec2::new(p.shadow[0], p.shadow[1])) / p.shadow[2] - 0.5;
+        if t0 >= 0.0 && c.x >= 0.0 && c.y >= 0.0 && c.x < n - 1.0 && c.y < n - 1.0 {
+            let (i, j) = (c.x as usize, c.y as usize);
+            let f = c - Vec2::new(i as f32, j as f32);
+            let at = |x: usize, y: usize| map[y * n as usize + x];
+            let top = at(i, j) + (at(i + 1, j) - at(i, j)) * f.x;
+            let bottom = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * f.x;
+            return top + (bottom - top) * f.y;
+        }
+    }
+    cloud_shadow_at(p, pos)
+}
+
 /// Bilinear, clamped sample of the row-major `map` at `uv`.
 pub fn sample_map(p: &CloudParams, map: &[Vec4], uv: Vec2) -> Vec4 {
     let n = p.march[2] as i32;

@@ -40,6 +40,13 @@ pub struct CloudsSettings {
     pub multiple_scattering: bool,
     /// Shadow the sun's light on the ground and in the haze.
     pub shadows: bool,
+    /// Texels along each side of the shadow map, which holds the sun's transmittance through
+    /// the layer on a square of the layer's base around the camera; 0: every pass marches the
+    /// layer itself at each point.
+    pub shadow_map_size: u32,
+    /// Side of the shadow map's square, metres. Points whose path to the sun enters the layer
+    /// outside it march the layer themselves.
+    pub shadow_map_extent_m: f32,
     /// Fade the noise octaves a map texel's footprint would alias (the talk's cloud density
     /// anti-aliasing).
     pub density_aa: bool,
@@ -74,6 +81,8 @@ impl Default for CloudsSettings {
             backward_scale: 2.16,
             multiple_scattering: true,
             shadows: true,
+            shadow_map_size: 1024,
+            shadow_map_extent_m: 4096.0,
             density_aa: true,
             map_size: 768,
             steps: 48,
@@ -153,6 +162,17 @@ impl TechniqueSettings for CloudsSettings {
             Field {
                 key: "wind_towards_deg",
                 range: Range::Float { lo: 0.0, hi: 360.0 },
+            },
+            Field {
+                key: "shadow_map_size",
+                range: Range::Int { lo: 0, hi: 4096 },
+            },
+            Field {
+                key: "shadow_map_extent_m",
+                range: Range::Float {
+                    lo: 100.0,
+                    hi: 1_000_000.0,
+                },
             },
             Field {
                 key: "albedo",
