@@ -410,7 +410,7 @@ fn the_wind_carries_the_clouds() {
 
 /// The shadow map: on the GPU against the twin's `cloud_shadow_at` at each texel's centre on
 /// the layer's base (a 32² map over 8 km, small features); its lookup against the march at
-/// points below the layer, at the default 4 m texels: within 2e-3 where the path enters the
+/// points below the layer, at the default 8 m texels: within 2e-3 where the path enters the
 /// map (bilinear between exact texel centres), the march itself outside it or above the base.
 /// The map lies where the camera's path to the sun enters the layer, snapped to whole texels.
 #[test]
@@ -498,6 +498,7 @@ fn shadow_map_and_its_lookup_agree_with_the_march() {
         worst = worst.max((looked_up - marched).abs());
         inside += 1;
     }
+    eprintln!("the map's lookup against the march: {worst} at worst");
     assert!(worst < 2e-3, "the map's lookup is {worst} off the march");
     assert_eq!(inside, 400);
     // Outside the map, and above the base: the march.

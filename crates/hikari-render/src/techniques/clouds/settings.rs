@@ -81,7 +81,7 @@ impl Default for CloudsSettings {
             backward_scale: 2.16,
             multiple_scattering: true,
             shadows: true,
-            shadow_map_size: 1024,
+            shadow_map_size: 512,
             shadow_map_extent_m: 4096.0,
             density_aa: true,
             map_size: 768,
