@@ -1,7 +1,8 @@
 //! One frame, top to bottom. Each numbered step is the step of the same number in
-//! ARCHITECTURE.md, except 4 to 6: the clouds (ARCHITECTURE.md's 6) come first, then the
-//! irradiance probes (its 4), whose sun bounce they shadow, then the reflection probes (its
-//! 5), which they shadow and whose sky they cover. Step 12 ends with the haze-lit particles,
+//! ARCHITECTURE.md, except 2 to 6: the clouds (ARCHITECTURE.md's 6) come first, before the
+//! atmosphere (its 2 and 3), whose SH sees the sky through them; then the irradiance probes
+//! (its 4), whose sun bounce they shadow, then the reflection probes (its 5), which they
+//! shadow and whose sky they cover. Step 12 ends with the haze-lit particles,
 //! which ARCHITECTURE.md does not list: they read the haze's light and go before TAA.
 
 use hikari_scene::{Camera, Sun};
@@ -369,18 +370,10 @@ pub fn record<'r>(
         0
     };
 
-    // 2. Atmosphere tables (rebuilt when the weather changes) resampled for this frame's sun
-    //    and moon, and 3. the sky's deringed SH.
-    let sky = t.sky.record(
-        g,
-        &s.settings.sky,
-        s.sun.as_ref(),
-        s.camera.position.y.max(0.0) / 1000.0,
-    )?;
-
-    // 4. Clouds: this frame's share of the paraboloid cloud map; the deferred lighting draws
-    //    them over the sky and shadows the sun with them, as the haze and the probes' sun
-    //    bounce do.
+    // 4. Clouds, before the atmosphere: this frame's share of the paraboloid cloud map and the
+    //    clouds' shadow map. The sky's SH sees the sky through them, the deferred lighting
+    //    draws them over the sky, and they shadow the sun there, in the haze, the GI and the
+    //    probes' sun bounce.
     let clouds = t.clouds.record(
         g,
         &s.settings.clouds,
@@ -392,9 +385,20 @@ pub fn record<'r>(
                 .sky
                 .date_time()
                 .map_or(0.0, |t| f64::from(t.seconds_of_day())),
-            sky.enabled && s.settings.sky.sky,
+            s.settings.sky.enabled && s.settings.sky.sky,
         ),
         s.camera.position,
+    )?;
+
+    // 2. Atmosphere tables (rebuilt when the weather changes) resampled for this frame's sun
+    //    and moon, and 3. the sky's deringed SH, with the clouds in it (`clouds.ambient`).
+    let sky = t.sky.record(
+        g,
+        &s.settings.sky,
+        s.sun.as_ref(),
+        s.camera.position.y.max(0.0) / 1000.0,
+        &clouds,
+        s.settings.clouds.ambient,
     )?;
 
     // 5. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon,

@@ -695,3 +695,84 @@ fn sky_pass_timings() {
         }
     }
 }
+
+/// The clouds in the sky's SH (`sky.sh_clouds`): the frame's final SH against the twin's
+/// projection of the twin's sky seen through the frame's cloud map (`clouds_over_sky`, lit by
+/// the directional light and the clear sky's mean radiance), raw and deringed, within the
+/// clear-sky test's 2e-3 of the largest coefficient. The clouds must move band 0 by more than
+/// 5 % (so that a frame that left them out fails), and with `clouds.ambient` off the SH is the
+/// clear sky's.
+#[test]
+fn the_sky_sh_sees_the_clouds_like_the_twin() {
+    use hikari_render::techniques::clouds::{CloudParams, reference as clouds};
+    if common::gpu().is_none() {
+        return;
+    }
+    let (scene, mut s) = frame("10:00", 64, 48);
+    s.settings.clouds.enabled = true;
+    s.settings.clouds.coverage = 0.55;
+    s.settings.clouds.feature_m = 3000.0;
+    s.settings.clouds.map_size = 64;
+    s.settings.clouds.steps = 16;
+    s.settings.clouds.light_steps = 3;
+    let read = |s: &hikari_render::FrameSettings| {
+        let mut renderer = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
+        let mut picked = None;
+        let mut r = renderer
+            .render_reading(s, |o| {
+                picked = Some((o.sky.params, o.clouds.map));
+                vec![o.sky.sh.into(), o.clouds.map.into()]
+            })
+            .unwrap();
+        let (params, map) = picked.unwrap();
+        let sh = bytemuck::cast_slice::<u8, [f32; 4]>(r.buffer("sky.sh").unwrap()).to_vec();
+        let map: Vec<glam::Vec4> = r
+            .take_image_of(map)
+            .unwrap()
+            .rgba
+            .iter()
+            .map(|v| glam::Vec4::from_array(*v))
+            .collect();
+        (params, sh, map)
+    };
+    let (params, got, map) = read(&s);
+    let weather = s.settings.sky.weather().unwrap();
+    let atmosphere =
+        sky::atmosphere_for(&weather.atmosphere(), s.settings.sky.table_sizes()).unwrap();
+    let twin = SkyTwin::new(&atmosphere, params);
+    let (clear_raw, clear) = twin.sh();
+    let sun = s.sun.clone().unwrap();
+    let cp = CloudParams::new(&s.settings.clouds, "clear", Some(&sun), 36_000.0, true);
+    let mean = clear.coeffs[0] * hikari_math::sh::basis::C0 as f32;
+    let sun_lux = sun.color * sun.illuminance_lux;
+    let (raw, deringed) = twin.sh_with(|d| {
+        clouds::clouds_over_sky(&cp, &map, d, twin.background_no_disks(d), sun_lux, mean)
+    });
+    let scale = raw.coeffs[0].max_element();
+    for (name, gpu, cpu) in [
+        ("raw", sh_of(&got[..9]), raw),
+        ("deringed", sh_of(&got[9..]), deringed),
+    ] {
+        for k in 0..9 {
+            let d = (gpu.coeffs[k] - cpu.coeffs[k]).abs().max_element();
+            assert!(
+                d <= scale * 2e-3,
+                "{name} coefficient {k}: GPU {} twin {}",
+                gpu.coeffs[k],
+                cpu.coeffs[k]
+            );
+        }
+    }
+    let moved = ((raw.coeffs[0] - clear_raw.coeffs[0]).abs() / clear_raw.coeffs[0]).max_element();
+    eprintln!("the clouds move band 0 by {moved}");
+    assert!(moved > 0.05, "the clouds move band 0 by only {moved}");
+
+    s.settings.clouds.ambient = false;
+    let (_, got, _) = read(&s);
+    for k in 0..9 {
+        let d = (sh_of(&got[..9]).coeffs[k] - clear_raw.coeffs[k])
+            .abs()
+            .max_element();
+        assert!(d <= scale * 2e-3, "clouds.ambient off: coefficient {k}");
+    }
+}

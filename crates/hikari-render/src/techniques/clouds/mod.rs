@@ -116,7 +116,7 @@ impl CloudParams {
         };
         let texel = extent_m / size as f32;
         let corner = ((entry - glam::Vec2::splat(0.5 * extent_m)) / texel).round() * texel;
-        if !corner.is_finite() || !(texel > 0.0) {
+        if !corner.is_finite() || !texel.is_finite() || texel <= 0.0 {
             return self;
         }
         self.shadow = [corner.x, corner.y, texel, size as f32];

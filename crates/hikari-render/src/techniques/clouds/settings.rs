@@ -40,6 +40,9 @@ pub struct CloudsSettings {
     pub multiple_scattering: bool,
     /// Shadow the sun's light on the ground and in the haze.
     pub shadows: bool,
+    /// The clouds enter the sky's SH: the sky's ambient light, the irradiance probes' and the
+    /// haze's sky light see them (off: the clear sky's).
+    pub ambient: bool,
     /// Texels along each side of the shadow map, which holds the sun's transmittance through
     /// the layer on a square of the layer's base around the camera; 0: every pass marches the
     /// layer itself at each point.
@@ -81,6 +84,7 @@ impl Default for CloudsSettings {
             backward_scale: 2.16,
             multiple_scattering: true,
             shadows: true,
+            ambient: true,
             shadow_map_size: 512,
             shadow_map_extent_m: 4096.0,
             density_aa: true,

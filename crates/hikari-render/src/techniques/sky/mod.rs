@@ -45,6 +45,7 @@ use crate::error::{RenderError, Result};
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
+use crate::techniques::clouds::{CLOUDS_ON, CloudsFrame};
 use gpu_build::{TableBuilder, TableTargets, WorkLayout};
 use lights::SkyLights;
 use settings::SkySettings;
@@ -337,6 +338,8 @@ fn upload(
 pub struct Sky {
     resample: ComputePipeline,
     sh: ComputePipeline,
+    /// `sh.wgsl` with CLOUDS: the sky's SH seen through the clouds.
+    sh_clouds: ComputePipeline,
     uploaded: Mutex<Option<Arc<Uploaded>>>,
     builder: TableBuilder,
     /// What the persistent GPU tables hold now.
@@ -348,6 +351,13 @@ impl Sky {
         Ok(Self {
             resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
             sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project_dering", &[])?,
+            sh_clouds: ComputePipeline::new(
+                ctx,
+                lib,
+                "sky/sh.wgsl",
+                "project_dering",
+                &[("CLOUDS", naga_oil::compose::ShaderDefValue::Bool(true))],
+            )?,
             uploaded: Mutex::new(None),
             builder: TableBuilder::new(ctx, lib)?,
             gpu_built: Mutex::new(None),
@@ -446,13 +456,16 @@ impl Sky {
 
     /// Adds the sky's passes. `directional` is the frame's directional light (the sky follows
     /// it when it is a scene's own sun); `camera_altitude_km` the camera's height above the
-    /// ground.
+    /// ground; `clouds` this frame's clouds, which enter the sky's SH (the ambient light of
+    /// every pass that reads it) where they are drawn and `clouds_in_sh`.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         s: &SkySettings,
         directional: Option<&Sun>,
         camera_altitude_km: f32,
+        clouds: &CloudsFrame,
+        clouds_in_sh: bool,
     ) -> Result<SkyFrame> {
         let sh = g.buffer("sky.sh", 18 * 16)?;
         if !s.enabled {
@@ -520,12 +533,33 @@ impl Sky {
         // 16 workgroups' partial sums, and their count, which the last workgroup resets.
         let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
         let (done, _) = g.persistent_buffer("sky.sh_done", 4)?;
+        let in_sh = clouds_in_sh && clouds.params.march[3] & CLOUDS_ON != 0;
+        let clear = match in_sh.then_some(clouds) {
+            Some(_) => g.buffer("sky.sh_clear", 18 * 16)?,
+            None => sh,
+        };
         g.pass("sky.sh")
             .write(partials)
-            .write(sh)
+            .write(clear)
             .write(done)
             .set(lookup)
+            .set(clouds.lookup)
             .dispatch(&self.sh, [16, 1, 1])?;
+        if let Some(c) = in_sh.then_some(clouds) {
+            // As the deferred lighting lights the clouds it draws: the directional light.
+            let sun_lux = directional
+                .filter(|_| c.params.sun[3] > 0.0)
+                .map_or(Vec3::ZERO, |d| d.color * d.illuminance_lux);
+            g.pass("sky.sh_clouds")
+                .write(partials)
+                .write(sh)
+                .write(done)
+                .read(clear)
+                .constants(&sun_lux.extend(0.0).to_array())
+                .set(lookup)
+                .set(c.lookup)
+                .dispatch(&self.sh_clouds, [16, 1, 1])?;
+        }
         let ambient = g
             .binding_set("sky_ambient")
             .constants(&SkyAmbientParams {

@@ -154,10 +154,16 @@ impl<'a> SkyTwin<'a> {
 
     /// The sky's L2 SH (the convention of hikari-math's `sh`): raw and deringed.
     pub fn sh(&self) -> (Sh<Vec3, 9>, Sh<Vec3, 9>) {
+        self.sh_with(|d| self.background_no_disks(d))
+    }
+
+    /// The L2 SH of `radiance` over the same directions, raw and deringed (`sh.wgsl`; with
+    /// CLOUDS, `radiance` is the sky seen through the clouds).
+    pub fn sh_with(&self, radiance: impl Fn(Vec3) -> Vec3) -> (Sh<Vec3, 9>, Sh<Vec3, 9>) {
         let mut sum = [DVec3::ZERO; 9];
         for i in 0..SH_SAMPLES {
             let d = fibonacci_dir(i, SH_SAMPLES);
-            let l = self.background_no_disks(d).as_dvec3();
+            let l = radiance(d).as_dvec3();
             let y = basis::eval_l2_f64(d.as_dvec3());
             for (s, yk) in sum.iter_mut().zip(y) {
                 *s += l * yk;

@@ -11,9 +11,17 @@
 // single workgroup doing everything measured 22 us (its serial lookups, 4 or 16 a thread,
 // cost more than the second launch). `finish` is the deringing alone from 64 given partial
 // sums; tests/sky.rs feeds it chosen skies.
+//
+// With CLOUDS defined (`sky.sh_clouds`), the same projection of the sky seen through the
+// clouds (`clouds_over_sky`, as the deferred lighting draws them), after the clear sky's pass:
+// the clouds' ambient term is lit by the clear sky's mean radiance. CPU twin:
+// SkyTwin::sh_with.
 
 #import hikari::sky::sky_background_no_disks
 #import hikari::sh::{SH_C0, SH_C1, SH_C2, SH_C3, SH_C4, sh_dering_window, sh_newton_step, sh_poly}
+// Imported by both variants (the binding sets follow the imports, not the defines): the pass
+// binds the clouds' set either way.
+#import hikari::clouds::clouds_over_sky
 
 // 9 coefficients (xyz) per partial sum: project_dering writes 16, finish reads 64.
 @group(0) @binding(0) var<storage, read_write> partials: array<vec4<f32>, 576>;
@@ -28,6 +36,23 @@ const THREADS: u32 = 64u;
 const GOLDEN_ANGLE: f32 = 2.39996322972865332;
 
 var<workgroup> terms: array<array<vec3<f32>, 9>, THREADS>;
+
+#ifdef CLOUDS
+// The clear sky's SH (`sky.sh_clear`): the mean radiance of its deringed band 0 lights the
+// clouds, as the deferred lighting's clouds over the sky are lit by the sky's.
+@group(0) @binding(3) var<storage, read> clear_sh: array<vec4<f32>, 18>;
+// xyz: the sun's (or moon's) illuminance, lux.
+@group(0) @binding(4) var<uniform> clouds_sun: vec4<f32>;
+#endif
+
+// The radiance the pass projects towards unit `d`.
+fn sh_radiance(d: vec3<f32>) -> vec3<f32> {
+#ifdef CLOUDS
+    return clouds_over_sky(d, sky_background_no_disks(d), clouds_sun.xyz, clear_sh[9].xyz * SH_C0);
+#else
+    return sky_background_no_disks(d);
+#endif
+}
 
 // Direction i of the spherical Fibonacci set: equal-area bands in z, golden-angle azimuths.
 fn fibonacci_dir(i: u32) -> vec3<f32> {
@@ -150,7 +175,7 @@ var<workgroup> last_group: u32;
 @compute @workgroup_size(256, 1, 1)
 fn project_dering(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_id) wg: vec3<u32>) {
     let d = fibonacci_dir(wg.x * GROUP_THREADS + lid);
-    let t = project_terms(d, sky_background_no_disks(d));
+    let t = project_terms(d, sh_radiance(d));
     // The 256 rows into the 64 of `terms`, 64 at a time, then a tree of halvings.
     for (var q = 0u; q < GROUP_THREADS / THREADS; q++) {
         if lid / THREADS == q {
