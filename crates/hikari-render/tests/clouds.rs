@@ -272,6 +272,9 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
         // differs visibly from the march: the frame must take the map's value where the path
         // enters it.
         s.settings.clouds.shadow_map_size = 2;
+        // The clear sky's SH in every frame, so that the frames without clouds or without the
+        // sun differ from this one only by what is compared (tests/sky.rs holds the SH).
+        s.settings.clouds.ambient = false;
         s.settings.direct_lighting.sun = sun_on;
         s.sun = sky::lights::directional_light(&s.settings.sky).unwrap();
         // Raise the view so that it holds the sky over the boxes and their ground.
@@ -511,4 +514,45 @@ fn shadow_map_and_its_lookup_agree_with_the_march() {
             twin::cloud_shadow_at(&p, pos)
         );
     }
+}
+
+/// What a frame redraws of the paraboloid map: nothing for the parameters it was drawn with (a
+/// still view), a slice while only the clock moves it a little (the wind less than a hundredth
+/// of a feature, the sun less than a quarter degree), the whole map for anything else.
+#[test]
+fn the_map_is_redrawn_only_as_much_as_it_changed() {
+    use hikari_render::techniques::clouds::{Redraw, redraw};
+    let s = CloudsSettings::default();
+    let at = |seconds: f64, sun_dir: Vec3| {
+        let sun = Sun {
+            direction: sun_dir.normalize(),
+            ..sun()
+        };
+        CloudParams::new(&s, "clear", Some(&sun), seconds, true)
+    };
+    let d0 = sun().direction;
+    let p = at(36_000.0, d0);
+    assert_eq!(redraw(None, &p), Redraw::Whole);
+    assert_eq!(redraw(Some(&p), &p), Redraw::Nothing);
+    let mut sliced = p;
+    sliced.slice = [60, 7, 0, 0];
+    sliced.shadow = [1.0, 2.0, 8.0, 512.0];
+    assert_eq!(redraw(Some(&p), &sliced), Redraw::Nothing);
+    // The wind at 8 m/s: one second carries the noise 8 m, a hundredth of 6 km is 60 m.
+    assert_eq!(redraw(Some(&p), &at(36_001.0, d0)), Redraw::Slice);
+    assert_eq!(redraw(Some(&p), &at(36_010.0, d0)), Redraw::Whole);
+    let turn = |deg: f32| glam::Quat::from_rotation_y(deg.to_radians()) * d0;
+    assert_eq!(redraw(Some(&p), &at(36_000.0, turn(0.1))), Redraw::Slice);
+    assert_eq!(redraw(Some(&p), &at(36_000.0, turn(1.0))), Redraw::Whole);
+    let thicker = CloudParams::new(
+        &CloudsSettings {
+            coverage: 0.5,
+            ..s.clone()
+        },
+        "clear",
+        Some(&sun()),
+        36_000.0,
+        true,
+    );
+    assert_eq!(redraw(Some(&p), &thicker), Redraw::Whole);
 }

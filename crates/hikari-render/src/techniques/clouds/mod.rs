@@ -3,7 +3,8 @@
 //! a paraboloid map of the upper hemisphere (768 x 768 by default) that stores, per texel, the
 //! Mie light scattered to the eye per unit sun illuminance, the light scattered per unit sky
 //! radiance, and the transmittance (the talk's red, green and blue channels). The map is
-//! redrawn a row in `time_slices` per frame, whole when its parameters change.
+//! drawn whole when its shape or lighting changes, a row in `time_slices` per frame while only
+//! the sky's clock moves it (the wind and the sun), and not at all while nothing changes.
 //!
 //! * `clouds.march`: the map (`march.wgsl`);
 //! * `clouds.shadow_map`: the sun's transmittance through the layer on a square of its base
@@ -124,6 +125,54 @@ impl CloudParams {
     }
 }
 
+/// What a frame redraws of the paraboloid map ([`redraw`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Redraw {
+    /// Every row: the map is new, or what shapes or lights it changed, or the clock jumped.
+    Whole,
+    /// A row in `time_slices`, with this frame's parameters: only the clock moved, a little
+    /// (the wind carried the noise less than a hundredth of a feature, the sun moved less than
+    /// a quarter of a degree since the map was last drawn whole).
+    Slice,
+    /// Nothing: the map was drawn with these very parameters.
+    Nothing,
+}
+
+/// What to redraw of a map last drawn whole with `drawn` (`None`: never, or its texture is
+/// new) for parameters `now`. The comparison leaves out `slice` and `shadow`, which do not
+/// shape the map.
+pub fn redraw(drawn: Option<&CloudParams>, now: &CloudParams) -> Redraw {
+    let Some(d) = drawn else {
+        return Redraw::Whole;
+    };
+    let strip = |p: &CloudParams| CloudParams {
+        slice: [0; 4],
+        shadow: [0.0; 4],
+        ..*p
+    };
+    let (d, now) = (strip(d), strip(now));
+    if d == now {
+        return Redraw::Nothing;
+    }
+    // Everything but the clock's: the wind's offset (offset.xy) and the sun's direction.
+    let clockless = |p: &CloudParams| CloudParams {
+        offset: [0.0, 0.0, p.offset[2], p.offset[3]],
+        sun: [0.0, 0.0, 0.0, p.sun[3]],
+        ..*p
+    };
+    if clockless(&d) != clockless(&now) {
+        return Redraw::Whole;
+    }
+    let moved = glam::Vec2::new(now.offset[0] - d.offset[0], now.offset[1] - d.offset[1]).length();
+    let turned = Vec3::from_slice(&now.sun[..3]).dot(Vec3::from_slice(&d.sun[..3]));
+    // shape[2] is 1 / feature size.
+    if moved * now.shape[2] < 0.01 && turned > 0.25f32.to_radians().cos() {
+        Redraw::Slice
+    } else {
+        Redraw::Whole
+    }
+}
+
 /// Where the path from `pos` towards the sun enters the layer's base (world x, z), as
 /// `cloud_shadow_at` marches it: the sun's elevation is floored at sin 0.05 (about 3°).
 /// None above the base.
@@ -148,11 +197,20 @@ pub struct CloudsFrame {
     pub lookup: BindingSet,
 }
 
+/// What the persistent map holds.
+#[derive(Default)]
+struct MapState {
+    /// The parameters every row was last drawn with.
+    whole: Option<CloudParams>,
+    /// The parameters of the last sliced frame, and how many sliced frames in a row had them.
+    last: Option<CloudParams>,
+    steady: u32,
+}
+
 pub struct Clouds {
     march: ComputePipeline,
     shadow_map: ComputePipeline,
-    /// The parameters the persistent map was last drawn whole with.
-    drawn: Mutex<Option<CloudParams>>,
+    drawn: Mutex<MapState>,
 }
 
 fn lookup_set(
@@ -209,7 +267,7 @@ impl Clouds {
         Ok(Self {
             march: ComputePipeline::new(ctx, lib, "clouds/march.wgsl", "main", &[])?,
             shadow_map: ComputePipeline::new(ctx, lib, "clouds/shadow_map.wgsl", "main", &[])?,
-            drawn: Mutex::new(None),
+            drawn: Mutex::new(MapState::default()),
         })
     }
 
@@ -233,19 +291,43 @@ impl Clouds {
         let size = s.map_size;
         let (map, fresh) =
             g.persistent_texture("clouds.map", TextureDesc::d2(size, size, MAP_FORMAT))?;
-        let mut drawn = self.drawn.lock().unwrap_or_else(|e| e.into_inner());
-        let mut p = params;
-        if fresh || drawn.as_ref() != Some(&params) {
-            *drawn = Some(params);
+        let mut state = self.drawn.lock().unwrap_or_else(|e| e.into_inner());
+        let decision = if fresh {
+            Redraw::Whole
         } else {
-            let n = s.time_slices.max(1);
-            p.slice = [n, (g.frame_index() % u64::from(n)) as u32, 0, 0];
+            redraw(state.whole.as_ref(), &params)
+        };
+        let mut p = params;
+        match decision {
+            Redraw::Whole => {
+                *state = MapState {
+                    whole: Some(params),
+                    ..MapState::default()
+                };
+            }
+            Redraw::Nothing => {}
+            Redraw::Slice => {
+                let n = s.time_slices.max(1);
+                p.slice = [n, (g.frame_index() % u64::from(n)) as u32, 0, 0];
+                state.steady = if state.last == Some(params) {
+                    state.steady + 1
+                } else {
+                    1
+                };
+                state.last = Some(params);
+                // n frames in a row with the same parameters redrew every row with them.
+                if state.steady >= n {
+                    state.whole = Some(params);
+                }
+            }
         }
-        g.pass("clouds.march")
-            .constants(&p)
-            .write(map)
-            .dispatch_threads(&self.march, [size, size.div_ceil(p.slice[0]), 1])?;
-        drop(drawn);
+        drop(state);
+        if decision != Redraw::Nothing {
+            g.pass("clouds.march")
+                .constants(&p)
+                .write(map)
+                .dispatch_threads(&self.march, [size, size.div_ceil(p.slice[0]), 1])?;
+        }
         let params = params.with_shadow_map(s.shadow_map_size, s.shadow_map_extent_m, camera);
         let n = params.shadow[3] as u32;
         let shadow_map = g.texture(
