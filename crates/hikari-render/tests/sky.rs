@@ -504,11 +504,14 @@ fn run_finish(
     let sh = g.buffer("sky.sh", 18 * 16).unwrap();
     // The module's workgroup count of `project_dering`, which `finish` does not use.
     let done = g.buffer("sky.sh_done", 4).unwrap();
+    // The clouds' binding set, which the module imports for its CLOUDS variant.
+    let clouds = hikari_render::techniques::clouds::disabled_lookup(&mut g).unwrap();
     g.pass("sky.sh")
         .write(p)
         .write(sh)
         .write(done)
         .set(lookup)
+        .set(clouds)
         .dispatch(pipeline, [1, 1, 1])
         .unwrap();
     g.readback(sh);

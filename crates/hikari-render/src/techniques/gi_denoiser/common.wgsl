@@ -151,6 +151,29 @@ fn plane_weight(t: TangentPlane, view: View, q: vec2<i32>, depth: f32, flags: ve
     return plane_falloff(relative, 1.0, flags);
 }
 
+// The weight of the sample at pixel `q` for the centre `s` with tangent plane `t`: 0 outside the
+// image or on the sky, else the geometry weight, times the normal weight (a plain dot product)
+// with `normal_weight`. `checked`: 0 also where a G-buffer texel it reads is not finite (without
+// it, such a texel gives a NaN or zero weight, which the caller's `w > 0` test drops).
+fn sample_weight(depth_tex: texture_2d<f32>, normal_tex: texture_2d<f32>, view: View, t: TangentPlane, s: Surface, q: vec2<i32>, size: vec2<u32>, flags: vec4<u32>, normal_weight: bool, checked: bool) -> f32 {
+    if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
+        return 0.0;
+    }
+    let depth = textureLoad(depth_tex, q, 0).x;
+    if !(depth > 0.0) || (checked && !is_finite_f(depth)) {
+        return 0.0;
+    }
+    let w = plane_weight(t, view, q, depth, flags);
+    if !normal_weight || !(w > 0.0) {
+        return w;
+    }
+    let oct = textureLoad(normal_tex, q, 0).xy;
+    if checked && !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
+        return 0.0;
+    }
+    return w * max(dot(s.normal, oct_decode(oct)), 0.0);
+}
+
 // Poisson point `i` of the packed disk entry `e` (= disk[i / 2]), rotated by this frame's
 // angle (one rotation for every pixel); `rotation` is GiDenoiserParams::rotation.
 fn disk_point(i: u32, e: vec4<f32>, rotation: vec4<f32>) -> vec2<f32> {

@@ -10,9 +10,8 @@
 // CPU twin: gi_denoiser/reference.rs `spatial_pass`.
 
 #import hikari::view::View
-#import hikari::octahedral::oct_decode
 #import hikari::finite::{is_finite_f, is_finite4}
-#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, disk_point, moments_3x3, hit_radius_cap, TangentPlane, tangent_plane, plane_weight}
+#import hikari::gi_denoiser_common::{GiDenoiserParams, Surface, make_surface, radius_scale_z, radius_scale_variance, radius_pixels, combine_weight, disk_point, moments_3x3, hit_radius_cap, TangentPlane, tangent_plane, sample_weight}
 
 @group(0) @binding(0) var<uniform> params: GiDenoiserParams;
 @group(0) @binding(1) var<uniform> view: View;
@@ -44,26 +43,9 @@ fn gather(s: Surface, plane: TangentPlane, centre_px: vec2<f32>, radius: f32, st
     var sum = centre;
     for (var i = 0u; i < params.flags.x; i += step) {
         let q = vec2<i32>(floor(centre_px + disk[i] * radius));
-        if any(q < vec2<i32>(0)) || any(q >= vec2<i32>(size)) {
-            continue;
-        }
-        let depth = textureLoad(depth_tex, q, 0).x;
-        if !(depth > 0.0) || (checked && !is_finite_f(depth)) {
-            continue;
-        }
-        var w = plane_weight(plane, view, q, depth, params.flags);
+        let w = sample_weight(depth_tex, normal_tex, view, plane, s, q, size, params.flags, params.flags.y != 0u, checked);
         if !(w > 0.0) {
             continue;
-        }
-        if params.flags.y != 0u {
-            let oct = textureLoad(normal_tex, q, 0).xy;
-            if checked && !is_finite4(vec4<f32>(oct, 0.0, 0.0)) {
-                continue;
-            }
-            w *= max(dot(s.normal, oct_decode(oct)), 0.0);
-            if !(w > 0.0) {
-                continue;
-            }
         }
         // The heavy data, only for samples that count.
         let y = textureLoad(in_y, q, 0);
