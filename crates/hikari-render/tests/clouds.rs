@@ -260,14 +260,12 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
         s.settings.sky.time = "10:00".into();
         s.settings.area_lights.enabled = false;
         s.settings.haze.enabled = false;
-        s.settings.clouds.enabled = clouds;
-        s.settings.clouds.coverage = 0.45;
-        s.settings.clouds.offset_x_m = offset;
         // Features small enough that the 64-px view holds cloud edges, and the boxes' shadow.
-        s.settings.clouds.feature_m = 1500.0;
-        s.settings.clouds.map_size = 64;
-        s.settings.clouds.steps = 16;
-        s.settings.clouds.light_steps = 3;
+        s.settings.clouds = CloudsSettings {
+            enabled: clouds,
+            offset_x_m: offset,
+            ..common::small_clouds(0.45, 1500.0)
+        };
         // The coarsest shadow map (2 x 2 texels 2 km apart), so that its bilinear lookup
         // differs visibly from the march: the frame must take the map's value where the path
         // enters it.

@@ -2366,14 +2366,8 @@ fn misses_and_hits_see_the_clouds_like_the_twin() {
             * Mat4::from_scale(Vec3::splat(6.0 / 400.0)),
     });
     let clouds_settings = |offset: f32| hikari_render::settings::CloudsSettings {
-        enabled: true,
-        coverage: 0.45,
-        feature_m: 1500.0,
         offset_x_m: offset,
-        map_size: 64,
-        steps: 16,
-        light_steps: 3,
-        ..Default::default()
+        ..common::small_clouds(0.45, 1500.0)
     };
     // The frame's clock: 10:00 (36 000 s), the wind's offset included.
     let params_of = |c: &hikari_render::settings::CloudsSettings| {

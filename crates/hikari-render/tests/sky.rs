@@ -712,12 +712,7 @@ fn the_sky_sh_sees_the_clouds_like_the_twin() {
         return;
     }
     let (scene, mut s) = frame("10:00", 64, 48);
-    s.settings.clouds.enabled = true;
-    s.settings.clouds.coverage = 0.55;
-    s.settings.clouds.feature_m = 3000.0;
-    s.settings.clouds.map_size = 64;
-    s.settings.clouds.steps = 16;
-    s.settings.clouds.light_steps = 3;
+    s.settings.clouds = common::small_clouds(0.55, 3000.0);
     let read = |s: &hikari_render::FrameSettings| {
         let mut renderer = Renderer::new(common::gpu().unwrap(), &scene).unwrap();
         let mut picked = None;

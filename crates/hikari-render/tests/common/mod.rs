@@ -98,3 +98,17 @@ pub fn small_frame_settings(
         settings,
     }
 }
+
+/// Clouds small enough for the CPU driver (a 64² map, 16 steps with 3 towards the light) with
+/// features of `feature_m` metres, so that a small view holds cloud edges.
+pub fn small_clouds(coverage: f32, feature_m: f32) -> hikari_render::settings::CloudsSettings {
+    hikari_render::settings::CloudsSettings {
+        enabled: true,
+        coverage,
+        feature_m,
+        map_size: 64,
+        steps: 16,
+        light_steps: 3,
+        ..Default::default()
+    }
+}
