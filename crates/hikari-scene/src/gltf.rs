@@ -1307,7 +1307,7 @@ impl<'o> Loader<'o> {
 /// centred on the node's world position, its box's half extents scaled by the node's scale;
 /// every key optional (the emitter's defaults): `half_extents` [x, y, z], `count`, `size_m`
 /// [birth, death], `opacity`, `velocity_mps` [x, y, z], `lifetime_s`, `albedo` [r, g, b],
-/// `haze_lit`, `seed`. An unknown key or a value of the wrong kind is an error; ranges are
+/// `haze_lit`, `seed`, `hours` [from, to]. An unknown key or a value of the wrong kind is an error; ranges are
 /// checked with the scene by `Scene::validate`.
 fn particle_emitter(
     extras: &gltf::json::Extras,
@@ -1363,6 +1363,10 @@ fn particle_emitter(
             "lifetime_s" => e.lifetime_s = number(key, v)?,
             "albedo" => e.albedo = Vec3::from_slice(&numbers(key, v, 3)?),
             "haze_lit" => e.haze_lit = v.as_bool().ok_or_else(|| bad(key, "true or false", v))?,
+            "hours" => {
+                let h = numbers(key, v, 2)?;
+                e.hours = Some([h[0], h[1]]);
+            }
             "seed" => {
                 e.seed = v
                     .as_u64()

@@ -36,6 +36,11 @@ pub struct ParticleEmitter {
     /// lighting, kept for A/B comparisons).
     pub haze_lit: bool,
     pub seed: u32,
+    /// Local hours `[from, to]` (each in [0, 24], different) between which the emitter shows,
+    /// as morning mist or evening smoke does: every particle's opacity fades in over the
+    /// window's first hour and out over its last (over half the window if that is shorter);
+    /// `from > to` runs through midnight. `None`: at every hour.
+    pub hours: Option<[f32; 2]>,
 }
 
 impl Default for ParticleEmitter {
@@ -52,6 +57,7 @@ impl Default for ParticleEmitter {
             albedo: Vec3::splat(0.9),
             haze_lit: true,
             seed: 0,
+            hours: None,
         }
     }
 }
@@ -125,12 +131,36 @@ impl ParticleEmitter {
         {
             return Err(err(format!("albedo {} must be in [0, 1]", self.albedo)));
         }
+        if let Some(h) = self.hours
+            && (!h.iter().all(|x| (0.0..=24.0).contains(x)) || h[0] % 24.0 == h[1] % 24.0)
+        {
+            return Err(err(format!(
+                "hours {h:?} must be two different hours in [0, 24]"
+            )));
+        }
         Ok(())
+    }
+
+    /// How much of the emitter shows at `time_s` seconds into the day (the sky's clock): 1
+    /// inside its `hours`, 0 outside, linear over the fades at both ends.
+    pub fn presence(&self, time_s: f64) -> f32 {
+        let Some([from, to]) = self.hours else {
+            return 1.0;
+        };
+        let hour = (time_s / 3600.0).rem_euclid(24.0) as f32;
+        let length = (to - from).rem_euclid(24.0);
+        let since = (hour - from).rem_euclid(24.0);
+        if since > length {
+            return 0.0;
+        }
+        let fade = length.min(2.0) * 0.5;
+        (since / fade).min((length - since) / fade).clamp(0.0, 1.0)
     }
 
     /// Particle `i` at `time_s` seconds of the scene's clock: born at a random point of the box
     /// at an even share of the lifetime, drifting with the velocity, growing from the first
-    /// size to the second, its opacity `opacity sin(pi age)`.
+    /// size to the second, its opacity `opacity sin(pi age)` times the emitter's
+    /// [`presence`](Self::presence) at that hour.
     pub fn particle(&self, i: u32, time_s: f64) -> Particle {
         let key = hash(self.seed ^ hash(i.wrapping_mul(0x9e37_79b9)));
         // Births spread evenly over a lifetime, each particle's phase jittered within its share.
@@ -146,7 +176,9 @@ impl ParticleEmitter {
         Particle {
             position,
             radius_m: self.size_m[0] + (self.size_m[1] - self.size_m[0]) * age,
-            opacity: self.opacity * (std::f32::consts::PI * age).sin().max(0.0),
+            opacity: self.opacity
+                * (std::f32::consts::PI * age).sin().max(0.0)
+                * self.presence(time_s),
         }
     }
 
@@ -239,6 +271,55 @@ mod tests {
         for e in bad {
             let msg = e.validate().unwrap_err().to_string();
             assert!(msg.contains("particles `particles`"), "{msg}");
+        }
+    }
+
+    #[test]
+    fn an_emitter_shows_only_in_its_hours_and_fades_at_their_ends() {
+        let at = |hours: Option<[f32; 2]>, h: f64| {
+            ParticleEmitter {
+                hours,
+                ..Default::default()
+            }
+            .presence(h * 3600.0)
+        };
+        assert_eq!(at(None, 13.0), 1.0);
+        // Dusk to mid-morning, through midnight: faded in by 18:30, out from 8:00 to 9:00.
+        let mist = Some([17.5, 9.0]);
+        for (h, want) in [
+            (12.0, 0.0),
+            (17.0, 0.0),
+            (18.0, 0.5),
+            (18.5, 1.0),
+            (23.9, 1.0),
+            (3.0, 1.0),
+            (27.0, 1.0),
+            (8.5, 0.5),
+            (9.5, 0.0),
+        ] {
+            assert!((at(mist, h) - want).abs() < 1e-4, "{h}: {}", at(mist, h));
+        }
+        // A window shorter than two hours fades over half of it each way.
+        assert!((at(Some([6.0, 7.0]), 6.5) - 1.0).abs() < 1e-4);
+        assert!((at(Some([6.0, 7.0]), 6.25) - 0.5).abs() < 1e-4);
+        let e = ParticleEmitter {
+            hours: mist,
+            ..Default::default()
+        };
+        assert!(e.particles_at(12.0 * 3600.0).all(|p| p.opacity == 0.0));
+        assert!(e.particles_at(22.0 * 3600.0).any(|p| p.opacity > 0.0));
+        for bad in [
+            [25.0, 3.0],
+            [-1.0, 3.0],
+            [5.0, 5.0],
+            [0.0, 24.0],
+            [f32::NAN, 3.0],
+        ] {
+            let e = ParticleEmitter {
+                hours: Some(bad),
+                ..Default::default()
+            };
+            assert!(e.validate().is_err(), "{bad:?}");
         }
     }
 }

@@ -27,7 +27,8 @@ fn node_extras_make_an_emitter_at_the_node() {
         "good",
         json!({"hikari": {"particles": {"half_extents": [1.0, 0.5, 1.5], "count": 32,
                "size_m": [0.5, 2.0], "opacity": 0.2, "velocity_mps": [0.1, 0.0, 0.0],
-               "lifetime_s": 30.0, "albedo": [0.9, 0.9, 0.85], "haze_lit": false, "seed": 9}},
+               "lifetime_s": 30.0, "albedo": [0.9, 0.9, 0.85], "haze_lit": false, "seed": 9,
+               "hours": [17.5, 9.0]}},
                "tool": "blender"}),
     );
     let loaded = load(&path).unwrap();
@@ -50,6 +51,7 @@ fn node_extras_make_an_emitter_at_the_node() {
         (32, [0.5, 2.0], 0.2, 30.0, false, 9)
     );
     assert_eq!(e.velocity_mps, Vec3::new(0.1, 0.0, 0.0));
+    assert_eq!(e.hours, Some([17.5, 9.0]));
     // Nothing in the extras but other tools' data: no emitter.
     let loaded = load(write_gltf("none", json!({"tool": "blender"}))).unwrap();
     assert!(loaded.scene.particles.is_empty());
@@ -64,6 +66,8 @@ fn bad_emitter_extras_are_errors_naming_the_node() {
         ("count_negative", json!({"count": -4})),
         ("short_size", json!({"size_m": [1.0]})),
         ("haze_lit_number", json!({"haze_lit": 1})),
+        ("hours_one", json!({"hours": [6.0]})),
+        ("hours_text", json!({"hours": ["dusk", "dawn"]})),
     ];
     for (name, p) in cases {
         let e = load(write_gltf(name, json!({"hikari": {"particles": p}})))
@@ -83,6 +87,16 @@ fn bad_emitter_extras_are_errors_naming_the_node() {
     .to_string();
     assert!(
         e.contains("particles `pond mist`") && e.contains("opacity"),
+        "{e}"
+    );
+    let e = load(write_gltf(
+        "late_hours",
+        json!({"hikari": {"particles": {"hours": [25.0, 3.0]}}}),
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("particles `pond mist`") && e.contains("hours"),
         "{e}"
     );
 }

@@ -200,6 +200,8 @@ pub fn build(seed: u64) -> Village {
         albedo: Vec3::splat(0.9),
         haze_lit: true,
         seed: 7,
+        // From dusk to mid-morning, as mist over still water lies.
+        hours: Some([17.5, 9.0]),
     });
     let layout = VillageLayout {
         seed,
