@@ -3,7 +3,7 @@
 // The clouds for other passes: over the sky (the paraboloid map, bilinear) and their shadow
 // on the sun's light. Binding set `clouds` (`CloudsFrame::lookup`). Twin: `clouds::reference`.
 
-#import hikari::cloud_density::{CloudParams, CLOUDS_ON, CLOUDS_SHADOWS, cloud_map_uv, cloud_shadow_at}
+#import hikari::cloud_density::{CloudParams, CLOUDS_ON, cloud_map_uv, cloud_shadow_at}
 
 @group(#{CLOUDS_GROUP}) @binding(0) var<uniform> clouds: CloudParams;
 @group(#{CLOUDS_GROUP}) @binding(1) var cloud_map: texture_2d<f32>;
@@ -30,9 +30,9 @@ fn clouds_over_sky(dir: vec3<f32>, background: vec3<f32>, sun_lux: vec3<f32>, sk
 // map where the path to the sun enters the layer inside it (bilinear between texel centres),
 // else marched here. Twin: `clouds::reference::cloud_shadow`.
 fn cloud_shadow(pos: vec3<f32>) -> f32 {
+    // `CloudParams::with_shadow_map` places a map (w > 0) only with shadows on and a lit sun.
     let n = clouds.shadow.w;
-    let both = CLOUDS_ON | CLOUDS_SHADOWS;
-    if n > 0.0 && (clouds.march.w & both) == both && clouds.sun.w > 0.0 {
+    if n > 0.0 {
         let s = clouds.sun.xyz;
         let t0 = (clouds.layer.x - pos.y) / max(s.y, 0.05);
         // Texel coordinates of the entry point, texel centres at whole numbers.

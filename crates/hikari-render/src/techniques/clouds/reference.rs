@@ -195,14 +195,13 @@ pub fn shadow_map(p: &CloudParams) -> Vec<f32> {
 /// the four texel centres around where the path from `pos` to the sun enters the layer, or
 /// [`cloud_shadow_at`] where that is outside the map or there is none.
 pub fn cloud_shadow(p: &CloudParams, map: &[f32], pos: Vec3) -> f32 {
+    // `CloudParams::with_shadow_map` places a map only with shadows on and a lit sun.
     let n = p.shadow[3];
-    let both = CLOUDS_ON | CLOUDS_SHADOWS;
-    if n > 0.0 && p.march[3] & both == both && p.sun[3] != 0.0 {
-        let s = Vec3::from_slice(&p.sun[..3]);
-        let t0 = (p.layer[0] - pos.y) / s.y.max(0.05);
-        let entry = Vec2::new(pos.x, pos.z) + Vec2::new(s.x, s.z) * t0;
+    if n > 0.0
+        && let Some(entry) = super::shadow_entry(p, pos)
+    {
         let c = (entry - Vec2::new(p.shadow[0], p.shadow[1])) / p.shadow[2] - 0.5;
-        if t0 >= 0.0 && c.x >= 0.0 && c.y >= 0.0 && c.x < n - 1.0 && c.y < n - 1.0 {
+        if c.x >= 0.0 && c.y >= 0.0 && c.x < n - 1.0 && c.y < n - 1.0 {
             let (i, j) = (c.x as usize, c.y as usize);
             let f = c - Vec2::new(i as f32, j as f32);
             let at = |x: usize, y: usize| map[y * n as usize + x];

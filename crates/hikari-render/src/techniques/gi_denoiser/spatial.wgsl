@@ -4,8 +4,8 @@
 // (distance to the tangent plane), and in the second pass the normal (a plain dot product).
 // Y SH and CoCg share the weights. Output: lerp(denoised, input, 0.5 * accumulation speed).
 // A non-finite input texel is dropped where it is read, so it never reaches the output: the
-// samples are summed first without finite tests (the loop is bound by arithmetic, and the
-// tests were a third of it), and only a pixel whose sum came out non-finite sums them again,
+// samples are summed first without finite tests (the loop is bound by arithmetic; 2 % of the
+// pass on the H200), and only a pixel whose sum came out non-finite sums them again,
 // dropping each non-finite texel; with finite texels both give the same sum.
 // CPU twin: gi_denoiser/reference.rs `spatial_pass`.
 

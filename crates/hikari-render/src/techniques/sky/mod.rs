@@ -534,9 +534,10 @@ impl Sky {
         let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
         let (done, _) = g.persistent_buffer("sky.sh_done", 4)?;
         let in_sh = clouds_in_sh && clouds.params.march[3] & CLOUDS_ON != 0;
-        let clear = match in_sh.then_some(clouds) {
-            Some(_) => g.buffer("sky.sh_clear", 18 * 16)?,
-            None => sh,
+        let clear = if in_sh {
+            g.buffer("sky.sh_clear", 18 * 16)?
+        } else {
+            sh
         };
         g.pass("sky.sh")
             .write(partials)
@@ -545,10 +546,10 @@ impl Sky {
             .set(lookup)
             .set(clouds.lookup)
             .dispatch(&self.sh, [16, 1, 1])?;
-        if let Some(c) = in_sh.then_some(clouds) {
+        if in_sh {
             // As the deferred lighting lights the clouds it draws: the directional light.
             let sun_lux = directional
-                .filter(|_| c.params.sun[3] > 0.0)
+                .filter(|_| clouds.params.sun[3] > 0.0)
                 .map_or(Vec3::ZERO, |d| d.color * d.illuminance_lux);
             g.pass("sky.sh_clouds")
                 .write(partials)
@@ -557,7 +558,7 @@ impl Sky {
                 .read(clear)
                 .constants(&sun_lux.extend(0.0).to_array())
                 .set(lookup)
-                .set(c.lookup)
+                .set(clouds.lookup)
                 .dispatch(&self.sh_clouds, [16, 1, 1])?;
         }
         let ambient = g
