@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use serde_json::json;
 
-use hikari_render::FrameSettings;
+use hikari_render::{FrameSettings, SunSource};
 use hikari_scene::{Camera, Scene};
 
 use crate::args::FrameArgs;
@@ -206,7 +206,7 @@ fn choose_light(
     settings: &mut hikari_render::Settings,
     args: &FrameArgs,
     file: &crate::config::ConfigFile,
-) -> anyhow::Result<(Option<hikari_scene::Sun>, Option<String>)> {
+) -> anyhow::Result<(SunSource, Option<String>)> {
     let defaults = hikari_render::settings::SkySettings::default();
     let sky = &settings.sky;
     let time_given = args.sky.sets_time()
@@ -228,21 +228,17 @@ fn choose_light(
         format!("{h:02}:{m:02}:{sec:02}")
     });
     if time_given {
-        let sun = hikari_render::techniques::sky::lights::directional_light(sky)?;
-        return Ok((sun, now));
+        return Ok((SunSource::Sky, now));
     }
     if scene.sun.is_none() {
         settings.sky.sun = false;
         settings.sky.sky = false;
-        return Ok((None, None));
+        return Ok((SunSource::Off, None));
     }
-    match own_sun {
-        Some(s) => Ok((settings.sky.sun.then_some(s), None)),
-        None => {
-            let sun = hikari_render::techniques::sky::lights::directional_light(&settings.sky)?;
-            Ok((sun, now))
-        }
-    }
+    Ok(match own_sun {
+        Some(s) => (SunSource::Fixed(s), None),
+        None => (SunSource::Sky, now),
+    })
 }
 
 /// The scene and the frame settings: from the flags, then the config file, then defaults.

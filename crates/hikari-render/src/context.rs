@@ -75,6 +75,22 @@ pub struct GpuContext {
     pub features: wgpu::Features,
     pub limits: wgpu::Limits,
     pub startup: StartupTimes,
+    /// Bind every `var<uniform>` as a read-only storage buffer (same bytes, same layout).
+    /// On for Mesa's CPU driver (llvmpipe/lavapipe), which recompiles a shader each time it is
+    /// bound when a branch or loop bound reads a uniform, and keeps every compiled copy: 13 MB
+    /// and about a second a frame. Storage loads are never inlined. `HIKARI_UNIFORMS_AS_STORAGE`
+    /// (`1` or `0`) overrides the choice.
+    pub uniforms_as_storage: bool,
+}
+
+/// Whether `info` is Mesa's CPU driver, whose shader compiler inlines uniform values that
+/// steer branches by compiling the shader anew at each bind ([`GpuContext::uniforms_as_storage`]).
+fn inlines_uniforms(info: &wgpu::AdapterInfo) -> bool {
+    let mesa_cpu = |s: &str| {
+        let s = s.to_ascii_lowercase();
+        s.contains("llvmpipe") || s.contains("lavapipe")
+    };
+    info.device_type == wgpu::DeviceType::Cpu && (mesa_cpu(&info.name) || mesa_cpu(&info.driver))
 }
 
 impl GpuContext {
@@ -146,8 +162,14 @@ impl GpuContext {
             .await
             .map_err(|e| RenderError::Device(e.to_string()))?;
         let t3 = Instant::now();
+        let uniforms_as_storage = match std::env::var("HIKARI_UNIFORMS_AS_STORAGE").as_deref() {
+            Ok("1") => true,
+            Ok("0") => false,
+            _ => inlines_uniforms(&info),
+        };
 
         Ok(Self {
+            uniforms_as_storage,
             instance,
             adapter,
             device,

@@ -31,6 +31,21 @@ pub enum RenderError {
     #[error("frame graph: {0}")]
     Graph(String),
 
+    /// A setting outside its range, of the wrong type or unknown.
+    #[error("settings: {0}")]
+    Settings(#[from] crate::settings::SettingError),
+
+    /// A setting whose value is well formed but unusable: a LUT file that does not read.
+    #[error("settings: `{field}`: {message}")]
+    Setting { field: String, message: String },
+
+    /// The scene, a camera or a light handed to the renderer is not valid.
+    #[error("{what}: {source}")]
+    Scene {
+        what: String,
+        source: hikari_scene::SceneError,
+    },
+
     #[error("{what} of {requested} exceeds this GPU's limit of {limit}")]
     Limit {
         what: String,

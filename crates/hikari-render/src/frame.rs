@@ -5,16 +5,15 @@
 //! shadow and whose sky they cover. Step 12 ends with the haze-lit particles,
 //! which ARCHITECTURE.md does not list: they read the haze's light and go before TAA.
 
-use hikari_scene::{Camera, Sun};
-
 use crate::brdf_tables::BrdfTables;
 use crate::context::GpuContext;
 use crate::error::Result;
+use crate::frame_context::FrameContext;
+pub use crate::frame_context::FrameSettings;
 use crate::graph::{FrameGraph, Tex};
 use crate::raster::{RasterQueues, Rasterizer};
 use crate::scene_gpu::SceneGpu;
 use crate::scene_rt::SceneRt;
-use crate::settings::Settings;
 use crate::shader::{self, ShaderLibrary};
 use crate::techniques::area_lights::{
     AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,
@@ -24,6 +23,7 @@ use crate::techniques::clouds::{CloudParams, Clouds};
 use crate::techniques::direct_lighting::GiLight;
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
+use crate::techniques::gbuffer::overrides::{GBufferTexel, override_gbuffer};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
 use crate::techniques::gi_denoiser::{
     DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput, RecurrentNames,
@@ -40,197 +40,22 @@ use crate::techniques::reflection_probes::{
 };
 use crate::techniques::sky::{Sky, SkyFrame};
 use crate::techniques::sun_shadows::{self, SunShadowMaps, SunShadows};
-use crate::techniques::taa::{self, Taa};
+use crate::techniques::taa::Taa;
 use crate::techniques::tonemap::{LocalGain, Tonemap, TonemapInputs};
-use crate::view::View;
-
-/// What a frame depends on besides the scene.
-#[derive(Clone, Debug)]
-pub struct FrameSettings {
-    pub width: u32,
-    pub height: u32,
-    pub camera: Camera,
-    /// The camera of the previous frame, for motion vectors; `None`: it did not move.
-    pub prev_camera: Option<Camera>,
-    /// The sun or moon; `None`: no directional light.
-    pub sun: Option<Sun>,
-    pub settings: Settings,
-}
-
-impl FrameSettings {
-    /// The CPU meter (the exposure when the `exposure` technique is off): the configured
-    /// EV100, else the incident-light meter rule EV100 = log2(E * 100 / C) with C = 250
-    /// (ISO 2720) on the sun's illuminance.
-    pub fn ev100(&self) -> f32 {
-        self.ev100_with_sky(0.0)
-    }
-
-    /// [`FrameSettings::ev100`] metered on the sun and a sky of `sky_lux` on the ground.
-    pub fn ev100_with_sky(&self, sky_lux: f32) -> f32 {
-        self.settings
-            .exposure
-            .ev100
-            .unwrap_or_else(|| (self.metered_lux_with_sky(sky_lux) * 100.0 / 250.0).log2())
-    }
-
-    /// The illuminance the CPU meter reads: the configured EV100's, else the sun's.
-    pub fn metered_lux(&self) -> f32 {
-        self.metered_lux_with_sky(0.0)
-    }
-
-    /// The illuminance the exposure is set for, with the sky's own light (`sky_lux` on a
-    /// horizontal plane): the configured EV100's, else the larger of the sun's and the sky's
-    /// (at least a thousandth of a lux, so that a scene without either stays finite). At dawn
-    /// and dusk the sky outshines the low sun; the punctual lights' cut-off follows it.
-    pub fn metered_lux_with_sky(&self, sky_lux: f32) -> f32 {
-        match self.settings.exposure.ev100 {
-            Some(ev) => 2f32.powf(ev) * 250.0 / 100.0,
-            None => self
-                .sun
-                .as_ref()
-                .map_or(0.0, |s| s.illuminance_lux)
-                .max(sky_lux)
-                .max(1e-3),
-        }
-    }
-}
 
 /// What one frame leaves for the next, besides the graph's persistent resources.
 #[derive(Clone, Debug, Default)]
 pub struct FrameState {
     pub shadow_cache: sun_shadows::ShadowCache,
     pub raster_queues: RasterQueues,
-    /// Where the last frame's camera was, to tell a cut (a new camera that claims it did not
-    /// move) from a still frame: temporal techniques drop their history on a cut.
-    pub last_camera: Option<[f32; 6]>,
     /// The per-instance table of ray-traced GI, built when the technique is first on.
     pub rtgi_scene: Option<SharedRtGiScene>,
-    /// Drop the ray-traced GI history next frame (a camera cut); cleared once used.
-    pub rtgi_reset: bool,
     /// Which denoiser outputs the last frame kept as the accumulation's history
     /// (`GiDenoiser::recurrent_names`): when that changes, a kept texture may be stale.
     pub rtgi_recurrent: Option<RecurrentNames>,
     /// Tests only: G-buffer texels overwritten every frame after the G-buffer pass
     /// ([`crate::renderer::Renderer::override_gbuffer_texels`]).
     pub gbuffer_overrides: Vec<GBufferTexel>,
-}
-
-/// Which G-buffer texture a [`GBufferTexel`] overwrites.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GBufferTarget {
-    /// `gbuffer.depth` (R32Float, reverse-Z).
-    Depth,
-    /// `gbuffer.normal` (Rgba16Float, octahedral).
-    Normal,
-    /// `gbuffer.albedo` (Rgba8Unorm: it cannot hold NaN or infinity).
-    Albedo,
-    /// `gbuffer.motion` (Rgba16Float).
-    Motion,
-    /// `gbuffer.emissive` (Rgba16Float, nits).
-    Emissive,
-}
-
-/// A rectangle of G-buffer texels to overwrite with one value, so that tests can put bad
-/// values (NaN, infinity) where the frame's later passes read them.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GBufferTexel {
-    pub target: GBufferTarget,
-    /// The rectangle's top-left texel.
-    pub pixel: [u32; 2],
-    /// The rectangle's width and height in texels ([1, 1]: one texel).
-    pub size: [u32; 2],
-    /// One texel's bytes in the target's format (4 for depth and albedo, 8 for the others),
-    /// written to every texel of the rectangle.
-    pub bytes: Vec<u8>,
-}
-
-/// Records the copies of `texels` into the G-buffer; a rectangle outside the image or a texel
-/// of the wrong size is an error naming it.
-fn override_gbuffer<'r>(
-    g: &mut FrameGraph<'r>,
-    gbuffer: &GBuffer,
-    size: [u32; 2],
-    texels: &[GBufferTexel],
-) -> Result<()> {
-    use crate::techniques::gbuffer as gb;
-    use wgpu::util::DeviceExt;
-    for (i, t) in texels.iter().enumerate() {
-        let (tex, format) = match t.target {
-            GBufferTarget::Depth => (gbuffer.depth, gb::DEPTH_FORMAT),
-            GBufferTarget::Normal => (gbuffer.normal, gb::NORMAL_FORMAT),
-            GBufferTarget::Albedo => (gbuffer.albedo, gb::ALBEDO_FORMAT),
-            GBufferTarget::Motion => (gbuffer.motion, gb::MOTION_FORMAT),
-            GBufferTarget::Emissive => (gbuffer.emissive, gb::EMISSIVE_FORMAT),
-        };
-        let texel_bytes = format.block_copy_size(None).unwrap_or(0) as usize;
-        let inside = |k: usize| {
-            t.size[k] > 0
-                && t.pixel[k]
-                    .checked_add(t.size[k])
-                    .is_some_and(|e| e <= size[k])
-        };
-        if t.bytes.len() != texel_bytes || !inside(0) || !inside(1) {
-            return Err(crate::error::RenderError::Graph(format!(
-                "G-buffer override {i} ({:?}, {:?} at {:?}): {} bytes for a {texel_bytes}-byte \
-                 texel of a {}x{} image",
-                t.target,
-                t.size,
-                t.pixel,
-                t.bytes.len(),
-                size[0],
-                size[1]
-            )));
-        }
-        // Rows padded to the copy's alignment.
-        let row = (texel_bytes * t.size[0] as usize)
-            .next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize);
-        let mut contents = vec![0u8; row * t.size[1] as usize];
-        for r in contents.chunks_exact_mut(row) {
-            for c in r.chunks_exact_mut(texel_bytes).take(t.size[0] as usize) {
-                c.copy_from_slice(&t.bytes);
-            }
-        }
-        let data = g
-            .ctx()
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("gbuffer.override"),
-                contents: &contents,
-                usage: wgpu::BufferUsages::COPY_SRC,
-            });
-        let origin = wgpu::Origin3d {
-            x: t.pixel[0],
-            y: t.pixel[1],
-            z: 0,
-        };
-        let extent = wgpu::Extent3d {
-            width: t.size[0],
-            height: t.size[1],
-            depth_or_array_layers: 1,
-        };
-        g.pass("gbuffer.override")
-            .uses(tex, true)
-            .encode(move |enc, res| {
-                enc.copy_buffer_to_texture(
-                    wgpu::TexelCopyBufferInfo {
-                        buffer: &data,
-                        layout: wgpu::TexelCopyBufferLayout {
-                            offset: 0,
-                            bytes_per_row: Some(row as u32),
-                            rows_per_image: None,
-                        },
-                    },
-                    wgpu::TexelCopyTextureInfo {
-                        texture: res.texture(tex),
-                        mip_level: 0,
-                        origin,
-                        aspect: wgpu::TextureAspect::All,
-                    },
-                    extent,
-                );
-            })?;
-    }
-    Ok(())
 }
 
 /// Every technique's pipelines, built once.
@@ -254,6 +79,8 @@ pub struct Techniques {
     pub local_tonemap: LocalTonemap,
     pub ray_traced_gi: RayTracedGi,
     pub tonemap: Tonemap,
+    /// What a window shows of a frame (the viewer's debug views), after the frame.
+    pub debug_view: crate::techniques::debug_view::DebugView,
     /// The BRDF's albedo tables, bound by every pass that shades with `hikari::brdf`.
     pub brdf_tables: BrdfTables,
 }
@@ -282,6 +109,7 @@ impl Techniques {
             local_tonemap: LocalTonemap::new(ctx, &mut lib)?,
             ray_traced_gi: RayTracedGi::new(ctx, &mut lib)?,
             tonemap: Tonemap::new(ctx, &mut lib)?,
+            debug_view: crate::techniques::debug_view::DebugView::new(ctx, &mut lib)?,
         })
     }
 }
@@ -326,49 +154,31 @@ pub struct FrameOutputs {
     pub ldr: Tex,
 }
 
+/// Records one frame, step by step, from the frame context `cx` (step 0, resolved by the
+/// renderer before this) and the frame's settings `s`.
+#[allow(clippy::too_many_arguments)]
 pub fn record<'r>(
     g: &mut FrameGraph<'r>,
     t: &'r Techniques,
     scene: &'r SceneGpu,
     area: &'r AreaLightScene,
     rt: &'r SceneRt,
+    cx: &FrameContext,
     s: &FrameSettings,
     state: &mut FrameState,
 ) -> Result<FrameOutputs> {
     // The scene BVH as the caller updated it for this frame (`SceneRt::update`): GI rays
     // trace every kept instance, shadow rays all but the lamp shells.
     let rt_bvh = rt.import(g)?;
-    let size = [s.width, s.height];
-    let aspect = s.width as f32 / s.height as f32;
-
-    // 1. Update: camera and sun. The sun (or moon) comes from the sky settings' date, time and
-    //    place (`sky::lights`, resolved by the caller into `s.sun`) or is the scene's own.
-    //    With TAA on, the camera moves by a sub-pixel jitter each frame.
-    let taa_on = s.settings.taa.enabled;
-    let jitter = if taa_on {
-        taa::reference::jitter(g.frame_index(), s.settings.taa.jitter_samples)
-    } else {
-        [0.0; 2]
-    };
-    let view = View::with_previous(
-        &s.camera,
-        s.prev_camera.as_ref().unwrap_or(&s.camera),
-        s.width,
-        s.height,
-    )
-    .jittered(jitter);
-    let pose = camera_pose(&s.camera);
-    let camera_cut = s.prev_camera.is_none() && state.last_camera.is_some_and(|p| p != pose);
-    state.last_camera = Some(pose);
-    let to_sun = s.sun.as_ref().map_or(glam::Vec3::ZERO, |sun| sun.direction);
+    let size = cx.size;
+    let view = cx.view;
+    let history = cx.history.valid();
+    let sun = cx.sun.as_ref();
     let emitters = &scene.cpu.particles;
     let scene = &scene.import(g);
-    // `direct_lighting.punctual` switches the point and spot lights off in every pass.
-    let punctual_lights = if s.settings.direct_lighting.punctual {
-        scene.light_count
-    } else {
-        0
-    };
+
+    // 1. Update: camera, sun or moon, the sky's clock, the metered light and the lights'
+    //    cut-off are the frame context's (`frame_context.rs`), resolved before this walk.
 
     // 4. Clouds, before the atmosphere: this frame's share of the paraboloid cloud map and the
     //    clouds' shadow map. The sky's SH sees the sky through them, the deferred lighting
@@ -380,11 +190,8 @@ pub fn record<'r>(
         CloudParams::new(
             &s.settings.clouds,
             &s.settings.sky.weather,
-            s.sun.as_ref(),
-            s.settings
-                .sky
-                .date_time()
-                .map_or(0.0, |t| f64::from(t.seconds_of_day())),
+            sun,
+            cx.clock_s,
             s.settings.sky.enabled && s.settings.sky.sky,
         ),
         s.camera.position,
@@ -395,7 +202,8 @@ pub fn record<'r>(
     let sky = t.sky.record(
         g,
         &s.settings.sky,
-        s.sun.as_ref(),
+        cx.sky.as_ref(),
+        sun,
         s.camera.position.y.max(0.0) / 1000.0,
         &clouds,
         s.settings.clouds.ambient,
@@ -408,7 +216,7 @@ pub fn record<'r>(
         &s.settings.irradiance_probes,
         &sky,
         clouds.lookup,
-        s.sun.as_ref(),
+        sun,
         s.camera.position,
     )?;
 
@@ -426,13 +234,11 @@ pub fn record<'r>(
             probes: &probes,
             clouds: &clouds,
             lights: scene.lights,
-            light_count: punctual_lights,
-            sun: s.sun.as_ref(),
-            cutoff_lux: crate::techniques::direct_lighting::light_cutoff_lux(
-                s.metered_lux_with_sky(sky.sky_lux),
-            ),
+            light_count: cx.punctual_lights,
+            sun,
+            cutoff_lux: cx.light_cutoff_lux,
             weather: &s.settings.sky.weather,
-            relight_all: camera_cut,
+            relight_all: cx.history.view_changed(),
             camera: s.camera.position,
             sky_light: s.settings.sky.sky,
         },
@@ -445,8 +251,8 @@ pub fn record<'r>(
         scene,
         &mut state.shadow_cache,
         &s.camera,
-        aspect,
-        to_sun,
+        cx.aspect,
+        sun.map_or(glam::Vec3::ZERO, |sun| sun.direction),
         &s.settings.sun_shadows,
         &mut state.raster_queues,
     )?;
@@ -480,10 +286,11 @@ pub fn record<'r>(
         };
         let params = RtGiParams::new(
             &s.settings.ray_traced_gi,
-            g.frame_index(),
-            s.sun.as_ref(),
-            punctual_lights,
-            s.metered_lux_with_sky(sky.sky_lux),
+            cx.frame_index,
+            sun,
+            cx.punctual_lights,
+            cx.metered_lux,
+            cx.light_cutoff_lux,
             sky_source,
         )
         .with_hit_lights(
@@ -517,13 +324,9 @@ pub fn record<'r>(
                 None => Default::default(),
             },
         };
-        let (frame, rays) = t.ray_traced_gi.record(
-            g,
-            &rt_scene,
-            &inputs,
-            state.rtgi_reset || camera_cut || recurrence_changed,
-        )?;
-        state.rtgi_reset = false;
+        let (frame, rays) =
+            t.ray_traced_gi
+                .record(g, &rt_scene, &inputs, !history || recurrence_changed)?;
         ray_traced_gi = Some(frame);
         ray_traced_gi_rays = Some(rays);
     }
@@ -566,9 +369,9 @@ pub fn record<'r>(
     //     sky's SH as ambient light, or the placeholders with the atmosphere off).
     let brdf = t.brdf_tables.binding_set(g);
     let mut lighting = LightingParams::new(
-        s.sun.as_ref(),
-        punctual_lights,
-        s.metered_lux_with_sky(sky.sky_lux),
+        sun,
+        cx.punctual_lights,
+        cx.light_cutoff_lux,
         &s.settings.direct_lighting,
     );
     if sky.enabled {
@@ -587,9 +390,9 @@ pub fn record<'r>(
     let area_params = AreaLightParams::new(
         &s.settings.area_lights,
         area.light_count(),
-        punctual_lights,
-        s.metered_lux_with_sky(sky.sky_lux),
-        g.frame_index(),
+        cx.punctual_lights,
+        cx.light_cutoff_lux,
+        cx.frame_index,
     );
     if area_params.shades_punctual() {
         lighting.skip_punctual();
@@ -610,7 +413,7 @@ pub fn record<'r>(
         Some(t.area_lights.denoiser.record(
             g,
             &view,
-            &ShadowDenoiseParams::new(&s.settings.area_lights, camera_cut),
+            &ShadowDenoiseParams::new(&s.settings.area_lights, !history),
             &ShadowDenoiseInputs {
                 depth: gbuffer.depth,
                 normal: gbuffer.normal,
@@ -649,14 +452,13 @@ pub fn record<'r>(
     //     the local lights, integrated front to back and composited over every pixel. It needs
     //     the atmosphere: the placeholder sky has no SH to light it.
     let haze = if s.settings.haze.enabled && sky.enabled {
-        let metered = s.metered_lux_with_sky(sky.sky_lux);
         let params = HazeParams::new(
             &s.settings.haze,
             &s.settings.sky.weather,
-            s.sun.as_ref().filter(|_| s.settings.direct_lighting.sun),
-            punctual_lights,
-            lighting.cutoff[0],
-            metered,
+            cx.lit_sun(&s.settings),
+            cx.punctual_lights,
+            cx.light_cutoff_lux,
+            cx.metered_lux,
         );
         let frame = t.haze.record(
             g,
@@ -672,7 +474,7 @@ pub fn record<'r>(
                 clouds: clouds.lookup,
                 probes: probes.lookup,
             },
-            !camera_cut,
+            history,
         )?;
         Some((params, frame))
     } else {
@@ -685,17 +487,10 @@ pub fn record<'r>(
     //     the hazed image; the haze-lit ones take the haze's froxel light (the talk's "haze
     //     lighting" for particles).
     if s.settings.particles.enabled && !emitters.is_empty() {
-        let clock = s
-            .settings
-            .sky
-            .date_time()
-            .map_or(0.0, |t| f64::from(t.seconds_of_day()));
-        let mut sprites = particles::sprites(emitters, clock, s.camera.position);
+        let mut sprites = particles::sprites(emitters, cx.clock_s, s.camera.position);
         particles::with_screen_rects(&mut sprites, &view);
-        let sun = s
-            .sun
-            .as_ref()
-            .filter(|_| s.settings.direct_lighting.sun)
+        let sun = cx
+            .lit_sun(&s.settings)
             .map(|sun| (sun.direction, sun.color * sun.illuminance_lux));
         // A sky of `sky_lux` on the ground and a dark ground: about sky_lux / 2 pi on average
         // over the sphere.
@@ -718,9 +513,9 @@ pub fn record<'r>(
     }
 
     // 13. TAA.
-    let hdr = if taa_on {
+    let hdr = if s.settings.taa.enabled {
         t.taa
-            .record(g, hazed, gbuffer.motion, size, &s.settings.taa, !camera_cut)?
+            .record(g, hazed, gbuffer.motion, size, &s.settings.taa, history)?
             .output
     } else {
         hazed
@@ -734,20 +529,8 @@ pub fn record<'r>(
         hdr,
         lit_frame.illuminance,
         size,
-        &ExposureParams::new(
-            &s.settings.exposure,
-            sky.knobs.exposure_bias_ev,
-            s.ev100_with_sky(sky.sky_lux),
-        ),
+        &ExposureParams::new(&s.settings.exposure, sky.knobs.exposure_bias_ev, cx.ev100),
     )?;
-    let sun_elevation_deg = s.sun.as_ref().map_or(f32::NAN, |sun| {
-        sun.direction
-            .normalize_or_zero()
-            .y
-            .clamp(-1.0, 1.0)
-            .asin()
-            .to_degrees()
-    });
     let local_tonemap = t.local_tonemap.record(
         g,
         hdr,
@@ -756,7 +539,7 @@ pub fn record<'r>(
         &s.settings.local_tonemap,
         s.settings
             .local_tonemap
-            .look_for(&s.settings.sky.weather, sun_elevation_deg),
+            .look_for(&s.settings.sky.weather, cx.sun_elevation_deg()),
     )?;
     let ldr = t.tonemap.record(
         g,
@@ -790,10 +573,4 @@ pub fn record<'r>(
         local_tonemap,
         ldr,
     })
-}
-
-/// The camera's position and forward direction, which together tell a cut.
-fn camera_pose(c: &Camera) -> [f32; 6] {
-    let f = c.forward();
-    [c.position.x, c.position.y, c.position.z, f.x, f.y, f.z]
 }

@@ -8,6 +8,7 @@ pub mod checks;
 pub mod context;
 pub mod error;
 pub mod frame;
+pub mod frame_context;
 pub mod graph;
 pub mod layout;
 pub mod output;
@@ -27,7 +28,7 @@ pub mod view;
 
 pub use context::{ContextOptions, GpuContext};
 pub use error::{RenderError, Result};
-pub use frame::FrameSettings;
-pub use renderer::{RenderedFrame, Renderer};
+pub use frame_context::{FrameContext, FrameSettings, HistoryReset, SunSource};
+pub use renderer::{Display, DisplayedFrame, RenderedFrame, Renderer};
 pub use settings::{Preset, Settings};
 pub use wgpu;

@@ -312,6 +312,7 @@ fn samplers_of_integer_textures(module: &naga::Module) -> Vec<naga::Handle<naga:
 fn layout_entries(
     slots: &[BindingSlot],
     visibility: wgpu::ShaderStages,
+    uniforms_as_storage: bool,
 ) -> Vec<wgpu::BindGroupLayoutEntry> {
     slots
         .iter()
@@ -334,7 +335,11 @@ fn layout_entries(
                     view_dimension: *view,
                 },
                 BindingKind::Uniform => wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
+                    ty: if uniforms_as_storage {
+                        wgpu::BufferBindingType::Storage { read_only: true }
+                    } else {
+                        wgpu::BufferBindingType::Uniform
+                    },
                     has_dynamic_offset: false,
                     min_binding_size: None,
                 },
@@ -396,7 +401,7 @@ impl PipelineInfo {
             ctx.device
                 .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                     label: Some(&format!("{label} {what}")),
-                    entries: &layout_entries(slots, visibility),
+                    entries: &layout_entries(slots, visibility, ctx.uniforms_as_storage),
                 })
         };
         let slots = groups.remove(0);
@@ -457,7 +462,27 @@ fn checked_module(
         });
     }
     let groups = reflect_groups(path, &module, &sets)?;
+    let module = if ctx.uniforms_as_storage {
+        uniforms_as_storage(module)
+    } else {
+        module
+    };
     Ok((module, groups, sets))
+}
+
+/// `module` with every uniform buffer declared as a read-only storage buffer instead
+/// ([`GpuContext::uniforms_as_storage`]). WGSL lays out a type the same in both address spaces
+/// (the uniform space only adds alignment rules), so the bytes the graph uploads read alike.
+/// The reflected slots keep saying `Uniform`: the graph's checks are the same on every adapter.
+fn uniforms_as_storage(mut module: naga::Module) -> naga::Module {
+    for (_, var) in module.global_variables.iter_mut() {
+        if var.space == naga::AddressSpace::Uniform {
+            var.space = naga::AddressSpace::Storage {
+                access: naga::StorageAccess::LOAD,
+            };
+        }
+    }
+    module
 }
 
 fn shader_module(ctx: &GpuContext, path: &str, module: naga::Module) -> wgpu::ShaderModule {

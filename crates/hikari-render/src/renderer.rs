@@ -1,10 +1,11 @@
 //! A renderer: a GPU context, the techniques, an uploaded scene, and the frame graph's state.
 
-use hikari_scene::Scene;
+use hikari_scene::{Camera, Scene};
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
-use crate::frame::{self, FrameOutputs, FrameSettings, FrameState, Techniques};
+use crate::frame::{self, FrameOutputs, FrameState, Techniques};
+use crate::frame_context::{FrameContext, FrameSettings, HistoryReset, HistoryValidity, SunSource};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
 use crate::raster::RasterQueues;
 use crate::scene_gpu::SceneGpu;
@@ -16,6 +17,24 @@ pub struct RenderedFrame {
     pub result: FrameResult,
     pub hdr: Option<ImageRgba32>,
     pub ldr: Option<ImageRgba32>,
+}
+
+/// What [`Renderer::frame_into`] writes into the caller's texture.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Display {
+    /// A texture of the frame by its graph name (`gbuffer.normal`: the names `--dump` knows);
+    /// `None`: the final image.
+    pub source: Option<String>,
+    /// How its values are shown; `None`: the mapping that suits its name
+    /// ([`crate::techniques::debug_view::Mapping::for_name`]) at the frame's exposure.
+    pub mapping: Option<crate::techniques::debug_view::Mapping>,
+}
+
+/// A frame written into a caller's texture.
+pub struct DisplayedFrame {
+    pub result: FrameResult,
+    /// The names of the frame's textures that [`Display::source`] can show.
+    pub names: Vec<String>,
 }
 
 /// Frames drawn again at most after their rasteriser queues overflowed; each try grows the
@@ -36,6 +55,14 @@ pub struct Renderer {
     state: FrameState,
     /// Interactive mode: when the last frame began, for the exposure's adaptation.
     interactive_clock: Option<Option<std::time::Instant>>,
+    /// The live frame that [`Renderer::frame`] draws, changed by the setters between frames.
+    live: Option<FrameSettings>,
+    /// The camera pose and size of the last frame rendered, to tell a cut or a resize.
+    last_pose: Option<([f32; 6], [u32; 2])>,
+    /// A reason to drop temporal history that the next frame takes up.
+    pending_reset: Option<HistoryReset>,
+    /// The context of the last frame rendered.
+    last_context: Option<FrameContext>,
 }
 
 /// The longest frame time the exposure adapts over in one step (`exposure.frame_seconds`'s
@@ -57,8 +84,237 @@ impl Renderer {
             scene_source: scene.clone(),
             state: FrameState::default(),
             interactive_clock: None,
+            live: None,
+            last_pose: None,
+            pending_reset: None,
+            last_context: None,
             ctx,
         })
+    }
+
+    /// Replaces the scene: its geometry, materials, lights and BVH are uploaded anew, the
+    /// probe bake and reflection probes are dropped (attach the new scene's with
+    /// [`Renderer::set_probe_bake`] and [`Renderer::set_reflection_probes`]) and the next frame
+    /// starts without temporal history. On an error the old scene stays.
+    pub fn reload_scene(&mut self, scene: &Scene) -> Result<()> {
+        let scene_gpu = SceneGpu::upload(&self.ctx, scene)?;
+        let area_lights = AreaLightScene::new(&self.ctx, scene)?;
+        let scene_rt = SceneRt::new(&self.ctx, scene, &scene_gpu.textures.color)?;
+        self.scene = scene_gpu;
+        self.area_lights = area_lights;
+        self.scene_rt = scene_rt;
+        self.scene_source = scene.clone();
+        self.techniques.irradiance_probes.set_bake(&self.ctx, None);
+        self.techniques
+            .reflection_probes
+            .set_probes(&self.ctx, &[])?;
+        let queues = std::mem::take(&mut self.state.raster_queues);
+        self.state = FrameState {
+            raster_queues: queues,
+            ..FrameState::default()
+        };
+        self.pending_reset = Some(HistoryReset::SceneChange);
+        Ok(())
+    }
+
+    // ---- The live renderer API: set what the next frame shows, then call `frame`. ----
+
+    /// Sets the whole live frame (size, camera, sun source, settings) that [`Renderer::frame`]
+    /// draws; the setters below change parts of it. Validates it first.
+    pub fn set_frame(&mut self, frame: FrameSettings) -> Result<()> {
+        self.validate(&frame)?;
+        if let Some(old) = &self.live
+            && old.settings.switches() != frame.settings.switches()
+        {
+            self.pending_reset
+                .get_or_insert(HistoryReset::SettingsChange);
+        }
+        self.live = Some(frame);
+        Ok(())
+    }
+
+    /// The live frame, once [`Renderer::set_frame`] has given one.
+    pub fn live_frame(&self) -> Option<&FrameSettings> {
+        self.live.as_ref()
+    }
+
+    fn live_mut(&mut self) -> Result<&mut FrameSettings> {
+        self.live.as_mut().ok_or_else(|| {
+            RenderError::Graph("the live frame is not set: call Renderer::set_frame first".into())
+        })
+    }
+
+    /// Changes the live frame with `change`, keeping the old one if the result is not valid.
+    fn change_live(&mut self, change: impl FnOnce(&mut FrameSettings)) -> Result<()> {
+        let mut next = self.live_mut()?.clone();
+        change(&mut next);
+        self.set_frame(next)
+    }
+
+    /// Sets every settings field at once. A technique switched on or off drops the temporal
+    /// history; any other change keeps it, so that the image follows the change smoothly.
+    pub fn set_settings(&mut self, settings: crate::Settings) -> Result<()> {
+        self.change_live(|f| f.settings = settings)
+    }
+
+    /// Sets the sky's clock: local date `YYYY-MM-DD` and time `HH:MM[:SS]`. The sun or moon,
+    /// sky, clouds, probes and haze follow from the next frame on, temporal history kept.
+    pub fn set_clock(&mut self, date: &str, time: &str) -> Result<()> {
+        self.change_live(|f| {
+            f.settings.sky.date = date.into();
+            f.settings.sky.time = time.into();
+        })
+    }
+
+    /// Sets the local time of day in seconds after midnight (wrapped into one day, to the
+    /// nearest second), keeping the date.
+    pub fn set_time_of_day(&mut self, seconds: f64) -> Result<()> {
+        if !seconds.is_finite() {
+            return Err(crate::settings::SettingError {
+                field: "sky.time".into(),
+                value: seconds.to_string(),
+                allowed: "a finite number of seconds".into(),
+            }
+            .into());
+        }
+        let s = (seconds.rem_euclid(86_400.0).round() as u32) % 86_400;
+        let time = format!("{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60);
+        self.change_live(|f| f.settings.sky.time = time)
+    }
+
+    /// Sets the place: latitude and longitude in degrees, the local time's UTC offset in hours.
+    pub fn set_place(
+        &mut self,
+        latitude_deg: f64,
+        longitude_deg: f64,
+        utc_offset_h: f64,
+    ) -> Result<()> {
+        self.change_live(|f| {
+            let sky = &mut f.settings.sky;
+            sky.latitude_deg = latitude_deg;
+            sky.longitude_deg = longitude_deg;
+            sky.utc_offset_h = utc_offset_h;
+        })
+    }
+
+    /// Sets the weather preset (`clear`, `hazy`, `overcast`); the atmosphere's tables are
+    /// rebuilt once for it.
+    pub fn set_weather(&mut self, weather: &str) -> Result<()> {
+        self.change_live(|f| f.settings.sky.weather = weather.into())
+    }
+
+    /// Sets where the directional light comes from.
+    pub fn set_sun_source(&mut self, sun: SunSource) -> Result<()> {
+        self.change_live(|f| f.sun = sun)
+    }
+
+    /// Moves the camera. Moving (`cut` false) keeps the temporal history, reprojected by the
+    /// motion from the last frame's camera; a cut (a jump to another view) drops it.
+    pub fn set_camera(&mut self, camera: Camera, cut: bool) -> Result<()> {
+        let f = self.live_mut()?;
+        let old = std::mem::replace(&mut f.camera, camera);
+        if cut {
+            f.prev_camera = None;
+        } else if f.prev_camera.is_none() {
+            f.prev_camera = Some(old);
+        }
+        let next = f.clone();
+        if let Err(e) = self.validate(&next) {
+            let f = self.live_mut()?;
+            f.camera = f.prev_camera.take().unwrap_or_else(|| f.camera.clone());
+            return Err(e);
+        }
+        if cut {
+            self.pending_reset.get_or_insert(HistoryReset::CameraCut);
+        }
+        Ok(())
+    }
+
+    /// Sets the output size; the frame's textures are reallocated and history restarts.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        self.change_live(|f| {
+            f.width = width;
+            f.height = height;
+        })
+    }
+
+    /// Renders the live frame ([`Renderer::set_frame`] and the setters), reading the images
+    /// back with `read_images`.
+    pub fn frame(&mut self, read_images: bool) -> Result<RenderedFrame> {
+        let f = self.live_mut()?.clone();
+        let out = self.render(&f, read_images)?;
+        // The camera shown becomes the one the next frame's motion starts from.
+        self.live_mut()?.prev_camera = None;
+        Ok(out)
+    }
+
+    /// The frame context of the last frame rendered: its sun or moon, metered light, history
+    /// validity and why, for viewers and tests.
+    pub fn last_context(&self) -> Option<&FrameContext> {
+        self.last_context.as_ref()
+    }
+
+    /// The directional light the live frame resolves to (the sun or the moon for the sky's
+    /// clock, a fixed sun, or none).
+    pub fn live_sun(&self) -> Result<Option<hikari_scene::Sun>> {
+        match &self.live {
+            Some(f) => f.directional_light(),
+            None => Ok(None),
+        }
+    }
+
+    /// Checks a frame's settings, size and cameras before anything is recorded; the error
+    /// names the field, the limit or the camera.
+    pub fn validate(&self, settings: &FrameSettings) -> Result<()> {
+        settings.settings.validate()?;
+        let limit = self.ctx.limits.max_texture_dimension_2d;
+        for (what, v) in [("width", settings.width), ("height", settings.height)] {
+            if v == 0 || v > limit {
+                return Err(RenderError::Limit {
+                    what: format!("image {what}"),
+                    requested: v as u64,
+                    limit: limit as u64,
+                });
+            }
+        }
+        let invalid = |what: &str, source: hikari_scene::SceneError| RenderError::Scene {
+            what: what.into(),
+            source,
+        };
+        settings
+            .camera
+            .validate()
+            .and_then(|()| {
+                settings
+                    .camera
+                    .validate_projection(settings.width as f32 / settings.height.max(1) as f32)
+            })
+            .map_err(|e| invalid("camera", e))?;
+        if let Some(prev) = &settings.prev_camera {
+            prev.validate().map_err(|e| invalid("previous camera", e))?;
+        }
+        if let SunSource::Fixed(sun) = &settings.sun {
+            sun.validate().map_err(|e| invalid("sun", e))?;
+        }
+        Ok(())
+    }
+
+    /// Why the next frame of `settings` may not use the history, if it may not: a reason
+    /// given by a setter, the first frame, a new size, or a camera that moved while claiming
+    /// it did not (a cut).
+    fn history_for(&mut self, settings: &FrameSettings) -> HistoryValidity {
+        let size = [settings.width, settings.height];
+        let pose = camera_pose(&settings.camera);
+        let reset = self.pending_reset.take().or(match self.last_pose {
+            None => Some(HistoryReset::FirstFrame),
+            Some((_, s)) if s != size => Some(HistoryReset::Resize),
+            Some((p, _)) if settings.prev_camera.is_none() && p != pose => {
+                Some(HistoryReset::CameraCut)
+            }
+            _ => None,
+        });
+        self.last_pose = Some((pose, size));
+        HistoryValidity { reset }
     }
 
     /// Uses `bake`'s irradiance probes from the next frame on (`None`: none, the sky's SH
@@ -108,15 +364,18 @@ impl Renderer {
         &mut self.state.raster_queues
     }
 
-    /// Drops temporal history next frame (a camera cut).
+    /// Drops temporal history next frame (a camera cut), in every temporal pass.
     pub fn cut_camera(&mut self) {
-        self.state.rtgi_reset = true;
+        self.pending_reset.get_or_insert(HistoryReset::CameraCut);
     }
 
     /// Tests only: overwrites these G-buffer texels in every following frame, right after the
     /// G-buffer pass (bad input for the passes that read it); an empty list stops it. A
     /// rectangle outside the image or a texel of the wrong size makes the frame an error.
-    pub fn override_gbuffer_texels(&mut self, texels: Vec<crate::frame::GBufferTexel>) {
+    pub fn override_gbuffer_texels(
+        &mut self,
+        texels: Vec<crate::techniques::gbuffer::overrides::GBufferTexel>,
+    ) {
         self.state.gbuffer_overrides = texels;
     }
 
@@ -164,7 +423,63 @@ impl Renderer {
     pub fn render_reading(
         &mut self,
         settings: &FrameSettings,
+        pick: impl FnMut(&FrameOutputs) -> Vec<Res>,
+    ) -> Result<FrameResult> {
+        self.render_with(settings, pick, |_, _, _, _| Ok(()))
+    }
+
+    /// Renders the live frame ([`Renderer::set_frame`]) and writes what `display` names into
+    /// `target`, a texture of [`crate::techniques::debug_view::TARGET_FORMAT`] with
+    /// `STORAGE_BINDING` usage that the caller owns (a window's picture), at its size. Nothing
+    /// is read back: with [`Renderer::set_interactive`] no frame waits for the GPU.
+    pub fn frame_into(
+        &mut self,
+        target: &wgpu::Texture,
+        display: &Display,
+    ) -> Result<DisplayedFrame> {
+        let f = self.live_mut()?.clone();
+        let mut names = Vec::new();
+        let result = self.render_with(
+            &f,
+            |_| vec![],
+            |g, t, cx, out| {
+                let to = g.import_texture("debug_view.target", target);
+                let (source, mapping) = match &display.source {
+                    None => (out.ldr, crate::techniques::debug_view::Mapping::Raw),
+                    Some(name) => {
+                        let tex = g.find_written_texture(name).ok_or_else(|| {
+                            RenderError::Graph(format!(
+                                "display: no texture `{name}` in this frame; there are: {}",
+                                g.written_texture_names().join(", ")
+                            ))
+                        })?;
+                        let mapping = display.mapping.unwrap_or_else(|| {
+                            crate::techniques::debug_view::Mapping::for_name(name, cx.ev100)
+                        });
+                        (tex, mapping)
+                    }
+                };
+                t.debug_view.record(g, source, &mapping, to)?;
+                names = g.written_texture_names();
+                Ok(())
+            },
+        )?;
+        self.live_mut()?.prev_camera = None;
+        Ok(DisplayedFrame { result, names })
+    }
+
+    /// [`Renderer::render_reading`], with `finish` recording passes after the frame's own
+    /// (the window's picture) from its outputs.
+    fn render_with(
+        &mut self,
+        settings: &FrameSettings,
         mut pick: impl FnMut(&FrameOutputs) -> Vec<Res>,
+        mut finish: impl for<'r> FnMut(
+            &mut crate::graph::FrameGraph<'r>,
+            &'r Techniques,
+            &FrameContext,
+            &FrameOutputs,
+        ) -> Result<()>,
     ) -> Result<FrameResult> {
         let timed;
         let settings = match &mut self.interactive_clock {
@@ -179,37 +494,7 @@ impl Renderer {
             }
             _ => settings,
         };
-        settings
-            .settings
-            .validate()
-            .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
-        let limit = self.ctx.limits.max_texture_dimension_2d;
-        for (what, v) in [("width", settings.width), ("height", settings.height)] {
-            if v == 0 || v > limit {
-                return Err(RenderError::Limit {
-                    what: format!("image {what}"),
-                    requested: v as u64,
-                    limit: limit as u64,
-                });
-            }
-        }
-        let invalid =
-            |what: &str, e: hikari_scene::SceneError| RenderError::Graph(format!("{what}: {e}"));
-        settings
-            .camera
-            .validate()
-            .and_then(|()| {
-                settings
-                    .camera
-                    .validate_projection(settings.width as f32 / settings.height.max(1) as f32)
-            })
-            .map_err(|e| invalid("camera", e))?;
-        if let Some(prev) = &settings.prev_camera {
-            prev.validate().map_err(|e| invalid("previous camera", e))?;
-        }
-        if let Some(sun) = &settings.sun {
-            sun.validate().map_err(|e| invalid("sun", e))?;
-        }
+        self.validate(settings)?;
         if settings.settings.ray_traced_gi.enabled && self.state.rtgi_scene.is_none() {
             let rtgi =
                 crate::techniques::ray_traced_gi::RtGiScene::new(&self.ctx, &self.scene_source)?;
@@ -250,6 +535,14 @@ impl Renderer {
         }
         log::info!("{}", self.scene_rt.last_stats().unwrap_or(stats).summary());
         let binding_limit = self.ctx.limits.max_storage_buffer_binding_size;
+        // 0. The frame context: this frame's facts, resolved once.
+        let history = self.history_for(settings);
+        let cx = FrameContext::new(
+            settings,
+            self.runtime.frame_index(),
+            self.scene.light_count,
+            history,
+        )?;
         for _ in 0..MAX_QUEUE_RETRIES {
             let mut g = self.runtime.begin_frame(&self.ctx);
             let out = frame::record(
@@ -258,9 +551,11 @@ impl Renderer {
                 &self.scene,
                 &self.area_lights,
                 &self.scene_rt,
+                &cx,
                 settings,
                 &mut self.state,
             )?;
+            finish(&mut g, &self.techniques, &cx, &out)?;
             for r in pick(&out) {
                 g.readback(r);
             }
@@ -279,6 +574,7 @@ impl Renderer {
             // Interactive frames (the runtime does not wait for their counts) are shown as drawn.
             if !overflowed || !self.runtime.waits_for_readbacks() {
                 self.runtime.commit_frame();
+                self.last_context = Some(cx);
                 return Ok(result);
             }
             self.runtime.discard_frame();
@@ -287,4 +583,10 @@ impl Renderer {
             "the rasteriser's queues still overflowed after {MAX_QUEUE_RETRIES} tries"
         )))
     }
+}
+
+/// The camera's position and forward direction, which together tell a cut.
+fn camera_pose(c: &Camera) -> [f32; 6] {
+    let f = c.forward();
+    [c.position.x, c.position.y, c.position.z, f.x, f.y, f.z]
 }

@@ -183,6 +183,18 @@ macro_rules! register_settings {
                 Ok(())
             }
 
+            /// Each technique's `enabled` switch, `(technique, on)`, in registration order
+            /// (techniques without one are left out).
+            pub fn switches(&self) -> Vec<(&'static str, bool)> {
+                let mut out = Vec::new();
+                $(if let Ok(toml::Value::Table(t)) = toml::Value::try_from(&self.$name)
+                    && let Some(toml::Value::Boolean(on)) = t.get("enabled")
+                {
+                    out.push((stringify!($name), *on));
+                })*
+                out
+            }
+
             /// Every bounded field as `table.key` with its range, for documentation and tests.
             pub fn fields() -> Vec<(String, Range)> {
                 let mut out = Vec::new();

@@ -151,11 +151,14 @@ fn render(scene: &Scene, settings: FrameSettings) -> (Renderer, Frame) {
         })
         .unwrap();
     let mut img = |n: &str| r.take_image(n).unwrap();
+    // The frame took its cut-off from the frame context, whose sky is the frame's.
+    let cx = settings.context().unwrap();
+    assert_eq!(cx.sky_lux, sky_lux);
     let params = AreaLightParams::new(
         &settings.settings.area_lights,
         renderer.area_lights().light_count(),
         renderer.scene().light_count,
-        settings.metered_lux_with_sky(sky_lux),
+        cx.light_cutoff_lux,
         0,
     );
     let frame = Frame {
@@ -190,7 +193,7 @@ fn world_at(f: &Frame, x: u32, y: u32) -> Vec3 {
 fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
     let scene = hikari_scene::builtin::cornell();
     let mut settings = common::small_frame_settings(&scene, 64, 64);
-    settings.sun = None;
+    settings.sun = hikari_render::SunSource::Off;
     let (renderer, f) = render(&scene, settings);
     assert!(f.params.config[1] & area_lights::AREA_POLYGONS != 0);
     let lights = &renderer.area_lights().lights;
@@ -480,7 +483,7 @@ fn cornell_box_direct_light_matches_mitsuba() {
     assert_eq!((mw, mh), (64, 64));
     let scene = hikari_scene::builtin::cornell();
     let mut settings = common::small_frame_settings(&scene, 64, 64);
-    settings.sun = None;
+    settings.sun = hikari_render::SunSource::Off;
     let ctx = common::gpu_context();
     let mut renderer = Renderer::new(ctx, &scene).unwrap();
     let frames = 8;
@@ -825,7 +828,7 @@ fn village_at_night_gpu_matches_its_twin_within_the_ray_budget() {
         .find(|c| c.name == "night_street")
         .expect("the village has a night_street camera")
         .clone();
-    settings.sun = None;
+    settings.sun = hikari_render::SunSource::Off;
     let budget = settings.settings.area_lights.ray_budget;
     let (renderer, f) = render(&village, settings);
     assert!(

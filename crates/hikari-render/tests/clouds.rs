@@ -274,7 +274,7 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
         // sun differ from this one only by what is compared (tests/sky.rs holds the SH).
         s.settings.clouds.ambient = false;
         s.settings.direct_lighting.sun = sun_on;
-        s.sun = sky::lights::directional_light(&s.settings.sky).unwrap();
+        s.sun = hikari_render::SunSource::Sky;
         // Raise the view so that it holds the sky over the boxes and their ground.
         let f = (s.camera.target - s.camera.position).normalize();
         s.camera.target = s.camera.position + f + Vec3::new(0.0, 0.35, 0.0);
@@ -307,7 +307,7 @@ fn the_deferred_lighting_draws_and_shadows_with_the_clouds_as_the_twin() {
     let (lit_on, lux_on, depth, map, sh) = run(&on);
     let (lit_off, lux_off, _, _, _) = run(&frame(false, true));
     let (_, lux_dark, _, _, _) = run(&frame(true, false));
-    let sun = on.sun.clone().unwrap();
+    let sun = on.directional_light().unwrap().unwrap();
     let params = CloudParams::new(&on.settings.clouds, "clear", Some(&sun), 36_000.0, true)
         .with_shadow_map(
             on.settings.clouds.shadow_map_size,

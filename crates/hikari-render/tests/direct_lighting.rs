@@ -102,10 +102,15 @@ fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> 
         img("direct_lighting.radiance"),
     );
     let cpu = &renderer.scene().cpu;
+    let cx = settings.context().unwrap();
+    assert_eq!(
+        cx.sky_lux, sky_lux,
+        "the frame's sky is the frame context's"
+    );
     let mut params = LightingParams::new(
-        settings.sun.as_ref(),
+        cx.sun.as_ref(),
         cpu.lights.len() as u32,
-        settings.metered_lux_with_sky(sky_lux),
+        cx.light_cutoff_lux,
         &settings.settings.direct_lighting,
     );
     assert_eq!(sky_enabled, settings.settings.sky.enabled);
@@ -136,8 +141,7 @@ fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> 
             balance: {
                 // The weather's knobs at this frame's sun elevation, as the frame takes them.
                 let sky_settings = &settings.settings.sky;
-                let lights = sky::frame_lights(sky_settings, settings.sun.as_ref()).unwrap();
-                let k = sky::frame_knobs(sky_settings, &lights);
+                let k = cx.sky.as_ref().unwrap().knobs;
                 debug_assert_eq!(weather.name, sky_settings.weather);
                 [k.ambient_diffuse, k.ambient_specular]
             },
@@ -146,7 +150,7 @@ fn render_and_compare(scene: &hikari_scene::Scene, settings: &FrameSettings) -> 
         }
     });
 
-    let sun = settings.sun.clone().unwrap();
+    let sun = cx.sun.clone().unwrap();
     let cascades = sun_shadows::fit_cascades(
         &settings.camera,
         w as f32 / h as f32,
@@ -286,7 +290,7 @@ fn direct_lighting_with_the_sky_matches_its_cpu_twin() {
         settings.settings.clouds.enabled = false;
         settings.settings.sky.table_quality = 0;
         settings.settings.sky.time = time.into();
-        settings.sun = sky::lights::directional_light(&settings.settings.sky).unwrap();
+        settings.sun = hikari_render::SunSource::Sky;
         let (w, h) = (settings.width, settings.height);
         let c = render_and_compare(&scene, &settings);
         assert!(

@@ -97,14 +97,14 @@ fn non_finite_cameras_suns_and_lights_are_clear_errors() {
     assert!(err(renderer.render(&s, false)).contains("vfov"));
 
     let mut s = good.clone();
-    if let Some(sun) = s.sun.as_mut() {
+    if let hikari_render::SunSource::Fixed(sun) = &mut s.sun {
         sun.direction = glam::Vec3::new(f32::NAN, 1.0, 0.0);
     }
     let e = err(renderer.render(&s, false));
     assert!(e.contains("sun") && e.contains("direction"), "{e}");
 
     let mut s = good.clone();
-    if let Some(sun) = s.sun.as_mut() {
+    if let hikari_render::SunSource::Fixed(sun) = &mut s.sun {
         sun.illuminance_lux = f32::INFINITY;
     }
     assert!(err(renderer.render(&s, false)).contains("illuminance"));

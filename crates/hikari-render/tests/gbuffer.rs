@@ -289,7 +289,7 @@ fn resolve_against_twin(scene: &Scene, w: u32, h: u32) -> Vec<usize> {
         height: h,
         camera,
         prev_camera: Some(prev.clone()),
-        sun: scene.sun.clone(),
+        sun: scene.sun.clone().into(),
         settings: Settings {
             // The G-buffer does not depend on the sky: skip the atmosphere's table build.
             sky: hikari_render::settings::SkySettings {

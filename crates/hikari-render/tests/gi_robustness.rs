@@ -7,8 +7,8 @@
 mod common;
 
 use glam::{Mat4, Vec3, Vec4};
-use hikari_render::frame::{GBufferTarget, GBufferTexel};
 use hikari_render::graph::ImageRgba32;
+use hikari_render::techniques::gbuffer::overrides::{GBufferTarget, GBufferTexel};
 use hikari_render::techniques::ray_traced_gi::reference::world_from_depth;
 use hikari_render::view::View;
 use hikari_render::{FrameSettings, Renderer};

@@ -49,7 +49,7 @@ fn read_pfm(bytes: &[u8]) -> (u32, u32, Vec<[f32; 3]>) {
 fn cornell_settings(w: u32, h: u32) -> FrameSettings {
     let scene = hikari_scene::builtin::cornell();
     let mut s = common::small_frame_settings(&scene, w, h);
-    s.sun = None;
+    s.sun = hikari_render::SunSource::Off;
     s.settings.sky.sun = false;
     s.settings.sky.sky = false;
     s.settings.direct_lighting.placeholder_ambient = false;

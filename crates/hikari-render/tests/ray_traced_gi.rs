@@ -252,7 +252,7 @@ fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
         max_history: 3,
         ..RayTracedGiSettings::default()
     };
-    let mut base = RtGiParams::new(&settings, 0, None, 0, 1000.0, SkySource::None);
+    let mut base = RtGiParams::new(&settings, 0, None, 0, 1000.0, 0.1, SkySource::None);
     assert_ne!(base.flags() & FLAG_ACCUMULATE, 0);
     // A firefly clamp tight enough to act on these random samples from 2 frames of history
     // on, so that its 3x3 scale is compared too (reprojected, at the image's edges, beside
@@ -537,7 +537,7 @@ fn rtgi_settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
 /// tests of their own).
 fn twin_settings(scene: &Scene, w: u32, h: u32) -> FrameSettings {
     let mut s = rtgi_settings(scene, w, h);
-    s.sun = None;
+    s.sun = hikari_render::SunSource::Off;
     s.settings.ray_traced_gi.accumulate = false;
     s.settings.ray_traced_gi.hit_shadow_roulette = 0.0;
     s.settings.ray_traced_gi.hit_radiance_cap = 0.0;
@@ -905,7 +905,7 @@ fn hits_are_lit_like_the_twin() {
     } = render(&mut renderer, &s);
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
-    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let cutoff = s.context().unwrap().light_cutoff_lux;
     let mut lit = 0;
     let mut off = 0;
     for y in 0..h {
@@ -1172,7 +1172,7 @@ fn point_lights_at_hits(roulette: f32) {
     s.settings.ray_traced_gi.pretrace = false;
     s.settings.ray_traced_gi.hit_shadow_roulette = roulette;
     s.settings.exposure.ev100 = Some(0.0);
-    let level = roulette * s.metered_lux();
+    let level = roulette * s.context().unwrap().metered_lux;
     let (mut skipped, mut traced) = (0, 0);
     assert!(s.settings.area_lights.enabled && s.settings.area_lights.punctual_shadows);
     let mut renderer = Renderer::new(common::gpu_context(), &scene).unwrap();
@@ -1188,7 +1188,7 @@ fn point_lights_at_hits(roulette: f32) {
 
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
-    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let cutoff = s.context().unwrap().light_cutoff_lux;
     let in_board =
         |q: Vec3| (q.x - board_at.x).abs() < board_half && (q.z - board_at.z).abs() < board_half;
     // The hits' normal face the rays, which all go up here.
@@ -1362,7 +1362,7 @@ fn a_hit_beside_a_lamp_is_capped_relative_to_the_last_exposure() {
     };
     let (w, h) = (64u32, 64u32);
     let mut s = rtgi_settings(&scene, w, h);
-    s.sun = None;
+    s.sun = hikari_render::SunSource::Off;
     s.settings.ray_traced_gi.accumulate = false;
     s.settings.ray_traced_gi.pretrace = false;
     s.settings.ray_traced_gi.reuse_lit = false;
@@ -1375,14 +1375,14 @@ fn a_hit_beside_a_lamp_is_capped_relative_to_the_last_exposure() {
     let light = renderer.scene().cpu.lights[0];
     let view = View::new(&s.camera, w, h);
     let inv_vp = Mat4::from_cols_array_2d(&view.inv_view_proj);
-    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let cutoff = s.context().unwrap().light_cutoff_lux;
     let down = reference::oct_decode(
         reference::unpack_normal(reference::pack_normal(reference::oct_encode(Vec3::NEG_Y)))
             .unwrap(),
     );
     let lum = |c: Vec3| c.dot(Vec3::new(0.2126, 0.7152, 0.0722));
     // The first frame's EV100: the CPU meter's (`FrameSettings::ev100`), no history.
-    let mut ev100 = s.ev100();
+    let mut ev100 = s.context().unwrap().ev100;
     assert!((ev100 - (1e-3f32 * 0.4).log2()).abs() < 1e-5, "{ev100}");
     for frame in 0..2u32 {
         // No cap without a last exposure (0: none).
@@ -1652,7 +1652,7 @@ fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
             firefly_clamp: k,
             ..RayTracedGiSettings::default()
         };
-        let base = RtGiParams::new(&settings, 0, None, 0, metered_lux, SkySource::None);
+        let base = RtGiParams::new(&settings, 0, None, 0, metered_lux, 0.1, SkySource::None);
         let mut rt = GraphRuntime::new();
         let mut depth = vec![0f32; n];
         let mut motion = vec![[0f32; 4]; n];
@@ -2150,7 +2150,7 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
         ..
     } = render(&mut renderer, &s);
     // The grid the frame used: several cells, each listing a small part of the lights.
-    let cutoff = (s.metered_lux() * 1e-4).max(0.01);
+    let cutoff = s.context().unwrap().light_cutoff_lux;
     let grid = light_grid::LightGrid::build(
         &area.lights,
         &light_grid::punctual_records(&scene),
@@ -2394,7 +2394,7 @@ fn misses_and_hits_see_the_clouds_like_the_twin() {
         // SH with the clouds.
         s.settings.clouds.ambient = false;
         s.settings.ray_traced_gi.sun = gi_sun;
-        s.sun = Some(sun.clone());
+        s.sun = hikari_render::SunSource::Fixed(sun.clone());
         s
     };
     struct Out {

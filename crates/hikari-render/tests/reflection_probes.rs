@@ -273,7 +273,7 @@ const H: u32 = 48;
 
 fn settings(scene: &Scene, samples: u32) -> FrameSettings {
     let mut s = common::small_frame_settings(scene, W, H);
-    s.sun = None;
+    s.sun = hikari_render::SunSource::Off;
     s.settings.sky.enabled = true;
     s.settings.sky.sky = false;
     s.settings.sky.table_quality = 0;
@@ -432,7 +432,7 @@ fn a_lamp_lit_probe_is_normalised_by_the_lamp_at_the_surface() {
     let params = hikari_render::techniques::direct_lighting::LightingParams::new(
         None,
         1,
-        s.metered_lux(),
+        s.context().unwrap().light_cutoff_lux,
         &s.settings.direct_lighting,
     );
     let light = hikari_render::scene_gpu::LightGpu {
@@ -480,7 +480,7 @@ fn the_relit_cube_maps_are_the_twins_relighting_of_what_was_captured() {
     s.settings.sky.sky = false;
     s.settings.sky.table_quality = 0;
     s.settings.sky.time = "10:00".into();
-    s.sun = hikari_render::techniques::sky::lights::directional_light(&s.settings.sky).unwrap();
+    s.sun = hikari_render::SunSource::Sky;
     s.settings.area_lights.enabled = false;
     let n = 32;
     s.settings.reflection_probes.resolution = n;
@@ -511,7 +511,7 @@ fn the_relit_cube_maps_are_the_twins_relighting_of_what_was_captured() {
     assert_eq!(radiance.height, 6 * n);
     let depth =
         |layer: usize, x: i32, y: i32| normal_depth.pixel(x as u32, layer as u32 * n + y as u32)[2];
-    let sun = s.sun.clone().unwrap();
+    let sun = s.directional_light().unwrap().unwrap();
     let light = twin::RelightLight {
         sun: Some((sun.direction, sun.color * sun.illuminance_lux)),
         shadow: Some((2, &depth)),
@@ -619,7 +619,7 @@ fn the_wgsl_cube_and_cone_math_is_its_twin() {
 
 #[test]
 fn non_finite_input_stays_out_of_the_reflections() {
-    use hikari_render::frame::{GBufferTarget, GBufferTexel};
+    use hikari_render::techniques::gbuffer::overrides::{GBufferTarget, GBufferTexel};
     let scene = room(metal_floor(0.3, Vec3::ZERO), &WALLS);
     let s = settings(&scene, 8);
     let mut r = Renderer::new(common::gpu_context(), &scene).unwrap();
@@ -723,7 +723,7 @@ fn only_probes_near_the_camera_are_captured_and_relit() {
         .map(|deg| {
             let a = deg.to_radians();
             let mut f = s.clone();
-            f.sun = Some(hikari_scene::Sun {
+            f.sun = hikari_render::SunSource::Fixed(hikari_scene::Sun {
                 direction: Vec3::new(a.cos(), a.sin(), 0.0),
                 illuminance_lux: 1000.0,
                 color: Vec3::ONE,

@@ -15,7 +15,7 @@ use hikari_render::graph::GraphRuntime;
 use hikari_render::pipeline::ComputePipeline;
 use hikari_render::shader::{self, ShaderLibrary};
 use hikari_render::techniques::gbuffer;
-use hikari_render::techniques::sky::{self, SkyParams, lights, reference::SkyTwin};
+use hikari_render::techniques::sky::{self, SkyParams, reference::SkyTwin};
 use hikari_render::wgpu::{self, util::DeviceExt};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
@@ -26,7 +26,7 @@ fn frame(time: &str, w: u32, h: u32) -> (hikari_scene::Scene, hikari_render::Fra
     s.settings.sky.enabled = true;
     s.settings.sky.table_quality = 0;
     s.settings.sky.time = time.into();
-    s.sun = lights::directional_light(&s.settings.sky).unwrap();
+    s.sun = hikari_render::SunSource::Sky;
     // Look up and across, so most of the image is sky.
     let c = &mut s.camera;
     c.target = c.position + Vec3::new(0.3, 0.35, 1.0).normalize();
@@ -80,7 +80,7 @@ fn sky_pixels_and_sky_sh_match_the_cpu_twin_morning_and_night() {
         let weather = s.settings.sky.weather().unwrap();
         let atmosphere =
             sky::atmosphere_for(&weather.atmosphere(), s.settings.sky.table_sizes()).unwrap();
-        let l = sky::frame_lights(&s.settings.sky, s.sun.as_ref()).unwrap();
+        let l = s.context().unwrap().sky.unwrap().lights;
         let want_params = SkyParams::new(&atmosphere, &l, &s.settings.sky, got.params.shell[3]);
         assert_eq!(
             got.params, want_params,
@@ -198,7 +198,7 @@ fn the_frames_twilight_sky_follows_the_cpu_model() {
         // A scene's own sun (not the ephemeris's), which the sky follows; the moon goes.
         let z = zenith_deg.to_radians();
         let sun_dir = Vec3::new(0.3 * z.sin(), z.cos(), z.sin()).normalize();
-        s.sun = Some(hikari_scene::Sun {
+        s.sun = hikari_render::SunSource::Fixed(hikari_scene::Sun {
             direction: sun_dir,
             illuminance_lux: 1000.0,
             color: Vec3::ONE,
@@ -739,7 +739,7 @@ fn the_sky_sh_sees_the_clouds_like_the_twin() {
         sky::atmosphere_for(&weather.atmosphere(), s.settings.sky.table_sizes()).unwrap();
     let twin = SkyTwin::new(&atmosphere, params);
     let (clear_raw, clear) = twin.sh();
-    let sun = s.sun.clone().unwrap();
+    let sun = s.directional_light().unwrap().unwrap();
     let cp = CloudParams::new(&s.settings.clouds, "clear", Some(&sun), 36_000.0, true);
     let mean = clear.coeffs[0] * hikari_math::sh::basis::C0 as f32;
     let sun_lux = sun.color * sun.illuminance_lux;

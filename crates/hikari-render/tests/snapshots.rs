@@ -166,11 +166,15 @@ fn render(shot: &Shot) -> Vec<u8> {
         scene.camera(c).unwrap().clone()
     });
     // A time: the sun or moon of that time on the sky settings' default date and place.
-    let sun = shot.time.map_or(scene.sun.clone(), |t| {
-        let mut sky = shot.settings.sky.clone();
-        sky.time = t.into();
-        hikari_render::techniques::sky::lights::directional_light(&sky).unwrap()
-    });
+    // As a fixed light: the sky is drawn for its direction and the settings' clock stays.
+    let sun = shot
+        .time
+        .map_or(scene.sun.clone(), |t| {
+            let mut sky = shot.settings.sky.clone();
+            sky.time = t.into();
+            hikari_render::techniques::sky::lights::directional_light(&sky).unwrap()
+        })
+        .into();
     let s = FrameSettings {
         width: SIZE.0,
         height: SIZE.1,

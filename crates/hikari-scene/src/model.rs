@@ -335,7 +335,7 @@ impl Camera {
 }
 
 /// The sun (or moon) as a directional light.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Sun {
     /// Unit vector from the scene towards the sun.
     pub direction: Vec3,

@@ -40,6 +40,12 @@ pub struct BenchFrameArgs {
     /// the refit budget) as in a running game; 0 keeps the time still.
     #[arg(long, default_value_t = 0.0)]
     pub time_step: f32,
+    /// Move the sky's clock this many seconds every frame (through the live renderer API,
+    /// as `timelapse` and the viewer do), so that the sun, sky, clouds, probes and haze follow
+    /// a moving light; 0 keeps the clock still. Compare with a still clock to see what a
+    /// clock change costs.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub clock_step: f64,
 }
 
 pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
@@ -54,6 +60,11 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         "--time-step {} is outside -10 to 10 seconds a frame",
         a.time_step
     );
+    anyhow::ensure!(
+        a.clock_step.is_finite() && a.clock_step.abs() <= 3600.0,
+        "--clock-step {} is outside -3600 to 3600 seconds a frame",
+        a.clock_step
+    );
     let ResolvedFrame {
         scene,
         mut settings,
@@ -62,12 +73,17 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
     // What runs, stated before the (possibly long) run, from what was resolved rather than
     // from the flags alone: a config file can name the scene, camera, time and size too.
     let header = format!(
-        "bench frame: {}, {} frames after {} warm-up{}",
+        "bench frame: {}, {} frames after {} warm-up{}{}",
         description.line(),
         a.frames,
         a.warmup,
         if a.dolly != 0.0 {
             format!(", dolly {} m a frame", a.dolly)
+        } else {
+            String::new()
+        },
+        if a.clock_step != 0.0 {
+            format!(", clock {} s a frame", a.clock_step)
         } else {
             String::new()
         }
@@ -88,12 +104,19 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         TimestampMode::Pass
     });
     let setup_ms = ms(t0.elapsed());
+    renderer.set_frame(settings.clone())?;
+    let clock = settings
+        .settings
+        .sky
+        .date_time()
+        .map(|t| f64::from(t.seconds_of_day()))
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
     for _ in 0..a.warmup {
-        renderer.render(&settings, false)?;
+        renderer.frame(false)?;
     }
     let mut timings = FrameTimings::default();
     let mut bvh = BvhUpdates::default();
-    for _ in 0..a.frames {
+    for i in 0..a.frames {
         if a.dolly != 0.0 {
             let step = settings.camera.forward() * a.dolly;
             settings.prev_camera = Some(settings.camera.clone());
@@ -104,7 +127,14 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             let t = settings.settings.scene_rt.time_s.unwrap_or(0.0);
             settings.settings.scene_rt.time_s = Some(t + a.time_step);
         }
-        let f = renderer.render(&settings, false)?;
+        if a.dolly != 0.0 || a.time_step != 0.0 {
+            renderer.set_settings(settings.settings.clone())?;
+            renderer.set_camera(settings.camera.clone(), false)?;
+        }
+        if a.clock_step != 0.0 {
+            renderer.set_time_of_day(clock + a.clock_step * f64::from(i + 1))?;
+        }
+        let f = renderer.frame(false)?;
         timings.add(&f.result);
         bvh.add(renderer.scene_rt_stats());
     }
@@ -127,6 +157,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
             "warmup": a.warmup,
             "dolly_m": a.dolly,
             "time_step_s": a.time_step,
+            "clock_step_s": a.clock_step,
             "frame_only": a.frame_only,
             "triangles": triangles,
             "startup_ms": { "instance": ms(startup.instance), "adapter": ms(startup.adapter), "device": ms(startup.device), "total": ms(startup.total()) },

@@ -17,6 +17,7 @@
 //! single dispatch) and `direct_lighting.shade` (which does the lookup among everything else)
 //! are printed beside them.
 
+use anyhow::Context;
 use clap::Args;
 use serde_json::json;
 
@@ -87,7 +88,12 @@ fn sky_radiance_sh(frame: &FrameSettings) -> anyhow::Result<[glam::Vec3; 9]> {
     let s = &frame.settings.sky;
     let (params, sizes) = s.table_key().map_err(|e| anyhow::anyhow!("{e}"))?;
     let atmosphere = sky::atmosphere_for(&params, sizes)?;
-    let lights = sky::frame_lights(s, frame.sun.as_ref())?;
+    let cx = frame.context()?;
+    let lights = cx
+        .sky
+        .as_ref()
+        .context("the probes' relight needs the sky on")?
+        .lights;
     let (raw, _) = SkyTwin::new(&atmosphere, SkyParams::new(&atmosphere, &lights, s, 0.0)).sh();
     Ok(raw.coeffs)
 }
@@ -155,6 +161,7 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
     let mut bench_rt = GraphRuntime::new();
     bench_rt.set_timestamps(TimestampMode::Pass);
 
+    let sun = settings.directional_light()?;
     let mut timings = FrameTimings::default();
     for i in 0..a.warmup + a.frames {
         let f = renderer.render(&settings, false)?;
@@ -162,7 +169,7 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         renderer.irradiance_probes().record_relight_bench(
             &mut g,
             &bench,
-            settings.sun.as_ref(),
+            sun.as_ref(),
             &s.irradiance_probes,
         )?;
         let r = g.execute()?;

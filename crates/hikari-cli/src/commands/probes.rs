@@ -142,12 +142,13 @@ pub fn run(a: ProbesArgs) -> anyhow::Result<()> {
         let s = &frame.settings.settings.sky;
         let (params, sizes) = s.table_key().map_err(|e| anyhow::anyhow!("{e}"))?;
         let atmosphere = sky::atmosphere_for(&params, sizes)?;
-        let lights = sky::frame_lights(s, frame.settings.sun.as_ref())?;
+        let cx = frame.settings.context()?;
+        let lights = cx.sky.as_ref().context("--time needs the sky on")?.lights;
         let sky_params = SkyParams::new(&atmosphere, &lights, s, 0.0);
         let (raw, _) = SkyTwin::new(&atmosphere, sky_params).sh();
         let knobs = sky::frame_knobs(s, &lights);
         let params = RelightParams::new(
-            frame.settings.sun.as_ref(),
+            cx.sun.as_ref(),
             &frame.settings.settings.irradiance_probes,
             0,
         );

@@ -118,6 +118,7 @@ pub fn run(args: TimelapseArgs) -> anyhow::Result<()> {
     let tty = std::io::stderr().is_terminal();
     let started = Instant::now();
     let mut renderer = still::renderer(&resolved, args.bake.as_deref())?;
+    renderer.set_frame(settings.clone())?;
     let mut last_time = String::new();
     for (n, &(fraction, written)) in plan.iter().enumerate() {
         let when = span.at(fraction)?;
@@ -125,10 +126,10 @@ pub fn run(args: TimelapseArgs) -> anyhow::Result<()> {
         sky.date = when.date_string();
         sky.time = when.time_string();
         let now = format!("{} {}", sky.date, sky.time);
-        settings.sun = hikari_render::techniques::sky::lights::directional_light(sky)
-            .map_err(|e| anyhow::anyhow!("{e}"))
-            .with_context(|| format!("the sun at {now}"))?;
-        let frame = renderer.render(&settings, written.is_some())?;
+        renderer
+            .set_clock(&sky.date, &sky.time)
+            .with_context(|| format!("the clock at {now}"))?;
+        let frame = renderer.frame(written.is_some())?;
         if let Some(k) = written {
             let png = args.output.join(format!("frame_{k:0digits$}.png"));
             let exr = png.with_extension("exr");

@@ -264,6 +264,38 @@ impl<'r> FrameGraph<'r> {
         Tex(self.textures.len() as u32 - 1)
     }
 
+    /// The description of `t`.
+    pub fn texture_desc(&self, t: Tex) -> TextureDesc {
+        self.textures[t.0 as usize].desc
+    }
+
+    /// The name of `t`.
+    pub fn texture_name(&self, t: Tex) -> &str {
+        &self.textures[t.0 as usize].name
+    }
+
+    /// The last texture named `name` that a pass of this frame has written so far (what
+    /// `--dump` would read), if any.
+    pub fn find_written_texture(&self, name: &str) -> Option<Tex> {
+        self.textures
+            .iter()
+            .rposition(|t| t.name == name && t.written)
+            .map(|i| Tex(i as u32))
+    }
+
+    /// The names of the textures passes of this frame have written so far, sorted, once each.
+    pub fn written_texture_names(&self) -> Vec<String> {
+        let mut names: Vec<String> = self
+            .textures
+            .iter()
+            .filter(|t| t.written)
+            .map(|t| t.name.clone())
+            .collect();
+        names.sort();
+        names.dedup();
+        names
+    }
+
     /// A texture that lives for this frame only. Its name (`technique.what`) is what
     /// `--dump` and timings show.
     pub fn texture(&mut self, name: &str, desc: TextureDesc) -> Result<Tex> {
@@ -444,7 +476,12 @@ impl<'r> FrameGraph<'r> {
     }
 
     fn push_constants<T: Pod>(&mut self, value: &T) -> Binding {
-        let align = self.ctx.limits.min_uniform_buffer_offset_alignment as usize;
+        // Constants bind as uniforms, or as storage on adapters that take them so
+        // (`GpuContext::uniforms_as_storage`): aligned for both.
+        let limits = &self.ctx.limits;
+        let align = limits
+            .min_uniform_buffer_offset_alignment
+            .max(limits.min_storage_buffer_offset_alignment) as usize;
         let offset = self.constants.len().next_multiple_of(align);
         self.constants.resize(offset, 0);
         self.constants.extend_from_slice(bytemuck::bytes_of(value));

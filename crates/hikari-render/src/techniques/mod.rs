@@ -5,6 +5,7 @@
 
 pub mod area_lights;
 pub mod clouds;
+pub mod debug_view;
 pub mod direct_lighting;
 pub mod exposure;
 pub mod gbuffer;

@@ -94,7 +94,7 @@ pub fn small_frame_settings(
         height: h,
         camera: scene.cameras[0].clone(),
         prev_camera: None,
-        sun: scene.sun.clone(),
+        sun: scene.sun.clone().into(),
         settings,
     }
 }

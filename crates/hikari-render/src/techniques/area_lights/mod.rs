@@ -17,7 +17,7 @@ pub use denoise::{DenoisedShadows, ShadowDenoiseInputs, ShadowDenoiseParams, Sha
 pub use lights::{AreaLightGpu, AreaTriangleGpu, PolygonLights};
 pub use settings::AreaLightsSettings;
 
-use super::direct_lighting::{LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, RADIANCE_FORMAT};
+use super::direct_lighting::RADIANCE_FORMAT;
 use super::gbuffer::GBuffer;
 use crate::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
@@ -52,13 +52,13 @@ pub struct AreaLightParams {
 }
 
 impl AreaLightParams {
-    /// `metered_lux`: the frame's metered illuminance, which sets the point and spot lights'
-    /// cut-off exactly as the deferred lighting's ([`super::direct_lighting::LightingParams`]).
+    /// `cutoff_lux`: the frame context's point and spot light cut-off, the deferred
+    /// lighting's too.
     pub fn new(
         s: &AreaLightsSettings,
         area_lights: u32,
         punctual_lights: u32,
-        metered_lux: f32,
+        cutoff_lux: f32,
         frame: u64,
     ) -> Self {
         let mut flags = 0;
@@ -76,12 +76,7 @@ impl AreaLightParams {
                 s.ray_budget.min(settings::MAX_SHADOW_PICKS),
                 0,
             ],
-            values: [
-                s.min_flux_lm,
-                s.punctual_radius_m,
-                (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX),
-                0.0,
-            ],
+            values: [s.min_flux_lm, s.punctual_radius_m, cutoff_lux, 0.0],
             rotation: frame_rotation(frame),
         }
     }

@@ -90,11 +90,12 @@ pub const PLACEHOLDER_SKY_ZENITH: Vec3 = Vec3::new(1800.0, 3200.0, 6500.0);
 pub const PLACEHOLDER_SKY_HORIZON: Vec3 = Vec3::new(6000.0, 7000.0, 8000.0);
 
 impl LightingParams {
-    /// `metered_lux`: the illuminance the exposure is set for ([`crate::FrameSettings::metered_lux`]).
+    /// `cutoff_lux`: the frame context's point and spot light cut-off
+    /// ([`crate::frame_context::FrameContext::light_cutoff_lux`]).
     pub fn new(
         sun: Option<&Sun>,
         light_count: u32,
-        metered_lux: f32,
+        cutoff_lux: f32,
         s: &DirectLightingSettings,
     ) -> Self {
         let (dir, lux, color) = match sun {
@@ -117,7 +118,7 @@ impl LightingParams {
             sky_zenith: (PLACEHOLDER_SKY_ZENITH * sky).extend(0.0).to_array(),
             sky_horizon: (PLACEHOLDER_SKY_HORIZON * sky).extend(0.0).to_array(),
             config: [light_count, flags, 0, 0],
-            cutoff: [light_cutoff_lux(metered_lux), 0.0, 0.0, 0.0],
+            cutoff: [cutoff_lux, 0.0, 0.0, 0.0],
             reflection: [0; 4],
             reflection_values: [0.0; 4],
         }

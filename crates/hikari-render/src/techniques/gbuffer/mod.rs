@@ -1,6 +1,7 @@
 //! G-buffer: the compute rasteriser writes a visibility buffer, then `gbuffer.resolve` turns it
 //! into the G-buffer textures. CPU twin: [`crate::techniques::gbuffer::reference`].
 
+pub mod overrides;
 pub mod reference;
 
 use crate::context::GpuContext;

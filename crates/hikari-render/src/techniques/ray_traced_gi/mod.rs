@@ -32,9 +32,7 @@ use naga_oil::compose::ShaderDefValue;
 use wgpu::util::DeviceExt;
 
 use super::area_lights::AreaLightScene;
-use super::direct_lighting::{
-    LIGHT_CUTOFF_FRACTION, LIGHT_CUTOFF_LUX, PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH,
-};
+use super::direct_lighting::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use super::exposure::PreviousExposure;
 use super::gbuffer::GBuffer;
 use super::gi_denoiser::RecurrentHistory;
@@ -141,13 +139,16 @@ pub enum SkySource {
 }
 
 impl RtGiParams {
-    /// `metered_lux` as for direct lighting's light cut-off.
+    /// `metered_lux` and `cutoff_lux`: the frame context's metered illuminance and point and
+    /// spot light cut-off.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         s: &RayTracedGiSettings,
         frame: u64,
         sun: Option<&Sun>,
         light_count: u32,
         metered_lux: f32,
+        cutoff_lux: f32,
         sky: SkySource,
     ) -> Self {
         let (dir, lux, color) = match sun {
@@ -179,7 +180,7 @@ impl RtGiParams {
                 s.max_distance_m,
                 s.ao_max_distance_m,
                 s.depth_tolerance,
-                (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX),
+                cutoff_lux,
             ],
             pretrace: [
                 s.pretrace_step_px,

@@ -121,20 +121,68 @@ pub fn atmosphere_for(params: &AtmosphereParams, sizes: TableSizes) -> Result<Ar
     Ok(a)
 }
 
-/// What the sky of a frame is lit by: the sun and the moon from the settings' date, time and
-/// place, except that a directional light that is neither of them (a scene's own sun) takes the
-/// sun's place in the sky and the moon goes.
-pub fn frame_lights(s: &SkySettings, directional: Option<&Sun>) -> Result<SkyLights> {
-    let mut l = SkyLights::new(s).map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
-    if let Some(d) = directional {
-        let close = |v: Vec3| v.normalize().dot(d.direction.normalize()) > 0.999_999;
-        if !close(l.sun.direction) && !close(l.moon.direction) {
-            l.sun.direction = d.direction.normalize();
-            l.sun.elevation_deg = f64::from(l.sun.direction.y.clamp(-1.0, 1.0).asin().to_degrees());
-            l.moon.extraterrestrial_lux = 0.0;
+/// The sky's CPU side of one frame, resolved in the frame context: the sun and moon as the
+/// sky sees them, the weather's knobs at the sun's elevation, the sky's own illuminance on the
+/// ground, and the CPU atmosphere whose lookups the frame makes (the full tables with
+/// `sky.tables_on_gpu` off, else a small build of the same parameters).
+#[derive(Clone, Debug)]
+pub struct FrameSky {
+    /// The sun and the moon from the date, time and place, except that a fixed directional
+    /// light (a scene's own sun) takes the sun's place and the moon goes.
+    pub lights: SkyLights,
+    pub knobs: ArtistKnobs,
+    /// The sky's illuminance on a horizontal plane at the ground, lux (0 with `sky.sky` off).
+    pub sky_lux: f32,
+    pub atmosphere: Arc<Atmosphere>,
+    pub params: AtmosphereParams,
+    /// The GPU tables' sizes.
+    pub sizes: TableSizes,
+}
+
+impl FrameSky {
+    pub fn new(s: &SkySettings, fixed_sun: Option<&Sun>) -> Result<Self> {
+        let mut lights = SkyLights::new(s)?;
+        if let Some(d) = fixed_sun {
+            lights.sun.direction = d.direction.normalize();
+            lights.sun.elevation_deg =
+                f64::from(lights.sun.direction.y.clamp(-1.0, 1.0).asin().to_degrees());
+            lights.moon.extraterrestrial_lux = 0.0;
         }
+        let knobs = frame_knobs(s, &lights);
+        if !s.sky {
+            lights.sun.extraterrestrial_lux = 0.0;
+            lights.moon.extraterrestrial_lux = 0.0;
+        }
+        // The tables follow the weather alone; the time of day moves only the knobs.
+        let (params, sizes) = s.table_key()?;
+        let atmosphere = if s.tables_on_gpu {
+            atmosphere_for(&params, settings::table_sizes(SCALAR_TABLE_QUALITY))?
+        } else {
+            atmosphere_for(&params, sizes)?
+        };
+        let sky_lux = if s.sky {
+            [&lights.sun, &lights.moon]
+                .iter()
+                .map(|b| (sky_lux(b.extraterrestrial_lux, b.direction), b.direction))
+                .filter(|(lux, _)| *lux > 0.0)
+                .map(|(lux, dir)| {
+                    let zenith = dir.y.clamp(-1.0, 1.0).acos();
+                    lights::luminance(atmosphere.sky_irradiance(0.0, zenith, Vec3::splat(lux)))
+                })
+                .sum::<f32>()
+                * knobs.sky_brightness
+        } else {
+            0.0
+        };
+        Ok(Self {
+            lights,
+            knobs,
+            sky_lux,
+            atmosphere,
+            params,
+            sizes,
+        })
     }
-    Ok(l)
 }
 
 fn rows(m: [[f64; 3]; 3]) -> [[f32; 4]; 3] {
@@ -375,9 +423,9 @@ impl Sky {
         &'r self,
         g: &mut FrameGraph<'r>,
         s: &SkySettings,
-        params: &AtmosphereParams,
-        sizes: TableSizes,
+        fs: &FrameSky,
     ) -> Result<FrameTables> {
+        let (params, sizes) = (&fs.params, fs.sizes);
         if !s.tables_on_gpu {
             let u = self.tables(g.ctx(), params, sizes)?;
             return Ok(FrameTables {
@@ -411,7 +459,7 @@ impl Sky {
             *built = Some((params.clone(), sizes));
         }
         Ok(FrameTables {
-            atmosphere: atmosphere_for(params, settings::table_sizes(SCALAR_TABLE_QUALITY))?,
+            atmosphere: fs.atmosphere.clone(),
             rayleigh,
             rayleigh_single,
             mie,
@@ -454,50 +502,30 @@ impl Sky {
         Ok(u)
     }
 
-    /// Adds the sky's passes. `directional` is the frame's directional light (the sky follows
-    /// it when it is a scene's own sun); `camera_altitude_km` the camera's height above the
-    /// ground; `clouds` this frame's clouds, which enter the sky's SH (the ambient light of
-    /// every pass that reads it) where they are drawn and `clouds_in_sh`.
+    /// Adds the sky's passes for the frame context's sky `fs`. `directional` is the frame's
+    /// directional light; `camera_altitude_km` the camera's height above the ground;
+    /// `clouds` this frame's clouds, which enter the sky's SH (the ambient light of every pass
+    /// that reads it) where they are drawn and `clouds_in_sh`.
+    #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         s: &SkySettings,
+        fs: Option<&FrameSky>,
         directional: Option<&Sun>,
         camera_altitude_km: f32,
         clouds: &CloudsFrame,
         clouds_in_sh: bool,
     ) -> Result<SkyFrame> {
         let sh = g.buffer("sky.sh", 18 * 16)?;
-        if !s.enabled {
+        let Some(fs) = fs.filter(|_| s.enabled) else {
             return self.disabled(g, sh);
-        }
-        // The tables follow the weather alone; the time of day moves only the knobs.
-        let (atmosphere, sizes) = s
-            .table_key()
-            .map_err(|e| RenderError::Graph(format!("settings: {e}")))?;
-        let u = self.frame_tables(g, s, &atmosphere, sizes)?;
-        let mut lights = frame_lights(s, directional)?;
-        let knobs = frame_knobs(s, &lights);
-        if !s.sky {
-            lights.sun.extraterrestrial_lux = 0.0;
-            lights.moon.extraterrestrial_lux = 0.0;
-        }
-        let mut params =
-            SkyParams::with_sizes(&u.atmosphere, sizes, &lights, s, camera_altitude_km);
-        let horizontal_sky_lux = if s.sky {
-            [&lights.sun, &lights.moon]
-                .iter()
-                .map(|b| (sky_lux(b.extraterrestrial_lux, b.direction), b.direction))
-                .filter(|(lux, _)| *lux > 0.0)
-                .map(|(lux, dir)| {
-                    let zenith = dir.y.clamp(-1.0, 1.0).acos();
-                    lights::luminance(u.atmosphere.sky_irradiance(0.0, zenith, Vec3::splat(lux)))
-                })
-                .sum::<f32>()
-                * knobs.sky_brightness
-        } else {
-            0.0
         };
+        let u = self.frame_tables(g, s, fs)?;
+        let sizes = fs.sizes;
+        let (lights, knobs) = (&fs.lights, fs.knobs);
+        let mut params = SkyParams::with_sizes(&u.atmosphere, sizes, lights, s, camera_altitude_km);
+        let horizontal_sky_lux = fs.sky_lux;
         if !s.sun {
             params.disks[3] = 0.0;
         }

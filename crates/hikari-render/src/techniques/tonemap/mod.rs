@@ -86,8 +86,10 @@ pub fn tonemap_from_rec709(white: Option<[f32; 3]>) -> Result<Mat3Rows> {
     match white {
         None => Ok(to_tm),
         Some(w) => {
-            let wb = white_balance_rec709(w.map(f64::from))
-                .map_err(|e| RenderError::Graph(format!("settings: `tonemap.white`: {e}")))?;
+            let wb = white_balance_rec709(w.map(f64::from)).map_err(|e| RenderError::Setting {
+                field: "tonemap.white".into(),
+                message: e.to_string(),
+            })?;
             Ok(mul3(&to_tm, &wb))
         }
     }
@@ -294,8 +296,10 @@ impl Tonemap {
         {
             return Ok(l.clone());
         }
-        let lut = CubeLut::read(path)
-            .map_err(|e| RenderError::Graph(format!("settings: `tonemap.lut`: {e}")))?;
+        let lut = CubeLut::read(path).map_err(|e| RenderError::Setting {
+            field: "tonemap.lut".into(),
+            message: e.to_string(),
+        })?;
         let loaded = Arc::new(LoadedLut {
             path: path.to_path_buf(),
             stamp,
