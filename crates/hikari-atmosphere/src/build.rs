@@ -455,7 +455,7 @@ impl Ctx<'_> {
 }
 
 fn luminance_sum(table: &Table, to_rec709: &[[f64; 3]; 3], scale: impl Fn(usize) -> f64) -> f64 {
-    let y = [0.2126, 0.7152, 0.0722];
+    let y = hikari_math::color::REC709_LUMA.map(f64::from);
     let wy: [f64; 3] = std::array::from_fn(|c| (0..3).map(|k| y[k] * to_rec709[k][c]).sum());
     table
         .data

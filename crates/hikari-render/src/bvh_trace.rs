@@ -12,7 +12,7 @@
 //! [`RayOrder`] says whether neighbouring rays in the buffer take similar paths; it picks one of
 //! two kernel configurations, measured best for each kind of ray (BENCHMARKS.md).
 //!
-//! The kernel is the twin of `hikari_bvh::traverse` (tests/bvh_trace.rs checks it against it
+//! The kernel is the twin of `hikari_bvh::traverse` (tests/render/bvh_trace.rs checks it against it
 //! and against brute force). Its stack holds one entry per tree level below the root, TLAS and
 //! BLAS together; scenes deeper than [`STACK_SIZE`] are refused when recorded.
 //!

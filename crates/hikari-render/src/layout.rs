@@ -1,5 +1,5 @@
 //! Rust mirrors of WGSL structs are checked against naga's layout of the WGSL, field by field,
-//! in a test (`tests/struct_layout.rs`), so the two never drift.
+//! in a test (`tests/render/struct_layout.rs`), so the two never drift.
 
 /// A Rust struct's layout as the layout test compares it with the WGSL struct of that name.
 #[derive(Debug)]

@@ -270,7 +270,7 @@ pub fn cornell() -> Scene {
     let room_center = Vec3::new(0.278, 0.274, 0.280);
     let white = Vec3::new(0.725, 0.71, 0.68);
     let emission_rgb = Vec3::new(17.0, 12.0, 4.0);
-    let luminance = emission_rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let luminance = hikari_math::color::luminance(emission_rgb);
     let indoor = |m: Material| Material {
         interior: Some(1.0),
         roughness: 1.0,

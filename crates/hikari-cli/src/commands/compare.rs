@@ -160,7 +160,12 @@ pub fn mean_luminance(img: &ImageRgba32) -> f64 {
     let sum: f64 = img
         .rgba
         .iter()
-        .map(|p| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]))
+        .map(|p| {
+            let y = hikari_math::color::REC709_LUMA;
+            (0..3)
+                .map(|c| f64::from(y[c]) * f64::from(p[c]))
+                .sum::<f64>()
+        })
         .sum();
     sum / img.rgba.len().max(1) as f64
 }

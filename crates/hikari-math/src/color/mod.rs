@@ -15,6 +15,16 @@ pub mod spectral;
 pub mod spectral_data;
 pub mod transfer;
 
+/// The luminance weights of linear Rec.709 (ITU-R BT.709's Y row, as every renderer rounds it):
+/// `Y = 0.2126 R + 0.7152 G + 0.0722 B`. The one place they are written; WGSL's is
+/// `hikari::color::luminance`.
+pub const REC709_LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// The luminance of linear Rec.709 `c` ([`REC709_LUMA`]).
+pub fn luminance(c: glam::Vec3) -> f32 {
+    c.dot(glam::Vec3::from_array(REC709_LUMA))
+}
+
 /// A 3x3 matrix as rows, `m[row][col]`.
 pub type Mat3Rows = [[f64; 3]; 3];
 

@@ -182,7 +182,7 @@ pub fn dering<T: ShCoeff>(sh: &Sh<T, 9>) -> Deringed<T> {
 }
 
 /// Rec.709 luminance weights, used to pick one direction for RGB SH.
-const LUMA: Vec3 = Vec3::new(0.2126, 0.7152, 0.0722);
+const LUMA: Vec3 = Vec3::from_array(crate::color::REC709_LUMA);
 
 /// Direction of the maximum of the linear (band 0 + 1) part, `normalize(c₃, c₁, c₂)`; for RGB,
 /// of the Rec.709 luminance. `None` when the band-1 part is zero.

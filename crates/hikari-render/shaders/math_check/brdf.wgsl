@@ -1,7 +1,7 @@
 // Verification kernel for the BRDF twin `hikari::brdf` (with its tables `hikari::brdf_tables`):
 // not used by any frame. One invocation per case, flat f32 records (sizes mirrored by
 // `Kernel::in_stride` / `Kernel::out_stride` in src/checks/math_check.rs), compared with
-// hikari-math's `brdf` module in tests/math_twins.rs.
+// hikari-math's `brdf` module in tests/render/math_twins.rs.
 
 #import hikari::brdf::{
     BrdfMaterial, brdf_evaluate, brdf_evaluate_isotropic, brdf_view, brdf_light_weights,

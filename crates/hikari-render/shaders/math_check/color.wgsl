@@ -1,7 +1,7 @@
 // Verification kernels for the colour twin `hikari::color`: not used by any frame. One
 // invocation per case, flat f32 records (sizes mirrored by `Kernel::in_stride` /
 // `Kernel::out_stride` in src/checks/math_check.rs), compared with hikari-math's `color`
-// module in tests/math_twins.rs.
+// module in tests/render/math_twins.rs.
 
 #import hikari::color::{
     REC709_TO_XYZ, XYZ_TO_REC709, REC709_TO_ACESCG, ACESCG_TO_REC709, REC709_TO_TONEMAP,

@@ -1,6 +1,6 @@
 // Verification kernels for the SH twin `hikari::sh`: not used by any frame. Each invocation reads
 // one case from `inputs`, calls the twin and writes what hikari-math on the CPU must reproduce
-// to `outputs` (tests/math_twins.rs). Cases are flat f32 records so that no WGSL array stride or
+// to `outputs` (tests/render/math_twins.rs). Cases are flat f32 records so that no WGSL array stride or
 // vec3 padding rule stands between the two sides; the record sizes (IN_* / OUT_*) are mirrored
 // by `Kernel::in_stride` / `Kernel::out_stride` in src/checks/math_check.rs.
 // RGB SH are stored coefficient-major: c0.r, c0.g, c0.b, c1.r, ...

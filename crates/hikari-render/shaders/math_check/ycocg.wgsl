@@ -1,7 +1,7 @@
 // Verification kernel for the Metro Exodus YCoCg + L1 encoding of `hikari::sh`: not used by any
 // frame. One invocation per case, flat f32 records (sizes mirrored by `Kernel::in_stride` /
 // `Kernel::out_stride` in src/checks/math_check.rs), compared with hikari-math's
-// `sh::ycocg` in tests/math_twins.rs.
+// `sh::ycocg` in tests/render/math_twins.rs.
 
 #import hikari::sh::{
     ShYCoCg, sh_rgb_to_ycocg, sh_ycocg_to_rgb, shy_encode, shy_to_color, shy_resolve_diffuse,

@@ -1,5 +1,5 @@
 //! Verification kernels for the WGSL math twins (`hikari::sh`, `hikari::color`, `hikari::brdf`): no frame uses
-//! them. `tests/math_twins.rs` runs each on a few hundred random cases and compares the results
+//! them. `tests/render/math_twins.rs` runs each on a few hundred random cases and compares the results
 //! with hikari-math on the CPU, so a twin that drifts from its reference fails a test instead
 //! of showing up as a lighting bug.
 //!

@@ -19,7 +19,7 @@
 //!
 //! The rays are the CPU's; what differs is rounding: f32 sums in another order, the GPU's
 //! sin/cos in the secondary directions, and fused multiply-adds in hit points and normals,
-//! which may flip a ray that grazes an edge. tests/probe_bake_gpu.rs bounds the difference.
+//! which may flip a ray that grazes an edge. tests/render/probe_bake_gpu.rs bounds the difference.
 
 use std::cell::RefCell;
 

@@ -18,7 +18,7 @@
 //! list, every larger triangle is queued tile by tile after the opaque entries) and
 //! `{technique}.rasterize_alpha_tiles` (pass 2 on those entries, with the alpha test). Both are
 //! the same WGSL built with `ALPHA_TEST`, so opaque geometry runs exactly the code it ran before.
-//! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/raster.rs).
+//! CPU twin: rays through the pixel centres with `hikari_bvh` (tests/render/raster.rs).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;

@@ -1,7 +1,7 @@
 //! One folder per technique: its passes (`mod.rs`), its WGSL, its CPU twin (`reference.rs`)
 //! and its settings (`settings.rs`), under one name. The technique `sun_shadows` labels its
 //! passes `sun_shadows.*`, names its dumps `sun_shadows.*`, and is tested in
-//! `tests/sun_shadows.rs`.
+//! `tests/render/sun_shadows.rs`.
 
 pub mod area_lights;
 pub mod clouds;

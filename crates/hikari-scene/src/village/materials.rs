@@ -24,7 +24,7 @@ pub const ANDON_NITS: f32 = 600.0;
 /// Charity's black-body colour table, 10° observer, decoded to linear), scaled to luminance 1.
 pub fn warm_white() -> Vec3 {
     let c = Vec3::new(1.0, 0.4564, 0.1470);
-    c / c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    c / hikari_math::color::luminance(c)
 }
 
 /// Indices of the village's materials in the scene.

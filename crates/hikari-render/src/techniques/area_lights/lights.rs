@@ -149,7 +149,7 @@ impl PolygonLights {
                 .flatten()
                 .map(|p| p.distance(centroid))
                 .fold(0.0f32, f32::max);
-            let luminance = radiance.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+            let luminance = hikari_math::color::luminance(radiance);
             let texture = EmitterTexture::of(scene, mat, mesh);
             let first = out.triangles.len() as u32;
             let mut acc = 0.0;
@@ -241,10 +241,12 @@ impl EmitterTexture {
             .data
             .chunks_exact(4)
             .map(|p| {
-                Vec3::new(srgb(p[0]), srgb(p[1]), srgb(p[2])).dot(Vec3::new(0.2126, 0.7152, 0.0722))
+                Vec3::new(srgb(p[0]), srgb(p[1]), srgb(p[2]))
+                    .dot(Vec3::from_array(hikari_math::color::REC709_LUMA))
             })
             .collect();
-        let mean = emissive_texture_mean(scene, mat).dot(Vec3::new(0.2126, 0.7152, 0.0722));
+        let mean = emissive_texture_mean(scene, mat)
+            .dot(Vec3::from_array(hikari_math::color::REC709_LUMA));
         (mean > 0.0 && luminance.len() == (tex.width * tex.height) as usize).then_some(Self {
             width: tex.width,
             height: tex.height,

@@ -19,7 +19,7 @@ fn v3(a: [f32; 4]) -> Vec3 {
 }
 
 fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    hikari_math::color::luminance(c)
 }
 
 /// The shader's sample `i` of `pixel` under the frame rotation `rotation` (R2 sequence, shifted

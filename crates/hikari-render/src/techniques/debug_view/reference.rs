@@ -34,10 +34,7 @@ pub fn display(v: Vec4, mapping: &Mapping) -> Vec3 {
             srgb(Vec3::splat(s.clamp(0.0, 1.0)))
         }
         Mapping::Luminance { ev100 } => {
-            let y = v
-                .truncate()
-                .max(Vec3::ZERO)
-                .dot(Vec3::new(0.2126, 0.7152, 0.0722));
+            let y = hikari_math::color::luminance(v.truncate().max(Vec3::ZERO));
             let (lo, span) = luminance_ramp(ev100);
             ramp((y.max(1e-20).log2() - lo) / span)
         }

@@ -11,7 +11,7 @@ pub const INCIDENT_C: f32 = 250.0;
 pub const REFLECTED_K: f32 = 12.5;
 
 /// Rec.709 luminance weights.
-pub const LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+pub const LUMA: [f32; 3] = hikari_math::color::REC709_LUMA;
 
 /// Where the histograms' bins lie.
 #[derive(Clone, Copy, Debug, PartialEq)]

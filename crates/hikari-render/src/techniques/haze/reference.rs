@@ -181,7 +181,7 @@ pub fn probe_sky_visibility(
     sky_sh: &Sh<Vec3, 9>,
     balance: f32,
 ) -> f32 {
-    let luma = Vec3::new(0.2126, 0.7152, 0.0722);
+    let luma = Vec3::from_array(hikari_math::color::REC709_LUMA);
     let c0 = 0.5 / std::f32::consts::PI.sqrt();
     let open = (sky_sh.coeffs[0] * (c0 * std::f32::consts::PI)).max(Vec3::ZERO) * balance;
     match probe_average {

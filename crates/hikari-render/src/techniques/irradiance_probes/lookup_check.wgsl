@@ -1,4 +1,4 @@
-// Runs the probe lookup at given points, for tests/irradiance_probes.rs (GPU against
+// Runs the probe lookup at given points, for tests/render/irradiance_probes.rs (GPU against
 // reference::irradiance_at).
 
 #import hikari::irradiance_probes::probe_irradiance_at

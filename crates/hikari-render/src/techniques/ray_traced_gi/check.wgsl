@@ -1,6 +1,6 @@
 // Verification kernel (not used by any frame): ray generation, the sample weight, the hit
 // word's packing and the albedo of hits for given cases, compared with
-// ray_traced_gi::reference in tests/ray_traced_gi.rs. Three vec4s in and out a case.
+// ray_traced_gi::reference in tests/render/ray_traced_gi.rs. Three vec4s in and out a case.
 // In: (pixel x, pixel y, frame, distance), (normal, metalness), (albedo, 0).
 // Out, as bits: (direction, cosine), (noise u1, u2, hit word, weight), (hit albedo, 0).
 

@@ -44,7 +44,7 @@ pub fn grid_cutoff(cutoff_lux: f32) -> f32 {
 }
 
 fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    hikari_math::color::luminance(c)
 }
 
 /// Reach (m) of area light `l` about its centroid at `cutoff_lux`, as the shade pass computes

@@ -377,7 +377,7 @@ pub fn random(pixel: [u32; 2], frame: u32, k: u32) -> f32 {
 }
 
 fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    hikari_math::color::luminance(c)
 }
 
 /// One of `scores` picked in proportion to its value, as the shade pass picks lights: in order,

@@ -1,5 +1,5 @@
 // Verification kernel (not used by any frame) for `hikari::rtgi_resolve`, compared with
-// ray_traced_gi::reference in tests/ray_traced_gi.rs.
+// ray_traced_gi::reference in tests/render/ray_traced_gi.rs.
 // In, 5 vec4 a case: gi_y; (Co, Cg, material alpha, 0); (n, 0); (v, 0); (f0, f90).
 // Out, 2 vec4: (diffuse, 0), (specular, 0).
 

@@ -123,7 +123,7 @@ impl TableBuildParams {
         let shell = Shell::new(p.bottom_radius_km, p.top_radius_km);
         let l = WorkLayout::new(sizes, p.max_scattering_orders);
         let to709 = p.color_space.to_rec709();
-        let y = [0.2126, 0.7152, 0.0722];
+        let y = hikari_math::color::REC709_LUMA.map(f64::from);
         let lum: [f64; 3] = std::array::from_fn(|c| (0..3).map(|k| y[k] * to709[k][c]).sum());
         let u = |v: usize| v as u32;
         let [tmu, tr] = sizes.transmittance;

@@ -54,7 +54,7 @@ pub struct SkyLights {
 }
 
 pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    hikari_math::color::luminance(c)
 }
 
 fn mat_mul(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {

@@ -10,7 +10,7 @@
 // then one workgroup adding and deringing): on the H200 those measured 7.9 + 8.0 us, while a
 // single workgroup doing everything measured 22 us (its serial lookups, 4 or 16 a thread,
 // cost more than the second launch). `finish` is the deringing alone from 64 given partial
-// sums; tests/sky.rs feeds it chosen skies.
+// sums; tests/render/sky.rs feeds it chosen skies.
 //
 // With CLOUDS defined (`sky.sh_clouds`), the same projection of the sky seen through the
 // clouds (`clouds_over_sky`, as the deferred lighting draws them), after the clear sky's pass:
@@ -72,7 +72,7 @@ fn fibonacci_dir(i: u32) -> vec3<f32> {
 // replays the binary search's path over the 8 verdicts: the same strength as the serial search
 // even where the verdict is not monotone in the strength. Each minimum search keeps the serial
 // one's tie-breaking (the first of equal values in start order), so the result is that of
-// `sh_dering_l2_rgb`, which tests/math_twins.rs holds to hikari_math::sh::dering.
+// `sh_dering_l2_rgb`, which tests/render/math_twins.rs holds to hikari_math::sh::dering.
 
 const FINISH_THREADS: u32 = 192u;
 // Threads per (strength, channel) minimum search; each takes 2 of the 16 start slots
@@ -212,7 +212,7 @@ fn project_dering(@builtin(local_invocation_index) lid: u32, @builtin(workgroup_
     // (storage barrier), and the count's atomic orders the groups. WGSL has no device-scope
     // release/acquire, so this is the usual practice (as single-pass downsamplers do it) rather
     // than a guarantee of the memory model: checked on lavapipe and the H200
-    // (tests/sky.rs: the SH against the twin, and frame after frame).
+    // (tests/render/sky.rs: the SH against the twin, and frame after frame).
     storageBarrier();
     if lid == 0u {
         last_group = select(0u, 1u, atomicAdd(&sh_done, 1u) == GROUPS - 1u);

@@ -3,7 +3,7 @@
 // texel at the same wrapped place (`techniques/sun_shadows/mod.rs`), so a whole layer is copied as it
 // lies, four texels a thread (on the H200 a buffer-to-texture copy command took about four
 // times as long), and a strip texel by texel through the wrap-around.
-// Twin: a plain copy, checked by tests/direct_lighting.rs through the lookup.
+// Twin: a plain copy, checked by tests/render/direct_lighting.rs through the lookup.
 
 struct CopyParams {
     // Per region: x the layer, y the origin, z and w the first texel and the end (exclusive)
