@@ -76,12 +76,49 @@ pub fn load(path: impl AsRef<Path>) -> Result<Loaded, GltfError> {
 
 pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded, GltfError> {
     let path = path.as_ref();
+    guarded(path, || load_unguarded(path, options))
+}
+
+/// Loads a `.gltf` or `.glb` held in memory. Relative URIs (external buffers and images) are
+/// resolved against `base_dir`; with `None` they are an error, so only self-contained files
+/// (`.glb`, data URIs) load. Errors name the file as `<memory>`, or `base_dir/<memory>`.
+pub fn load_slice(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    options: &GltfOptions,
+) -> Result<Loaded, GltfError> {
+    guarded(&memory_name(base_dir), || {
+        load_slice_unguarded(bytes, base_dir, options)
+    })
+}
+
+/// [`load_slice`] without its `catch_unwind`, for tests and fuzzing that must see a panic.
+#[doc(hidden)]
+pub fn load_slice_unguarded(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    options: &GltfOptions,
+) -> Result<Loaded, GltfError> {
+    let name = memory_name(base_dir);
+    finish(
+        &name,
+        Loader::from_bytes(bytes, base_dir.map(Path::to_path_buf), options).and_then(Loader::run),
+    )
+}
+
+fn memory_name(base_dir: Option<&Path>) -> PathBuf {
+    base_dir.map_or_else(|| PathBuf::from("<memory>"), |b| b.join("<memory>"))
+}
+
+/// Runs a load, turning a panic into an error naming `path`.
+fn guarded(
+    path: &Path,
+    load: impl FnOnce() -> Result<Loaded, GltfError>,
+) -> Result<Loaded, GltfError> {
     // A last line of defence: the checks in `load_unguarded` should leave nothing for a
     // dependency to panic on, but a malformed file must never take the process down. Tests call
     // `load_unguarded` directly so that a panic there fails them instead of hiding here.
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        load_unguarded(path, options)
-    }));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
     result.unwrap_or_else(|panic| {
         let msg = panic
             .downcast_ref::<String>()
@@ -99,7 +136,12 @@ pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded
 /// use [`load`] or [`load_with`] otherwise.
 #[doc(hidden)]
 pub fn load_unguarded(path: &Path, options: &GltfOptions) -> Result<Loaded, GltfError> {
-    match Loader::new(path, options).and_then(Loader::run) {
+    finish(path, Loader::new(path, options).and_then(Loader::run))
+}
+
+/// Logs the warnings of a load, or names the file in its error.
+fn finish(path: &Path, result: Res<Loaded>) -> Result<Loaded, GltfError> {
+    match result {
         Ok(loaded) => {
             for w in &loaded.warnings {
                 log::warn!("{}: {w}", path.display());
@@ -186,7 +228,8 @@ fn check_light(light: &gltf::khr_lights_punctual::Light, direction: Vec3) -> Res
 }
 
 struct Loader<'o> {
-    base: PathBuf,
+    /// Where relative URIs point; `None` for a file loaded from memory without a directory.
+    base: Option<PathBuf>,
     options: &'o GltfOptions,
     doc: gltf::Document,
     buffers: Vec<gltf::buffer::Data>,
@@ -251,10 +294,15 @@ fn percent_decode(uri: &str) -> Res<String> {
 
 /// Checks a URI so that `gltf`'s importer only sees ones it handles without panicking; returns
 /// the local file it names, if any, for messages.
-fn check_uri(base: &Path, uri: &str) -> Res<Option<PathBuf>> {
+fn check_uri(base: Option<&Path>, uri: &str) -> Res<Option<PathBuf>> {
     if uri.starts_with("data:") {
         return Ok(None);
     }
+    let Some(base) = base else {
+        return Err(format!(
+            "URI `{uri}` names a file, but the glTF was read from memory with no directory to find it in"
+        ));
+    };
     if let Some(rest) = uri
         .strip_prefix("file://")
         .or_else(|| uri.strip_prefix("file:"))
@@ -347,16 +395,20 @@ fn describe(e: &gltf::Error) -> String {
 impl<'o> Loader<'o> {
     fn new(path: &Path, options: &'o GltfOptions) -> Res<Self> {
         let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        Self::from_bytes(&bytes, Some(base), options)
+    }
+
+    fn from_bytes(bytes: &[u8], base: Option<PathBuf>, options: &'o GltfOptions) -> Res<Self> {
         if bytes.starts_with(b"glTF") {
-            check_glb_header(&bytes)?;
+            check_glb_header(bytes)?;
         }
         let gltf::Gltf { document, blob } =
-            gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| describe(&e))?;
+            gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe(&e))?;
         let mut root = document.into_json();
         check_before_validation(&root)?;
         let quantization_declared = check_required_extensions(&mut root)?;
         let doc = gltf::Document::from_json(root).map_err(|e| describe(&e))?;
-        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let mut loader = Loader {
             base,
             options,
@@ -367,6 +419,13 @@ impl<'o> Loader<'o> {
         };
         loader.load_buffers(blob)?;
         Ok(loader)
+    }
+
+    /// The directory `gltf`'s importer resolves URIs against. `gltf` refuses even data URIs
+    /// without one; a file read from memory has none, but `check_uri` has then refused every URI
+    /// other than data:, so the directory given here is never used.
+    fn uri_base(&self) -> &Path {
+        self.base.as_deref().unwrap_or(Path::new("."))
     }
 
     fn warn(&self, w: String) {
@@ -396,9 +455,10 @@ impl<'o> Loader<'o> {
                     }
                 },
                 gltf::buffer::Source::Uri(uri) => {
-                    let file =
-                        check_uri(&self.base, uri).map_err(|e| format!("buffer {i}: {e}"))?;
-                    let data = gltf::buffer::Data::from_source(buffer.source(), Some(&self.base));
+                    let file = check_uri(self.base.as_deref(), uri)
+                        .map_err(|e| format!("buffer {i}: {e}"))?;
+                    let data =
+                        gltf::buffer::Data::from_source(buffer.source(), Some(self.uri_base()));
                     match (data, file) {
                         (Ok(d), _) => d.0,
                         (Err(gltf::Error::Io(e)), Some(file)) => {
@@ -673,7 +733,8 @@ impl<'o> Loader<'o> {
             // Where the image comes from, for messages.
             let (file, source) = match image.source() {
                 gltf::image::Source::Uri { uri, .. } => {
-                    let file = check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
+                    let file = check_uri(self.base.as_deref(), uri)
+                        .map_err(|e| format!("image {i}: {e}"))?;
                     let source = file
                         .as_ref()
                         .map_or_else(|| "data URI".to_owned(), |f| format!("`{}`", f.display()));
@@ -683,14 +744,17 @@ impl<'o> Loader<'o> {
                     (None, format!("buffer view {}", view.index()))
                 }
             };
-            let data =
-                gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
-                    .map_err(|e| match (&e, &file) {
-                        (gltf::Error::Io(io), Some(file)) => {
-                            format!("image {i}: cannot read `{}`: {io}", file.display())
-                        }
-                        _ => format!("image {i} ({source}): {}", describe(&e)),
-                    })?;
+            let data = gltf::image::Data::from_source(
+                image.source(),
+                Some(self.uri_base()),
+                &self.buffers,
+            )
+            .map_err(|e| match (&e, &file) {
+                (gltf::Error::Io(io), Some(file)) => {
+                    format!("image {i}: cannot read `{}`: {io}", file.display())
+                }
+                _ => format!("image {i} ({source}): {}", describe(&e)),
+            })?;
             images.push(to_rgba8(&data).ok_or_else(|| {
                 format!("image {i} ({source}): decoded pixel data has the wrong size")
             })?);

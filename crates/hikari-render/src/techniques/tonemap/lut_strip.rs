@@ -74,12 +74,21 @@ pub struct Rgba8Image {
 /// Reads a PNG (any bit depth, converted to 8-bit RGBA).
 pub fn read_png(path: &Path) -> Result<Rgba8Image, StripError> {
     let file = path.display().to_string();
-    let err = |m: String| StripError::Image {
+    let bytes = std::fs::read(path).map_err(|e| StripError::Image {
         file: file.clone(),
+        message: format!("cannot read: {e}"),
+    })?;
+    decode_png(&bytes, &file)
+}
+
+/// Decodes an image file's bytes (a PNG, or another format `image` recognises), converted to
+/// 8-bit RGBA; `file` names it in errors.
+pub fn decode_png(bytes: &[u8], file: &str) -> Result<Rgba8Image, StripError> {
+    let err = |m: String| StripError::Image {
+        file: file.into(),
         message: m,
     };
-    let img = image::ImageReader::open(path)
-        .map_err(|e| err(format!("cannot read: {e}")))?
+    let img = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| err(format!("cannot read: {e}")))?
         .decode()
