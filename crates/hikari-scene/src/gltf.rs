@@ -160,6 +160,12 @@ type Res<T> = Result<T, String>;
 /// Largest element count accepted for an accessor without a buffer view.
 const MAX_VIEWLESS_ELEMENTS: usize = 1 << 24;
 
+/// Most pixels of one image (16384 x 16384): its RGBA8 copy is then at most 1 GiB.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+
+/// Most bytes of RGBA8 texture data a file may decode to, over all its textures.
+pub const MAX_TEXTURE_BYTES: u64 = 4 << 30;
+
 /// Most nodes the flattened hierarchy may hold. A node listed as a child by several parents is
 /// repeated under each, so a few dozen nodes that each list the next twice would otherwise
 /// expand to billions of instances.
@@ -755,9 +761,29 @@ impl<'o> Loader<'o> {
                 }
                 _ => format!("image {i} ({source}): {}", describe(&e)),
             })?;
+            let pixels = u64::from(data.width) * u64::from(data.height);
+            if pixels > MAX_IMAGE_PIXELS {
+                return Err(format!(
+                    "image {i} ({source}) is {}x{} pixels; at most {MAX_IMAGE_PIXELS} are loaded",
+                    data.width, data.height
+                ));
+            }
             images.push(to_rgba8(&data).ok_or_else(|| {
                 format!("image {i} ({source}): decoded pixel data has the wrong size")
             })?);
+        }
+        // Each texture copies its image, so a few textures naming one large image would
+        // otherwise multiply it without bound: the total is checked before any copy.
+        let total: u64 = self
+            .doc
+            .textures()
+            .map(|t| images[t.source().index()].2.len() as u64)
+            .sum();
+        if total > MAX_TEXTURE_BYTES {
+            return Err(format!(
+                "the {} textures decode to {total} bytes of RGBA8 (textures naming the same image each copy it); at most {MAX_TEXTURE_BYTES} are loaded",
+                self.doc.textures().len()
+            ));
         }
         let mut textures = Vec::new();
         for t in self.doc.textures() {
