@@ -10,7 +10,7 @@ use hikari_fuzz::TARGETS;
 use hikari_fuzz::mutate::{Rng, mutate};
 
 /// Mutations per target; the whole file runs in a few seconds in the dev profile.
-const MUTATIONS: usize = 600;
+const MUTATIONS: usize = 1500;
 
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -33,15 +33,16 @@ fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
-/// The seeds and regression inputs of `target`.
-fn inputs(target: &str) -> Vec<(String, Vec<u8>)> {
-    let mut all = files(&root().join("fuzz/corpus").join(target));
-    all.extend(files(
+/// The seeds of `target` (mutated below) and its regression inputs (run as they are: some
+/// are large, and mutations of them could ask for what they were refused).
+fn inputs(target: &str) -> (Vec<(String, Vec<u8>)>, Vec<(String, Vec<u8>)>) {
+    let seeds = files(&root().join("fuzz/corpus").join(target));
+    let regressions = files(
         &Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("tests/regressions")
             .join(target),
-    ));
-    all
+    );
+    (seeds, regressions)
 }
 
 fn seed_of(target: &str) -> u64 {
@@ -53,10 +54,10 @@ fn seed_of(target: &str) -> u64 {
 /// Runs `target` on every input and `MUTATIONS` mutations, reporting the input of a panic.
 fn exercise(name: &str) {
     let target = TARGETS.iter().find(|(n, _)| *n == name).unwrap().1;
-    let inputs = inputs(name);
+    let (inputs, regressions) = inputs(name);
     assert!(!inputs.is_empty(), "fuzz/corpus/{name} has no seeds");
     let start = Instant::now();
-    for (file, data) in &inputs {
+    for (file, data) in inputs.iter().chain(&regressions) {
         if std::panic::catch_unwind(|| target(data)).is_err() {
             panic!("target {name} panicked on {file}");
         }
@@ -78,7 +79,7 @@ fn exercise(name: &str) {
     }
     eprintln!(
         "{name}: {} inputs and {MUTATIONS} mutations in {:.2} s",
-        inputs.len(),
+        inputs.len() + regressions.len(),
         start.elapsed().as_secs_f64()
     );
 }
@@ -188,4 +189,40 @@ fn valid_seeds_load() {
         }
         hikari_render::Settings::from_toml(None, table, &[]).unwrap_or_else(|e| panic!("{t}: {e}"));
     }
+}
+
+/// A 16000x16000 greyscale PNG header in 60 bytes: the image crate's own limit (512 MiB)
+/// admits its 256 MB, but the 8-bit RGBA copy would be 1 GB. Refused from the header.
+#[test]
+fn a_png_claiming_too_many_pixels_is_refused_before_decoding() {
+    use hikari_render::techniques::tonemap::lut_strip;
+    let name = "grey_16000x16000_header.png";
+    let data = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/regressions/lut_strip_png")
+            .join(name),
+    )
+    .unwrap();
+    let Err(e) = lut_strip::decode_png(&data, name) else {
+        panic!("accepted")
+    };
+    assert!(e.to_string().contains("16000x16000"), "{e}");
+}
+
+/// One 1024x1024 image (4 MB as RGBA8) named by 1100 textures, in 16 kB: each texture copies
+/// its image, so this asked for 4.6 GB. Refused before any copy.
+#[test]
+fn textures_multiplying_one_image_are_refused_before_copying() {
+    let name = "one_image_1100_textures.gltf";
+    let data = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/regressions/gltf")
+            .join(name),
+    )
+    .unwrap();
+    let options = hikari_scene::gltf::GltfOptions::default();
+    let Err(e) = hikari_scene::gltf::load_slice_unguarded(&data, None, &options) else {
+        panic!("accepted")
+    };
+    assert!(e.to_string().contains("1100 textures"), "{e}");
 }
