@@ -12,11 +12,14 @@ use hikari_fuzz::mutate::{Rng, mutate};
 /// Mutations per target; the whole file runs in a few seconds in the dev profile.
 const MUTATIONS: usize = 1500;
 
-fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+/// A file's name and bytes.
+type Named = (String, Vec<u8>);
+
+fn files(dir: &Path) -> Vec<Named> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Vec::new();
     };
-    let mut out: Vec<(String, Vec<u8>)> = entries
+    let mut out: Vec<Named> = entries
         .filter_map(|e| e.ok())
         .map(|e| e.path())
         .filter(|p| p.is_file())
@@ -35,7 +38,7 @@ fn root() -> PathBuf {
 
 /// The seeds of `target` (mutated below) and its regression inputs (run as they are: some
 /// are large, and mutations of them could ask for what they were refused).
-fn inputs(target: &str) -> (Vec<(String, Vec<u8>)>, Vec<(String, Vec<u8>)>) {
+fn inputs(target: &str) -> (Vec<Named>, Vec<Named>) {
     let seeds = files(&root().join("fuzz/corpus").join(target));
     let regressions = files(
         &Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -225,4 +228,36 @@ fn textures_multiplying_one_image_are_refused_before_copying() {
         panic!("accepted")
     };
     assert!(e.to_string().contains("1100 textures"), "{e}");
+}
+
+/// Found by the `glb` fuzzer: an image in a buffer view without `mimeType` made the `gltf`
+/// crate's `Image::source` unwrap `None`. Now an error naming the image.
+#[test]
+fn an_image_view_without_a_mime_type_is_an_error() {
+    let data = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/regressions/glb/image_view_without_mime_type.glb"),
+    )
+    .unwrap();
+    let options = hikari_scene::gltf::GltfOptions::default();
+    let Err(e) =
+        hikari_scene::gltf::load_slice_unguarded(&hikari_fuzz_glb_fixup(&data), None, &options)
+    else {
+        panic!("accepted")
+    };
+    assert!(
+        e.to_string()
+            .contains("images[0] has a bufferView but no mimeType"),
+        "{e}"
+    );
+}
+
+/// The header fix-up of the `glb` target.
+fn hikari_fuzz_glb_fixup(data: &[u8]) -> Vec<u8> {
+    let mut b = data.to_vec();
+    b[0..4].copy_from_slice(b"glTF");
+    b[4..8].copy_from_slice(&2u32.to_le_bytes());
+    let len = b.len() as u32;
+    b[8..12].copy_from_slice(&len.to_le_bytes());
+    b
 }

@@ -324,8 +324,9 @@ fn check_uri(base: Option<&Path>, uri: &str) -> Res<Option<PathBuf>> {
 }
 
 /// What the `gltf` crate's validation misses and its accessors would later `unwrap`: it
-/// indexes attribute accessors before checking they exist, and accepts a camera whose `type`
-/// names a projection the camera does not have.
+/// indexes attribute accessors before checking they exist, accepts a camera whose `type`
+/// names a projection the camera does not have, and an image without the members its source
+/// needs.
 fn check_before_validation(root: &gltf::json::Root) -> Res<()> {
     use gltf::json::camera::Type;
     use gltf::json::validation::Checked;
@@ -341,6 +342,23 @@ fn check_before_validation(root: &gltf::json::Root) -> Res<()> {
             return Err(format!(
                 "invalid glTF: cameras[{c}] has type \"{member}\" but no `{member}` member"
             ));
+        }
+    }
+    // `gltf`'s `Image::source` unwraps both: the mime type of an image in a buffer view (which
+    // glTF requires but `gltf`'s validation does not check) and the URI of one without a view.
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.buffer_view, &image.mime_type, &image.uri) {
+            (Some(_), None, _) => {
+                return Err(format!(
+                    "invalid glTF: images[{i}] has a bufferView but no mimeType (required with a bufferView)"
+                ));
+            }
+            (None, _, None) => {
+                return Err(format!(
+                    "invalid glTF: images[{i}] has neither a uri nor a bufferView"
+                ));
+            }
+            _ => {}
         }
     }
     for (m, mesh) in root.meshes.iter().enumerate() {
