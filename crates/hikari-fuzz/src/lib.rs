@@ -23,8 +23,11 @@ use hikari_render::techniques::tonemap::{cube::CubeLut, lut_strip};
 
 pub mod mutate;
 
+/// A fuzz target: never panics on any input.
+pub type Target = fn(&[u8]);
+
 /// Every target, by the name its cargo-fuzz target and corpus folder have.
-pub const TARGETS: &[(&str, fn(&[u8]))] = &[
+pub const TARGETS: &[(&str, Target)] = &[
     ("gltf", gltf),
     ("glb", glb),
     ("gltf_extras", gltf_extras),
