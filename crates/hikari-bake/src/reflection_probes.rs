@@ -223,6 +223,12 @@ pub fn gltf_reflection_probes(path: &Path) -> Result<Vec<ReflectionProbeBox>, Ba
     read_gltf_json(path, probes_of_document)
 }
 
+/// [`gltf_reflection_probes`] of a file's bytes; the error says what is wrong, without a file
+/// name.
+pub fn gltf_reflection_probes_from_bytes(bytes: &[u8]) -> Result<Vec<ReflectionProbeBox>, String> {
+    crate::volumes::parse_gltf_json(bytes, probes_of_document)
+}
+
 pub(crate) fn probes_of_document(doc: &Value) -> Result<Vec<ReflectionProbeBox>, String> {
     let mut out = Vec::new();
     for node in marked_nodes(doc, "reflection_probe")? {

@@ -158,9 +158,22 @@ pub(crate) fn read_gltf_json<T>(
         what,
     };
     let bytes = std::fs::read(path).map_err(|e| err(format!("cannot read: {e}")))?;
-    let json = gltf_json_bytes(&bytes).map_err(err)?;
-    let doc: Value = serde_json::from_slice(json).map_err(|e| err(format!("bad JSON: {e}")))?;
-    read(&doc).map_err(err)
+    parse_gltf_json(&bytes, read).map_err(err)
+}
+
+/// `read` of the JSON document of a glTF file's bytes (`.gltf` or `.glb`).
+pub(crate) fn parse_gltf_json<T>(
+    bytes: &[u8],
+    read: impl FnOnce(&Value) -> Result<T, String>,
+) -> Result<T, String> {
+    let json = gltf_json_bytes(bytes)?;
+    let doc: Value = serde_json::from_slice(json).map_err(|e| format!("bad JSON: {e}"))?;
+    read(&doc)
+}
+
+/// [`gltf_volumes`] of a file's bytes; the error says what is wrong, without a file name.
+pub fn gltf_volumes_from_bytes(bytes: &[u8]) -> Result<Vec<ProbeVolume>, String> {
+    parse_gltf_json(bytes, volumes_of_document)
 }
 
 /// The JSON chunk of a `.glb`, or the whole of a `.gltf`.

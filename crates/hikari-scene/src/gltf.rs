@@ -76,12 +76,49 @@ pub fn load(path: impl AsRef<Path>) -> Result<Loaded, GltfError> {
 
 pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded, GltfError> {
     let path = path.as_ref();
+    guarded(path, || load_unguarded(path, options))
+}
+
+/// Loads a `.gltf` or `.glb` held in memory. Relative URIs (external buffers and images) are
+/// resolved against `base_dir`; with `None` they are an error, so only self-contained files
+/// (`.glb`, data URIs) load. Errors name the file as `<memory>`, or `base_dir/<memory>`.
+pub fn load_slice(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    options: &GltfOptions,
+) -> Result<Loaded, GltfError> {
+    guarded(&memory_name(base_dir), || {
+        load_slice_unguarded(bytes, base_dir, options)
+    })
+}
+
+/// [`load_slice`] without its `catch_unwind`, for tests and fuzzing that must see a panic.
+#[doc(hidden)]
+pub fn load_slice_unguarded(
+    bytes: &[u8],
+    base_dir: Option<&Path>,
+    options: &GltfOptions,
+) -> Result<Loaded, GltfError> {
+    let name = memory_name(base_dir);
+    finish(
+        &name,
+        Loader::from_bytes(bytes, base_dir.map(Path::to_path_buf), options).and_then(Loader::run),
+    )
+}
+
+fn memory_name(base_dir: Option<&Path>) -> PathBuf {
+    base_dir.map_or_else(|| PathBuf::from("<memory>"), |b| b.join("<memory>"))
+}
+
+/// Runs a load, turning a panic into an error naming `path`.
+fn guarded(
+    path: &Path,
+    load: impl FnOnce() -> Result<Loaded, GltfError>,
+) -> Result<Loaded, GltfError> {
     // A last line of defence: the checks in `load_unguarded` should leave nothing for a
     // dependency to panic on, but a malformed file must never take the process down. Tests call
     // `load_unguarded` directly so that a panic there fails them instead of hiding here.
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        load_unguarded(path, options)
-    }));
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load));
     result.unwrap_or_else(|panic| {
         let msg = panic
             .downcast_ref::<String>()
@@ -99,7 +136,12 @@ pub fn load_with(path: impl AsRef<Path>, options: &GltfOptions) -> Result<Loaded
 /// use [`load`] or [`load_with`] otherwise.
 #[doc(hidden)]
 pub fn load_unguarded(path: &Path, options: &GltfOptions) -> Result<Loaded, GltfError> {
-    match Loader::new(path, options).and_then(Loader::run) {
+    finish(path, Loader::new(path, options).and_then(Loader::run))
+}
+
+/// Logs the warnings of a load, or names the file in its error.
+fn finish(path: &Path, result: Res<Loaded>) -> Result<Loaded, GltfError> {
+    match result {
         Ok(loaded) => {
             for w in &loaded.warnings {
                 log::warn!("{}: {w}", path.display());
@@ -117,6 +159,12 @@ type Res<T> = Result<T, String>;
 
 /// Largest element count accepted for an accessor without a buffer view.
 const MAX_VIEWLESS_ELEMENTS: usize = 1 << 24;
+
+/// Most pixels of one image (16384 x 16384): its RGBA8 copy is then at most 1 GiB.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 28;
+
+/// Most bytes of RGBA8 texture data a file may decode to, over all its textures.
+pub const MAX_TEXTURE_BYTES: u64 = 4 << 30;
 
 /// Most nodes the flattened hierarchy may hold. A node listed as a child by several parents is
 /// repeated under each, so a few dozen nodes that each list the next twice would otherwise
@@ -186,7 +234,8 @@ fn check_light(light: &gltf::khr_lights_punctual::Light, direction: Vec3) -> Res
 }
 
 struct Loader<'o> {
-    base: PathBuf,
+    /// Where relative URIs point; `None` for a file loaded from memory without a directory.
+    base: Option<PathBuf>,
     options: &'o GltfOptions,
     doc: gltf::Document,
     buffers: Vec<gltf::buffer::Data>,
@@ -251,10 +300,15 @@ fn percent_decode(uri: &str) -> Res<String> {
 
 /// Checks a URI so that `gltf`'s importer only sees ones it handles without panicking; returns
 /// the local file it names, if any, for messages.
-fn check_uri(base: &Path, uri: &str) -> Res<Option<PathBuf>> {
+fn check_uri(base: Option<&Path>, uri: &str) -> Res<Option<PathBuf>> {
     if uri.starts_with("data:") {
         return Ok(None);
     }
+    let Some(base) = base else {
+        return Err(format!(
+            "URI `{uri}` names a file, but the glTF was read from memory with no directory to find it in"
+        ));
+    };
     if let Some(rest) = uri
         .strip_prefix("file://")
         .or_else(|| uri.strip_prefix("file:"))
@@ -270,8 +324,9 @@ fn check_uri(base: &Path, uri: &str) -> Res<Option<PathBuf>> {
 }
 
 /// What the `gltf` crate's validation misses and its accessors would later `unwrap`: it
-/// indexes attribute accessors before checking they exist, and accepts a camera whose `type`
-/// names a projection the camera does not have.
+/// indexes attribute accessors before checking they exist, accepts a camera whose `type`
+/// names a projection the camera does not have, and an image without the members its source
+/// needs.
 fn check_before_validation(root: &gltf::json::Root) -> Res<()> {
     use gltf::json::camera::Type;
     use gltf::json::validation::Checked;
@@ -287,6 +342,23 @@ fn check_before_validation(root: &gltf::json::Root) -> Res<()> {
             return Err(format!(
                 "invalid glTF: cameras[{c}] has type \"{member}\" but no `{member}` member"
             ));
+        }
+    }
+    // `gltf`'s `Image::source` unwraps both: the mime type of an image in a buffer view (which
+    // glTF requires but `gltf`'s validation does not check) and the URI of one without a view.
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.buffer_view, &image.mime_type, &image.uri) {
+            (Some(_), None, _) => {
+                return Err(format!(
+                    "invalid glTF: images[{i}] has a bufferView but no mimeType (required with a bufferView)"
+                ));
+            }
+            (None, _, None) => {
+                return Err(format!(
+                    "invalid glTF: images[{i}] has neither a uri nor a bufferView"
+                ));
+            }
+            _ => {}
         }
     }
     for (m, mesh) in root.meshes.iter().enumerate() {
@@ -347,16 +419,20 @@ fn describe(e: &gltf::Error) -> String {
 impl<'o> Loader<'o> {
     fn new(path: &Path, options: &'o GltfOptions) -> Res<Self> {
         let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        Self::from_bytes(&bytes, Some(base), options)
+    }
+
+    fn from_bytes(bytes: &[u8], base: Option<PathBuf>, options: &'o GltfOptions) -> Res<Self> {
         if bytes.starts_with(b"glTF") {
-            check_glb_header(&bytes)?;
+            check_glb_header(bytes)?;
         }
         let gltf::Gltf { document, blob } =
-            gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| describe(&e))?;
+            gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe(&e))?;
         let mut root = document.into_json();
         check_before_validation(&root)?;
         let quantization_declared = check_required_extensions(&mut root)?;
         let doc = gltf::Document::from_json(root).map_err(|e| describe(&e))?;
-        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let mut loader = Loader {
             base,
             options,
@@ -367,6 +443,13 @@ impl<'o> Loader<'o> {
         };
         loader.load_buffers(blob)?;
         Ok(loader)
+    }
+
+    /// The directory `gltf`'s importer resolves URIs against. `gltf` refuses even data URIs
+    /// without one; a file read from memory has none, but `check_uri` has then refused every URI
+    /// other than data:, so the directory given here is never used.
+    fn uri_base(&self) -> &Path {
+        self.base.as_deref().unwrap_or(Path::new("."))
     }
 
     fn warn(&self, w: String) {
@@ -396,9 +479,10 @@ impl<'o> Loader<'o> {
                     }
                 },
                 gltf::buffer::Source::Uri(uri) => {
-                    let file =
-                        check_uri(&self.base, uri).map_err(|e| format!("buffer {i}: {e}"))?;
-                    let data = gltf::buffer::Data::from_source(buffer.source(), Some(&self.base));
+                    let file = check_uri(self.base.as_deref(), uri)
+                        .map_err(|e| format!("buffer {i}: {e}"))?;
+                    let data =
+                        gltf::buffer::Data::from_source(buffer.source(), Some(self.uri_base()));
                     match (data, file) {
                         (Ok(d), _) => d.0,
                         (Err(gltf::Error::Io(e)), Some(file)) => {
@@ -673,7 +757,8 @@ impl<'o> Loader<'o> {
             // Where the image comes from, for messages.
             let (file, source) = match image.source() {
                 gltf::image::Source::Uri { uri, .. } => {
-                    let file = check_uri(&self.base, uri).map_err(|e| format!("image {i}: {e}"))?;
+                    let file = check_uri(self.base.as_deref(), uri)
+                        .map_err(|e| format!("image {i}: {e}"))?;
                     let source = file
                         .as_ref()
                         .map_or_else(|| "data URI".to_owned(), |f| format!("`{}`", f.display()));
@@ -683,17 +768,40 @@ impl<'o> Loader<'o> {
                     (None, format!("buffer view {}", view.index()))
                 }
             };
-            let data =
-                gltf::image::Data::from_source(image.source(), Some(&self.base), &self.buffers)
-                    .map_err(|e| match (&e, &file) {
-                        (gltf::Error::Io(io), Some(file)) => {
-                            format!("image {i}: cannot read `{}`: {io}", file.display())
-                        }
-                        _ => format!("image {i} ({source}): {}", describe(&e)),
-                    })?;
+            let data = gltf::image::Data::from_source(
+                image.source(),
+                Some(self.uri_base()),
+                &self.buffers,
+            )
+            .map_err(|e| match (&e, &file) {
+                (gltf::Error::Io(io), Some(file)) => {
+                    format!("image {i}: cannot read `{}`: {io}", file.display())
+                }
+                _ => format!("image {i} ({source}): {}", describe(&e)),
+            })?;
+            let pixels = u64::from(data.width) * u64::from(data.height);
+            if pixels > MAX_IMAGE_PIXELS {
+                return Err(format!(
+                    "image {i} ({source}) is {}x{} pixels; at most {MAX_IMAGE_PIXELS} are loaded",
+                    data.width, data.height
+                ));
+            }
             images.push(to_rgba8(&data).ok_or_else(|| {
                 format!("image {i} ({source}): decoded pixel data has the wrong size")
             })?);
+        }
+        // Each texture copies its image, so a few textures naming one large image would
+        // otherwise multiply it without bound: the total is checked before any copy.
+        let total: u64 = self
+            .doc
+            .textures()
+            .map(|t| images[t.source().index()].2.len() as u64)
+            .sum();
+        if total > MAX_TEXTURE_BYTES {
+            return Err(format!(
+                "the {} textures decode to {total} bytes of RGBA8 (textures naming the same image each copy it); at most {MAX_TEXTURE_BYTES} are loaded",
+                self.doc.textures().len()
+            ));
         }
         let mut textures = Vec::new();
         for t in self.doc.textures() {

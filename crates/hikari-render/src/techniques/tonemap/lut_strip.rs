@@ -25,6 +25,8 @@ pub const STRIP_SIZE: u32 = 32;
 /// Largest difference, in 8-bit steps, between the two copies of a lattice point in a graded
 /// strip (editors that dither may move a pixel by a step).
 pub const COPY_TOLERANCE: u8 = 2;
+/// Most pixels [`decode_png`] reads: an 8K screenshot (7680x4320) with its strip fits.
+pub const MAX_PIXELS: u64 = 40_000_000;
 const TILE: u32 = STRIP_SIZE;
 const TILES: u32 = 2 * STRIP_SIZE;
 
@@ -74,15 +76,34 @@ pub struct Rgba8Image {
 /// Reads a PNG (any bit depth, converted to 8-bit RGBA).
 pub fn read_png(path: &Path) -> Result<Rgba8Image, StripError> {
     let file = path.display().to_string();
-    let err = |m: String| StripError::Image {
+    let bytes = std::fs::read(path).map_err(|e| StripError::Image {
         file: file.clone(),
+        message: format!("cannot read: {e}"),
+    })?;
+    decode_png(&bytes, &file)
+}
+
+/// Decodes an image file's bytes (a PNG, or another format `image` recognises), converted to
+/// 8-bit RGBA; `file` names it in errors.
+pub fn decode_png(bytes: &[u8], file: &str) -> Result<Rgba8Image, StripError> {
+    let err = |m: String| StripError::Image {
+        file: file.into(),
         message: m,
     };
-    let img = image::ImageReader::open(path)
-        .map_err(|e| err(format!("cannot read: {e}")))?
+    let decoder = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| err(format!("cannot read: {e}")))?
-        .decode()
+        .into_decoder()
+        .map_err(|e| err(format!("not a readable image: {e}")))?;
+    // The header's size is checked before anything is allocated: a few hundred bytes of PNG
+    // may claim gigapixels, and the 8-bit RGBA copy is up to 4x the decoded image.
+    let (w, h) = image::ImageDecoder::dimensions(&decoder);
+    if u64::from(w) * u64::from(h) > MAX_PIXELS {
+        return Err(err(format!(
+            "the header gives {w}x{h} pixels; at most {MAX_PIXELS} are read"
+        )));
+    }
+    let img = image::DynamicImage::from_decoder(decoder)
         .map_err(|e| err(format!("not a readable image: {e}")))?
         .to_rgba8();
     let (width, height) = img.dimensions();
