@@ -346,6 +346,9 @@ impl App {
             self.say(format!("{e:#}"), true);
         }
         self.frames += 1;
+        if self.args.print_frames {
+            println!("frame {} shown", self.frames);
+        }
         if self
             .args
             .exit_after_frames

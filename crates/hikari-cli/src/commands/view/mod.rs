@@ -35,6 +35,10 @@ pub struct ViewArgs {
     /// Exit (status 0) after this many frames have been shown; for scripts and tests.
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub exit_after_frames: Option<u64>,
+    /// Print `frame N shown` on stdout after each frame, for scripts and tests that follow
+    /// the frames.
+    #[arg(long, hide = true)]
+    pub print_frames: bool,
     /// On exit, write the last frame shown (the picture under the panel) to this PNG.
     #[arg(long, value_name = "PATH")]
     pub screenshot: Option<PathBuf>,
