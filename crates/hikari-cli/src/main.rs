@@ -14,7 +14,7 @@ use clap::{Parser, Subcommand};
 
 use commands::{
     bake, bench_frame, bench_overhead, bench_probes, bench_rays, compare, constants, info, lut,
-    probes, render, sky, timelapse,
+    probes, render, sky, timelapse, view,
 };
 
 #[derive(Parser)]
@@ -32,6 +32,9 @@ struct Cli {
 enum Command {
     /// Render a scene to a PNG (display) and a linear EXR (radiance in nits).
     Render(Box<render::RenderArgs>),
+    /// Open the scene in a window and render it live: fly the camera, turn the clock,
+    /// switch techniques, see debug views and per-pass timings (docs/viewer.md).
+    View(Box<view::ViewArgs>),
     /// Render a time-lapse: one view from --from to --to, the clock moving every frame,
     /// --count frames written as numbered PNGs and EXRs.
     Timelapse(Box<timelapse::TimelapseArgs>),
@@ -90,6 +93,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(*args),
+        Command::View(args) => view::run(*args),
         Command::Timelapse(args) => timelapse::run(*args),
         Command::Compare(args) => compare::run(*args),
         Command::Sky(args) => sky::run(args),

@@ -15,3 +15,4 @@ pub mod probes;
 pub mod render;
 pub mod sky;
 pub mod timelapse;
+pub mod view;
