@@ -516,8 +516,9 @@ fn shadow_map_and_its_lookup_agree_with_the_march() {
 }
 
 /// What a frame redraws of the paraboloid map: nothing for the parameters it was drawn with (a
-/// still view), a slice while only the clock moves it a little (the wind less than a hundredth
-/// of a feature, the sun less than a quarter degree), the whole map for anything else.
+/// still view), a share of its rows while only the clock moves it (as few shares as keep every
+/// row within 5 % of a feature's drift and a quarter degree of the sun's turn), the whole map
+/// for anything else or a clock that jumps.
 #[test]
 fn the_map_is_redrawn_only_as_much_as_it_changed() {
     use hikari_render::techniques::clouds::{Redraw, redraw};
@@ -531,18 +532,32 @@ fn the_map_is_redrawn_only_as_much_as_it_changed() {
     };
     let d0 = sun().direction;
     let p = at(36_000.0, d0);
-    assert_eq!(redraw(None, &p), Redraw::Whole);
-    assert_eq!(redraw(Some(&p), &p), Redraw::Nothing);
+    let r = |last: &CloudParams, now: &CloudParams| redraw(Some(&p), Some(last), now, 60);
+    assert_eq!(redraw(None, None, &p, 60), Redraw::Whole);
+    assert_eq!(r(&p, &p), Redraw::Nothing);
     let mut sliced = p;
     sliced.slice = [60, 7, 0, 0];
     sliced.shadow = [1.0, 2.0, 8.0, 512.0];
-    assert_eq!(redraw(Some(&p), &sliced), Redraw::Nothing);
-    // The wind at 8 m/s: one second carries the noise 8 m, a hundredth of 6 km is 60 m.
-    assert_eq!(redraw(Some(&p), &at(36_001.0, d0)), Redraw::Slice);
-    assert_eq!(redraw(Some(&p), &at(36_010.0, d0)), Redraw::Whole);
+    assert_eq!(r(&p, &sliced), Redraw::Nothing);
+    // The wind at 8 m/s over 6 km features: a second of clock a frame drifts 8 / 6000 of a
+    // feature, so 37 frames stay within 5 % (37.5); six seconds a frame (the viewer's
+    // default play rate at 60 frames a second) 6 slices; a minute a frame is a jump.
+    assert_eq!(r(&p, &at(36_001.0, d0)), Redraw::Slice { slices: 37 });
+    assert_eq!(r(&p, &at(36_006.0, d0)), Redraw::Slice { slices: 6 });
+    assert_eq!(r(&p, &at(36_060.0, d0)), Redraw::Whole);
+    // The step is the frame's, not the drift since the map was drawn whole.
+    assert_eq!(
+        r(&at(36_300.0, d0), &at(36_301.0, d0)),
+        Redraw::Slice { slices: 37 }
+    );
+    // At most `time_slices`, and a still clock whose rows were drawn in slices all along.
+    assert_eq!(
+        redraw(Some(&p), Some(&at(36_001.0, d0)), &at(36_001.0, d0), 60),
+        Redraw::Slice { slices: 60 }
+    );
     let turn = |deg: f32| glam::Quat::from_rotation_y(deg.to_radians()) * d0;
-    assert_eq!(redraw(Some(&p), &at(36_000.0, turn(0.1))), Redraw::Slice);
-    assert_eq!(redraw(Some(&p), &at(36_000.0, turn(1.0))), Redraw::Whole);
+    assert_eq!(r(&p, &at(36_000.0, turn(0.1))), Redraw::Slice { slices: 2 });
+    assert_eq!(r(&p, &at(36_000.0, turn(1.0))), Redraw::Whole);
     let thicker = CloudParams::new(
         &CloudsSettings {
             coverage: 0.5,
@@ -553,5 +568,10 @@ fn the_map_is_redrawn_only_as_much_as_it_changed() {
         36_000.0,
         true,
     );
-    assert_eq!(redraw(Some(&p), &thicker), Redraw::Whole);
+    assert_eq!(r(&p, &thicker), Redraw::Whole);
+    assert_eq!(
+        r(&thicker, &thicker),
+        Redraw::Whole,
+        "unlike what every row holds"
+    );
 }

@@ -80,10 +80,28 @@ pub fn parse_time(t: &str) -> Option<f64> {
 
 /// The settings as a TOML table of tables.
 fn table_of(settings: &Settings) -> toml::Table {
-    match toml::Value::try_from(settings) {
-        Ok(toml::Value::Table(t)) => t,
-        _ => toml::Table::new(),
-    }
+    with_table(settings, toml::Table::clone)
+}
+
+thread_local! {
+    /// The last settings serialised and their table: the panel reads every field every frame,
+    /// and the settings change only when someone edits them.
+    static TABLE: std::cell::RefCell<Option<(Settings, toml::Table)>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// `f` of the settings as a TOML table of tables, serialised once per change of `settings`.
+fn with_table<R>(settings: &Settings, f: impl FnOnce(&toml::Table) -> R) -> R {
+    TABLE.with_borrow_mut(|cache| {
+        if cache.as_ref().is_none_or(|(s, _)| s != settings) {
+            let table = match toml::Value::try_from(settings) {
+                Ok(toml::Value::Table(t)) => t,
+                _ => toml::Table::new(),
+            };
+            *cache = Some((settings.clone(), table));
+        }
+        f(&cache.as_ref().expect("filled above").1)
+    })
 }
 
 /// Settings from an edited table, checked.
@@ -98,7 +116,7 @@ fn from_table(t: toml::Table) -> Result<Settings, String> {
 /// The value of `table.key` (absent: an optional field that is not set).
 pub fn field_value(settings: &Settings, field: &str) -> Option<toml::Value> {
     let (table, key) = field.split_once('.')?;
-    table_of(settings).get(table)?.get(key).cloned()
+    with_table(settings, |t| t.get(table)?.get(key).cloned())
 }
 
 /// The number `v` brought into `range`: rounded to an integer, or to the nearest power of two,
@@ -161,20 +179,34 @@ pub fn with_switch(settings: &Settings, table: &str, on: bool) -> Result<Setting
     )
 }
 
+/// Each technique's `enabled` switch, `(technique, on)`, from the cached table.
+pub fn switches(settings: &Settings) -> Vec<(String, bool)> {
+    with_table(settings, |t| {
+        t.iter()
+            .filter_map(|(table, v)| {
+                let on = v.as_table()?.get("enabled")?.as_bool()?;
+                Some((table.clone(), on))
+            })
+            .collect()
+    })
+}
+
 /// Every on/off field other than the techniques' switches, as `table.key`.
 pub fn bool_fields(settings: &Settings) -> Vec<(String, bool)> {
-    let mut out = Vec::new();
-    for (table, values) in table_of(settings) {
-        let Some(values) = values.as_table() else {
-            continue;
-        };
-        for (key, v) in values {
-            if let (Some(b), false) = (v.as_bool(), key == "enabled") {
-                out.push((format!("{table}.{key}"), b));
+    with_table(settings, |t| {
+        let mut out = Vec::new();
+        for (table, values) in t {
+            let Some(values) = values.as_table() else {
+                continue;
+            };
+            for (key, v) in values {
+                if let (Some(b), false) = (v.as_bool(), key == "enabled") {
+                    out.push((format!("{table}.{key}"), b));
+                }
             }
         }
-    }
-    out
+        out
+    })
 }
 
 /// `preset`'s settings with the sky (clock, place, weather, sun and sky switches) kept: a

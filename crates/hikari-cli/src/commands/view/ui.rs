@@ -203,7 +203,7 @@ fn techniques(ui: &mut egui::Ui, m: &mut Model) {
         m.settings = panel::with_preset(&m.settings, p);
         m.preset = preset;
     }
-    for (table, on) in m.settings.switches() {
+    for (table, on) in panel::switches(&m.settings) {
         let mut now = on;
         let label = if table == "ray_traced_gi" {
             "ray_traced_gi (T)".to_string()
@@ -211,7 +211,7 @@ fn techniques(ui: &mut egui::Ui, m: &mut Model) {
             table.to_string()
         };
         if ui.checkbox(&mut now, label).changed()
-            && let Ok(s) = panel::with_switch(&m.settings, table, now)
+            && let Ok(s) = panel::with_switch(&m.settings, &table, now)
         {
             m.settings = s;
         }

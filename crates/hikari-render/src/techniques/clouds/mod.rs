@@ -3,8 +3,10 @@
 //! a paraboloid map of the upper hemisphere (768 x 768 by default) that stores, per texel, the
 //! Mie light scattered to the eye per unit sun illuminance, the light scattered per unit sky
 //! radiance, and the transmittance (the talk's red, green and blue channels). The map is
-//! drawn whole when its shape or lighting changes, a row in `time_slices` per frame while only
-//! the sky's clock moves it (the wind and the sun), and not at all while nothing changes.
+//! drawn whole when its shape or lighting changes or the clock jumps, a share of its rows per
+//! frame while the sky's clock moves it (the wind and the sun: at most `time_slices` shares,
+//! fewer when the clock runs fast, so that no row is older than [`STALE_FEATURE`] of a
+//! feature's drift or [`STALE_SUN_DEG`] of the sun's), and not at all while nothing changes.
 //!
 //! * `clouds.march`: the map (`march.wgsl`);
 //! * `clouds.shadow_map`: the sun's transmittance through the layer on a square of its base
@@ -125,24 +127,35 @@ impl CloudParams {
     }
 }
 
+/// The most a row of the map may lag the clock while it is redrawn in slices: the wind's drift
+/// as a fraction of a feature, and the sun's turn in degrees. A clock that moves more than
+/// this in one frame is a jump, and the map is drawn whole.
+pub const STALE_FEATURE: f32 = 0.05;
+pub const STALE_SUN_DEG: f32 = 0.25;
+
 /// What a frame redraws of the paraboloid map ([`redraw`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Redraw {
     /// Every row: the map is new, or what shapes or lights it changed, or the clock jumped.
     Whole,
-    /// A row in `time_slices`, with this frame's parameters: only the clock moved, a little
-    /// (the wind carried the noise less than a hundredth of a feature, the sun moved less than
-    /// a quarter of a degree since the map was last drawn whole).
-    Slice,
+    /// A row in `slices`, with this frame's parameters: only the clock moved, by so little a
+    /// frame that `slices` frames of it stay within [`STALE_FEATURE`] and [`STALE_SUN_DEG`].
+    Slice { slices: u32 },
     /// Nothing: the map was drawn with these very parameters.
     Nothing,
 }
 
-/// What to redraw of a map last drawn whole with `drawn` (`None`: never, or its texture is
-/// new) for parameters `now`. The comparison leaves out `slice` and `shadow`, which do not
-/// shape the map.
-pub fn redraw(drawn: Option<&CloudParams>, now: &CloudParams) -> Redraw {
-    let Some(d) = drawn else {
+/// What to redraw of the map for parameters `now`, given the parameters every row was drawn
+/// with (`whole`; `None`: never, or its texture is new), those of the frame before (`last`,
+/// which only the clock may separate from `now` for a slice) and the most slices a frame
+/// (`time_slices`). The comparison leaves out `slice` and `shadow`, which do not shape the map.
+pub fn redraw(
+    whole: Option<&CloudParams>,
+    last: Option<&CloudParams>,
+    now: &CloudParams,
+    time_slices: u32,
+) -> Redraw {
+    let Some(whole) = whole else {
         return Redraw::Whole;
     };
     let strip = |p: &CloudParams| CloudParams {
@@ -150,27 +163,51 @@ pub fn redraw(drawn: Option<&CloudParams>, now: &CloudParams) -> Redraw {
         shadow: [0.0; 4],
         ..*p
     };
-    let (d, now) = (strip(d), strip(now));
-    if d == now {
+    let now = strip(now);
+    if strip(whole) == now {
         return Redraw::Nothing;
     }
+    let last = strip(last.unwrap_or(whole));
     // Everything but the clock's: the wind's offset (offset.xy) and the sun's direction.
     let clockless = |p: &CloudParams| CloudParams {
         offset: [0.0, 0.0, p.offset[2], p.offset[3]],
         sun: [0.0, 0.0, 0.0, p.sun[3]],
         ..*p
     };
-    if clockless(&d) != clockless(&now) {
+    if clockless(&last) != clockless(&now) || clockless(whole) != clockless(&now) {
         return Redraw::Whole;
     }
-    let moved = glam::Vec2::new(now.offset[0] - d.offset[0], now.offset[1] - d.offset[1]).length();
-    let turned = Vec3::from_slice(&now.sun[..3]).dot(Vec3::from_slice(&d.sun[..3]));
-    // shape[2] is 1 / feature size.
-    if moved * now.shape[2] < 0.01 && turned > 0.25f32.to_radians().cos() {
-        Redraw::Slice
-    } else {
-        Redraw::Whole
+    // This frame's step of the clock: the wind's drift in features (shape[2] is 1 / feature
+    // size) and the sun's turn.
+    let moved = glam::Vec2::new(
+        now.offset[0] - last.offset[0],
+        now.offset[1] - last.offset[1],
+    )
+    .length()
+        * now.shape[2];
+    let (a, b) = (
+        Vec3::from_slice(&now.sun[..3]),
+        Vec3::from_slice(&last.sun[..3]),
+    );
+    // atan2 of the sine and cosine: exact for small angles, where acos of a dot product in f32
+    // is off by hundredths of a degree.
+    let turned = a.cross(b).length().atan2(a.dot(b)).to_degrees();
+    if !(moved < STALE_FEATURE && turned < STALE_SUN_DEG) {
+        return Redraw::Whole;
     }
+    let fit = |step: f32, limit: f32| {
+        if step > 0.0 {
+            (limit / step).floor().min(u32::MAX as f32) as u32
+        } else {
+            u32::MAX
+        }
+    };
+    let slices = time_slices
+        .max(1)
+        .min(fit(moved, STALE_FEATURE))
+        .min(fit(turned, STALE_SUN_DEG))
+        .max(1);
+    Redraw::Slice { slices }
 }
 
 /// Where the path from `pos` towards the sun enters the layer's base (world x, z), as
@@ -295,19 +332,24 @@ impl Clouds {
         let decision = if fresh {
             Redraw::Whole
         } else {
-            redraw(state.whole.as_ref(), &params)
+            redraw(
+                state.whole.as_ref(),
+                state.last.as_ref(),
+                &params,
+                s.time_slices,
+            )
         };
         let mut p = params;
         match decision {
             Redraw::Whole => {
                 *state = MapState {
                     whole: Some(params),
-                    ..MapState::default()
+                    last: Some(params),
+                    steady: 0,
                 };
             }
             Redraw::Nothing => {}
-            Redraw::Slice => {
-                let n = s.time_slices.max(1);
+            Redraw::Slice { slices: n } => {
                 p.slice = [n, (g.frame_index() % u64::from(n)) as u32, 0, 0];
                 state.steady = if state.last == Some(params) {
                     state.steady + 1
