@@ -31,8 +31,8 @@ pub fn all() -> Vec<StructLayout> {
     use crate::raster;
     use crate::scene_gpu;
     use crate::techniques::{
-        clouds, direct_lighting, exposure, gi_denoiser, haze, irradiance_probes, local_tonemap,
-        particles, ray_traced_gi, reflection_probes, sky, sun_shadows, taa, tonemap,
+        clouds, debug_view, direct_lighting, exposure, gi_denoiser, haze, irradiance_probes,
+        local_tonemap, particles, ray_traced_gi, reflection_probes, sky, sun_shadows, taa, tonemap,
     };
     use crate::view;
     vec![
@@ -223,6 +223,11 @@ pub fn all() -> Vec<StructLayout> {
                 offsets2,
                 offsets3
             ]
+        ),
+        gpu_layout!(
+            debug_view::DisplayParams,
+            "debug_view/display.wgsl",
+            [mode, sizes, values]
         ),
         gpu_layout!(
             taa::TaaParams,

@@ -10,6 +10,7 @@ mod bvh_alpha;
 mod bvh_trace;
 mod clouds;
 mod common;
+mod debug_view;
 mod direct_lighting;
 mod exposure;
 mod frame;
