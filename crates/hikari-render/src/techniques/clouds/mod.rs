@@ -163,18 +163,18 @@ pub fn redraw(
         shadow: [0.0; 4],
         ..*p
     };
-    let now = strip(now);
-    if strip(whole) == now {
+    let (whole, now) = (strip(whole), strip(now));
+    if whole == now {
         return Redraw::Nothing;
     }
-    let last = strip(last.unwrap_or(whole));
+    let last = strip(last.unwrap_or(&whole));
     // Everything but the clock's: the wind's offset (offset.xy) and the sun's direction.
     let clockless = |p: &CloudParams| CloudParams {
         offset: [0.0, 0.0, p.offset[2], p.offset[3]],
         sun: [0.0, 0.0, 0.0, p.sun[3]],
         ..*p
     };
-    if clockless(&last) != clockless(&now) || clockless(whole) != clockless(&now) {
+    if clockless(&last) != clockless(&now) || clockless(&whole) != clockless(&now) {
         return Redraw::Whole;
     }
     // This frame's step of the clock: the wind's drift in features (shape[2] is 1 / feature
