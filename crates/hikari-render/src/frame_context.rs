@@ -92,8 +92,39 @@ pub enum HistoryReset {
     Resize,
     /// A technique was switched on or off.
     SettingsChange,
+    /// The light jumped: the clock, place or weather changed the sun or moon by more than
+    /// [`LIGHT_JUMP_DEG`] (or switched between them) in one step. Small steps, as a playing
+    /// clock makes, keep the history and let it follow the light.
+    LightJump,
     /// A new scene was loaded.
     SceneChange,
+}
+
+/// The most the directional light may turn between two frames for the history to follow it
+/// (a minute or two of clock; the viewer's playing clock turns it 0.025° a frame, its 30-minute
+/// steps 7°).
+pub const LIGHT_JUMP_DEG: f32 = 1.0;
+
+/// Whether going from the frame `old` to `new` makes the light jump (see
+/// [`HistoryReset::LightJump`]): another weather, a sun or moon that appears, goes, or turns
+/// more than [`LIGHT_JUMP_DEG`], or whose illuminance changes by more than a factor of two.
+pub fn light_jumps(old: &FrameSettings, new: &FrameSettings) -> bool {
+    if old.settings.sky.weather != new.settings.sky.weather {
+        return true;
+    }
+    let (Ok(a), Ok(b)) = (old.directional_light(), new.directional_light()) else {
+        return true;
+    };
+    match (a, b) {
+        (None, None) => false,
+        (Some(a), Some(b)) => {
+            let (u, v) = (a.direction.normalize(), b.direction.normalize());
+            let turned = u.cross(v).length().atan2(u.dot(v)).to_degrees();
+            let ratio = a.illuminance_lux.max(1e-9) / b.illuminance_lux.max(1e-9);
+            turned > LIGHT_JUMP_DEG || !(0.5..=2.0).contains(&ratio)
+        }
+        _ => true,
+    }
 }
 
 /// Whether this frame may use the temporal history, and if not why.

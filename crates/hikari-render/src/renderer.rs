@@ -123,11 +123,13 @@ impl Renderer {
     /// draws; the setters below change parts of it. Validates it first.
     pub fn set_frame(&mut self, frame: FrameSettings) -> Result<()> {
         self.validate(&frame)?;
-        if let Some(old) = &self.live
-            && old.settings.switches() != frame.settings.switches()
-        {
-            self.pending_reset
-                .get_or_insert(HistoryReset::SettingsChange);
+        if let Some(old) = &self.live {
+            if old.settings.switches() != frame.settings.switches() {
+                self.pending_reset
+                    .get_or_insert(HistoryReset::SettingsChange);
+            } else if crate::frame_context::light_jumps(old, &frame) {
+                self.pending_reset.get_or_insert(HistoryReset::LightJump);
+            }
         }
         self.live = Some(frame);
         Ok(())
@@ -158,7 +160,9 @@ impl Renderer {
     }
 
     /// Sets the sky's clock: local date `YYYY-MM-DD` and time `HH:MM[:SS]`. The sun or moon,
-    /// sky, clouds, probes and haze follow from the next frame on, temporal history kept.
+    /// sky, clouds, probes and haze follow from the next frame on; the temporal history is
+    /// kept for a small step and dropped when the light jumps
+    /// ([`crate::HistoryReset::LightJump`]).
     pub fn set_clock(&mut self, date: &str, time: &str) -> Result<()> {
         self.change_live(|f| {
             f.settings.sky.date = date.into();

@@ -555,7 +555,10 @@ fn the_map_is_redrawn_only_as_much_as_it_changed() {
         redraw(Some(&p), Some(&at(36_001.0, d0)), &at(36_001.0, d0), 60),
         Redraw::Slice { slices: 60 }
     );
-    let turn = |deg: f32| glam::Quat::from_rotation_y(deg.to_radians()) * d0;
+    // The sun turned by exactly `deg` (about an axis square to it): 0.1° a frame fits two
+    // frames in a quarter degree.
+    let axis = d0.normalize().any_orthonormal_vector();
+    let turn = |deg: f32| glam::Quat::from_axis_angle(axis, deg.to_radians()) * d0;
     assert_eq!(r(&p, &at(36_000.0, turn(0.1))), Redraw::Slice { slices: 2 });
     assert_eq!(r(&p, &at(36_000.0, turn(1.0))), Redraw::Whole);
     let thicker = CloudParams::new(

@@ -39,12 +39,21 @@ fn each_live_change_resets_exactly_the_history_it_should() {
     r.frame(false).unwrap();
     assert_eq!(reset_of(&r), None, "a still frame keeps its history");
 
-    // The clock moves: the sun follows, the history stays.
+    // The clock moves a little: the sun follows, the history stays.
     let before = r.last_context().unwrap().sun.clone().unwrap();
+    r.set_clock("2024-07-21", "12:00:30").unwrap();
+    r.frame(false).unwrap();
+    let cx = r.last_context().unwrap();
+    assert_eq!(
+        cx.history.reset, None,
+        "a small step of the clock keeps the history"
+    );
+    assert_ne!(cx.sun.clone().unwrap().direction, before.direction);
+    // The clock jumps: the light jumps and the history goes.
     r.set_clock("2024-07-21", "16:30").unwrap();
     r.frame(false).unwrap();
     let cx = r.last_context().unwrap();
-    assert_eq!(cx.history.reset, None, "a new time keeps the history");
+    assert_eq!(cx.history.reset, Some(HistoryReset::LightJump));
     let after = cx.sun.clone().unwrap();
     assert!(
         after.direction.dot(before.direction) < 0.95 && after.direction.y < before.direction.y,
@@ -77,6 +86,10 @@ fn each_live_change_resets_exactly_the_history_it_should() {
     r.frame(false).unwrap();
     assert_eq!(reset_of(&r), Some(HistoryReset::CameraCut));
 
+    // Another weather is a jump of the light too.
+    r.set_weather("overcast").unwrap();
+    r.frame(false).unwrap();
+    assert_eq!(reset_of(&r), Some(HistoryReset::LightJump));
     // A continuous setting keeps the history; switching a technique drops it.
     let mut settings = r.live_frame().unwrap().settings.clone();
     settings.exposure.compensation_ev += 0.5;
@@ -182,11 +195,37 @@ fn resident_bytes() -> Option<u64> {
 /// Mesa's CPU driver compiled a shader anew at every bind when a branch read a uniform, and
 /// kept each copy: 13 MB a frame. hikari binds uniforms as storage there
 /// (`GpuContext::uniforms_as_storage`); over frames with every technique on, memory is flat.
+/// The frames run in a process of their own (this test binary again, running
+/// [`memory_probe`] alone), so that the tests running beside this one do not count.
 #[test]
 fn memory_stays_flat_over_frames_with_every_technique_on() {
-    let Some(before) = resident_bytes() else {
+    if resident_bytes().is_none() {
         return; // not Linux: nothing to read
-    };
+    }
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([
+            "live::memory_probe",
+            "--exact",
+            "--include-ignored",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && text.contains("1 passed"),
+        "the memory probe failed:\n{text}"
+    );
+}
+
+/// The frames of [`memory_stays_flat_over_frames_with_every_technique_on`], run by it in a
+/// process of their own.
+#[test]
+#[ignore = "run by memory_stays_flat_over_frames_with_every_technique_on in its own process"]
+fn memory_probe() {
+    let before = resident_bytes().unwrap();
     let ctx = common::gpu_context();
     if ctx.info.device_type == hikari_render::wgpu::DeviceType::Cpu {
         assert!(
