@@ -258,15 +258,6 @@ impl Renderer {
         self.last_context.as_ref()
     }
 
-    /// The directional light the live frame resolves to (the sun or the moon for the sky's
-    /// clock, a fixed sun, or none).
-    pub fn live_sun(&self) -> Result<Option<hikari_scene::Sun>> {
-        match &self.live {
-            Some(f) => f.directional_light(),
-            None => Ok(None),
-        }
-    }
-
     /// Checks a frame's settings, size and cameras before anything is recorded; the error
     /// names the field, the limit or the camera.
     pub fn validate(&self, settings: &FrameSettings) -> Result<()> {
