@@ -9,7 +9,7 @@ pub enum RenderError {
         "no GPU adapter found for backends {backends:?}.\n\
          hikari needs a Vulkan, Metal, DX12 or GL driver. On a machine without a GPU, install the \
          CPU Vulkan driver: `sudo apt-get install mesa-vulkan-drivers` (Debian/Ubuntu), then run \
-         with WGPU_BACKEND=vulkan. `cargo xtask setup` does this for you."
+         with WGPU_BACKEND=vulkan. In a hikari checkout, `./x setup` does this for you."
     )]
     NoAdapter { backends: wgpu::Backends },
 
