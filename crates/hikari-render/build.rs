@@ -21,7 +21,11 @@ fn collect(dir: &Path, root: &Path, out: &mut Vec<(String, std::path::PathBuf)>)
                 .unwrap()
                 .to_string_lossy()
                 .replace('\\', "/");
-            let key = rel.strip_prefix("techniques/").unwrap_or(&rel).to_string();
+            let key = ["techniques/", "scene/"]
+                .iter()
+                .find_map(|p| rel.strip_prefix(p))
+                .unwrap_or(&rel)
+                .to_string();
             out.push((key, p));
         }
     }

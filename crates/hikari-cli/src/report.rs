@@ -225,15 +225,15 @@ mod tests {
 /// The scene BVH's per-frame update (`Renderer::scene_rt_stats`) over many frames.
 #[derive(Default)]
 pub struct BvhUpdates {
-    frames: Vec<hikari_render::scene_rt::FrameBvhStats>,
+    frames: Vec<hikari_render::scene::rt::FrameBvhStats>,
 }
 
 impl BvhUpdates {
-    pub fn add(&mut self, s: Option<hikari_render::scene_rt::FrameBvhStats>) {
+    pub fn add(&mut self, s: Option<hikari_render::scene::rt::FrameBvhStats>) {
         self.frames.extend(s);
     }
 
-    fn stats(&self, f: impl Fn(&hikari_render::scene_rt::FrameBvhStats) -> f64) -> Stats {
+    fn stats(&self, f: impl Fn(&hikari_render::scene::rt::FrameBvhStats) -> f64) -> Stats {
         Stats::of(self.frames.iter().map(f).collect()).unwrap_or_default()
     }
 

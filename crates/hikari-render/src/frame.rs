@@ -11,10 +11,10 @@ use crate::error::Result;
 use crate::frame_context::FrameContext;
 pub use crate::frame_context::FrameSettings;
 use crate::graph::{FrameGraph, Tex};
-use crate::raster::{RasterQueues, Rasterizer};
-use crate::scene_gpu::SceneGpu;
-use crate::scene_rt::SceneRt;
-use crate::shader::{self, ShaderLibrary};
+use crate::scene::raster::{RasterQueues, Rasterizer};
+use crate::scene::upload::SceneGpu;
+use crate::scene::rt::SceneRt;
+use crate::shader;
 use crate::techniques::area_lights::{
     AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,
     ShadowDenoiseParams,
@@ -87,7 +87,7 @@ pub struct Techniques {
 
 impl Techniques {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
-        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
+        let mut lib = shader::library(shader::capabilities_for(ctx.features))?;
         Ok(Self {
             raster: Rasterizer::new(ctx, &mut lib)?,
             sky: Sky::new(ctx, &mut lib)?,

@@ -73,7 +73,7 @@ impl FrameSettings {
         match &self.sun {
             SunSource::Sky => crate::techniques::sky::lights::SkyLights::new(&self.settings.sky)
                 .map(|l| l.directional())
-                .map_err(RenderError::Settings),
+                .map_err(RenderError::from),
             SunSource::Fixed(sun) => Ok(Some(sun.clone())),
             SunSource::Off => Ok(None),
         }

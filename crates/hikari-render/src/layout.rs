@@ -1,35 +1,14 @@
-//! Rust mirrors of WGSL structs are checked against naga's layout of the WGSL, field by field,
-//! in a test (`tests/render/struct_layout.rs`), so the two never drift.
+//! The renderer's GPU structs and the constants its Rust and WGSL share, registered for the
+//! engine's layout checks (`hikari_gpu::layout`, `tests/render/struct_layout.rs`).
 
-/// A Rust struct's layout as the layout test compares it with the WGSL struct of that name.
-#[derive(Debug)]
-pub struct StructLayout {
-    /// WGSL struct name (the Rust struct has the same name and field names).
-    pub name: &'static str,
-    /// Entry shader that declares or imports the struct.
-    pub shader: &'static str,
-    pub size: usize,
-    pub fields: Vec<(&'static str, usize)>,
-}
-
-/// `gpu_layout!(Type, "shader/path.wgsl", [field, ...])`.
-#[macro_export]
-macro_rules! gpu_layout {
-    ($t:ty, $shader:literal, [$($f:ident),* $(,)?]) => {
-        $crate::layout::StructLayout {
-            name: stringify!($t).rsplit("::").next().unwrap_or(stringify!($t)).trim(),
-            shader: $shader,
-            size: ::std::mem::size_of::<$t>(),
-            fields: vec![$((stringify!($f), ::std::mem::offset_of!($t, $f))),*],
-        }
-    };
-}
+pub use hikari_gpu::layout::*;
+use hikari_gpu::{gpu_const, gpu_layout};
 
 /// Every GPU struct of the crate.
 pub fn all() -> Vec<StructLayout> {
     use crate::checks::{graph_check, math_check};
-    use crate::raster;
-    use crate::scene_gpu;
+    use crate::scene::raster;
+    use crate::scene::upload;
     use crate::techniques::{
         clouds, debug_view, direct_lighting, exposure, gi_denoiser, haze, irradiance_probes,
         local_tonemap, particles, ray_traced_gi, reflection_probes, sky, sun_shadows, taa, tonemap,
@@ -109,27 +88,27 @@ pub fn all() -> Vec<StructLayout> {
             ]
         ),
         gpu_layout!(
-            scene_gpu::VertexAttr,
+            upload::VertexAttr,
             "gbuffer/resolve.wgsl",
             [uv, normal, tangent, color, extra, pad]
         ),
         gpu_layout!(
-            scene_gpu::InstanceGpu,
+            upload::InstanceGpu,
             "gbuffer/resolve.wgsl",
             [model, normal_model, prev_model, material, flags, pad]
         ),
         gpu_layout!(
-            scene_gpu::MaterialGpu,
+            upload::MaterialGpu,
             "gbuffer/resolve.wgsl",
             [base_color, emissive, params, extra, textures, more_textures]
         ),
         gpu_layout!(
-            scene_gpu::Chunk,
+            upload::Chunk,
             "gbuffer/resolve.wgsl",
             [instance, first_triangle, count, pad, bounds_lo, bounds_hi]
         ),
         gpu_layout!(
-            scene_gpu::LightGpu,
+            upload::LightGpu,
             "direct_lighting/shade.wgsl",
             [position_range, direction_kind, intensity, spot]
         ),
@@ -274,7 +253,7 @@ pub fn all() -> Vec<StructLayout> {
             [count, pad_a, pad_b, pad_c]
         ),
         gpu_layout!(
-            crate::bvh_trace::TraceParams,
+            crate::scene::bvh_trace::TraceParams,
             "bvh/trace.wgsl",
             [count, image_width, pad0, pad1]
         ),
@@ -307,12 +286,12 @@ pub fn all() -> Vec<StructLayout> {
             [t, u, v, primitive, instance, _pad]
         ),
         gpu_layout!(
-            crate::scene_bvh::AlphaInstance,
+            crate::scene::bvh::AlphaInstance,
             "bvh/trace.wgsl",
             [cutoff, alpha, texture, first_triangle]
         ),
         gpu_layout!(
-            crate::scene_bvh::AlphaTriangle,
+            crate::scene::bvh::AlphaTriangle,
             "bvh/trace.wgsl",
             [uv, alpha]
         ),
@@ -364,3 +343,85 @@ pub fn all() -> Vec<StructLayout> {
         ),
     ]
 }
+
+/// Every constant the crate's Rust and WGSL both declare, with an entry shader that sees the
+/// WGSL one. `tests/render/struct_layout.rs` checks each value against naga's module and that
+/// no constant declared in both languages is missing here.
+pub fn constants() -> Vec<SharedConstant> {
+    vec![
+        gpu_const!(crate::techniques::haze::reference::AIR_INTERIOR_MASK, "haze/light.wgsl"),
+        gpu_const!(crate::techniques::area_lights::lights::AREA_LIGHT_DOUBLE_SIDED, "area_lights/shade.wgsl"),
+        gpu_const!(crate::techniques::area_lights::lights::AREA_LIGHT_FORCED, "area_lights/shade.wgsl"),
+        gpu_const!(crate::techniques::area_lights::AREA_POLYGONS, "area_lights/shade.wgsl"),
+        gpu_const!(crate::techniques::area_lights::AREA_PUNCTUAL, "area_lights/shade.wgsl"),
+        gpu_const!(crate::scene::upload::CHUNK_TRIANGLES, "raster/triangles.wgsl"),
+        gpu_const!(crate::techniques::clouds::CLOUDS_DENSITY_AA, "clouds/march.wgsl"),
+        gpu_const!(crate::techniques::clouds::CLOUDS_MULTIPLE, "clouds/march.wgsl"),
+        gpu_const!(crate::techniques::clouds::CLOUDS_ON, "clouds/march.wgsl"),
+        gpu_const!(crate::techniques::clouds::CLOUDS_SHADOWS, "clouds/march.wgsl"),
+        gpu_const!(crate::techniques::gi_denoiser::reference::EDGE_NORMAL_COS, "gi_denoiser/ao.wgsl"),
+        gpu_const!(crate::techniques::exposure::EXPOSURE_FIXED, "exposure/adapt.wgsl"),
+        gpu_const!(crate::techniques::exposure::EXPOSURE_HIGHLIGHTS, "exposure/adapt.wgsl"),
+        gpu_const!(crate::scene::upload::EXTRA_BITANGENT_NEGATIVE, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::scene::upload::EXTRA_HAS_INTERIOR, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::scene::upload::EXTRA_HAS_TANGENT, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::techniques::local_tonemap::reference::FIXED, "local_tonemap/fill.wgsl"),
+        gpu_const!(crate::techniques::gi_denoiser::params::FLAG_RECURRENT, "gi_denoiser/spatial.wgsl"),
+        gpu_const!(crate::techniques::haze::HAZE_DENSITY_AA, "haze/composite.wgsl"),
+        gpu_const!(crate::techniques::haze::HAZE_LOCAL_LIGHTS, "haze/light.wgsl"),
+        gpu_const!(crate::techniques::haze::HAZE_SKY, "haze/light.wgsl"),
+        gpu_const!(crate::techniques::haze::HAZE_SKY_OCCLUSION, "haze/light.wgsl"),
+        gpu_const!(crate::techniques::haze::HAZE_SUN_SHADOWS, "haze/light.wgsl"),
+        gpu_const!(crate::techniques::haze::HAZE_TRICUBIC, "haze/composite.wgsl"),
+        gpu_const!(crate::techniques::exposure::reference::INCIDENT_C, "exposure/adapt.wgsl"),
+        gpu_const!(crate::scene::upload::INSTANCE_ALPHA_TESTED, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::scene::upload::INSTANCE_DOUBLE_SIDED, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::scene::upload::INSTANCE_MOVED, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::scene::upload::INSTANCE_OWN_NORMAL_MATRIX, "gbuffer/resolve.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_EMISSIVE, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_PLACEHOLDER_AMBIENT, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_PROBES, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_PUNCTUAL, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_REFLECTION_PROBES, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_RTGI, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_SKY, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::LIGHTING_SUN, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::direct_lighting::reference::MAX_RADIANCE, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::area_lights::denoise::MAX_VISIBILITY, "area_lights/temporal.wgsl"),
+        gpu_const!(crate::techniques::exposure::reference::NO_HIGHLIGHT, "exposure/adapt.wgsl"),
+        gpu_const!(crate::techniques::gbuffer::NO_INSTANCE, "ray_traced_gi/pretrace.wgsl"),
+        gpu_const!(crate::scene::upload::NO_TEXTURE, "area_lights/shade.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::gpu_data::PROBES_GRID, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::gpu_data::PROBES_INTERIOR_MASK, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::gpu_data::PROBES_PRESENT, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::area_lights::reference::PUNCTUAL_KEY, "area_lights/shade.wgsl"),
+        gpu_const!(crate::techniques::exposure::reference::REFLECTED_K, "exposure/adapt.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_BOOST, "irradiance_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_BOUNCE, "irradiance_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_DERING, "irradiance_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RELIGHT_PROBES, "reflection_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RELIGHT_SHADOWS, "reflection_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RELIGHT_SKY, "reflection_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_SUN_BOUNCE, "irradiance_probes/relight.wgsl"),
+        gpu_const!(crate::techniques::ray_traced_gi::reference::REPROJECTION_MIN_WEIGHT, "area_lights/temporal.wgsl"),
+        gpu_const!(crate::techniques::ray_traced_gi::reference::REPROJECTION_SNAP, "area_lights/temporal.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RP_HORIZON, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RP_NORMALIZE, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RP_ON, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::reflection_probes::RP_PARALLAX_ROUGHNESS, "direct_lighting/shade.wgsl"),
+        gpu_const!(crate::techniques::area_lights::denoise::SHADOW_DENOISE_RESET, "area_lights/temporal.wgsl"),
+        gpu_const!(crate::scene::raster::TILE_SIZE, "raster/tiles.wgsl"),
+        gpu_const!(crate::techniques::area_lights::denoise::VISIBILITY_EPS, "area_lights/spatial.wgsl"),
+    ]
+}
+
+/// Names both languages declare for different things, so the completeness check skips them.
+pub const UNRELATED_SAME_NAMES: [&str; 3] = [
+    // The LUT strip's tile (its PNG layout) and the particles', TAA's and GI hit mean's
+    // workgroup tiles.
+    "TILE",
+    // The GPU bake's workgroup and the GI trace's.
+    "WORKGROUP",
+    // The haze twin's f16 ceiling (65504) and the probes', G-buffer's and TAA's clamps below it.
+    "MAX_HALF",
+];

@@ -7,9 +7,9 @@ use crate::error::{RenderError, Result};
 use crate::frame::{self, FrameOutputs, FrameState, Techniques};
 use crate::frame_context::{FrameContext, FrameSettings, HistoryReset, HistoryValidity, SunSource};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
-use crate::raster::RasterQueues;
-use crate::scene_gpu::SceneGpu;
-use crate::scene_rt::{FrameBvhStats, SceneRt};
+use crate::scene::raster::RasterQueues;
+use crate::scene::upload::SceneGpu;
+use crate::scene::rt::{FrameBvhStats, SceneRt};
 use crate::techniques::area_lights::AreaLightScene;
 
 /// A rendered frame: timings, and the images if they were asked for.
@@ -274,7 +274,7 @@ impl Renderer {
         }
         let invalid = |what: &str, source: hikari_scene::SceneError| RenderError::Scene {
             what: what.into(),
-            source,
+            source: Box::new(source),
         };
         settings
             .camera

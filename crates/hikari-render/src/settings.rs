@@ -223,7 +223,7 @@ register_settings! {
     reflection_probes: ReflectionProbesSettings,
     ray_traced_gi: RayTracedGiSettings,
     tonemap: TonemapSettings,
-    scene_rt: crate::scene_rt::SceneRtSettings,
+    scene_rt: crate::scene::rt::SceneRtSettings,
 }
 
 impl Settings {

@@ -8,7 +8,7 @@ use serde_json::json;
 
 use hikari_render::checks::graph_check::{EmptyParams, GraphCheck};
 use hikari_render::graph::{GraphRuntime, TimestampMode};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::{ContextOptions, GpuContext};
 
 use crate::args::JsonArgs;
@@ -77,7 +77,7 @@ pub fn run(a: OverheadArgs) -> anyhow::Result<()> {
     anyhow::ensure!(a.passes >= 2, "--passes must be at least 2");
     anyhow::ensure!(a.frames > 0, "--frames must be at least 1");
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
+    let mut lib = shader::library(shader::capabilities_for(ctx.features))?;
     let check = GraphCheck::new(&ctx, &mut lib)?;
     let mut rt = GraphRuntime::new();
     let mut measure = |passes: u32,

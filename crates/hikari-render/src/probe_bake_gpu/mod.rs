@@ -35,12 +35,12 @@ use hikari_bake::{BakeError, ProbeRequest, TransportSettings, TransportTracer};
 use hikari_scene::Scene;
 use wgpu::util::DeviceExt;
 
-use crate::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode};
+use crate::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::GraphRuntime;
 use crate::pipeline::ComputePipeline;
-use crate::shader::{self, ShaderLibrary};
+use crate::shader;
 
 /// Floats the accumulate kernel writes per probe.
 const OUT_STRIDE: usize = 40;
@@ -122,7 +122,7 @@ impl<'a> GpuTransport<'a> {
         let rays = SceneRays::build(scene).map_err(bake_error)?;
         let albedo = SurfaceAlbedo::new(scene);
         let tables = TransportTables::new(&rays, &albedo);
-        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
+        let mut lib = shader::library(shader::capabilities_for(ctx.features))?;
         let mut trace = BvhTrace::with_config(ctx, &mut lib, TraceConfig::incoherent())?;
         if !rays.tlas().instances.is_empty() {
             trace.upload_blases(ctx, rays.blases())?;

@@ -6,7 +6,7 @@ use crate::common;
 
 use glam::{DVec3, Mat4, Vec3, Vec4};
 use hikari_bvh::{BuildOptions, Tlas};
-use hikari_render::scene_bvh::{self, SceneAlphaFilter};
+use hikari_render::scene::bvh::{self, SceneAlphaFilter};
 use hikari_render::techniques::area_lights::reference::{self, TwinScene};
 use hikari_render::techniques::area_lights::{self, AreaLightParams, PolygonLights};
 use hikari_render::techniques::{direct_lighting, gbuffer};
@@ -202,9 +202,9 @@ fn gpu_matches_its_cpu_twin_on_the_cornell_box() {
         1,
         "the Cornell box's light is an area light"
     );
-    let blases = scene_bvh::blases(&scene, &BuildOptions::default()).unwrap();
+    let blases = bvh::blases(&scene, &BuildOptions::default()).unwrap();
     let tlas = Tlas::build(
-        &scene_bvh::instances(&scene),
+        &bvh::instances(&scene),
         &area_lights::shadow_casters(&scene),
         &blases,
     )
@@ -630,9 +630,9 @@ fn point_lights_cast_ray_traced_shadows() {
     let scene = point_light_scene(true);
     let (renderer, f) = render(&scene, settings(&scene, true));
     assert!(f.params.shades_punctual());
-    let blases = scene_bvh::blases(&scene, &BuildOptions::default()).unwrap();
+    let blases = bvh::blases(&scene, &BuildOptions::default()).unwrap();
     let tlas = Tlas::build(
-        &scene_bvh::instances(&scene),
+        &bvh::instances(&scene),
         &area_lights::shadow_casters(&scene),
         &blases,
     )
@@ -797,9 +797,9 @@ fn texel_at(f: &Frame, x: u32, y: u32) -> direct_lighting::reference::Texel {
 
 /// The shadow rays' BVH as the twin traces it: every instance but the shells around a light.
 fn twin_bvh(scene: &Scene) -> (Vec<hikari_bvh::Blas>, Tlas) {
-    let blases = scene_bvh::blases(scene, &BuildOptions::default()).unwrap();
+    let blases = bvh::blases(scene, &BuildOptions::default()).unwrap();
     let tlas = Tlas::build(
-        &scene_bvh::instances(scene),
+        &bvh::instances(scene),
         &area_lights::shadow_casters(scene),
         &blases,
     )
@@ -1237,7 +1237,7 @@ impl DenoiseRig {
             }
         }
         let ctx = common::gpu_context();
-        let mut lib = hikari_render::shader::ShaderLibrary::new(
+        let mut lib = hikari_render::shader::library(
             hikari_render::shader::capabilities_for(ctx.features),
         )
         .unwrap();

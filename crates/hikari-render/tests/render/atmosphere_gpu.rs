@@ -27,7 +27,7 @@ use crate::common;
 
 use hikari_atmosphere::table::Table;
 use hikari_atmosphere::{Atmosphere, AtmosphereParams, ColorSpace, TableSizes};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::sky::gpu_build::{TableBuilder, print_build_timings};
 
 /// Allowed relative luminance error of the transmittance table, every texel.
@@ -174,7 +174,7 @@ fn compare(
 #[test]
 fn gpu_tables_match_the_cpu_model() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let builder = TableBuilder::new(&ctx, &mut lib).unwrap();
     let hazy = AtmosphereParams {
         mie_scattering_per_km: 0.02,
@@ -205,7 +205,7 @@ fn gpu_tables_match_the_cpu_model() {
 #[ignore = "timing at full size: run by hand on real hardware"]
 fn gpu_build_time_per_table_at_full_size() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let builder = TableBuilder::new(&ctx, &mut lib).unwrap();
     let params = AtmosphereParams::default();
     for run in 0..3 {

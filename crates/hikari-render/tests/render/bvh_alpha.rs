@@ -2,7 +2,7 @@
 //! on the built-in `cutout` scene: closest and any hit, both kernel configurations, for rays
 //! through its two double-sided quads from the front and from behind, and rays from the ground
 //! towards the sun. Held to two references: the CPU traversal with the CPU twin of the filter
-//! (`scene_bvh::SceneAlphaFilter`), and the analytic coverage of the quads
+//! (`bvh::SceneAlphaFilter`), and the analytic coverage of the quads
 //! (`builtin::cutout_checker_covered`, `builtin::cutout_ramp_alpha` against the ramp's cut-off)
 //! at the exact point where the ray crosses them.
 //!
@@ -24,11 +24,11 @@ use hikari_bvh::reference::{random_dir, same_hit};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Ray, Tlas};
 use hikari_render::GpuContext;
-use hikari_render::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, TraceMode};
+use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, TraceMode};
 use hikari_render::graph::GraphRuntime;
-use hikari_render::scene_bvh::{self, BvhAlpha, SceneAlphaFilter};
-use hikari_render::scene_textures::TextureArrays;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::scene::bvh::{self, BvhAlpha, SceneAlphaFilter};
+use hikari_render::scene::textures::TextureArrays;
+use hikari_render::shader;
 use hikari_scene::Scene;
 use hikari_scene::builtin::{self, CUTOUT_RAMP_CUTOFF};
 use wgpu::util::DeviceExt;
@@ -94,8 +94,8 @@ struct Bvh {
 }
 
 fn bvh(scene: &Scene) -> Bvh {
-    let blases = scene_bvh::blases(scene, &BuildOptions::default()).unwrap();
-    let instances = scene_bvh::instances(scene);
+    let blases = bvh::blases(scene, &BuildOptions::default()).unwrap();
+    let instances = bvh::instances(scene);
     let all: Vec<u32> = (0..instances.len() as u32).collect();
     let tlas = Tlas::build(&instances, &all, &blases).unwrap();
     Bvh { blases, tlas }
@@ -117,7 +117,7 @@ fn gpu_trace(
     alpha: Option<&BvhAlpha>,
     rays: &[Ray],
 ) -> hikari_render::Result<GpuHits> {
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     gpu_trace_with(ctx, BvhTrace::new(ctx, &mut lib)?, scene, bvh, alpha, rays)
 }
 
@@ -255,7 +255,7 @@ fn compare(
 #[test]
 fn cut_out_meshes_are_marked_non_opaque() {
     let scene = builtin::cutout();
-    assert_eq!(scene_bvh::cutout_meshes(&scene), [false, true, true]);
+    assert_eq!(bvh::cutout_meshes(&scene), [false, true, true]);
     let bvh = bvh(&scene);
     for (m, blas) in bvh.blases.iter().enumerate() {
         let opaque = blas.triangles.iter().all(|t| t.is_opaque());
@@ -366,12 +366,12 @@ fn kernels_without_the_cut_out_test_refuse_cut_outs() {
     let scene = builtin::cutout();
     let bvh = bvh(&scene);
     let rays = rays(&scene, false);
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let trace = BvhTrace::with_configs(
         &ctx,
         &mut lib,
-        hikari_render::bvh_trace::TraceConfig::coherent(),
-        hikari_render::bvh_trace::TraceConfig::incoherent(),
+        hikari_render::scene::bvh_trace::TraceConfig::coherent(),
+        hikari_render::scene::bvh_trace::TraceConfig::incoherent(),
     )
     .unwrap();
     let alpha = BvhAlpha::for_scene(&scene);

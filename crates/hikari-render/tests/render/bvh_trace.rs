@@ -11,10 +11,10 @@ use hikari_bvh::reference::{
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
 use hikari_render::GpuContext;
-use hikari_render::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode};
+use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode};
 use hikari_render::graph::GraphRuntime;
-use hikari_render::scene_bvh::BvhAlpha;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::scene::bvh::BvhAlpha;
+use hikari_render::shader;
 use wgpu::util::DeviceExt;
 
 struct Scene {
@@ -50,13 +50,13 @@ impl Scene {
 
 struct Gpu {
     ctx: GpuContext,
-    lib: ShaderLibrary,
+    lib: shader::ShaderLibrary,
 }
 
 impl Gpu {
     fn new() -> Self {
         let ctx = common::gpu_context();
-        let lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+        let lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
         Self { ctx, lib }
     }
 
@@ -757,8 +757,8 @@ fn village_matches() {
     let mut gpu = Gpu::new();
     let village = hikari_scene::builtin::village();
     let scene = Scene::new(
-        hikari_render::scene_bvh::meshes(&village),
-        hikari_render::scene_bvh::instances(&village),
+        hikari_render::scene::bvh::meshes(&village),
+        hikari_render::scene::bvh::instances(&village),
     );
     // From every named camera (inside houses and the temple too) in random directions, so
     // the rays meet thin walls, furniture, leaves and terrain; brute force keeps the count low.

@@ -6,7 +6,7 @@ use crate::common;
 
 use glam::{Vec2, Vec3, Vec4};
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::clouds::reference as twin;
 use hikari_render::techniques::clouds::settings::CloudsSettings;
 use hikari_render::techniques::clouds::{CLOUDS_ON, CloudParams, Clouds};
@@ -145,7 +145,7 @@ fn cloud_shadow_follows_coverage() {
 }
 
 fn gpu_map(ctx: &hikari_render::GpuContext, s: &CloudsSettings, p: CloudParams) -> Vec<Vec4> {
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let clouds = Clouds::new(ctx, &mut lib).unwrap();
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(ctx);
@@ -447,7 +447,7 @@ fn shadow_map_and_its_lookup_agree_with_the_march() {
 
     {
         let ctx = common::gpu_context();
-        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+        let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
         let clouds = Clouds::new(&ctx, &mut lib).unwrap();
         let mut rt = GraphRuntime::new();
         let mut g = rt.begin_frame(&ctx);

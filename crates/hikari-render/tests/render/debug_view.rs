@@ -3,7 +3,7 @@
 
 use glam::Vec4;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::debug_view::{DebugView, Mapping, TARGET_FORMAT, reference};
 
 use crate::common;
@@ -31,7 +31,7 @@ fn source_texels(w: u32, h: u32) -> Vec<Vec4> {
 #[test]
 fn every_mapping_matches_its_twin() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let view = DebugView::new(&ctx, &mut lib).unwrap();
     let (w, h) = (16u32, 8u32);
     let texels = source_texels(w, h);

@@ -6,7 +6,7 @@ use crate::common;
 
 use glam::Vec3;
 use hikari_render::graph::{FrameResult, GraphRuntime};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::exposure::reference::{self, HISTOGRAM_BINS};
 use hikari_render::techniques::exposure::{Exposure, ExposureParams, ExposureSettings};
 use hikari_render::{GpuContext, Renderer};
@@ -24,7 +24,7 @@ struct Rig {
 impl Rig {
     fn new() -> Self {
         let ctx = common::gpu_context();
-        let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+        let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
         let exposure = Exposure::new(&ctx, &mut lib).unwrap();
         Self {
             ctx,

@@ -5,7 +5,7 @@
 use crate::common;
 
 use hikari_render::Renderer;
-use hikari_render::raster::QueueSizes;
+use hikari_render::scene::raster::QueueSizes;
 
 fn tiny_queues(renderer: &mut Renderer) {
     for t in ["gbuffer", "sun_shadows"] {

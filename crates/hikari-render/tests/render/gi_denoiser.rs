@@ -9,7 +9,7 @@ use glam::{UVec2, Vec2, Vec3, Vec4};
 use hikari_math::sh::ycocg::ShL1YCoCg;
 use hikari_render::GpuContext;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::gi_denoiser::reference::{self, GeometryImage, GiImage};
 use hikari_render::techniques::gi_denoiser::{
     GiDenoiser, GiDenoiserGeometry, GiDenoiserInput, GiDenoiserParams, GiDenoiserSettings,
@@ -279,7 +279,7 @@ struct Gpu {
 
 fn gpu() -> Gpu {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let denoiser = GiDenoiser::new(&ctx, &mut lib).unwrap();
     Gpu { ctx, denoiser }
 }

@@ -6,13 +6,13 @@ use crate::common;
 use hikari_render::RenderError;
 use hikari_render::checks::graph_check::{FillParams, GraphCheck};
 use hikari_render::graph::{GraphRuntime, TextureDesc, TimestampMode};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 
 const F16: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 fn setup() -> (hikari_render::GpuContext, GraphCheck) {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let check = GraphCheck::new(&ctx, &mut lib).unwrap();
     (ctx, check)
 }

@@ -9,8 +9,8 @@ use glam::{Vec3, Vec4};
 use half::f16;
 use hikari_math::sh::Sh;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::scene_gpu::LightGpu;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::scene::upload::LightGpu;
+use hikari_render::shader;
 use hikari_render::techniques::haze::reference::{self as twin, HazeLightInputs};
 use hikari_render::techniques::haze::settings::HazeSettings;
 use hikari_render::techniques::haze::{
@@ -302,7 +302,7 @@ fn run_gpu_frames(
     lights: &[LightGpu],
     probes: Option<&Probes>,
 ) -> Vec<GpuRun> {
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let haze = Haze::new(ctx, &mut lib).unwrap();
     let depth_tex = common::texture_with_data(
         ctx,

@@ -299,7 +299,7 @@ fn cut_out_texels_are_seen_through() {
     close(a.per_instance[0], (red + blue * 3.0) / 4.0, 1e-6);
     // The frame BVH's BLASes, marked the same way, give the same table.
     let blases =
-        hikari_render::scene_bvh::blases(&scene, &hikari_bvh::BuildOptions::default()).unwrap();
+        hikari_render::scene::bvh::blases(&scene, &hikari_bvh::BuildOptions::default()).unwrap();
     let b = InstanceAlbedo::with_blases(&scene, &blases, VIEW_RESOLUTION);
     assert_eq!(a.per_instance, b.per_instance);
 }
@@ -373,7 +373,7 @@ fn village_cost() {
     assert!(a.per_instance.iter().all(|v| v.is_finite()));
     // With the frame BVH's BLASes (what the renderer could pass): the trace alone.
     let blases =
-        hikari_render::scene_bvh::blases(&scene, &hikari_bvh::BuildOptions::default()).unwrap();
+        hikari_render::scene::bvh::blases(&scene, &hikari_bvh::BuildOptions::default()).unwrap();
     let t = std::time::Instant::now();
     let b = InstanceAlbedo::with_blases(&scene, &blases, VIEW_RESOLUTION);
     println!(

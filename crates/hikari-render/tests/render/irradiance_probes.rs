@@ -14,7 +14,7 @@ use hikari_math::sh::{Sh, ShL2Rgb};
 use hikari_probes::{Bake, BakeSettings, GridTile, HULL, ProbeSh, SceneKey, TILE_PROBE_COUNT};
 use hikari_render::graph::GraphRuntime;
 use hikari_render::pipeline::ComputePipeline;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::clouds::{self, CloudParams, settings::CloudsSettings};
 use hikari_render::techniques::irradiance_probes::gpu_data::{
     PROBES_INTERIOR_MASK, PROBES_PRESENT, ProbeGpuData, ProbeLookupParams,
@@ -106,7 +106,7 @@ fn settings_with(f: impl FnOnce(&mut IrradianceProbesSettings)) -> IrradiancePro
 #[test]
 fn relight_matches_the_cpu_twin() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let pipeline = ComputePipeline::new(
         &ctx,
         &mut lib,
@@ -295,7 +295,7 @@ fn gpu_lookup(
 #[test]
 fn lookup_matches_the_cpu_twin() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let pipeline = ComputePipeline::new(
         &ctx,
         &mut lib,
@@ -768,7 +768,7 @@ fn the_mesh_blends_into_the_grid_at_its_bounds() {
     );
 
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let pipeline = ComputePipeline::new(
         &ctx,
         &mut lib,
@@ -889,7 +889,7 @@ fn the_bench_dispatches_relight_copies_of_the_bake() {
         GRID_PASS, MESH_PASS, RelightBench, RelightBenchSpec, SCENE_MESH_PASS,
     };
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let technique = IrradianceProbes::new(&ctx, &mut lib).unwrap();
     let data = ProbeGpuData::new(&synthetic_bake(23));
     let mut rng = SmallRng::seed_from_u64(0xBE7C);

@@ -5,7 +5,7 @@
 use crate::common;
 
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::local_tonemap::reference::{self, Twin};
 use hikari_render::techniques::local_tonemap::{
     GRID_SIZE, LocalTonemap, LocalTonemapParams, LocalTonemapSettings, Look,
@@ -176,7 +176,7 @@ fn run_gpu_with_highlight(
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
         });
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let tm = LocalTonemap::new(&ctx, &mut lib).unwrap();
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(&ctx);
@@ -366,7 +366,7 @@ fn the_tonemap_evaluates_the_gain_as_the_twins_do() {
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
         });
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let local = LocalTonemap::new(&ctx, &mut lib).unwrap();
     let tm = Tonemap::new(&ctx, &mut lib).unwrap();
     let ts = TonemapSettings::default();

@@ -28,7 +28,7 @@ use hikari_math::sh::dering::{
 use hikari_math::sh::ycocg::{ShL1YCoCg, rgb_to_ycocg, ycocg_to_rgb};
 use hikari_math::sh::{ShL1, ShL2, ShL2Rgb, window, zonal};
 use hikari_render::checks::math_check::{Kernel, MathCheck};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 
@@ -38,7 +38,7 @@ const EPS: f64 = f32::EPSILON as f64 * 0.5;
 /// Runs `kernel` on `input` and returns one output record per case; `None` without a GPU.
 fn run(kernel: Kernel, input: &[f32]) -> Vec<Vec<f32>> {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let check = MathCheck::new(&ctx, &mut lib, kernel).unwrap();
     let out = check.run(&ctx, input).unwrap();
     assert_eq!(

@@ -7,7 +7,7 @@ use crate::common;
 use glam::{Vec3, Vec4};
 use half::f16;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::haze::HazeParams;
 use hikari_render::techniques::haze::settings::HazeSettings;
 use hikari_render::techniques::particles::settings::ParticlesSettings;
@@ -64,7 +64,7 @@ fn draw_on_gpu(
     background: &[Vec3],
 ) -> Vec<[f32; 4]> {
     let (w, h) = (view.viewport[0] as u32, view.viewport[1] as u32);
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let pass = Particles::new(ctx, &mut lib).unwrap();
     let depth_tex = common::texture_with_data(
         ctx,

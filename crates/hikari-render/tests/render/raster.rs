@@ -7,16 +7,16 @@ use crate::common;
 use glam::{Mat4, Vec3, Vec4};
 use hikari_bvh::reference::closest_hit_instances;
 use hikari_bvh::{Instance, Mesh, Ray};
-use hikari_render::raster::QueueSizes;
-use hikari_render::scene_gpu::SceneCpu;
+use hikari_render::scene::raster::QueueSizes;
+use hikari_render::scene::upload::SceneCpu;
 use hikari_render::techniques::gbuffer::reference::{decode_id, pixel_ray};
 use hikari_render::{FrameSettings, Renderer};
 use hikari_scene::Scene;
 
 fn bvh_scene(scene: &Scene) -> (Vec<Mesh>, Vec<Instance>) {
     (
-        hikari_render::scene_bvh::meshes(scene),
-        hikari_render::scene_bvh::instances(scene),
+        hikari_render::scene::bvh::meshes(scene),
+        hikari_render::scene::bvh::instances(scene),
     )
 }
 
@@ -392,11 +392,11 @@ fn views_with_non_finite_or_huge_matrices_stay_inside_their_target() {
     // fails every depth test; the integer clamp in `poly_rect` is what bounds the loops on
     // drivers that turn NaN into other integers.)
     use hikari_render::graph::GraphRuntime;
-    use hikari_render::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
-    use hikari_render::scene_gpu::SceneGpu;
-    use hikari_render::shader::{self, ShaderLibrary};
+    use hikari_render::scene::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
+    use hikari_render::scene::upload::SceneGpu;
+    use hikari_render::shader;
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let raster = Rasterizer::new(&ctx, &mut lib).unwrap();
     let scene = hikari_scene::builtin::boxes();
     let scene_gpu = SceneGpu::upload(&ctx, &scene).unwrap();

@@ -7,7 +7,7 @@ use glam::{Mat4, Vec2, Vec3};
 use hikari_math::sh::basis::{C0, C1};
 use hikari_math::sh::ycocg::{ShL1YCoCg, rgb_to_ycocg, ycocg_to_rgb};
 use hikari_render::graph::{GraphRuntime, ImageRgba32};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::direct_lighting::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use hikari_render::techniques::ray_traced_gi::reference::{
     self, AccumulateInput, Accumulated, FireflyClamp, HitWord, accumulate_pixel, pack_hit,
@@ -44,7 +44,7 @@ fn random_unit(rng: &mut SmallRng) -> Vec3 {
 #[test]
 fn ray_generation_packing_and_albedo_match_the_cpu_twin() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let rtgi = RayTracedGi::new(&ctx, &mut lib).unwrap();
     let mut rng = SmallRng::seed_from_u64(18);
     let cases = 4096usize;
@@ -236,7 +236,7 @@ fn rgba(img: &ImageRgba32) -> &[[f32; 4]] {
 #[test]
 fn accumulation_matches_the_cpu_twin_and_rejects_bad_history() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let rtgi = RayTracedGi::new(&ctx, &mut lib).unwrap();
     let (w, h) = (64u32, 64u32);
     let camera = Camera {
@@ -997,7 +997,7 @@ fn hits_are_lit_like_the_twin() {
 #[test]
 fn resolve_helpers_match_the_cpu_twin() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let rtgi = RayTracedGi::new(&ctx, &mut lib).unwrap();
     let brdf = hikari_render::brdf_tables::BrdfTables::new(&ctx);
     let mut rng = SmallRng::seed_from_u64(99);
@@ -1623,7 +1623,7 @@ fn the_lighting_resolves_gi_near_and_the_far_field_beyond() {
 #[test]
 fn a_firefly_in_a_converged_history_moves_it_by_at_most_the_clamp() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let rtgi = RayTracedGi::new(&ctx, &mut lib).unwrap();
     let (w, h) = (16u32, 16u32);
     let n = (w * h) as usize;
@@ -1843,7 +1843,7 @@ fn scattered_lights(
     points: usize,
     areas: usize,
 ) -> (
-    Vec<hikari_render::scene_gpu::LightGpu>,
+    Vec<hikari_render::scene::upload::LightGpu>,
     hikari_render::techniques::area_lights::PolygonLights,
 ) {
     use hikari_render::techniques::area_lights::lights::{
@@ -1865,7 +1865,7 @@ fn scattered_lights(
             } else {
                 f32::MAX
             };
-            hikari_render::scene_gpu::LightGpu {
+            hikari_render::scene::upload::LightGpu {
                 position_range: p.extend(range).to_array(),
                 direction_kind: [0.0, -1.0, 0.0, if spot { 1.0 } else { 0.0 }],
                 intensity: (Vec3::new(1.0, 0.8, 0.5) * rng.random_range(0.01..0.5))

@@ -435,9 +435,9 @@ fn a_lamp_lit_probe_is_normalised_by_the_lamp_at_the_surface() {
         s.context().unwrap().light_cutoff_lux,
         &s.settings.direct_lighting,
     );
-    let light = hikari_render::scene_gpu::LightGpu {
+    let light = hikari_render::scene::upload::LightGpu {
         position_range: lamp_at.extend(2.5).to_array(),
-        direction_kind: [0.0, 0.0, -1.0, hikari_render::scene_gpu::LIGHT_POINT],
+        direction_kind: [0.0, 0.0, -1.0, hikari_render::scene::upload::LIGHT_POINT],
         intensity: [4.0, 4.0, 4.0, 0.0],
         spot: [0.0, 1.0, 0.0, 0.0],
     };
@@ -558,7 +558,7 @@ fn the_wgsl_cube_and_cone_math_is_its_twin() {
     use rand::rngs::SmallRng;
     use rand::{Rng, SeedableRng};
     let ctx = common::gpu_context();
-    let mut lib = hikari_render::shader::ShaderLibrary::new(
+    let mut lib = hikari_render::shader::library(
         hikari_render::shader::capabilities_for(ctx.features),
     )
     .unwrap();

@@ -7,8 +7,8 @@ use glam::{Mat4, Vec2, Vec3};
 use hikari_bvh::reference::{closest_hit_instances, closest_hit_mesh, random_dir, same_hit};
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Ray};
-use hikari_render::scene_bvh;
-use hikari_render::scene_rt::{FrameBvh, SceneRtSettings, kept_instances};
+use hikari_render::scene::bvh;
+use hikari_render::scene::rt::{FrameBvh, SceneRtSettings, kept_instances};
 use hikari_scene::{Deformation, Instance, Light, Material, Mesh, Scene, shapes};
 
 /// A tapered column, vertically subdivided so that a sway bends it.
@@ -106,7 +106,7 @@ fn culled_tlas_finds_the_closest_hits_of_every_instance_inside_the_kept_region()
         frame.stats.instances_kept + frame.stats.instances_culled,
         scene.instances.len()
     );
-    let meshes = scene_bvh::meshes(&scene);
+    let meshes = bvh::meshes(&scene);
     let inv = vp.inverse();
     let mut rng = SplitMix64::new(18);
     // What the bare frustum keeps: hits outside it show that the margin is needed and kept.
@@ -188,7 +188,7 @@ fn refitted_swaying_tree_hits_like_its_deformed_mesh() {
             .collect(),
     );
     let fresh = Blas::from_mesh("fresh", &deformed, &BuildOptions::default()).unwrap();
-    let rest = &scene_bvh::meshes(&scene)[tree_mesh];
+    let rest = &bvh::meshes(&scene)[tree_mesh];
     let refitted = &bvh.blases[tree_mesh];
     let mut rng = SplitMix64::new(7);
     let (mut hits, mut moved) = (0, 0);
@@ -377,8 +377,8 @@ fn the_raster_and_the_bvh_draw_the_deformed_tree() {
         let img = r.take_image_of(tex.unwrap()).unwrap();
         img.rgba.iter().map(|p| p[0]).collect::<Vec<f32>>()
     };
-    let instances = scene_bvh::instances(&scene);
-    let rest_meshes = scene_bvh::meshes(&scene);
+    let instances = bvh::instances(&scene);
+    let rest_meshes = bvh::meshes(&scene);
     let time = 0.6; // a quarter period at 0.4 Hz: the full 2 m
     let mut moved_meshes = rest_meshes.clone();
     moved_meshes[1].positions = scene.meshes[1].deformed(time).0;
@@ -543,8 +543,8 @@ fn motion_vectors_follow_deforming_vertices() {
     s.prev_camera = Some(cam_a.clone());
     let (motion, depth, vis) = read(&mut renderer, &s);
 
-    let instances = scene_bvh::instances(&scene);
-    let mut meshes = scene_bvh::meshes(&scene);
+    let instances = bvh::instances(&scene);
+    let mut meshes = bvh::meshes(&scene);
     meshes[2].positions = scene.meshes[2].deformed(t1).0;
     let before = scene.meshes[2].deformed(t0).0;
     let want_depth = cpu_depth(&cam_b, w, h, &meshes, &instances);

@@ -1,12 +1,12 @@
 //! Every WGSL file composes and validates with naga; no GPU needed.
 
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 
 #[test]
 fn every_entry_shader_composes_and_validates() {
     // What the renderer requires of every adapter (64-bit atomics for the rasteriser).
     let caps = shader::required_capabilities();
-    let mut lib = ShaderLibrary::new(caps).expect("modules load");
+    let mut lib = shader::library(caps).expect("modules load");
     let entries = lib.entry_shaders();
     assert!(entries.len() >= 5, "found only {entries:?}");
     let mut failures = Vec::new();
@@ -34,7 +34,7 @@ fn the_rasteriser_variants_compose_and_validate() {
     // materials, colour textures and a sampler after the rest (0 to 12, no gaps).
     use naga_oil::compose::ShaderDefValue::Bool;
     let caps = shader::required_capabilities();
-    let mut lib = ShaderLibrary::new(caps).expect("modules load");
+    let mut lib = shader::library(caps).expect("modules load");
     let variants = [
         vec![("DEPTH_ONLY", Bool(true))],
         vec![("ALPHA_TEST", Bool(true))],
@@ -117,7 +117,7 @@ fn bindings_outside_group_zero_are_refused() {
 #[test]
 fn shared_modules_bind_in_groups_of_their_own() {
     let caps = shader::required_capabilities();
-    let mut lib = ShaderLibrary::new(caps).unwrap();
+    let mut lib = shader::library(caps).unwrap();
     assert_eq!(
         lib.binding_sets("direct_lighting/shade.wgsl"),
         [
@@ -177,5 +177,5 @@ fn bvh_stack_size_matches_the_kernel() {
         .trim_end_matches('u')
         .parse()
         .unwrap();
-    assert_eq!(value, hikari_render::bvh_trace::STACK_SIZE);
+    assert_eq!(value, hikari_render::scene::bvh_trace::STACK_SIZE);
 }

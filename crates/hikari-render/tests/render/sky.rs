@@ -13,7 +13,7 @@ use hikari_render::Renderer;
 use hikari_render::checks::math_check::{Kernel, MathCheck};
 use hikari_render::graph::GraphRuntime;
 use hikari_render::pipeline::ComputePipeline;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::gbuffer;
 use hikari_render::techniques::sky::{self, SkyParams, reference::SkyTwin};
 use hikari_render::wgpu::{self, util::DeviceExt};
@@ -518,7 +518,7 @@ fn run_finish(
 #[test]
 fn the_sky_pass_derings_as_hikari_math_does() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let pipeline = ComputePipeline::new(&ctx, &mut lib, "sky/sh.wgsl", "finish", &[]).unwrap();
     let serial = MathCheck::new(&ctx, &mut lib, Kernel::ShDering).unwrap();
     let mut rng = SmallRng::seed_from_u64(0x5C7_DE41);

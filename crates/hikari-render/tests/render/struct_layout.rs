@@ -1,56 +1,117 @@
 //! Rust mirrors of WGSL structs match naga's layout: same field names, offsets and size.
 
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 
 #[test]
 fn rust_structs_match_wgsl_layouts() {
-    let mut lib = ShaderLibrary::new(shader::required_capabilities()).unwrap();
-    let mut failures = Vec::new();
+    let mut lib = shader::library(shader::required_capabilities()).unwrap();
     let layouts = hikari_render::layout::all();
     assert!(!layouts.is_empty());
+    let mut failures = Vec::new();
     for l in layouts {
         let module = lib.module(l.shader, &[]).unwrap();
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
-        let found = module.types.iter().find(|(_, t)| {
-            t.name.as_deref().map(shader::undecorated) == Some(l.name)
-                && matches!(t.inner, naga::TypeInner::Struct { .. })
-        });
-        let Some((handle, ty)) = found else {
-            failures.push(format!("{}: no WGSL struct `{}`", l.shader, l.name));
-            continue;
-        };
-        let naga::TypeInner::Struct { members, span } = &ty.inner else {
-            unreachable!()
-        };
-        let wgsl: Vec<(String, usize)> = members
-            .iter()
-            .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
-            .collect();
-        let rust: Vec<(String, usize)> =
-            l.fields.iter().map(|(n, o)| (n.to_string(), *o)).collect();
-        if wgsl != rust {
-            failures.push(format!(
-                "{}: fields differ\n  WGSL {wgsl:?}\n  Rust {rust:?}",
-                l.name
-            ));
-        }
-        if *span as usize != l.size {
-            failures.push(format!(
-                "{}: WGSL size {} but Rust size {}",
-                l.name, span, l.size
-            ));
-        }
-        // A uniform's size must be a multiple of its alignment for arrays and bindings.
-        let align = layouter[handle].alignment.round_up(1) as usize;
-        if l.size % align != 0 {
-            failures.push(format!(
-                "{}: size {} not a multiple of alignment {align}",
-                l.name, l.size
-            ));
-        }
+        failures.extend(hikari_render::layout::struct_differences(&l, &module));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn shared_constants_match_wgsl_values() {
+    let mut lib = shader::library(shader::required_capabilities()).unwrap();
+    let constants = hikari_render::layout::constants();
+    assert!(constants.len() > 50, "the registry lost its constants");
+    let mut failures = Vec::new();
+    for c in &constants {
+        let module = lib.module(c.shader, &[]).unwrap();
+        failures.extend(hikari_render::layout::constant_difference(c, &module));
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn a_changed_constant_is_caught() {
+    // The check must see a difference of value and of type, not only a missing name.
+    let mut lib = shader::library(shader::required_capabilities()).unwrap();
+    let module = lib.module("direct_lighting/shade.wgsl", &[]).unwrap();
+    let mut c = hikari_render::layout::constants()
+        .into_iter()
+        .find(|c| c.name == "LIGHTING_SUN")
+        .unwrap();
+    assert!(hikari_render::layout::constant_difference(&c, &module).is_none());
+    let hikari_render::layout::ConstValue::U32(v) = c.value else {
+        panic!("LIGHTING_SUN is a u32 flag")
+    };
+    c.value = hikari_render::layout::ConstValue::U32(v << 1);
+    assert!(hikari_render::layout::constant_difference(&c, &module).is_some());
+    c.value = hikari_render::layout::ConstValue::I32(v as i32);
+    assert!(hikari_render::layout::constant_difference(&c, &module).is_some());
+}
+
+/// `(name, file)` of every scalar constant declared in the files under `dir` whose names end
+/// in `ext`, by a line scan: `const NAME: u32 =` in Rust (any visibility), `const NAME` in WGSL.
+fn constants_in(dir: &std::path::Path, ext: &str, found: &mut Vec<(String, String)>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            constants_in(&path, ext, found);
+            continue;
+        }
+        if path.extension().is_none_or(|e| e != ext) {
+            continue;
+        }
+        for line in std::fs::read_to_string(&path).unwrap().lines() {
+            let line = line.trim_start();
+            let line = line
+                .strip_prefix("pub(crate) ")
+                .or_else(|| line.strip_prefix("pub "))
+                .unwrap_or(line);
+            let Some(rest) = line.strip_prefix("const ") else {
+                continue;
+            };
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || *c == '_')
+                .collect();
+            let typed = rest[name.len()..].trim_start();
+            let scalar = ext == "wgsl"
+                || ["u32", "i32", "f32"]
+                    .iter()
+                    .any(|t| typed.strip_prefix(':').is_some_and(|r| r.trim_start().starts_with(t)));
+            if !name.is_empty() && scalar {
+                found.push((name, path.display().to_string()));
+            }
+        }
+    }
+}
+
+#[test]
+fn every_constant_both_languages_declare_is_registered() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (mut rust, mut wgsl) = (Vec::new(), Vec::new());
+    constants_in(&root.join("src"), "rs", &mut rust);
+    constants_in(&root.join("src"), "wgsl", &mut wgsl);
+    constants_in(&root.join("shaders"), "wgsl", &mut wgsl);
+    assert!(rust.iter().any(|(n, _)| n == "LIGHTING_SUN"), "the Rust scan missed LIGHTING_SUN");
+    assert!(wgsl.iter().any(|(n, _)| n == "LIGHTING_SUN"), "the WGSL scan missed LIGHTING_SUN");
+    let registered: Vec<&str> = hikari_render::layout::constants()
+        .iter()
+        .map(|c| c.name)
+        .collect();
+    let mut missing: Vec<String> = rust
+        .iter()
+        .filter(|(n, _)| wgsl.iter().any(|(w, _)| w == n))
+        .filter(|(n, _)| !registered.contains(&n.as_str()))
+        .filter(|(n, _)| !hikari_render::layout::UNRELATED_SAME_NAMES.contains(&n.as_str()))
+        .map(|(n, file)| format!("{n} ({file})"))
+        .collect();
+    missing.sort();
+    missing.dedup();
+    assert!(
+        missing.is_empty(),
+        "constants declared in Rust and WGSL without a value check; add them to \
+         layout::constants() (or, if they mean different things, to UNRELATED_SAME_NAMES): {}",
+        missing.join(", ")
+    );
 }
 
 /// Names of the `#[repr(C)]` structs deriving `Pod` in the Rust sources under `dir`: the
@@ -102,9 +163,11 @@ fn pod_structs_in(dir: &std::path::Path, found: &mut Vec<(String, String)>) {
 
 #[test]
 fn every_pod_struct_of_the_crate_is_registered() {
-    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut found = Vec::new();
-    pod_structs_in(&src, &mut found);
+    pod_structs_in(&root.join("src"), &mut found);
+    // A Pod struct the engine gains must be registered too.
+    pod_structs_in(&root.join("../hikari-gpu/src"), &mut found);
     // The scan itself must see the structs we know of, or it proves nothing.
     for known in ["View", "RasterParams", "ShadowParams", "CopyParams"] {
         assert!(

@@ -12,8 +12,8 @@ use hikari_scene::Scene;
 
 fn bvh_scene(scene: &Scene) -> (Vec<Mesh>, Vec<Instance>) {
     (
-        hikari_render::scene_bvh::meshes(scene),
-        hikari_render::scene_bvh::instances(scene),
+        hikari_render::scene::bvh::meshes(scene),
+        hikari_render::scene::bvh::instances(scene),
     )
 }
 

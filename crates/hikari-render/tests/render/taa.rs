@@ -6,7 +6,7 @@ use crate::common;
 use glam::{Vec2, Vec3, Vec4};
 use half::f16;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::taa::reference::{self, TaaInputs};
 use hikari_render::techniques::taa::settings::TaaSettings;
 use hikari_render::techniques::taa::{Taa, TaaParams};
@@ -35,7 +35,7 @@ fn half_texture(ctx: &hikari_render::GpuContext, px: &[[f32; 4]]) -> wgpu::Textu
 
 fn resolve_matches_twin(clip: bool) {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let taa = Taa::new(&ctx, &mut lib).unwrap();
     let settings = TaaSettings {
         clip,

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use hikari_render::GpuContext;
 use hikari_render::graph::GraphRuntime;
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::techniques::tonemap::cube::CubeLut;
 use hikari_render::techniques::tonemap::settings::TonemapSettings;
 use hikari_render::techniques::tonemap::{
@@ -385,7 +385,7 @@ fn graded_cube(dir: &std::path::Path) -> String {
 #[test]
 fn tonemap_matches_its_cpu_twin_with_every_switch_on_and_off() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let tonemap = Tonemap::new(&ctx, &mut lib).unwrap();
     let inp = inputs();
     let dir = tmp_dir("twin");
@@ -453,7 +453,7 @@ fn tonemap_matches_its_cpu_twin_with_every_switch_on_and_off() {
 #[test]
 fn an_identity_lut_round_trips_within_one_step() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let tonemap = Tonemap::new(&ctx, &mut lib).unwrap();
     let inp = inputs();
     let dir = tmp_dir("identity");
@@ -476,7 +476,7 @@ fn an_identity_lut_round_trips_within_one_step() {
 #[test]
 fn a_damaged_lut_file_is_an_error_naming_the_file_and_line() {
     let ctx = common::gpu_context();
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features)).unwrap();
+    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
     let tonemap = Tonemap::new(&ctx, &mut lib).unwrap();
     let dir = tmp_dir("damaged");
     let path = dir.join("bad.cube");

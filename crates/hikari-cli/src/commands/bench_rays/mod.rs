@@ -26,9 +26,9 @@ use anyhow::{Context, ensure};
 use clap::Args;
 
 use hikari_bvh::Tlas;
-use hikari_render::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, TraceConfig};
+use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, TraceConfig};
 use hikari_render::graph::{GraphRuntime, TimestampMode};
-use hikari_render::shader::{self, ShaderLibrary};
+use hikari_render::shader;
 use hikari_render::wgpu;
 use hikari_render::wgpu::util::DeviceExt;
 use hikari_render::{ContextOptions, GpuContext};
@@ -127,7 +127,7 @@ pub fn run(args: RaysArgs) -> anyhow::Result<()> {
         })
         .collect();
 
-    let mut lib = ShaderLibrary::new(shader::capabilities_for(ctx.features))?;
+    let mut lib = shader::library(shader::capabilities_for(ctx.features))?;
     let mut rt = GraphRuntime::new();
     rt.set_timestamps(TimestampMode::Pass);
     let mut results = Vec::new();

@@ -3,7 +3,7 @@
 use serde_json::json;
 
 use hikari_bvh::Tlas;
-use hikari_render::bvh_trace::TraceConfig;
+use hikari_render::scene::bvh_trace::TraceConfig;
 
 use super::measure::Measured;
 use super::quality::TlasQuality;

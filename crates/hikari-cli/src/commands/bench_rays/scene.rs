@@ -54,7 +54,7 @@ pub(super) fn load(name: &str) -> anyhow::Result<BenchScene> {
     scene
         .validate()
         .with_context(|| format!("scene `{name}`"))?;
-    let meshes = hikari_render::scene_bvh::meshes(&scene);
+    let meshes = hikari_render::scene::bvh::meshes(&scene);
     let mut blases = Vec::new();
     for _ in 0..3 {
         let t0 = Instant::now();
@@ -68,7 +68,7 @@ pub(super) fn load(name: &str) -> anyhow::Result<BenchScene> {
             .collect::<anyhow::Result<_>>()?;
         blas_build_ms.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    let instances = hikari_render::scene_bvh::instances(&scene);
+    let instances = hikari_render::scene::bvh::instances(&scene);
     let mut triangles = Vec::new();
     let mut cdf = Vec::new();
     let mut area = 0.0f64;

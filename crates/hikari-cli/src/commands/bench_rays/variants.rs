@@ -2,7 +2,7 @@
 
 use anyhow::{Context, bail};
 
-use hikari_render::bvh_trace::{Refill, TraceConfig};
+use hikari_render::scene::bvh_trace::{Refill, TraceConfig};
 
 /// A `--variants` entry: the configurations for coherent and for incoherent rays.
 pub(super) fn parse_variant(spec: &str) -> anyhow::Result<(TraceConfig, TraceConfig)> {

@@ -19,12 +19,12 @@ pub use settings::AreaLightsSettings;
 
 use super::direct_lighting::RADIANCE_FORMAT;
 use super::gbuffer::GBuffer;
-use crate::bvh_trace::BvhBuffers;
+use crate::scene::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{BindingSet, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::scene_gpu::SceneInFrame;
+use crate::scene::upload::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
@@ -116,7 +116,7 @@ pub fn frame_rotation(frame: u64) -> [f32; 4] {
 }
 
 /// What the pass needs of a scene, built once when it is loaded: its area lights. The shadow
-/// rays trace the frame's scene BVH (`scene_rt::SceneRt`, its shadow TLAS), from which the
+/// rays trace the frame's scene BVH (`scene::rt::SceneRt`, its shadow TLAS), from which the
 /// instances that are the glowing shell of a point or spot light ([`shadow_casters`]) are left
 /// out: they stand for that light's own light passing through them (the village's lanterns).
 pub struct AreaLightScene {

@@ -11,7 +11,7 @@ use super::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, AreaTriangleGpu,
 use super::settings::{MAX_LIGHTS_PER_PIXEL, MAX_SHADOW_PICKS};
 use super::{AREA_POLYGONS, AREA_PUNCTUAL, AreaLightParams};
 use crate::reference::octahedral;
-use crate::scene_gpu::LightGpu;
+use crate::scene::upload::LightGpu;
 use crate::techniques::direct_lighting::reference::{Texel, clamp};
 
 fn v3(a: [f32; 4]) -> Vec3 {

@@ -20,7 +20,7 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{BindingSet, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::scene_gpu::SceneInFrame;
+use crate::scene::upload::SceneInFrame;
 use crate::settings::DirectLightingSettings;
 use crate::shader::ShaderLibrary;
 use crate::view::View;

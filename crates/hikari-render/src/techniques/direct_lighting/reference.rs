@@ -6,14 +6,14 @@ use hikari_math::brdf::{self, Material};
 use hikari_math::sh::{Sh, zonal};
 
 use crate::reference::octahedral;
-use crate::scene_gpu::LightGpu;
+use crate::scene::upload::LightGpu;
 use crate::techniques::direct_lighting::{
     LIGHTING_EMISSIVE, LIGHTING_PLACEHOLDER_AMBIENT, LIGHTING_PROBES, LIGHTING_PUNCTUAL,
     LIGHTING_SKY, LIGHTING_SUN, LightingParams,
 };
 use crate::techniques::sky::reference::SkyTwin;
 
-const MAX_RADIANCE: f32 = 65000.0;
+pub(crate) const MAX_RADIANCE: f32 = 65000.0;
 
 fn v3(a: [f32; 4]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])

@@ -8,8 +8,8 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
-use crate::scene_gpu::SceneInFrame;
+use crate::scene::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
+use crate::scene::upload::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 

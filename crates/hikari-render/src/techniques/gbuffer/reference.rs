@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::scene_gpu::{CHUNK_TRIANGLES, SceneCpu};
+use crate::scene::upload::{CHUNK_TRIANGLES, SceneCpu};
 
 /// The scene instance and the triangle within its mesh that visibility id `id` names.
 pub fn decode_id(scene: &SceneCpu, id: u32, mesh_first_triangle: u32) -> Option<(u32, u32)> {
@@ -185,13 +185,13 @@ pub fn resolve_deformed(
         area(world[0], p, world[2]) / total,
         area(world[0], world[1], p) / total,
     );
-    let attr: Vec<&crate::scene_gpu::VertexAttr> =
+    let attr: Vec<&crate::scene::upload::VertexAttr> =
         idx.iter().map(|&i| &cpu.attributes[i as usize]).collect();
-    let lerp3 = |f: &dyn Fn(&crate::scene_gpu::VertexAttr) -> DVec3| {
+    let lerp3 = |f: &dyn Fn(&crate::scene::upload::VertexAttr) -> DVec3| {
         f(attr[0]) * w.x + f(attr[1]) * w.y + f(attr[2]) * w.z
     };
     let decode = |p: u32| {
-        crate::reference::octahedral::decode(crate::scene_gpu::unpack_snorm16x2(p)).as_dvec3()
+        crate::reference::octahedral::decode(crate::scene::upload::unpack_snorm16x2(p)).as_dvec3()
     };
     let normal_model = glam::DMat3::from_mat4(model).inverse().transpose();
     let mut n = (normal_model * lerp3(&|a| decode(a.normal))).normalize();
@@ -207,7 +207,7 @@ pub fn resolve_deformed(
         r.map_or(DVec4::ONE, |r| tex.sample(r.texture, uv_at, srgb))
     };
     let unorm16 = |c: u32| DVec2::new((c & 0xffff) as f64, (c >> 16) as f64) / 65535.0;
-    let color = |a: &crate::scene_gpu::VertexAttr| {
+    let color = |a: &crate::scene::upload::VertexAttr| {
         let (rg, ba) = (unorm16(a.color[0]), unorm16(a.color[1]));
         DVec3::new(rg.x, rg.y, ba.x)
     };

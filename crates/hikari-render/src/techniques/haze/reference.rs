@@ -11,7 +11,7 @@ use super::{
     HAZE_DENSITY_AA, HAZE_LOCAL_LIGHTS, HAZE_SKY, HAZE_SKY_OCCLUSION, HAZE_SUN_SHADOWS,
     HAZE_TRICUBIC, HazeParams,
 };
-use crate::scene_gpu::LightGpu;
+use crate::scene::upload::LightGpu;
 use crate::techniques::gbuffer;
 use crate::view::View;
 

@@ -361,8 +361,7 @@ impl IrradianceProbes {
         gb: &GBuffer,
         view: &View,
     ) -> Result<Option<Tex>> {
-        if !self.lookup_pass.load(Ordering::Relaxed) && !g.rt.dumps.iter().any(|d| d == PIXELS_DUMP)
-        {
+        if !self.lookup_pass.load(Ordering::Relaxed) && !g.dump_requested(PIXELS_DUMP) {
             return Ok(None);
         }
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];

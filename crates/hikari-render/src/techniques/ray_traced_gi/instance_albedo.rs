@@ -37,8 +37,8 @@ use hikari_scene::{Material, Scene};
 use rayon::prelude::*;
 
 use super::reference::{hit_albedo, texture_mean};
-use crate::scene_bvh::SceneAlphaFilter;
-use crate::scene_gpu::alpha_cutoff;
+use crate::scene::bvh::SceneAlphaFilter;
+use crate::scene::upload::alpha_cutoff;
 use crate::techniques::gbuffer::reference::TwinTextures;
 
 /// Rays per side of each of the six orthographic views of a mesh.
@@ -100,7 +100,7 @@ impl InstanceAlbedo {
     }
 
     /// [`InstanceAlbedo::for_scene`] through BLASes already built: `blases[m]` of scene mesh
-    /// `m`, as `crate::scene_bvh::blases` builds them for the frame's BVH (same triangles,
+    /// `m`, as `crate::scene::bvh::blases` builds them for the frame's BVH (same triangles,
     /// cut-out meshes marked non-opaque), which saves building them twice at scene load.
     pub fn with_blases(scene: &Scene, blases: &[Blas], resolution: u32) -> Self {
         Pairs::of(scene).measure(scene, resolution, |m| blases.get(m), Duration::ZERO)

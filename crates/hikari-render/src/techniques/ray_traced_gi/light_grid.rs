@@ -23,7 +23,7 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::scene_gpu::LightGpu;
+use crate::scene::upload::LightGpu;
 use crate::techniques::area_lights::lights::{AREA_LIGHT_FORCED, AreaLightGpu};
 
 /// Most cells along an axis.

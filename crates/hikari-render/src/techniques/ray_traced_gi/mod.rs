@@ -38,7 +38,7 @@ use super::gbuffer::GBuffer;
 use super::gi_denoiser::RecurrentHistory;
 use super::sky::SkyFrame;
 use super::sun_shadows::SunShadowMaps;
-use crate::bvh_trace::BvhBuffers;
+use crate::scene::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
@@ -241,13 +241,13 @@ impl RtGiParams {
     }
 }
 
-/// What the technique keeps of a scene besides the frame's BVH (`scene_rt::SceneRt`, which it
+/// What the technique keeps of a scene besides the frame's BVH (`scene::rt::SceneRt`, which it
 /// traces through [`RtGiInputs::bvh`]): the per-instance albedo table, on the GPU, and the
 /// grid of light lists that lights hits ([`light_grid`]), rebuilt when what it was built from
 /// changes.
 pub struct RtGiScene {
     /// The scene's point and spot lights, for their reach ([`light_grid::punctual_records`]).
-    punctual: Vec<crate::scene_gpu::LightGpu>,
+    punctual: Vec<crate::scene::upload::LightGpu>,
     light_grid: Mutex<Option<LightGridGpu>>,
     /// [`reference::instance_table`].
     instance_table: wgpu::Buffer,

@@ -318,7 +318,7 @@ pub fn triangle_normals<'a>(
 pub fn punctual_irradiance(
     x: Vec3,
     n: Vec3,
-    light: &crate::scene_gpu::LightGpu,
+    light: &crate::scene::upload::LightGpu,
     cutoff_lux: f32,
 ) -> Vec3 {
     let pos = Vec3::from_slice(&light.position_range[..3]);
@@ -353,7 +353,7 @@ pub fn hash(v: u32) -> u32 {
 /// point on a disc of the light's radius facing `x` (its own, else `default_radius_m`), from
 /// random numbers 6 and 7 of the pixel and frame.
 pub fn punctual_shadow_target(
-    light: &crate::scene_gpu::LightGpu,
+    light: &crate::scene::upload::LightGpu,
     x: Vec3,
     default_radius_m: f32,
     pixel: [u32; 2],

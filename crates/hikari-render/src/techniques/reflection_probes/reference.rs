@@ -173,7 +173,7 @@ pub fn prefilter_integral(env: impl Fn(Vec3) -> Vec3, n: Vec3, alpha: f64, steps
 /// lighting parameters, whose cut-off shortens the light's range.
 pub fn box_light_irradiance(
     p: &ReflectionProbeGpu,
-    light: &crate::scene_gpu::LightGpu,
+    light: &crate::scene::upload::LightGpu,
     cutoff: &crate::techniques::direct_lighting::LightingParams,
     x: Vec3,
     n: Vec3,

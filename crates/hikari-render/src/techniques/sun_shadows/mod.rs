@@ -32,10 +32,10 @@ use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
-use crate::raster::{
+use crate::scene::raster::{
     MAX_VIEWS, RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer, pack_point,
 };
-use crate::scene_gpu::SceneInFrame;
+use crate::scene::upload::SceneInFrame;
 use crate::settings::SunShadowsSettings;
 use crate::shader::ShaderLibrary;
 

@@ -14,7 +14,7 @@ use hikari_bvh::{
 use hikari_scene::Scene;
 
 use super::settings::SceneRtSettings;
-use crate::scene_bvh;
+use crate::scene::bvh;
 use crate::techniques::area_lights::shadow_casters;
 
 /// What one frame's update cost and did.
@@ -178,8 +178,8 @@ fn scheduler_for(s: &SceneRtSettings, animated: &[Animated], blases: &[Blas]) ->
 impl FrameBvh {
     /// Builds every BLAS of `scene` in its rest pose.
     pub fn new(scene: &Scene) -> Result<Self, BvhError> {
-        let blases = scene_bvh::blases(scene, &BuildOptions::default())?;
-        let instances = scene_bvh::instances(scene);
+        let blases = bvh::blases(scene, &BuildOptions::default())?;
+        let instances = bvh::instances(scene);
         let mut casters = vec![false; instances.len()];
         for i in shadow_casters(scene) {
             casters[i as usize] = true;

@@ -19,7 +19,7 @@ use hikari_scene::{Scene, Wrap};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::{Buf, FrameGraph, Tex};
-use crate::scene_textures::{self, TextureArrays};
+use crate::scene::textures::{self, TextureArrays};
 
 /// Triangles per chunk; the rasteriser's workgroup size.
 pub const CHUNK_TRIANGLES: u32 = 64;
@@ -140,7 +140,7 @@ pub struct Chunk {
 pub struct SceneGpu {
     pub positions: wgpu::Buffer,
     /// What `positions` held the frame before: the same but for deforming meshes, whose
-    /// last frame's pose gives the G-buffer's motion (`scene_rt::SceneRt::update_raster`).
+    /// last frame's pose gives the G-buffer's motion (`scene::rt::SceneRt::update_raster`).
     pub prev_positions: wgpu::Buffer,
     pub attributes: wgpu::Buffer,
     pub indices: wgpu::Buffer,
@@ -238,7 +238,7 @@ pub fn orthonormal_tangent(n: Vec3) -> Vec3 {
 }
 
 impl SceneCpu {
-    pub fn build(scene: &Scene, layers: &scene_textures::LayerMap) -> Self {
+    pub fn build(scene: &Scene, layers: &textures::LayerMap) -> Self {
         let mut cpu = SceneCpu {
             particles: scene.particles.clone(),
             ..SceneCpu::default()

@@ -1,6 +1,6 @@
 //! The GPU copy of the frame's ray-tracing scene: the packed BLAS list (uploaded at load,
 //! then only the refitted BLAS rewritten in place), the two TLAS rewritten every frame, and
-//! the cut-out data of `scene_bvh::BvhAlpha`.
+//! the cut-out data of `bvh::BvhAlpha`.
 
 use bytemuck::{Pod, Zeroable};
 use hikari_bvh::{InstanceRecord, PackedBlases, TriangleRecord, WideNode};
@@ -8,13 +8,13 @@ use hikari_scene::Scene;
 
 use super::frame_bvh::{FrameBvh, FrameBvhStats, FrameTlases};
 use super::settings::SceneRtSettings;
-use crate::bvh_trace::{BvhBuffers, STACK_SIZE};
+use crate::scene::bvh_trace::{BvhBuffers, STACK_SIZE};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::FrameGraph;
 use crate::reference::octahedral;
-use crate::scene_bvh::{AlphaInstance, AlphaTriangle, BvhAlpha};
-use crate::scene_gpu::{SceneGpu, VertexAttr, snorm16x2};
+use crate::scene::bvh::{AlphaInstance, AlphaTriangle, BvhAlpha};
+use crate::scene::upload::{SceneGpu, VertexAttr, snorm16x2};
 
 /// A storage buffer that grows (by half again) when its contents outgrow it, else is
 /// rewritten in place.

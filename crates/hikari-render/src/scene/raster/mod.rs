@@ -12,7 +12,7 @@
 //! turn; a workgroup reads the records only of the triangles it draws tiles of.
 //!
 //! Alpha-tested triangles (glTF MASK cut-outs) never enter those three passes: their chunks
-//! come last in the scene's chunk table ([`crate::scene_gpu::SceneGpu::first_alpha_chunk`]),
+//! come last in the scene's chunk table ([`crate::scene::upload::SceneGpu::first_alpha_chunk`]),
 //! the three passes stop before them, and two more passes draw them only when the scene has
 //! some: `{technique}.rasterize_alpha` (pass 1 with the alpha test on each fragment; no large
 //! list, every larger triangle is queued tile by tile after the opaque entries) and
@@ -27,7 +27,7 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::{Buf, FrameGraph, FrameResult, SamplerKind};
 use crate::pipeline::ComputePipeline;
-use crate::scene_gpu::SceneInFrame;
+use crate::scene::upload::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use naga_oil::compose::ShaderDefValue;
 

@@ -25,7 +25,7 @@
 //! must hold `count` records.
 //!
 //! Alpha cut-outs: hits on triangles marked non-opaque (`hikari_bvh::TRIANGLE_NON_OPAQUE`,
-//! see `scene_bvh::blases`) count only where the material's alpha passes its cut-off, which the
+//! see `bvh::blases`) count only where the material's alpha passes its cut-off, which the
 //! kernel evaluates from [`BvhAlpha`] and the scene's sRGB texture array
 //! ([`BvhTrace::upload_alpha`]). Until that is uploaded, placeholders stand in (one zeroed
 //! record of each table, a 1 x 1 texture), which is all a BVH without marked triangles needs:
@@ -43,7 +43,7 @@ use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex};
 use crate::pipeline::ComputePipeline;
-use crate::scene_bvh::{AlphaInstance, AlphaTriangle, BvhAlpha};
+use crate::scene::bvh::{AlphaInstance, AlphaTriangle, BvhAlpha};
 use crate::shader::ShaderLibrary;
 
 /// Stack entries of the kernel (`BVH_STACK_SIZE` in `shaders/bvh/traverse.wgsl`).
@@ -418,7 +418,7 @@ impl BvhTrace {
 
     /// Uploads the cut-out data of the scene the BVH was built from ([`BvhAlpha::for_scene`]),
     /// with its sRGB texture array (`SceneGpu::textures.color`, layers as
-    /// `scene_textures::LayerMap` numbers them; `None`: a 1 x 1 white texture, for alpha data
+    /// `textures::LayerMap` numbers them; `None`: a 1 x 1 white texture, for alpha data
     /// that names no texture). Needed once the BVH has triangles marked non-opaque; call again
     /// when the scene's instances or materials change.
     pub fn upload_alpha(
