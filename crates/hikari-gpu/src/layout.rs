@@ -53,8 +53,7 @@ impl From<f32> for ConstValue {
     }
 }
 
-/// A Rust constant and the entry shader whose module must hold a WGSL constant of the same
-/// name, type and value.
+/// A Rust constant and the WGSL file that declares a constant of the same name, type and value.
 #[derive(Debug)]
 pub struct SharedConstant {
     pub name: &'static str,
@@ -67,7 +66,11 @@ pub struct SharedConstant {
 macro_rules! gpu_const {
     ($c:path, $shader:literal) => {
         $crate::layout::SharedConstant {
-            name: stringify!($c).rsplit("::").next().unwrap_or(stringify!($c)).trim(),
+            name: stringify!($c)
+                .rsplit("::")
+                .next()
+                .unwrap_or(stringify!($c))
+                .trim(),
             shader: $shader,
             value: $crate::layout::ConstValue::from($c),
         }
@@ -119,31 +122,41 @@ pub fn struct_differences(l: &StructLayout, module: &naga::Module) -> Vec<String
     failures
 }
 
-/// The scalar value of the WGSL constant `name` in `module`, if it has one.
-pub fn wgsl_constant(module: &naga::Module, name: &str) -> Option<ConstValue> {
+/// The value of the scalar constant `name` that the WGSL file `source` declares at module
+/// scope. The file's one-line `const` declarations are evaluated by naga on their own: a
+/// composed shader would not do, as naga folds a constant that only constant expressions use
+/// into its users and drops it.
+pub fn wgsl_constant(source: &str, name: &str) -> Result<ConstValue, String> {
+    let declarations: String = source
+        .lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with("const ") && l.ends_with(';'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let module = naga::front::wgsl::parse_str(&declarations)
+        .map_err(|e| format!("its constants do not evaluate alone: {e}"))?;
     let (_, c) = module
         .constants
         .iter()
-        .find(|(_, c)| c.name.as_deref().map(undecorated) == Some(name))?;
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .ok_or("no module-scope `const` of that name")?;
     match module.global_expressions[c.init] {
-        naga::Expression::Literal(naga::Literal::U32(v)) => Some(ConstValue::U32(v)),
-        naga::Expression::Literal(naga::Literal::I32(v)) => Some(ConstValue::I32(v)),
-        naga::Expression::Literal(naga::Literal::F32(v)) => Some(ConstValue::F32(v)),
-        _ => None,
+        naga::Expression::Literal(naga::Literal::U32(v)) => Ok(ConstValue::U32(v)),
+        naga::Expression::Literal(naga::Literal::I32(v)) => Ok(ConstValue::I32(v)),
+        naga::Expression::Literal(naga::Literal::F32(v)) => Ok(ConstValue::F32(v)),
+        ref e => Err(format!("not a u32, i32 or f32 scalar: {e:?}")),
     }
 }
 
-/// Why `c` disagrees with `module`; `None` when the WGSL constant has the same type and value.
-pub fn constant_difference(c: &SharedConstant, module: &naga::Module) -> Option<String> {
-    match wgsl_constant(module, c.name) {
-        Some(v) if v == c.value => None,
-        Some(v) => Some(format!(
+/// Why `c` disagrees with the WGSL file `source` that declares it; `None` when the WGSL
+/// constant has the same type and value.
+pub fn constant_difference(c: &SharedConstant, source: &str) -> Option<String> {
+    match wgsl_constant(source, c.name) {
+        Ok(v) if v == c.value => None,
+        Ok(v) => Some(format!(
             "{} ({}): WGSL {v:?} but Rust {:?}",
             c.name, c.shader, c.value
         )),
-        None => Some(format!(
-            "{} ({}): no scalar WGSL constant of that name",
-            c.name, c.shader
-        )),
+        Err(e) => Some(format!("{} ({}): {e}", c.name, c.shader)),
     }
 }

@@ -12,8 +12,8 @@ use crate::frame_context::FrameContext;
 pub use crate::frame_context::FrameSettings;
 use crate::graph::{FrameGraph, Tex};
 use crate::scene::raster::{RasterQueues, Rasterizer};
-use crate::scene::upload::SceneGpu;
 use crate::scene::rt::SceneRt;
+use crate::scene::upload::SceneGpu;
 use crate::shader;
 use crate::techniques::area_lights::{
     AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,

@@ -344,74 +344,240 @@ pub fn all() -> Vec<StructLayout> {
     ]
 }
 
-/// Every constant the crate's Rust and WGSL both declare, with an entry shader that sees the
-/// WGSL one. `tests/render/struct_layout.rs` checks each value against naga's module and that
+/// Every constant the crate's Rust and WGSL both declare, with the WGSL file that declares it. `tests/render/struct_layout.rs` checks each value against naga's module and that
 /// no constant declared in both languages is missing here.
 pub fn constants() -> Vec<SharedConstant> {
     vec![
-        gpu_const!(crate::techniques::haze::reference::AIR_INTERIOR_MASK, "haze/light.wgsl"),
-        gpu_const!(crate::techniques::area_lights::lights::AREA_LIGHT_DOUBLE_SIDED, "area_lights/shade.wgsl"),
-        gpu_const!(crate::techniques::area_lights::lights::AREA_LIGHT_FORCED, "area_lights/shade.wgsl"),
-        gpu_const!(crate::techniques::area_lights::AREA_POLYGONS, "area_lights/shade.wgsl"),
-        gpu_const!(crate::techniques::area_lights::AREA_PUNCTUAL, "area_lights/shade.wgsl"),
-        gpu_const!(crate::scene::upload::CHUNK_TRIANGLES, "raster/triangles.wgsl"),
-        gpu_const!(crate::techniques::clouds::CLOUDS_DENSITY_AA, "clouds/march.wgsl"),
-        gpu_const!(crate::techniques::clouds::CLOUDS_MULTIPLE, "clouds/march.wgsl"),
-        gpu_const!(crate::techniques::clouds::CLOUDS_ON, "clouds/march.wgsl"),
-        gpu_const!(crate::techniques::clouds::CLOUDS_SHADOWS, "clouds/march.wgsl"),
-        gpu_const!(crate::techniques::gi_denoiser::reference::EDGE_NORMAL_COS, "gi_denoiser/ao.wgsl"),
-        gpu_const!(crate::techniques::exposure::EXPOSURE_FIXED, "exposure/adapt.wgsl"),
-        gpu_const!(crate::techniques::exposure::EXPOSURE_HIGHLIGHTS, "exposure/adapt.wgsl"),
-        gpu_const!(crate::scene::upload::EXTRA_BITANGENT_NEGATIVE, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::scene::upload::EXTRA_HAS_INTERIOR, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::scene::upload::EXTRA_HAS_TANGENT, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::techniques::local_tonemap::reference::FIXED, "local_tonemap/fill.wgsl"),
-        gpu_const!(crate::techniques::gi_denoiser::params::FLAG_RECURRENT, "gi_denoiser/spatial.wgsl"),
-        gpu_const!(crate::techniques::haze::HAZE_DENSITY_AA, "haze/composite.wgsl"),
-        gpu_const!(crate::techniques::haze::HAZE_LOCAL_LIGHTS, "haze/light.wgsl"),
-        gpu_const!(crate::techniques::haze::HAZE_SKY, "haze/light.wgsl"),
-        gpu_const!(crate::techniques::haze::HAZE_SKY_OCCLUSION, "haze/light.wgsl"),
-        gpu_const!(crate::techniques::haze::HAZE_SUN_SHADOWS, "haze/light.wgsl"),
-        gpu_const!(crate::techniques::haze::HAZE_TRICUBIC, "haze/composite.wgsl"),
-        gpu_const!(crate::techniques::exposure::reference::INCIDENT_C, "exposure/adapt.wgsl"),
-        gpu_const!(crate::scene::upload::INSTANCE_ALPHA_TESTED, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::scene::upload::INSTANCE_DOUBLE_SIDED, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::scene::upload::INSTANCE_MOVED, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::scene::upload::INSTANCE_OWN_NORMAL_MATRIX, "gbuffer/resolve.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_EMISSIVE, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_PLACEHOLDER_AMBIENT, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_PROBES, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_PUNCTUAL, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_REFLECTION_PROBES, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_RTGI, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_SKY, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::LIGHTING_SUN, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::direct_lighting::reference::MAX_RADIANCE, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::area_lights::denoise::MAX_VISIBILITY, "area_lights/temporal.wgsl"),
-        gpu_const!(crate::techniques::exposure::reference::NO_HIGHLIGHT, "exposure/adapt.wgsl"),
-        gpu_const!(crate::techniques::gbuffer::NO_INSTANCE, "ray_traced_gi/pretrace.wgsl"),
-        gpu_const!(crate::scene::upload::NO_TEXTURE, "area_lights/shade.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::gpu_data::PROBES_GRID, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::gpu_data::PROBES_INTERIOR_MASK, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::gpu_data::PROBES_PRESENT, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::area_lights::reference::PUNCTUAL_KEY, "area_lights/shade.wgsl"),
-        gpu_const!(crate::techniques::exposure::reference::REFLECTED_K, "exposure/adapt.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_BOOST, "irradiance_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_BOUNCE, "irradiance_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_DERING, "irradiance_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RELIGHT_PROBES, "reflection_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RELIGHT_SHADOWS, "reflection_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RELIGHT_SKY, "reflection_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::irradiance_probes::RELIGHT_SUN_BOUNCE, "irradiance_probes/relight.wgsl"),
-        gpu_const!(crate::techniques::ray_traced_gi::reference::REPROJECTION_MIN_WEIGHT, "area_lights/temporal.wgsl"),
-        gpu_const!(crate::techniques::ray_traced_gi::reference::REPROJECTION_SNAP, "area_lights/temporal.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RP_HORIZON, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RP_NORMALIZE, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RP_ON, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::reflection_probes::RP_PARALLAX_ROUGHNESS, "direct_lighting/shade.wgsl"),
-        gpu_const!(crate::techniques::area_lights::denoise::SHADOW_DENOISE_RESET, "area_lights/temporal.wgsl"),
-        gpu_const!(crate::scene::raster::TILE_SIZE, "raster/tiles.wgsl"),
-        gpu_const!(crate::techniques::area_lights::denoise::VISIBILITY_EPS, "area_lights/spatial.wgsl"),
+        gpu_const!(
+            crate::techniques::haze::reference::AIR_INTERIOR_MASK,
+            "haze/light.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::lights::AREA_LIGHT_DOUBLE_SIDED,
+            "common/area_polygon.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::lights::AREA_LIGHT_FORCED,
+            "common/area_polygon.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::AREA_POLYGONS,
+            "area_lights/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::AREA_PUNCTUAL,
+            "area_lights/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::CHUNK_TRIANGLES,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::clouds::CLOUDS_DENSITY_AA,
+            "clouds/density.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::clouds::CLOUDS_MULTIPLE,
+            "clouds/density.wgsl"
+        ),
+        gpu_const!(crate::techniques::clouds::CLOUDS_ON, "clouds/density.wgsl"),
+        gpu_const!(
+            crate::techniques::clouds::CLOUDS_SHADOWS,
+            "clouds/density.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::gi_denoiser::reference::EDGE_NORMAL_COS,
+            "gi_denoiser/ao.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::exposure::EXPOSURE_FIXED,
+            "exposure/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::exposure::EXPOSURE_HIGHLIGHTS,
+            "exposure/common.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::EXTRA_BITANGENT_NEGATIVE,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::EXTRA_HAS_INTERIOR,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::EXTRA_HAS_TANGENT,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::local_tonemap::reference::FIXED,
+            "local_tonemap/fill.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::gi_denoiser::params::FLAG_RECURRENT,
+            "gi_denoiser/common.wgsl"
+        ),
+        gpu_const!(crate::techniques::haze::HAZE_DENSITY_AA, "haze/common.wgsl"),
+        gpu_const!(
+            crate::techniques::haze::HAZE_LOCAL_LIGHTS,
+            "haze/common.wgsl"
+        ),
+        gpu_const!(crate::techniques::haze::HAZE_SKY, "haze/common.wgsl"),
+        gpu_const!(
+            crate::techniques::haze::HAZE_SKY_OCCLUSION,
+            "haze/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::haze::HAZE_SUN_SHADOWS,
+            "haze/common.wgsl"
+        ),
+        gpu_const!(crate::techniques::haze::HAZE_TRICUBIC, "haze/common.wgsl"),
+        gpu_const!(
+            crate::techniques::exposure::reference::INCIDENT_C,
+            "exposure/adapt.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::INSTANCE_DOUBLE_SIDED,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::INSTANCE_MOVED,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::scene::upload::INSTANCE_OWN_NORMAL_MATRIX,
+            "common/scene_gpu.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_EMISSIVE,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_PLACEHOLDER_AMBIENT,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_PROBES,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_PUNCTUAL,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_REFLECTION_PROBES,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_RTGI,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_SKY,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::LIGHTING_SUN,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::direct_lighting::reference::MAX_RADIANCE,
+            "direct_lighting/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::denoise::MAX_VISIBILITY,
+            "area_lights/denoise_common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::exposure::reference::NO_HIGHLIGHT,
+            "exposure/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::gbuffer::NO_INSTANCE,
+            "ray_traced_gi/pretrace.wgsl"
+        ),
+        gpu_const!(crate::scene::upload::NO_TEXTURE, "common/scene_gpu.wgsl"),
+        gpu_const!(
+            crate::techniques::irradiance_probes::gpu_data::PROBES_GRID,
+            "irradiance_probes/lookup.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::irradiance_probes::gpu_data::PROBES_INTERIOR_MASK,
+            "irradiance_probes/lookup.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::irradiance_probes::gpu_data::PROBES_PRESENT,
+            "irradiance_probes/lookup.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::reference::PUNCTUAL_KEY,
+            "area_lights/shade.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::exposure::reference::REFLECTED_K,
+            "exposure/adapt.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::irradiance_probes::RELIGHT_BOOST,
+            "irradiance_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::irradiance_probes::RELIGHT_BOUNCE,
+            "irradiance_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::irradiance_probes::RELIGHT_DERING,
+            "irradiance_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RELIGHT_PROBES,
+            "reflection_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RELIGHT_SHADOWS,
+            "reflection_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RELIGHT_SKY,
+            "reflection_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::irradiance_probes::RELIGHT_SUN_BOUNCE,
+            "irradiance_probes/relight.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::ray_traced_gi::reference::REPROJECTION_MIN_WEIGHT,
+            "common/view.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::ray_traced_gi::reference::REPROJECTION_SNAP,
+            "common/view.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RP_HORIZON,
+            "reflection_probes/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RP_NORMALIZE,
+            "reflection_probes/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RP_ON,
+            "reflection_probes/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::reflection_probes::RP_PARALLAX_ROUGHNESS,
+            "reflection_probes/common.wgsl"
+        ),
+        gpu_const!(
+            crate::techniques::area_lights::denoise::SHADOW_DENOISE_RESET,
+            "area_lights/denoise_common.wgsl"
+        ),
+        gpu_const!(crate::scene::raster::TILE_SIZE, "raster/setup.wgsl"),
+        gpu_const!(
+            crate::techniques::area_lights::denoise::VISIBILITY_EPS,
+            "area_lights/denoise_common.wgsl"
+        ),
     ]
 }
 

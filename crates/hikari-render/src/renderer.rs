@@ -8,8 +8,8 @@ use crate::frame::{self, FrameOutputs, FrameState, Techniques};
 use crate::frame_context::{FrameContext, FrameSettings, HistoryReset, HistoryValidity, SunSource};
 use crate::graph::{FrameResult, GraphRuntime, ImageRgba32, Res};
 use crate::scene::raster::RasterQueues;
-use crate::scene::upload::SceneGpu;
 use crate::scene::rt::{FrameBvhStats, SceneRt};
+use crate::scene::upload::SceneGpu;
 use crate::techniques::area_lights::AreaLightScene;
 
 /// A rendered frame: timings, and the images if they were asked for.

@@ -72,7 +72,7 @@ const NO_TEXTURE: u32 = 0xffffffffu;
 const INSTANCE_DOUBLE_SIDED: u32 = 1u;
 const INSTANCE_OWN_NORMAL_MATRIX: u32 = 2u;
 const INSTANCE_MOVED: u32 = 4u;
-const INSTANCE_ALPHA_TESTED: u32 = 8u;
+// Bit 8 (INSTANCE_ALPHA_TESTED) is read only on the CPU, by the BVH build.
 const EXTRA_BITANGENT_NEGATIVE: u32 = 0x10000u;
 const EXTRA_HAS_TANGENT: u32 = 0x20000u;
 const EXTRA_HAS_INTERIOR: u32 = 0x40000u;

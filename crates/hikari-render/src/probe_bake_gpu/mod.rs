@@ -35,11 +35,11 @@ use hikari_bake::{BakeError, ProbeRequest, TransportSettings, TransportTracer};
 use hikari_scene::Scene;
 use wgpu::util::DeviceExt;
 
-use crate::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::GraphRuntime;
 use crate::pipeline::ComputePipeline;
+use crate::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode};
 use crate::shader;
 
 /// Floats the accumulate kernel writes per probe.

@@ -284,8 +284,8 @@ fn without_the_alpha_test_both_comparisons_fail() {
 #[test]
 fn opaque_chunks_come_first_and_cut_outs_carry_their_cut_off() {
     // No GPU needed: what the scene upload tells the rasteriser.
-    use hikari_render::scene::upload::{INSTANCE_ALPHA_TESTED, SceneCpu};
     use hikari_render::scene::textures::LayerMap;
+    use hikari_render::scene::upload::{INSTANCE_ALPHA_TESTED, SceneCpu};
     let scene = builtin::cutout();
     let cpu = SceneCpu::build(&scene, &LayerMap::for_scene(&scene));
     let first = cpu.first_alpha_chunk as usize;

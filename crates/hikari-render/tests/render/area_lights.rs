@@ -1237,10 +1237,9 @@ impl DenoiseRig {
             }
         }
         let ctx = common::gpu_context();
-        let mut lib = hikari_render::shader::library(
-            hikari_render::shader::capabilities_for(ctx.features),
-        )
-        .unwrap();
+        let mut lib =
+            hikari_render::shader::library(hikari_render::shader::capabilities_for(ctx.features))
+                .unwrap();
         let denoiser = area_lights::ShadowDenoiser::new(&ctx, &mut lib).unwrap();
         let mut rt = hikari_render::graph::GraphRuntime::new();
         rt.set_dumps(

@@ -11,9 +11,11 @@ use hikari_bvh::reference::{
 use hikari_bvh::rng::SplitMix64;
 use hikari_bvh::{Blas, BuildOptions, Hit, Instance, Mesh, Ray, Tlas};
 use hikari_render::GpuContext;
-use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode};
 use hikari_render::graph::GraphRuntime;
 use hikari_render::scene::bvh::BvhAlpha;
+use hikari_render::scene::bvh_trace::{
+    BvhTrace, HIT_BYTES, RayOrder, Refill, TraceConfig, TraceMode,
+};
 use hikari_render::shader;
 use wgpu::util::DeviceExt;
 

@@ -392,7 +392,9 @@ fn views_with_non_finite_or_huge_matrices_stay_inside_their_target() {
     // fails every depth test; the integer clamp in `poly_rect` is what bounds the loops on
     // drivers that turn NaN into other integers.)
     use hikari_render::graph::GraphRuntime;
-    use hikari_render::scene::raster::{RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer};
+    use hikari_render::scene::raster::{
+        RasterJob, RasterQueues, RasterTarget, RasterView, Rasterizer,
+    };
     use hikari_render::scene::upload::SceneGpu;
     use hikari_render::shader;
     let ctx = common::gpu_context();

@@ -558,10 +558,9 @@ fn the_wgsl_cube_and_cone_math_is_its_twin() {
     use rand::rngs::SmallRng;
     use rand::{Rng, SeedableRng};
     let ctx = common::gpu_context();
-    let mut lib = hikari_render::shader::library(
-        hikari_render::shader::capabilities_for(ctx.features),
-    )
-    .unwrap();
+    let mut lib =
+        hikari_render::shader::library(hikari_render::shader::capabilities_for(ctx.features))
+            .unwrap();
     let check = MathCheck::new(&ctx, &mut lib, Kernel::ReflectionProbe).unwrap();
     let mut rng = SmallRng::seed_from_u64(7);
     let unit = |rng: &mut SmallRng| {

@@ -56,7 +56,7 @@ fn the_rasteriser_variants_compose_and_validate() {
 #[test]
 fn every_wgsl_file_on_disk_is_embedded() {
     // Shared modules under shaders/, each technique's own beside its code under src/; keys
-    // as build.rs gives them (src/techniques/x/y.wgsl is x/y.wgsl).
+    // as build.rs gives them (src/techniques/x/y.wgsl is x/y.wgsl, src/scene/x/y.wgsl x/y.wgsl).
     let crate_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut on_disk = Vec::new();
     for root in ["shaders", "src"] {
@@ -73,7 +73,11 @@ fn every_wgsl_file_on_disk_is_embedded() {
                         .unwrap()
                         .to_string_lossy()
                         .replace('\\', "/");
-                    on_disk.push(rel.strip_prefix("techniques/").unwrap_or(&rel).to_string());
+                    let key = ["techniques/", "scene/"]
+                        .iter()
+                        .find_map(|p| rel.strip_prefix(p))
+                        .unwrap_or(&rel);
+                    on_disk.push(key.to_string());
                 }
             }
         }

@@ -7,8 +7,10 @@ use anyhow::{Context, ensure};
 
 use hikari_bvh::{Blas, Hit, Ray, Tlas};
 use hikari_render::GpuContext;
-use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode};
 use hikari_render::graph::GraphRuntime;
+use hikari_render::scene::bvh_trace::{
+    BvhTrace, HIT_BYTES, RAY_BYTES, RayOrder, TraceConfig, TraceMode,
+};
 use hikari_render::wgpu;
 
 use super::RaysArgs;

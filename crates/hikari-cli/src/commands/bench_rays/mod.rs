@@ -26,8 +26,8 @@ use anyhow::{Context, ensure};
 use clap::Args;
 
 use hikari_bvh::Tlas;
-use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, TraceConfig};
 use hikari_render::graph::{GraphRuntime, TimestampMode};
+use hikari_render::scene::bvh_trace::{BvhTrace, HIT_BYTES, RAY_BYTES, TraceConfig};
 use hikari_render::shader;
 use hikari_render::wgpu;
 use hikari_render::wgpu::util::DeviceExt;

@@ -8,12 +8,12 @@ use hikari_scene::Scene;
 
 use super::frame_bvh::{FrameBvh, FrameBvhStats, FrameTlases};
 use super::settings::SceneRtSettings;
-use crate::scene::bvh_trace::{BvhBuffers, STACK_SIZE};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::FrameGraph;
 use crate::reference::octahedral;
 use crate::scene::bvh::{AlphaInstance, AlphaTriangle, BvhAlpha};
+use crate::scene::bvh_trace::{BvhBuffers, STACK_SIZE};
 use crate::scene::upload::{SceneGpu, VertexAttr, snorm16x2};
 
 /// A storage buffer that grows (by half again) when its contents outgrow it, else is

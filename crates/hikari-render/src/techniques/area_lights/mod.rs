@@ -19,11 +19,11 @@ pub use settings::AreaLightsSettings;
 
 use super::direct_lighting::RADIANCE_FORMAT;
 use super::gbuffer::GBuffer;
-use crate::scene::bvh_trace::BvhBuffers;
 use crate::context::GpuContext;
 use crate::error::Result;
 use crate::graph::{BindingSet, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
+use crate::scene::bvh_trace::BvhBuffers;
 use crate::scene::upload::SceneInFrame;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
