@@ -180,6 +180,14 @@ pub fn record<'r>(
     // 1. Update: camera, sun or moon, the sky's clock, the metered light and the lights'
     //    cut-off are the frame context's (`frame_context.rs`), resolved before this walk.
 
+    // 2. G-buffer: the scene rasterised into visibility, resolved into surfaces. First, as
+    //    nothing it draws depends on the lighting; the reflection probes' captures use its
+    //    pipelines.
+    let gbuffer = t
+        .gbuffer
+        .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
+    override_gbuffer(g, &gbuffer, size, &state.gbuffer_overrides)?;
+
     // 4. Clouds, before the atmosphere: this frame's share of the paraboloid cloud map and the
     //    clouds' shadow map. The sky's SH sees the sky through them, the deferred lighting
     //    draws them over the sky, and they shadow the sun there, in the haze, the GI and the
@@ -256,12 +264,6 @@ pub fn record<'r>(
         &s.settings.sun_shadows,
         &mut state.raster_queues,
     )?;
-
-    // 8. G-buffer.
-    let gbuffer = t
-        .gbuffer
-        .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
-    override_gbuffer(g, &gbuffer, size, &state.gbuffer_overrides)?;
 
     // The probes' irradiance per pixel, only for `--dump irradiance_probes.pixels`.
     t.irradiance_probes

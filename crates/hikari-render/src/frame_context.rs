@@ -15,8 +15,8 @@
 use hikari_scene::{Camera, Sun};
 
 use crate::error::{RenderError, Result};
+use crate::lights::light_cutoff_lux;
 use crate::settings::Settings;
-use crate::techniques::direct_lighting::light_cutoff_lux;
 use crate::techniques::sky::FrameSky;
 use crate::techniques::taa;
 use crate::view::View;
@@ -278,4 +278,14 @@ pub fn metered_lux(settings: &Settings, sun: Option<&Sun>, sky_lux: f32) -> f32 
             .max(sky_lux)
             .max(1e-3),
     }
+}
+
+/// Last frame's adapted exposure, for passes that run before this frame's.
+#[derive(Clone, Copy, Debug)]
+pub struct PreviousExposure {
+    /// `exposure.state` as the last frame left it: Rgba32Float 1x1, x the EV100 (scale =
+    /// 1 / (1.2 · 2^x)), y 1 once written (zeros in a new history).
+    pub state: crate::graph::Tex,
+    /// Whether a frame has written it (false on a graph runtime's first frame).
+    pub valid: bool,
 }

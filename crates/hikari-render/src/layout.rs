@@ -353,11 +353,11 @@ pub fn constants() -> Vec<SharedConstant> {
             "haze/light.wgsl"
         ),
         gpu_const!(
-            crate::techniques::area_lights::lights::AREA_LIGHT_DOUBLE_SIDED,
+            crate::lights::polygon::AREA_LIGHT_DOUBLE_SIDED,
             "common/area_polygon.wgsl"
         ),
         gpu_const!(
-            crate::techniques::area_lights::lights::AREA_LIGHT_FORCED,
+            crate::lights::polygon::AREA_LIGHT_FORCED,
             "common/area_polygon.wgsl"
         ),
         gpu_const!(
@@ -481,7 +481,7 @@ pub fn constants() -> Vec<SharedConstant> {
             "direct_lighting/shade.wgsl"
         ),
         gpu_const!(
-            crate::techniques::direct_lighting::reference::MAX_RADIANCE,
+            crate::reference::lighting::MAX_RADIANCE,
             "direct_lighting/shade.wgsl"
         ),
         gpu_const!(

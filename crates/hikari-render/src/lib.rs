@@ -10,6 +10,7 @@ pub mod error;
 pub mod frame;
 pub mod frame_context;
 pub mod layout;
+pub mod lights;
 pub mod output;
 pub mod probe_bake_gpu;
 pub mod reference;

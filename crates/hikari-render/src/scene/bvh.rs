@@ -16,9 +16,9 @@ use glam::{Affine3A, Vec2};
 use hikari_bvh::{Blas, BuildOptions, BvhError, Instance, Mesh};
 use hikari_scene::Scene;
 
+use crate::reference::textures::TwinTextures;
 use crate::scene::textures::LayerMap;
 use crate::scene::upload::{NO_TEXTURE, alpha_cutoff, unorm16x2};
-use crate::techniques::gbuffer::reference::TwinTextures;
 
 pub fn meshes(scene: &Scene) -> Vec<Mesh> {
     scene

@@ -6,6 +6,9 @@ use crate::common;
 
 use glam::{DVec3, Mat4, Vec3, Vec4};
 use hikari_bvh::{BuildOptions, Tlas};
+use hikari_render::lights::reference::{
+    area_light_reach, light_vector_irradiance, polygon_vector_irradiance,
+};
 use hikari_render::scene::bvh::{self, SceneAlphaFilter};
 use hikari_render::techniques::area_lights::reference::{self, TwinScene};
 use hikari_render::techniques::area_lights::{self, AreaLightParams, PolygonLights};
@@ -56,7 +59,7 @@ fn square_light_irradiance_on_a_parallel_plane_matches_the_closed_form() {
             let s = side * 0.5;
             let want = rectangle_closed_form(-s - px, s - px, -s - pz, s - pz, h);
             let q = rectangle(-s, s, -s, s, h, DVec3::new(px, 0.0, pz));
-            let got = reference::polygon_vector_irradiance(&q, n).dot(n);
+            let got = polygon_vector_irradiance(&q, n).dot(n);
             let err = (got - want).abs() / want;
             worst = worst.max(err);
             assert!(
@@ -67,11 +70,11 @@ fn square_light_irradiance_on_a_parallel_plane_matches_the_closed_form() {
     }
     // Far away the square is a point: E = A / d^2 per unit radiance.
     let q = rectangle(-0.01, 0.01, -0.01, 0.01, 10.0, DVec3::ZERO);
-    let got = reference::polygon_vector_irradiance(&q, n).dot(n);
+    let got = polygon_vector_irradiance(&q, n).dot(n);
     assert!((got - 4e-4 / 100.0).abs() < 1e-9, "{got}");
     // A light below the horizon gives nothing; one straddling it only its upper part.
     let below = rectangle(-1.0, 1.0, -1.0, 1.0, -1.0, DVec3::ZERO);
-    assert_eq!(reference::polygon_vector_irradiance(&below, n).dot(n), 0.0);
+    assert_eq!(polygon_vector_irradiance(&below, n).dot(n), 0.0);
     println!("worst relative error against the closed form: {worst:e}");
 }
 
@@ -98,7 +101,7 @@ fn a_light_split_into_triangles_integrates_as_the_whole_polygon() {
     });
     let lights = PolygonLights::for_scene(&scene);
     assert_eq!(lights.lights.len(), 1, "{:?}", lights.skipped);
-    let got = reference::light_vector_irradiance(
+    let got = light_vector_irradiance(
         lights.triangles_of(0),
         false,
         DVec3::new(0.2, 0.0, 0.1),
@@ -108,7 +111,7 @@ fn a_light_split_into_triangles_integrates_as_the_whole_polygon() {
     let want = rectangle_closed_form(-0.7, 0.3, -0.6, 0.4, 1.0);
     assert!((got - want).abs() < 1e-6 * want, "{got} vs {want}");
     // Seen from above (its back), a one-sided light gives nothing.
-    let back = reference::light_vector_irradiance(
+    let back = light_vector_irradiance(
         lights.triangles_of(0),
         false,
         DVec3::new(0.0, 2.0, 0.0),
@@ -365,11 +368,9 @@ fn penumbra_profile(side: f32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
             // light where x_l >= -x.
             let s = side as f64 * 0.5;
             let pp = p.as_dvec3();
-            let full =
-                reference::polygon_vector_irradiance(&rectangle(-s, s, -s, s, 2.0, pp), DVec3::Y).y;
+            let full = polygon_vector_irradiance(&rectangle(-s, s, -s, s, 2.0, pp), DVec3::Y).y;
             let x0 = (-pp.x).clamp(-s, s);
-            let vis =
-                reference::polygon_vector_irradiance(&rectangle(x0, s, -s, s, 2.0, pp), DVec3::Y).y;
+            let vis = polygon_vector_irradiance(&rectangle(x0, s, -s, s, 2.0, pp), DVec3::Y).y;
             exact[x as usize] += (vis / full) as f32 / h as f32;
         }
         xs.push(sum_x / h as f32);
@@ -761,7 +762,7 @@ fn an_area_light_brings_less_than_the_cut_off_beyond_its_reach() {
             radiance_flux: [nits, nits, nits, std::f32::consts::PI * nits * area],
             range: [0; 4],
         };
-        let reach = reference::area_light_reach(&params, &light) as f64;
+        let reach = area_light_reach(&light, params.values[2]) as f64;
         // On the axis, facing the light: the closed form.
         let on_axis = nits as f64 * rectangle_closed_form(-s, s, -s, s, reach);
         assert!(
@@ -773,8 +774,7 @@ fn an_area_light_brings_less_than_the_cut_off_beyond_its_reach() {
             let y = -(1.0f64 - x * x - z * z).max(0.0).sqrt();
             let p = DVec3::new(x, y, z).normalize() * reach;
             let q = rectangle(-s, s, -s, s, 0.0, p);
-            let e = nits as f64
-                * reference::polygon_vector_irradiance(&q, -p.normalize()).dot(-p.normalize());
+            let e = nits as f64 * polygon_vector_irradiance(&q, -p.normalize()).dot(-p.normalize());
             assert!(
                 e <= cutoff as f64,
                 "side {side} m, cut-off {cutoff} lux: {e} lux at {p} (reach {reach} m)"
@@ -882,7 +882,7 @@ fn village_at_night_gpu_matches_its_twin_within_the_ray_budget() {
                     .iter()
                     .filter(|l| {
                         Vec3::from_slice(&l.centroid_radius[..3]).distance(world)
-                            < reference::area_light_reach(&f.params, l)
+                            < area_light_reach(l, f.params.values[2])
                     })
                     .count();
                 most_area_in_reach = most_area_in_reach.max(in_reach);

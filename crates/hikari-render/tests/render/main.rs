@@ -23,6 +23,7 @@ mod haze;
 mod instance_albedo;
 mod irradiance_probes;
 mod irradiance_probes_leak;
+mod layering;
 mod live;
 mod local_tonemap;
 mod math_twins;

@@ -8,7 +8,6 @@ use hikari_math::sh::basis::{C0, C1};
 use hikari_math::sh::ycocg::{ShL1YCoCg, rgb_to_ycocg, ycocg_to_rgb};
 use hikari_render::graph::{GraphRuntime, ImageRgba32};
 use hikari_render::shader;
-use hikari_render::techniques::direct_lighting::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use hikari_render::techniques::ray_traced_gi::reference::{
     self, AccumulateInput, Accumulated, FireflyClamp, HitWord, accumulate_pixel, pack_hit,
     unpack_hit,
@@ -16,6 +15,7 @@ use hikari_render::techniques::ray_traced_gi::reference::{
 use hikari_render::techniques::ray_traced_gi::{
     FLAG_ACCUMULATE, FLAG_RESET, RayTracedGi, RayTracedGiSettings, RtGiParams, SkySource,
 };
+use hikari_render::techniques::sky::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use hikari_render::view::View;
 use hikari_render::{FrameSettings, Renderer};
 use hikari_scene::{Camera, Instance, Material, Scene, Sun, shapes};
@@ -1846,7 +1846,7 @@ fn scattered_lights(
     Vec<hikari_render::scene::upload::LightGpu>,
     hikari_render::techniques::area_lights::PolygonLights,
 ) {
-    use hikari_render::techniques::area_lights::lights::{
+    use hikari_render::lights::polygon::{
         AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, AreaLightGpu, PolygonLights,
     };
     let at = |rng: &mut SmallRng| {
@@ -1912,7 +1912,7 @@ fn scattered_lights(
 /// sums), bit for bit.
 #[test]
 fn light_grid_lists_every_light_that_reaches_a_cell() {
-    use hikari_render::techniques::ray_traced_gi::light_grid::{
+    use hikari_render::lights::grid::{
         HEADER_RECORDS, LightGrid, area_reach, grid_cutoff, punctual_reach,
     };
     let mut rng = SmallRng::seed_from_u64(18);
@@ -2051,7 +2051,7 @@ fn light_grid_lists_every_light_that_reaches_a_cell() {
 /// rays all pass.
 #[test]
 fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
-    use hikari_render::techniques::ray_traced_gi::light_grid;
+    use hikari_render::lights::grid;
     use hikari_scene::{Light, LightKind};
     let mut rng = SmallRng::seed_from_u64(250);
     let ceiling_albedo = Vec3::new(0.8, 0.7, 0.6);
@@ -2148,11 +2148,11 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
     } = render(&mut renderer, &s);
     // The grid the frame used: several cells, each listing a small part of the lights.
     let cutoff = s.context().unwrap().light_cutoff_lux;
-    let grid = light_grid::LightGrid::build(
+    let grid = grid::LightGrid::build(
         &area.lights,
-        &light_grid::punctual_records(&scene),
+        &grid::punctual_records(&scene),
         min_flux,
-        light_grid::grid_cutoff(cutoff),
+        grid::grid_cutoff(cutoff),
     );
     let cells = grid.dims().iter().product::<u32>() as usize;
     eprintln!(
@@ -2247,11 +2247,9 @@ fn many_lights_at_hits_are_lit_like_the_all_lights_twin() {
 #[test]
 #[ignore = "a measurement, for the documentation"]
 fn village_light_grid_size() {
+    use hikari_render::lights::LIGHT_CUTOFF_LUX;
+    use hikari_render::lights::grid::{LightGrid, grid_cutoff, punctual_records};
     use hikari_render::techniques::area_lights::PolygonLights;
-    use hikari_render::techniques::direct_lighting::LIGHT_CUTOFF_LUX;
-    use hikari_render::techniques::ray_traced_gi::light_grid::{
-        LightGrid, grid_cutoff, punctual_records,
-    };
     let scene = hikari_scene::builtin::village();
     let area = PolygonLights::for_scene(&scene);
     let punctual = punctual_records(&scene);
@@ -2274,10 +2272,7 @@ fn village_light_grid_size() {
     let bright = area
         .lights
         .iter()
-        .filter(|l| {
-            hikari_render::techniques::ray_traced_gi::light_grid::area_reach(l, min_flux, 1.0)
-                .is_some()
-        })
+        .filter(|l| hikari_render::lights::grid::area_reach(l, min_flux, 1.0).is_some())
         .count();
     eprintln!(
         "village: {} area lights ({bright} over {min_flux} lm or forced), {} point/spot lights; \
@@ -2299,8 +2294,8 @@ fn village_light_grid_size() {
 /// stands for keep w = 0.
 #[test]
 fn lamp_shells_do_not_add_their_emission_at_hits() {
+    use hikari_render::lights::polygon::SKIPPED_LAMP_SHELL;
     use hikari_render::techniques::area_lights::PolygonLights;
-    use hikari_render::techniques::area_lights::lights::SKIPPED_LAMP_SHELL;
     let scene = hikari_scene::builtin::village();
     let table = reference::instance_table(&scene);
     let area = PolygonLights::for_scene(&scene);

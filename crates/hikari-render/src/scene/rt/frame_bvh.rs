@@ -14,8 +14,8 @@ use hikari_bvh::{
 use hikari_scene::Scene;
 
 use super::settings::SceneRtSettings;
+use crate::lights::shadow_casters;
 use crate::scene::bvh;
-use crate::techniques::area_lights::shadow_casters;
 
 /// What one frame's update cost and did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

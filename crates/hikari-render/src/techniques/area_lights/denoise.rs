@@ -149,10 +149,7 @@ impl ShadowDenoiser {
             .write(vz.cur)
             .dispatch_threads(&self.temporal, [w, h, 1])?;
         let filtered = g.texture("area_lights.visibility_filtered", d2(VISIBILITY_FORMAT))?;
-        let radiance = g.texture(
-            "area_lights.denoised",
-            d2(crate::techniques::direct_lighting::RADIANCE_FORMAT),
-        )?;
+        let radiance = g.texture("area_lights.denoised", d2(crate::lights::RADIANCE_FORMAT))?;
         g.pass("area_lights.spatial")
             .constants(view)
             .constants(&params)

@@ -3,16 +3,17 @@
 //! in the same order), shadow rays through hikari-bvh's CPU traversal of the same BVH, with
 //! the shader's sample pattern.
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use hikari_bvh::{Blas, Ray, Tlas};
 use hikari_math::brdf::{self, Material};
 
-use super::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, AreaTriangleGpu, PolygonLights};
 use super::settings::{MAX_LIGHTS_PER_PIXEL, MAX_SHADOW_PICKS};
 use super::{AREA_POLYGONS, AREA_PUNCTUAL, AreaLightParams};
+use crate::lights::polygon::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED, PolygonLights};
+use crate::lights::reference::{area_light_reach, light_attenuation, light_vector_irradiance};
+use crate::reference::lighting::{Texel, clamp};
 use crate::reference::octahedral;
 use crate::scene::upload::LightGpu;
-use crate::techniques::direct_lighting::reference::{Texel, clamp};
 
 fn v3(a: [f32; 4]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
@@ -74,60 +75,6 @@ pub struct Shaded {
     pub lux: f32,
     /// Shadow rays traced through the BVH.
     pub rays: u32,
-}
-
-/// Lambert's vector irradiance per unit radiance (sr) of the polygon `q` (vertices relative to
-/// the receiving point, wound so that its front faces the point), clipped to the hemisphere
-/// around `n`: the irradiance on a surface of normal `n` is `L n·F` (Lambert 1760; Arvo 1995).
-pub fn polygon_vector_irradiance(q: &[DVec3], n: DVec3) -> DVec3 {
-    let mut clipped = Vec::with_capacity(q.len() + 1);
-    for i in 0..q.len() {
-        let (a, b) = (q[i], q[(i + 1) % q.len()]);
-        let (da, db) = (a.dot(n), b.dot(n));
-        if da >= 0.0 {
-            clipped.push(a);
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            clipped.push(a + (b - a) * (da / (da - db)));
-        }
-    }
-    if clipped.len() < 3 {
-        return DVec3::ZERO;
-    }
-    let mut f = DVec3::ZERO;
-    for i in 0..clipped.len() {
-        let a = clipped[i].normalize();
-        let b = clipped[(i + 1) % clipped.len()].normalize();
-        let c = b.cross(a);
-        let s = c.length();
-        let theta = s.atan2(a.dot(b));
-        f += 0.5 * if s < 1e-12 { c } else { c * (theta / s) };
-    }
-    f
-}
-
-/// Vector irradiance per unit radiance of a light's triangles at `world` (see
-/// [`polygon_vector_irradiance`]): back faces skipped, or turned round when double-sided.
-pub fn light_vector_irradiance(
-    tris: &[AreaTriangleGpu],
-    double_sided: bool,
-    world: DVec3,
-    n: DVec3,
-) -> DVec3 {
-    let mut f = DVec3::ZERO;
-    for t in tris {
-        let q0 = v3(t.p0_cdf).as_dvec3() - world;
-        let mut q1 = v3(t.p1).as_dvec3() - world;
-        let mut q2 = v3(t.p2).as_dvec3() - world;
-        if -q0.dot((q1 - q0).cross(q2 - q0)) <= 0.0 {
-            if !double_sided {
-                continue;
-            }
-            std::mem::swap(&mut q1, &mut q2);
-        }
-        f += polygon_vector_irradiance(&[q0, q1, q2], n);
-    }
-    f
 }
 
 /// The scene as the twin traces it: the BVH of `AreaLightScene` (BLAS per mesh, a TLAS over
@@ -415,7 +362,7 @@ fn light_shares(
             }
             // Beyond the distance where its illuminance must be below the cut-off (the
             // shader culls per tile with the same bound).
-            if to_c.length() >= area_light_reach(p, l) {
+            if to_c.length() >= area_light_reach(l, p.values[2]) {
                 continue;
             }
             let s = l.radiance_flux[3] / to_c.length_squared().max(r * r);
@@ -440,7 +387,7 @@ fn light_shares(
             let to_light = v3(light.position_range) - world;
             let d2 = to_light.length_squared();
             let l = to_light / d2.max(1e-8).sqrt();
-            let e = v3(light.intensity) * attenuation(p, light, l, d2);
+            let e = v3(light.intensity) * light_attenuation(p.values[2], light, l, d2);
             if luminance(e).is_nan() || luminance(e) <= 0.0 {
                 continue;
             }
@@ -453,32 +400,6 @@ fn light_shares(
         }
     }
     out
-}
-
-/// Distance (m) from an area light's centroid beyond which it brings less than the frame's
-/// cut-off (lux, `p.values[2]`): no point of it is nearer than d − r, and it brings at most
-/// L A / (d − r)².
-pub fn area_light_reach(p: &AreaLightParams, l: &super::AreaLightGpu) -> f32 {
-    let peak = luminance(v3(l.radiance_flux)) * l.normal_area[3];
-    l.centroid_radius[3] + (peak.max(0.0) / p.values[2]).sqrt()
-}
-
-/// The deferred lighting's point and spot attenuation (`direct_lighting::reference`), with
-/// this pass's cut-off.
-fn attenuation(p: &AreaLightParams, light: &LightGpu, l: Vec3, d2: f32) -> f32 {
-    let peak = v3(light.intensity).max_element();
-    let range = light.position_range[3]
-        .min((peak / p.values[2]).sqrt())
-        .max(1e-3);
-    let x = d2 / (range * range);
-    let window = (1.0 - x * x).clamp(0.0, 1.0);
-    let mut a = window * window / d2.max(1e-4);
-    if light.direction_kind[3] > 0.5 {
-        let s =
-            ((-l).dot(v3(light.direction_kind)) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
-        a *= s * s;
-    }
-    a
 }
 
 fn orthonormal(n: Vec3) -> Vec3 {

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::techniques::haze::reference::hg_phase;
+use crate::reference::phase::hg_phase;
 
 use super::{CLOUDS_DENSITY_AA, CLOUDS_MULTIPLE, CLOUDS_ON, CLOUDS_SHADOWS, CloudParams};
 

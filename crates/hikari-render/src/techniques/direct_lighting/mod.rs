@@ -5,6 +5,7 @@
 pub mod reference;
 pub mod settings;
 
+use super::sky::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
@@ -25,7 +26,7 @@ use crate::settings::DirectLightingSettings;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 
-pub const RADIANCE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub use crate::lights::RADIANCE_FORMAT;
 
 pub const LIGHTING_SUN: u32 = 1;
 pub const LIGHTING_PUNCTUAL: u32 = 2;
@@ -68,26 +69,6 @@ pub struct LightingParams {
     /// x: their normalisation's largest ratio.
     pub reflection_values: [f32; 4],
 }
-
-/// A punctual light is cut off where its illuminance falls below this fraction of the frame's
-/// metered illuminance (or [`LIGHT_CUTOFF_LUX`], whichever is larger): in daylight a lantern's
-/// light a few metres away is far below what the exposure can show.
-pub const LIGHT_CUTOFF_FRACTION: f32 = 1e-4;
-
-/// The least cut-off illuminance: a hundredth of a lux is far below moonlight, so the cut is
-/// invisible at any exposure that shows the scene.
-pub const LIGHT_CUTOFF_LUX: f32 = 0.01;
-
-/// Lux below which a point or spot light is cut off in a frame metered at `metered_lux`.
-pub fn light_cutoff_lux(metered_lux: f32) -> f32 {
-    (metered_lux * LIGHT_CUTOFF_FRACTION).max(LIGHT_CUTOFF_LUX)
-}
-
-/// Placeholder sky radiance (nits) under the default 100000 lux sun, until the atmosphere
-/// issue: a clear-day blue zenith and a paler horizon, of the order of a real clear sky (a
-/// few thousand nits). It scales with the sun's illuminance, so night skies are dark.
-pub const PLACEHOLDER_SKY_ZENITH: Vec3 = Vec3::new(1800.0, 3200.0, 6500.0);
-pub const PLACEHOLDER_SKY_HORIZON: Vec3 = Vec3::new(6000.0, 7000.0, 8000.0);
 
 impl LightingParams {
     /// `cutoff_lux`: the frame context's point and spot light cut-off

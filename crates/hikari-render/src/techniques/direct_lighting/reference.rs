@@ -1,10 +1,13 @@
 //! CPU twin of `direct_lighting.shade`, built on hikari-math's BRDF (f64 inside) rather than a
 //! transcription of the shader, so the two agree only if both are right.
 
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use hikari_math::brdf::{self, Material};
 use hikari_math::sh::{Sh, zonal};
 
+use crate::lights::reference::light_attenuation;
+use crate::reference::lighting::clamp;
+pub use crate::reference::lighting::{MAX_RADIANCE, Texel};
 use crate::reference::octahedral;
 use crate::scene::upload::LightGpu;
 use crate::techniques::direct_lighting::{
@@ -12,8 +15,6 @@ use crate::techniques::direct_lighting::{
     LIGHTING_SKY, LIGHTING_SUN, LightingParams,
 };
 use crate::techniques::sky::reference::SkyTwin;
-
-pub(crate) const MAX_RADIANCE: f32 = 65000.0;
 
 fn v3(a: [f32; 4]) -> Vec3 {
     Vec3::new(a[0], a[1], a[2])
@@ -75,40 +76,6 @@ impl SkyLight<'_> {
 
 fn fresnel_at(m: &Material, n: Vec3, v: Vec3) -> Vec3 {
     brdf::fresnel::fresnel_schlick_f90(m.f0(), m.f90(), n.dot(v).max(0.0) as f64).as_vec3()
-}
-
-/// Where the light's illuminance falls to the frame's cutoff, or its own range if nearer.
-pub fn light_range(p: &LightingParams, light: &LightGpu) -> f32 {
-    let peak = v3(light.intensity).max_element();
-    light.position_range[3]
-        .min((peak / p.cutoff[0]).sqrt())
-        .max(1e-3)
-}
-
-/// Illuminance per candela of a punctual light `d2` metres squared away in direction `l`
-/// (unit, surface to light): inverse square, the range window, the spot cone.
-pub fn light_attenuation(p: &LightingParams, light: &LightGpu, l: Vec3, d2: f32) -> f32 {
-    let range = light_range(p, light);
-    let x = d2 / (range * range);
-    let window = (1.0 - x * x).clamp(0.0, 1.0);
-    let mut a = window * window / d2.max(1e-4);
-    if light.direction_kind[3] > 0.5 {
-        let s =
-            ((-l).dot(v3(light.direction_kind)) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
-        a *= s * s;
-    }
-    a
-}
-
-/// A G-buffer texel as the lighting pass reads it.
-#[derive(Clone, Copy, Debug)]
-pub struct Texel {
-    pub depth: f32,
-    pub normal: Vec4,
-    pub albedo: Vec4,
-    pub material: Vec4,
-    /// Emitted nits (rgb) and the dielectric specular weight (a), as `gbuffer.emissive`.
-    pub emissive: Vec4,
 }
 
 /// Radiance of one pixel. `world` is the surface point, `v` the unit vector to the camera
@@ -174,7 +141,7 @@ pub fn shade_with_sky(
             let l = to_light / d2.max(1e-8).sqrt();
             radiance += brdf::evaluate(&m, n, t, b, v, l)
                 * v3(light.intensity)
-                * light_attenuation(p, light, l, d2);
+                * light_attenuation(p.cutoff[0], light, l, d2);
         }
     }
     if flags & LIGHTING_PLACEHOLDER_AMBIENT != 0 {
@@ -196,11 +163,4 @@ pub fn shade_with_sky(
         radiance += texel.emissive.truncate();
     }
     clamp(radiance)
-}
-
-pub fn clamp(r: Vec3) -> Vec3 {
-    Vec3::from_array(
-        r.to_array()
-            .map(|c| if c >= 0.0 { c.min(MAX_RADIANCE) } else { 0.0 }),
-    )
 }

@@ -109,15 +109,7 @@ fn state_desc() -> TextureDesc {
     TextureDesc::d2(1, 1, wgpu::TextureFormat::Rgba32Float)
 }
 
-/// Last frame's adapted exposure, for passes that run before this frame's.
-#[derive(Clone, Copy, Debug)]
-pub struct PreviousExposure {
-    /// `exposure.state` as the last frame left it: Rgba32Float 1x1, x the EV100 (scale =
-    /// 1 / (1.2 · 2^x)), y 1 once written (zeros in a new history).
-    pub state: Tex,
-    /// Whether a frame has written it (false on a graph runtime's first frame).
-    pub valid: bool,
-}
+pub use crate::frame_context::PreviousExposure;
 
 pub struct Exposure {
     clear: ComputePipeline,

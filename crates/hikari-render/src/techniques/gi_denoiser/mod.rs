@@ -78,15 +78,7 @@ pub struct DenoisedGi {
 /// [`GiDenoiser::recurrent_names`]: the kept GI textures (Y, CoCg) and the kept AO.
 pub type RecurrentNames = (Option<[&'static str; 2]>, Option<&'static str>);
 
-/// Last frame's denoised output, for a recurrent accumulation (see
-/// [`GiDenoiser::recurrent_history`]): `(textures, valid)`, `None` where that part is not kept.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RecurrentHistory {
-    /// Y (Rgba16Float) and CoCg (Rg16Float).
-    pub gi: Option<([Tex; 2], bool)>,
-    /// R16Float.
-    pub ao: Option<(Tex, bool)>,
-}
+pub use crate::techniques::ray_traced_gi::RecurrentHistory;
 
 pub struct GiDenoiser {
     hit_mean: ComputePipeline,

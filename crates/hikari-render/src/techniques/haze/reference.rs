@@ -4,6 +4,7 @@
 //! Every function here mirrors a WGSL function of the same name in `common.wgsl` or the pass
 //! shaders, in f32 as the GPU computes.
 
+pub use crate::reference::phase::hg_phase;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use hikari_math::sh::Sh;
 
@@ -23,12 +24,6 @@ pub const MAX_HALF: f32 = 65504.0;
 pub fn first_slice_m(near: f32, far: f32, growth: f32, slices: u32) -> f32 {
     let (near, far, r) = (f64::from(near), f64::from(far), f64::from(growth));
     ((far - near) * (r - 1.0) / (r.powi(slices as i32) - 1.0)) as f32
-}
-
-/// Henyey-Greenstein phase function, per steradian (`hikari::phase::hg_phase`); `cos_theta`
-/// between the light's direction of travel and the scattered direction (1: straight on).
-pub fn hg_phase(cos_theta: f32, g: f32) -> f32 {
-    hikari_atmosphere::phase::henyey_greenstein(f64::from(cos_theta), f64::from(g)) as f32
 }
 
 /// Extinction per metre at world height `y`.

@@ -37,9 +37,9 @@ use hikari_scene::{Material, Scene};
 use rayon::prelude::*;
 
 use super::reference::{hit_albedo, texture_mean};
+use crate::reference::textures::TwinTextures;
 use crate::scene::bvh::SceneAlphaFilter;
 use crate::scene::upload::alpha_cutoff;
-use crate::techniques::gbuffer::reference::TwinTextures;
 
 /// Rays per side of each of the six orthographic views of a mesh.
 pub const VIEW_RESOLUTION: u32 = 32;

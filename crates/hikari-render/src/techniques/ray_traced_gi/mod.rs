@@ -18,7 +18,6 @@
 //! CPU twins: [`reference`]. Documentation: docs/ray-traced-gi.md.
 
 pub mod instance_albedo;
-pub mod light_grid;
 pub mod reference;
 pub mod settings;
 
@@ -31,21 +30,31 @@ use hikari_scene::{Scene, Sun};
 use naga_oil::compose::ShaderDefValue;
 use wgpu::util::DeviceExt;
 
-use super::area_lights::AreaLightScene;
-use super::direct_lighting::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
-use super::exposure::PreviousExposure;
 use super::gbuffer::GBuffer;
-use super::gi_denoiser::RecurrentHistory;
 use super::sky::SkyFrame;
+use super::sky::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
+use crate::frame_context::PreviousExposure;
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
+use crate::lights::AreaLightScene;
 use crate::pipeline::ComputePipeline;
 use crate::scene::bvh_trace::BvhBuffers;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 pub use settings::RayTracedGiSettings;
+
+/// Last frame's denoised output (the GI denoiser's), for a recurrent accumulation (see
+/// `GiDenoiser::recurrent_history`, which fills it): `(textures, valid)`, `None` where that
+/// part is not kept.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RecurrentHistory {
+    /// Y (Rgba16Float) and CoCg (Rg16Float).
+    pub gi: Option<([Tex; 2], bool)>,
+    /// R16Float.
+    pub ao: Option<(Tex, bool)>,
+}
 
 /// The ray-traced GI signal of a frame (interfaces.md), all full resolution.
 #[derive(Clone, Copy, Debug)]
@@ -246,7 +255,7 @@ impl RtGiParams {
 /// grid of light lists that lights hits ([`light_grid`]), rebuilt when what it was built from
 /// changes.
 pub struct RtGiScene {
-    /// The scene's point and spot lights, for their reach ([`light_grid::punctual_records`]).
+    /// The scene's point and spot lights, for their reach ([`crate::lights::grid::punctual_records`]).
     punctual: Vec<crate::scene::upload::LightGpu>,
     light_grid: Mutex<Option<LightGridGpu>>,
     /// [`reference::instance_table`].
@@ -260,7 +269,7 @@ pub struct RtGiScene {
 
 /// The uploaded light grid and what it was built from.
 struct LightGridGpu {
-    key: light_grid::LightGridKey,
+    key: crate::lights::grid::LightGridKey,
     cells: wgpu::Buffer,
     indices: wgpu::Buffer,
     stats: LightGridStats,
@@ -325,7 +334,7 @@ impl RtGiScene {
             });
         Ok(Self {
             mesh_first,
-            punctual: light_grid::punctual_records(scene),
+            punctual: crate::lights::grid::punctual_records(scene),
             light_grid: Mutex::new(None),
             instance_table: storage_buffer(
                 ctx,
@@ -389,17 +398,21 @@ impl RtGiScene {
         params: &RtGiParams,
     ) -> Result<(Buf, Buf)> {
         let (min_flux, cutoff) = (params.area[1], params.distances[3]);
-        let key =
-            light_grid::LightGridKey::new(&area.lights.lights, &self.punctual, min_flux, cutoff);
+        let key = crate::lights::grid::LightGridKey::new(
+            &area.lights.lights,
+            &self.punctual,
+            min_flux,
+            cutoff,
+        );
         let mut slot = self.light_grid.lock().map_err(|_| {
             crate::error::RenderError::Graph("ray_traced_gi: light grid lock poisoned".into())
         })?;
         if slot.as_ref().map(|s| s.key) != Some(key) {
-            let grid = light_grid::LightGrid::build(
+            let grid = crate::lights::grid::LightGrid::build(
                 &area.lights.lights,
                 &self.punctual,
                 min_flux,
-                light_grid::grid_cutoff(cutoff),
+                crate::lights::grid::grid_cutoff(cutoff),
             );
             let s = LightGridStats {
                 cells: grid.dims(),

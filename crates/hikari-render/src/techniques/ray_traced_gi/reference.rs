@@ -3,6 +3,10 @@
 //! twins are in `rtgi.wgsl` (`hikari::ray_traced_gi`) and `accumulate.wgsl`.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
+
+pub use crate::reference::reprojection::{
+    REPROJECTION_MIN_WEIGHT, REPROJECTION_SNAP, bilinear_taps,
+};
 use hikari_math::sampling::blue_noise::{BLUE_NOISE_SIZE, blue_noise_slice};
 use hikari_math::sh::ShL1;
 use hikari_math::sh::ycocg::ShL1YCoCg;
@@ -197,7 +201,7 @@ pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
         r.and_then(|r| means.get(r.texture).copied())
             .unwrap_or(Vec3::ONE)
     };
-    let area = crate::techniques::area_lights::PolygonLights::for_scene(scene);
+    let area = crate::lights::PolygonLights::for_scene(scene);
     scene
         .instances
         .iter()
@@ -217,7 +221,7 @@ pub fn instance_table(scene: &Scene) -> Vec<[f32; 4]> {
                 .map(|(_, why)| *why);
             let is_area_light = emission.max_element() > 0.0
                 && (skipped.is_none()
-                    || skipped == Some(crate::techniques::area_lights::lights::SKIPPED_LAMP_SHELL));
+                    || skipped == Some(crate::lights::polygon::SKIPPED_LAMP_SHELL));
             [
                 albedo.extend(0.0).to_array(),
                 emission
@@ -415,14 +419,14 @@ pub fn pick_light(e: impl IntoIterator<Item = Vec3>, u: f32) -> Option<(usize, V
 /// light under `min_flux_lm` (unless flagged), not beyond where it falls below `cutoff_lux`,
 /// not wholly behind its one-sided plane or below the horizon.
 pub fn area_light_reaches(
-    lights: &crate::techniques::area_lights::PolygonLights,
+    lights: &crate::lights::PolygonLights,
     i: usize,
     x: Vec3,
     n: Vec3,
     min_flux_lm: f32,
     cutoff_lux: f32,
 ) -> bool {
-    use crate::techniques::area_lights::lights::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED};
+    use crate::lights::polygon::{AREA_LIGHT_DOUBLE_SIDED, AREA_LIGHT_FORCED};
     let l = &lights.lights[i];
     let forced = l.range[2] & AREA_LIGHT_FORCED != 0;
     let double_sided = l.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
@@ -442,7 +446,7 @@ pub fn area_light_reaches(
 /// What a hit picks area light `i` by, as the shade pass: its flux over the squared distance
 /// to its centroid, 0 where it cannot reach `x` ([`area_light_reaches`]).
 pub fn area_light_score(
-    lights: &crate::techniques::area_lights::PolygonLights,
+    lights: &crate::lights::PolygonLights,
     i: usize,
     x: Vec3,
     n: Vec3,
@@ -462,21 +466,21 @@ pub fn area_light_score(
 /// pass lights hits: 0 where it cannot reach `x` ([`area_light_reaches`]), else the light's
 /// radiance times the polygon integration (`area_lights::reference`).
 pub fn area_light_irradiance(
-    lights: &crate::techniques::area_lights::PolygonLights,
+    lights: &crate::lights::PolygonLights,
     i: usize,
     x: Vec3,
     n: Vec3,
     min_flux_lm: f32,
     cutoff_lux: f32,
 ) -> Vec3 {
-    use crate::techniques::area_lights::lights::AREA_LIGHT_DOUBLE_SIDED;
+    use crate::lights::polygon::AREA_LIGHT_DOUBLE_SIDED;
     if !area_light_reaches(lights, i, x, n, min_flux_lm, cutoff_lux) {
         return Vec3::ZERO;
     }
     let l = &lights.lights[i];
     let double_sided = l.range[2] & AREA_LIGHT_DOUBLE_SIDED != 0;
     let radiance = Vec3::from_slice(&l.radiance_flux[..3]);
-    let f = crate::techniques::area_lights::reference::light_vector_irradiance(
+    let f = crate::lights::reference::light_vector_irradiance(
         lights.triangles_of(i),
         double_sided,
         x.as_dvec3(),
@@ -487,11 +491,7 @@ pub fn area_light_irradiance(
 
 /// The point of area light `i` that the hit's shadow ray goes to, from two numbers in [0, 1):
 /// a triangle by area (the first number, rescaled within it), then uniform on it.
-pub fn area_light_point(
-    lights: &crate::techniques::area_lights::PolygonLights,
-    i: usize,
-    u: Vec2,
-) -> Vec3 {
+pub fn area_light_point(lights: &crate::lights::PolygonLights, i: usize, u: Vec2) -> Vec3 {
     let tris = lights.triangles_of(i);
     let (mut k, mut lo) = (0, 0.0);
     while u.x > tris[k].p0_cdf[3] && k + 1 < tris.len() {
@@ -626,38 +626,6 @@ pub fn firefly_scale(
         }
     }
     scale
-}
-
-/// The smallest summed weight of the valid bilinear taps that a reprojected history needs
-/// (`REPROJECTION_MIN_WEIGHT` of `hikari::view`).
-pub const REPROJECTION_MIN_WEIGHT: f32 = 0.01;
-/// A bilinear fraction within this of 0 or 1 snaps to it (`REPROJECTION_SNAP`): a still
-/// camera's motion vectors carry rounding.
-pub const REPROJECTION_SNAP: f32 = 1.0 / 64.0;
-
-/// The bilinear taps about `prev`, a position in last frame's pixels (`hikari::view`'s
-/// `reprojection` and `bilinear_weight`): texel and weight of each of the 2x2, fractions within
-/// [`REPROJECTION_SNAP`] of 0 or 1 snapped. Taps may lie off the image; the caller skips them.
-pub fn bilinear_taps(prev: Vec2) -> [([i64; 2], f32); 4] {
-    let base = (prev - 0.5).floor();
-    let snap = |f: f32| {
-        if (f - f.round()).abs() < REPROJECTION_SNAP {
-            f.round()
-        } else {
-            f
-        }
-    };
-    let f = prev - 0.5 - base;
-    let frac = Vec2::new(snap(f.x), snap(f.y));
-    std::array::from_fn(|k| {
-        let wx = if k & 1 != 0 { frac.x } else { 1.0 - frac.x };
-        let wy = if k & 2 != 0 { frac.y } else { 1.0 - frac.y };
-        let t = [
-            base.x as i64 + (k & 1) as i64,
-            base.y as i64 + (k >> 1) as i64,
-        ];
-        (t, wx * wy)
-    })
 }
 
 /// Temporal accumulation of one pixel: reprojects by the motion vector, bilinearly over the

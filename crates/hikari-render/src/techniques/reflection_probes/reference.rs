@@ -169,16 +169,16 @@ pub fn prefilter_integral(env: impl Fn(Vec3) -> Vec3, n: Vec3, alpha: f64, steps
 }
 
 /// Twin of `rp_box_light_irradiance`: the irradiance (lux) one point or spot light gives x of
-/// normal n, unshadowed, if it lies inside the probe's box, else 0. `cutoff`: the frame's
-/// lighting parameters, whose cut-off shortens the light's range.
+/// normal n, unshadowed, if it lies inside the probe's box, else 0. `cutoff_lux`: the frame's
+/// punctual-light cut-off, which shortens the light's range.
 pub fn box_light_irradiance(
     p: &ReflectionProbeGpu,
     light: &crate::scene::upload::LightGpu,
-    cutoff: &crate::techniques::direct_lighting::LightingParams,
+    cutoff_lux: f32,
     x: Vec3,
     n: Vec3,
 ) -> Vec3 {
-    use crate::techniques::direct_lighting::reference::light_attenuation;
+    use crate::lights::reference::light_attenuation;
     let at = Vec3::from_slice(&light.position_range[..3]);
     if to_box(p).transform_point3(at).abs().max_element() > 1.0 {
         return Vec3::ZERO;
@@ -187,7 +187,7 @@ pub fn box_light_irradiance(
     let d2 = to_light.length_squared().max(1e-8);
     let l = to_light / d2.sqrt();
     Vec3::from_slice(&light.intensity[..3])
-        * (light_attenuation(cutoff, light, l, d2) * n.dot(l).max(0.0))
+        * (light_attenuation(cutoff_lux, light, l, d2) * n.dot(l).max(0.0))
 }
 
 /// Twin of the relight's capture light: the luminance of the irradiance at the capture point

@@ -77,6 +77,12 @@ pub struct ResampleParams {
 
 /// Layers of `sky.resampled`: the multiple scattering (`rayleigh − rayleigh_single`) at the
 /// sun's and at the moon's zenith angle.
+/// The sky without the atmosphere (`sky.enabled` off): radiance (nits) under the default
+/// 100000 lux sun, a clear-day blue zenith and a paler horizon, of the order of a real clear
+/// sky (a few thousand nits). It scales with the sun's illuminance, so night skies are dark.
+pub const PLACEHOLDER_SKY_ZENITH: glam::Vec3 = glam::Vec3::new(1800.0, 3200.0, 6500.0);
+pub const PLACEHOLDER_SKY_HORIZON: glam::Vec3 = glam::Vec3::new(6000.0, 7000.0, 8000.0);
+
 pub const RESAMPLED_LAYERS: u32 = 2;
 
 /// The per-frame parameters of `hikari::sky_ambient`.

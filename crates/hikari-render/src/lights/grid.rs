@@ -23,8 +23,8 @@
 
 use glam::{DVec3, Vec3};
 
+use super::polygon::{AREA_LIGHT_FORCED, AreaLightGpu};
 use crate::scene::upload::LightGpu;
-use crate::techniques::area_lights::lights::{AREA_LIGHT_FORCED, AreaLightGpu};
 
 /// Most cells along an axis.
 pub const MAX_CELLS_PER_AXIS: u32 = 64;
