@@ -39,6 +39,29 @@ impl Atmosphere {
         Self::with_sizes(params, TableSizes::default())
     }
 
+    /// [`Atmosphere::with_sizes`], built once and shared while the same parameters and sizes are
+    /// asked for: the last two builds are kept, so alternating between two weathers (or a
+    /// renderer and the `hikari sky` command in one process) does not rebuild. A table build
+    /// is a pure function of its inputs, so every caller may share one.
+    pub fn shared(
+        params: &AtmosphereParams,
+        sizes: TableSizes,
+    ) -> Result<std::sync::Arc<Self>, AtmosphereError> {
+        use std::sync::{Arc, Mutex};
+        type Cache = Vec<(AtmosphereParams, TableSizes, Arc<Atmosphere>)>;
+        static CACHE: Mutex<Cache> = Mutex::new(Vec::new());
+        let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, _, a)) = cache.iter().find(|(p, s, _)| p == params && *s == sizes) {
+            return Ok(a.clone());
+        }
+        let a = Arc::new(Self::with_sizes(params.clone(), sizes)?);
+        cache.push((params.clone(), sizes, a.clone()));
+        if cache.len() > 2 {
+            cache.remove(0);
+        }
+        Ok(a)
+    }
+
     /// The same with chosen table sizes.
     pub fn with_sizes(
         params: AtmosphereParams,

@@ -56,6 +56,23 @@ pub struct FrameState {
     /// Tests only: G-buffer texels overwritten every frame after the G-buffer pass
     /// ([`crate::renderer::Renderer::override_gbuffer_texels`]).
     pub gbuffer_overrides: Vec<GBufferTexel>,
+    /// What each technique keeps between frames besides its graph textures.
+    pub techniques: TechniqueStates,
+}
+
+/// Every technique's state between frames. A technique is its pipelines ([`Techniques`]) and
+/// this value, which the renderer owns: a frame records from it and advances a copy, which
+/// the renderer keeps only when it shows the frame.
+#[derive(Clone, Debug, Default)]
+pub struct TechniqueStates {
+    pub irradiance_probes: crate::techniques::irradiance_probes::IrradianceProbesState,
+    pub reflection_probes: crate::techniques::reflection_probes::ReflectionProbesState,
+    pub sky: crate::techniques::sky::SkyState,
+    pub clouds: crate::techniques::clouds::CloudsState,
+    pub haze: crate::techniques::haze::HazeState,
+    pub particles: crate::techniques::particles::ParticlesState,
+    pub tonemap: crate::techniques::tonemap::TonemapState,
+    pub ray_traced_gi: crate::techniques::ray_traced_gi::RtGiState,
 }
 
 /// Every technique's pipelines, built once.
@@ -194,6 +211,7 @@ pub fn record<'r>(
     //    probes' sun bounce.
     let clouds = t.clouds.record(
         g,
+        &mut state.techniques.clouds,
         &s.settings.clouds,
         CloudParams::new(
             &s.settings.clouds,
@@ -209,10 +227,9 @@ pub fn record<'r>(
     //    and moon, and 3. the sky's deringed SH, with the clouds in it (`clouds.ambient`).
     let sky = t.sky.record(
         g,
+        &mut state.techniques.sky,
+        cx,
         &s.settings.sky,
-        cx.sky.as_ref(),
-        sun,
-        s.camera.position.y.max(0.0) / 1000.0,
         &clouds,
         s.settings.clouds.ambient,
     )?;
@@ -221,6 +238,7 @@ pub fn record<'r>(
     //    whose bounce the clouds shadow.
     let probes = t.irradiance_probes.record(
         g,
+        &mut state.techniques.irradiance_probes,
         &s.settings.irradiance_probes,
         &sky,
         clouds.lookup,
@@ -232,6 +250,7 @@ pub fn record<'r>(
     //    cover their sky): captured once, this frame's share relit and prefiltered.
     let reflection_probes = t.reflection_probes.record(
         g,
+        &mut state.techniques.reflection_probes,
         &t.gbuffer,
         &t.raster,
         scene,
@@ -266,8 +285,13 @@ pub fn record<'r>(
     )?;
 
     // The probes' irradiance per pixel, only for `--dump irradiance_probes.pixels`.
-    t.irradiance_probes
-        .record_pixels_dump(g, &probes, &gbuffer, &view)?;
+    t.irradiance_probes.record_pixels_dump(
+        g,
+        &state.techniques.irradiance_probes,
+        &probes,
+        &gbuffer,
+        &view,
+    )?;
 
     // 9. Ray-traced GI and AO (issue 18): one ray a pixel, pre-traced in screen space, the
     //    rest through the BVH, lit, encoded and accumulated for the denoiser.
@@ -326,9 +350,13 @@ pub fn record<'r>(
                 None => Default::default(),
             },
         };
-        let (frame, rays) =
-            t.ray_traced_gi
-                .record(g, &rt_scene, &inputs, !history || recurrence_changed)?;
+        let (frame, rays) = t.ray_traced_gi.record(
+            g,
+            &mut state.techniques.ray_traced_gi,
+            &rt_scene,
+            &inputs,
+            !history || recurrence_changed,
+        )?;
         ray_traced_gi = Some(frame);
         ray_traced_gi_rays = Some(rays);
     }
@@ -464,9 +492,10 @@ pub fn record<'r>(
         );
         let frame = t.haze.record(
             g,
+            &mut state.techniques.haze,
+            cx,
             &s.settings.haze,
             &params,
-            &view,
             &HazeInputs {
                 depth: gbuffer.depth,
                 lit: lit_frame.radiance,
@@ -476,7 +505,6 @@ pub fn record<'r>(
                 clouds: clouds.lookup,
                 probes: probes.lookup,
             },
-            history,
         )?;
         Some((params, frame))
     } else {
@@ -505,6 +533,7 @@ pub fn record<'r>(
         );
         hazed = t.particles.record(
             g,
+            &mut state.techniques.particles,
             &view,
             &params,
             &sprites,
@@ -545,6 +574,7 @@ pub fn record<'r>(
     )?;
     let ldr = t.tonemap.record(
         g,
+        &mut state.techniques.tonemap,
         &s.settings.tonemap,
         TonemapInputs {
             hdr,

@@ -247,6 +247,29 @@ impl FrameContext {
         })
     }
 
+    /// The context of a bare `view` at `frame_index` with valid history, for passes recorded
+    /// outside a renderer's frame (tests, tools): no sun, no sky, a 1000 lux meter.
+    pub fn for_view(view: View, frame_index: u64) -> Self {
+        let size = [view.viewport[0] as u32, view.viewport[1] as u32];
+        let metered_lux = 1000.0;
+        Self {
+            size,
+            aspect: view.viewport[0] / view.viewport[1].max(1.0),
+            frame_index,
+            jitter: [view.jitter[0], view.jitter[1]],
+            view,
+            history: HistoryValidity::VALID,
+            sun: None,
+            sky: None,
+            sky_lux: 0.0,
+            metered_lux,
+            ev100: (metered_lux * 100.0 / 250.0).log2(),
+            light_cutoff_lux: light_cutoff_lux(metered_lux),
+            clock_s: 0.0,
+            punctual_lights: 0,
+        }
+    }
+
     /// The directional light where `direct_lighting.sun` lets it light surfaces (the haze,
     /// the particles).
     pub fn lit_sun<'a>(&'a self, settings: &Settings) -> Option<&'a Sun> {

@@ -104,10 +104,6 @@ impl Renderer {
         self.area_lights = area_lights;
         self.scene_rt = scene_rt;
         self.scene_source = scene.clone();
-        self.techniques.irradiance_probes.set_bake(&self.ctx, None);
-        self.techniques
-            .reflection_probes
-            .set_probes(&self.ctx, &[])?;
         let queues = std::mem::take(&mut self.state.raster_queues);
         self.state = FrameState {
             raster_queues: queues,
@@ -315,7 +311,10 @@ impl Renderer {
     /// Uses `bake`'s irradiance probes from the next frame on (`None`: none, the sky's SH
     /// lights surfaces unoccluded). Non-finite numbers in the bake become 0.
     pub fn set_probe_bake(&mut self, bake: Option<&hikari_probes::Bake>) {
-        self.techniques.irradiance_probes.set_bake(&self.ctx, bake);
+        self.state
+            .techniques
+            .irradiance_probes
+            .set_bake(&self.ctx, bake);
     }
 
     /// Uses `probes` as the relit reflection probes from the next frame on (captured then);
@@ -324,15 +323,22 @@ impl Renderer {
         &mut self,
         probes: &[hikari_bake::reflection_probes::ReflectionProbeBox],
     ) -> Result<()> {
-        self.techniques
+        self.state
+            .techniques
             .reflection_probes
             .set_probes(&self.ctx, probes)
     }
 
-    /// The irradiance probes (the uploaded bake's layout, the lookup pass's switch, the
-    /// relight's timed dispatches), for `hikari bench probes`.
+    /// The irradiance probes' passes (the relight's timed dispatches), for `hikari bench probes`.
     pub fn irradiance_probes(&self) -> &crate::techniques::irradiance_probes::IrradianceProbes {
         &self.techniques.irradiance_probes
+    }
+
+    /// The irradiance probes' state (the uploaded bake's layout, the lookup pass's switch).
+    pub fn irradiance_probes_state(
+        &mut self,
+    ) -> &mut crate::techniques::irradiance_probes::IrradianceProbesState {
+        &mut self.state.techniques.irradiance_probes
     }
 
     pub fn scene(&self) -> &SceneGpu {
@@ -539,6 +545,8 @@ impl Renderer {
             history,
         )?;
         for _ in 0..MAX_QUEUE_RETRIES {
+            // The techniques' states advance with a shown frame only.
+            let before = self.state.techniques.clone();
             let mut g = self.runtime.begin_frame(&self.ctx);
             let out = frame::record(
                 &mut g,
@@ -564,7 +572,7 @@ impl Renderer {
                 // Cascades and cube maps drawn into an overflowing queue lack triangles: draw
                 // them all again.
                 self.state.shadow_cache = Default::default();
-                self.techniques.reflection_probes.invalidate_capture();
+                self.state.techniques.reflection_probes.invalidate_capture();
             }
             // Interactive frames (the runtime does not wait for their counts) are shown as drawn.
             if !overflowed || !self.runtime.waits_for_readbacks() {
@@ -573,6 +581,7 @@ impl Renderer {
                 return Ok(result);
             }
             self.runtime.discard_frame();
+            self.state.techniques = before;
         }
         Err(RenderError::Graph(format!(
             "the rasteriser's queues still overflowed after {MAX_QUEUE_RETRIES} tries"

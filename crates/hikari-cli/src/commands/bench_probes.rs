@@ -145,13 +145,13 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         &settings,
         a.bake.as_deref(),
     )?;
-    let data = renderer.irradiance_probes().data().ok_or_else(|| {
+    let data = renderer.irradiance_probes_state().data().ok_or_else(|| {
         anyhow::anyhow!(
             "bench probes: {} has no irradiance probes in its bake",
             description.line()
         )
     })?;
-    renderer.irradiance_probes().set_lookup_pass(true);
+    renderer.irradiance_probes_state().set_lookup_pass(true);
     renderer.runtime.set_timestamps(TimestampMode::Pass);
     let spec = RelightBenchSpec {
         grid_tiles: a.grid_tiles,

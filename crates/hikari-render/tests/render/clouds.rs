@@ -149,7 +149,9 @@ fn gpu_map(ctx: &hikari_render::GpuContext, s: &CloudsSettings, p: CloudParams) 
     let clouds = Clouds::new(ctx, &mut lib).unwrap();
     let mut rt = GraphRuntime::new();
     let mut g = rt.begin_frame(ctx);
-    let f = clouds.record(&mut g, s, p, Vec3::ZERO).unwrap();
+    let f = clouds
+        .record(&mut g, &mut Default::default(), s, p, Vec3::ZERO)
+        .unwrap();
     g.readback(f.map);
     let r = g.execute().unwrap();
     r.image("clouds.map")
@@ -451,7 +453,9 @@ fn shadow_map_and_its_lookup_agree_with_the_march() {
         let clouds = Clouds::new(&ctx, &mut lib).unwrap();
         let mut rt = GraphRuntime::new();
         let mut g = rt.begin_frame(&ctx);
-        let f = clouds.record(&mut g, &s, p, camera).unwrap();
+        let f = clouds
+            .record(&mut g, &mut Default::default(), &s, p, camera)
+            .unwrap();
         assert_eq!(f.params.shadow, p.shadow);
         g.readback(f.shadow_map);
         let r = g.execute().unwrap();

@@ -365,6 +365,7 @@ fn run_gpu_frames(
     });
     let mut rt = GraphRuntime::new();
     let mut runs = Vec::new();
+    let mut state = hikari_render::techniques::haze::HazeState::default();
     for (view, params) in frames {
         let mut g = rt.begin_frame(ctx);
         let probe_set = match (probes, &probe_bufs) {
@@ -394,12 +395,14 @@ fn run_gpu_frames(
             })
             .read(sh)
             .finish();
+        let cx = hikari_render::FrameContext::for_view(*view, g.frame_index());
         let out = haze
             .record(
                 &mut g,
+                &mut state,
+                &cx,
                 settings,
                 params,
-                view,
                 &HazeInputs {
                     depth,
                     lit,
@@ -409,7 +412,6 @@ fn run_gpu_frames(
                     clouds,
                     probes: probe_set,
                 },
-                true,
             )
             .unwrap();
         g.readback(out.light);

@@ -201,3 +201,31 @@ fn the_scan_sees_an_import() {
         ["gbuffer", "haze"].map(String::from).into()
     );
 }
+
+#[test]
+fn techniques_keep_no_state_of_their_own() {
+    // A technique's state lives in the renderer's frame state (`frame::TechniqueStates`),
+    // advanced with a shown frame: no interior mutability and no process-wide statics here.
+    let mut files = Vec::new();
+    rust_files(&src().join("techniques"), &mut files);
+    let forbidden = [
+        "Mutex<", "RwLock<", "RefCell<", "Cell<", "Atomic", "static ",
+    ];
+    let mut found = Vec::new();
+    for file in &files {
+        for (i, line) in code(file).lines().enumerate() {
+            for f in forbidden {
+                if line.contains(f) && !line.contains("&'static") && !line.contains("'static str") {
+                    found.push(format!(
+                        "{}:{}: {}",
+                        file.strip_prefix(src()).unwrap().display(),
+                        i + 1,
+                        line.trim()
+                    ));
+                }
+            }
+        }
+    }
+    assert!(files.len() > 40, "the scan found too few files");
+    assert!(found.is_empty(), "{}", found.join("\n"));
+}

@@ -379,6 +379,7 @@ fn the_tonemap_evaluates_the_gain_as_the_twins_do() {
     let ldr = tm
         .record(
             &mut g,
+            &mut Default::default(),
             &ts,
             TonemapInputs {
                 hdr,

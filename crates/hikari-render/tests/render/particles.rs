@@ -122,7 +122,16 @@ fn draw_on_gpu(
     };
     let image = g.import_texture("test.image", &image_tex);
     let out = pass
-        .record(&mut g, view, params, sprites, depth_t, light, image)
+        .record(
+            &mut g,
+            &mut Default::default(),
+            view,
+            params,
+            sprites,
+            depth_t,
+            light,
+            image,
+        )
         .unwrap();
     g.readback(out);
     let r = g.execute().unwrap();

@@ -300,6 +300,7 @@ fn run_gpu(
     let ldr = tonemap
         .record(
             &mut g,
+            &mut Default::default(),
             s,
             TonemapInputs {
                 hdr: hdr_t,
@@ -476,8 +477,6 @@ fn an_identity_lut_round_trips_within_one_step() {
 #[test]
 fn a_damaged_lut_file_is_an_error_naming_the_file_and_line() {
     let ctx = common::gpu_context();
-    let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
-    let tonemap = Tonemap::new(&ctx, &mut lib).unwrap();
     let dir = tmp_dir("damaged");
     let path = dir.join("bad.cube");
     std::fs::write(&path, "LUT_3D_SIZE 2\n0 0 0\n1 0 0\n").unwrap();
@@ -485,6 +484,7 @@ fn a_damaged_lut_file_is_an_error_naming_the_file_and_line() {
         lut: Some(path.display().to_string()),
         ..Default::default()
     };
-    let e = tonemap.grade(&ctx, &s).unwrap_err().to_string();
+    let mut state = hikari_render::techniques::tonemap::TonemapState::default();
+    let e = state.grade(&ctx, &s).unwrap_err().to_string();
     assert!(e.contains("bad.cube:3") && e.contains("truncated"), "{e}");
 }

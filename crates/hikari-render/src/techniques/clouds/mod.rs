@@ -21,8 +21,6 @@
 pub mod reference;
 pub mod settings;
 
-use std::sync::Mutex;
-
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use hikari_scene::Sun;
@@ -232,11 +230,14 @@ pub struct CloudsFrame {
     pub params: CloudParams,
     /// Binding set `clouds` of `hikari::clouds`.
     pub lookup: BindingSet,
+    /// Whether the clouds are on and drawn this frame (what other techniques ask, rather than
+    /// reading `params`' lanes).
+    pub drawn: bool,
 }
 
-/// What the persistent map holds.
-#[derive(Default)]
-struct MapState {
+/// What the persistent map holds, kept between frames in the renderer's frame state.
+#[derive(Clone, Debug, Default)]
+pub struct CloudsState {
     /// The parameters every row was last drawn with.
     whole: Option<CloudParams>,
     /// The parameters of the last sliced frame, and how many sliced frames in a row had them.
@@ -247,7 +248,6 @@ struct MapState {
 pub struct Clouds {
     march: ComputePipeline,
     shadow_map: ComputePipeline,
-    drawn: Mutex<MapState>,
 }
 
 fn lookup_set(
@@ -284,6 +284,7 @@ fn disabled_frame(g: &mut FrameGraph<'_>, mut params: CloudParams) -> Result<Clo
         shadow_map,
         params,
         lookup,
+        drawn: false,
     })
 }
 
@@ -304,16 +305,16 @@ impl Clouds {
         Ok(Self {
             march: ComputePipeline::new(ctx, lib, "clouds/march.wgsl", "main", &[])?,
             shadow_map: ComputePipeline::new(ctx, lib, "clouds/shadow_map.wgsl", "main", &[])?,
-            drawn: Mutex::new(MapState::default()),
         })
     }
 
     /// Draws this frame's share of the map (all of it when `params` changed) and the shadow
     /// map around `camera`, and makes the lookup set. With the clouds off, a 1x1 map and
-    /// parameters that draw nothing.
+    /// parameters that draw nothing. `state` says what the map holds.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut CloudsState,
         s: &CloudsSettings,
         params: CloudParams,
         camera: Vec3,
@@ -328,7 +329,6 @@ impl Clouds {
         let size = s.map_size;
         let (map, fresh) =
             g.persistent_texture("clouds.map", TextureDesc::d2(size, size, MAP_FORMAT))?;
-        let mut state = self.drawn.lock().unwrap_or_else(|e| e.into_inner());
         let decision = if fresh {
             Redraw::Whole
         } else {
@@ -342,7 +342,7 @@ impl Clouds {
         let mut p = params;
         match decision {
             Redraw::Whole => {
-                *state = MapState {
+                *state = CloudsState {
                     whole: Some(params),
                     last: Some(params),
                     steady: 0,
@@ -363,7 +363,6 @@ impl Clouds {
                 }
             }
         }
-        drop(state);
         if decision != Redraw::Nothing {
             g.pass("clouds.march")
                 .constants(&p)
@@ -393,6 +392,7 @@ impl Clouds {
             shadow_map,
             params,
             lookup,
+            drawn: true,
         })
     }
 }

@@ -24,10 +24,10 @@ use hikari_scene::Sun;
 
 use crate::context::GpuContext;
 use crate::error::Result;
+use crate::frame_context::FrameContext;
 use crate::graph::{BindingSet, Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
-use crate::view::View;
 use settings::HazeSettings;
 
 pub const HAZE_SUN_SHADOWS: u32 = 1;
@@ -176,10 +176,15 @@ impl HazeTemporal {
     }
 }
 
-pub struct Haze {
+/// What the haze keeps between frames in the renderer's frame state.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct HazeState {
     /// The frame index and parameters of the last frame that drew the haze, for the temporal
     /// filter: only the frame just before counts.
-    last: std::cell::Cell<Option<(u64, HazeParams)>>,
+    last: Option<(u64, HazeParams)>,
+}
+
+pub struct Haze {
     light: ComputePipeline,
     integrate: ComputePipeline,
     composite: ComputePipeline,
@@ -188,29 +193,30 @@ pub struct Haze {
 impl Haze {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
-            last: std::cell::Cell::new(None),
             light: ComputePipeline::new(ctx, lib, "haze/light.wgsl", "main", &[])?,
             integrate: ComputePipeline::new(ctx, lib, "haze/integrate.wgsl", "main", &[])?,
             composite: ComputePipeline::new(ctx, lib, "haze/composite.wgsl", "main", &[])?,
         })
     }
 
-    /// Lights and integrates the grid, and composites it over `inputs.lit`. `keep_history`
-    /// false (a camera cut) starts the temporal filter afresh.
+    /// Lights and integrates the grid, and composites it over `inputs.lit`. A frame whose
+    /// history is invalid (a camera cut) starts the temporal filter afresh.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut HazeState,
+        cx: &FrameContext,
         s: &HazeSettings,
         params: &HazeParams,
-        view: &View,
         inputs: &HazeInputs,
-        keep_history: bool,
     ) -> Result<HazeFrame> {
+        let view = &cx.view;
+        let keep_history = cx.history.valid();
         let [gw, gh, gn, _] = params.grid;
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];
         let history = g.history_texture("haze.light", TextureDesc::d3(gw, gh, gn, GRID_FORMAT))?;
         let frame = g.frame_index();
-        let last = self.last.replace(Some((frame, *params)));
+        let last = state.last.replace((frame, *params));
         let temporal = HazeTemporal::new(
             s,
             frame,

@@ -22,8 +22,7 @@ pub mod reference;
 pub mod relight_bench;
 pub mod settings;
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -120,10 +119,29 @@ struct Uploaded {
     chunks: wgpu::Buffer,
 }
 
-struct State {
+/// What the irradiance probes keep between frames in the renderer's frame state: the bake on
+/// the GPU ([`IrradianceProbesState::set_bake`]), how far its relight has gone, and whether
+/// the lookup pass is recorded every frame.
+#[derive(Clone, Default)]
+pub struct IrradianceProbesState {
     uploaded: Option<Arc<Uploaded>>,
     /// Relights since the upload (0: the next relights everything).
     updates: u64,
+    /// Record [`LOOKUP_PASS`] every frame, not only for `--dump` (to time it).
+    lookup_pass: bool,
+}
+
+impl std::fmt::Debug for IrradianceProbesState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("IrradianceProbesState")
+            .field(
+                "probes",
+                &self.uploaded.as_ref().map(|u| u.data.probe_count()),
+            )
+            .field("updates", &self.updates)
+            .field("lookup_pass", &self.lookup_pass)
+            .finish()
+    }
 }
 
 /// The dump of the probes' irradiance at every pixel (`pixels.wgsl`).
@@ -131,15 +149,43 @@ pub const PIXELS_DUMP: &str = "irradiance_probes.pixels";
 /// The pass that writes it: the probes' lookup alone at every pixel.
 pub const LOOKUP_PASS: &str = "irradiance_probes.lookup";
 
+impl IrradianceProbesState {
+    /// Uploads `bake` (replacing any earlier one; `None` removes it). Non-finite numbers in it
+    /// become 0 (logged). The next frame relights every probe.
+    pub fn set_bake(&mut self, ctx: &GpuContext, bake: Option<&Bake>) {
+        let uploaded = bake.map(|b| {
+            let data = ProbeGpuData::new(b);
+            if data.replaced_non_finite > 0 {
+                log::warn!(
+                    "irradiance probes: {} non-finite numbers in the bake replaced with 0",
+                    data.replaced_non_finite
+                );
+            }
+            Arc::new(upload(ctx, data))
+        });
+        self.uploaded = uploaded.filter(|u| u.data.probe_count() > 0);
+        self.updates = 0;
+    }
+
+    /// The uploaded bake's layout, if any.
+    pub fn data(&self) -> Option<ProbeGpuData> {
+        self.uploaded.as_ref().map(|u| u.data.clone())
+    }
+
+    /// Whether every frame records [`LOOKUP_PASS`] (else only a frame whose `--dump` names
+    /// [`PIXELS_DUMP`]): the lookup's cost on its own, as `hikari bench probes` times it. The
+    /// deferred lighting's own lookup is unchanged.
+    pub fn set_lookup_pass(&mut self, on: bool) {
+        self.lookup_pass = on;
+    }
+}
+
 pub struct IrradianceProbes {
     relight: ComputePipeline,
     pixels: ComputePipeline,
     gaunt: wgpu::Buffer,
     /// Bound when there is no bake: one zero element each.
     empty: Arc<Uploaded>,
-    state: Mutex<State>,
-    /// Record [`LOOKUP_PASS`] every frame, not only for `--dump` (to time it).
-    lookup_pass: AtomicBool,
 }
 
 fn storage(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
@@ -211,36 +257,7 @@ impl IrradianceProbes {
                 bytemuck::cast_slice(&gaunt_table()),
             ),
             empty: Arc::new(upload(ctx, ProbeGpuData::new(&empty))),
-            state: Mutex::new(State {
-                uploaded: None,
-                updates: 0,
-            }),
-            lookup_pass: AtomicBool::new(false),
         })
-    }
-
-    /// Uploads `bake` (replacing any earlier one; `None` removes it). Non-finite numbers in it
-    /// become 0 (logged). The next frame relights every probe.
-    pub fn set_bake(&self, ctx: &GpuContext, bake: Option<&Bake>) {
-        let uploaded = bake.map(|b| {
-            let data = ProbeGpuData::new(b);
-            if data.replaced_non_finite > 0 {
-                log::warn!(
-                    "irradiance probes: {} non-finite numbers in the bake replaced with 0",
-                    data.replaced_non_finite
-                );
-            }
-            Arc::new(upload(ctx, data))
-        });
-        let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        st.uploaded = uploaded.filter(|u| u.data.probe_count() > 0);
-        st.updates = 0;
-    }
-
-    /// The uploaded bake's layout, if any.
-    pub fn data(&self) -> Option<ProbeGpuData> {
-        let st = self.state.lock().unwrap_or_else(|e| e.into_inner());
-        st.uploaded.as_ref().map(|u| u.data.clone())
     }
 
     /// Relights this frame's share of the probes and makes the lookup's binding set.
@@ -248,6 +265,7 @@ impl IrradianceProbes {
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut IrradianceProbesState,
         s: &IrradianceProbesSettings,
         sky: &SkyFrame,
         clouds: BindingSet,
@@ -255,7 +273,7 @@ impl IrradianceProbes {
         camera: Vec3,
     ) -> Result<ProbesFrame> {
         let (u, update) = {
-            let mut st = self.state.lock().unwrap_or_else(|e| e.into_inner());
+            let st = state;
             match (&st.uploaded, s.enabled && sky.enabled) {
                 (Some(u), true) => {
                     let out = (u.clone(), Some(st.updates));
@@ -311,13 +329,6 @@ impl IrradianceProbes {
         })
     }
 
-    /// Whether every frame records [`LOOKUP_PASS`] (else only a frame whose `--dump` names
-    /// [`PIXELS_DUMP`]): the lookup's cost on its own, as `hikari bench probes` times it. The
-    /// deferred lighting's own lookup is unchanged.
-    pub fn set_lookup_pass(&self, on: bool) {
-        self.lookup_pass.store(on, Ordering::Relaxed);
-    }
-
     /// Records the dispatches of `bench` (one pass each, named by its workloads), relit from
     /// its sky and `light` (the frame's sun or moon) with the switches of `s`; returns their
     /// output, `irradiance_probes.bench_irradiance` (9 `vec4` a probe, the workloads' probes
@@ -357,11 +368,12 @@ impl IrradianceProbes {
     pub fn record_pixels_dump<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &IrradianceProbesState,
         probes: &ProbesFrame,
         gb: &GBuffer,
         view: &View,
     ) -> Result<Option<Tex>> {
-        if !self.lookup_pass.load(Ordering::Relaxed) && !g.dump_requested(PIXELS_DUMP) {
+        if !state.lookup_pass && !g.dump_requested(PIXELS_DUMP) {
             return Ok(None);
         }
         let [w, h] = [view.viewport[0] as u32, view.viewport[1] as u32];

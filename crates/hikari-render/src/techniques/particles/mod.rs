@@ -156,10 +156,15 @@ pub fn with_screen_rects(sprites: &mut [ParticleGpu], view: &View) {
     }
 }
 
+/// What the particles keep between frames in the renderer's frame state: the sprites' buffer,
+/// grown as needed.
+#[derive(Clone, Debug, Default)]
+pub struct ParticlesState {
+    buffer: Option<wgpu::Buffer>,
+}
+
 pub struct Particles {
     draw: ComputePipeline,
-    /// The sprites, grown as needed.
-    buffer: std::cell::RefCell<Option<wgpu::Buffer>>,
     /// A 1 x 1 x 1 stand-in for the haze's light when there is no haze.
     no_haze: wgpu::Texture,
 }
@@ -181,11 +186,7 @@ impl Particles {
             usage: wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
-        Ok(Self {
-            draw,
-            buffer: std::cell::RefCell::new(None),
-            no_haze,
-        })
+        Ok(Self { draw, no_haze })
     }
 
     /// Composites `sprites` (with their screen rectangles) over `image` (the hazed image) into
@@ -195,6 +196,7 @@ impl Particles {
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut ParticlesState,
         view: &View,
         params: &ParticleParams,
         sprites: &[ParticleGpu],
@@ -210,7 +212,7 @@ impl Particles {
         }
         let ctx = g.ctx();
         let bytes = std::mem::size_of_val(sprites).max(std::mem::size_of::<ParticleGpu>()) as u64;
-        let mut slot = self.buffer.borrow_mut();
+        let slot = &mut state.buffer;
         if slot.as_ref().is_none_or(|b| b.size() < bytes) {
             *slot = Some(ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("particles.sprites"),
@@ -220,7 +222,6 @@ impl Particles {
             }));
         }
         let buffer = slot.as_ref().expect("just made").clone();
-        drop(slot);
         ctx.queue
             .write_buffer(&buffer, 0, bytemuck::cast_slice(sprites));
         let sprite_buf = g.import_buffer("particles.sprites", &buffer);

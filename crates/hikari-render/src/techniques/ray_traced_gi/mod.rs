@@ -21,7 +21,7 @@ pub mod instance_albedo;
 pub mod reference;
 pub mod settings;
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -252,12 +252,10 @@ impl RtGiParams {
 
 /// What the technique keeps of a scene besides the frame's BVH (`scene::rt::SceneRt`, which it
 /// traces through [`RtGiInputs::bvh`]): the per-instance albedo table, on the GPU, and the
-/// grid of light lists that lights hits ([`light_grid`]), rebuilt when what it was built from
-/// changes.
+/// scene's point and spot lights, whose light grid [`RtGiState`] keeps.
 pub struct RtGiScene {
     /// The scene's point and spot lights, for their reach ([`crate::lights::grid::punctual_records`]).
     punctual: Vec<crate::scene::upload::LightGpu>,
-    light_grid: Mutex<Option<LightGridGpu>>,
     /// [`reference::instance_table`].
     instance_table: wgpu::Buffer,
     /// [`reference::normal_tables`]: per instance, then per mesh triangle.
@@ -267,7 +265,15 @@ pub struct RtGiScene {
     mesh_first: Vec<u32>,
 }
 
+/// What the GI keeps between frames in the renderer's frame state: the grid of light lists
+/// that lights hits ([`crate::lights::grid`]), rebuilt when what it was built from changes.
+#[derive(Clone, Debug, Default)]
+pub struct RtGiState {
+    light_grid: Option<LightGridGpu>,
+}
+
 /// The uploaded light grid and what it was built from.
+#[derive(Clone, Debug)]
 struct LightGridGpu {
     key: crate::lights::grid::LightGridKey,
     cells: wgpu::Buffer,
@@ -335,7 +341,6 @@ impl RtGiScene {
         Ok(Self {
             mesh_first,
             punctual: crate::lights::grid::punctual_records(scene),
-            light_grid: Mutex::new(None),
             instance_table: storage_buffer(
                 ctx,
                 "ray_traced_gi.instance_table",
@@ -387,12 +392,15 @@ impl RtGiScene {
     pub fn import(&self, g: &mut FrameGraph<'_>) -> Buf {
         g.import_buffer("ray_traced_gi.instance_table", &self.instance_table)
     }
+}
 
+impl RtGiState {
     /// The light grid for `area`'s lights and the scene's point and spot lights at `params`'
     /// cut-off and minimum flux, in a frame (cells, indices): built and uploaded when the key
     /// changed, else the last one.
     fn import_light_grid(
-        &self,
+        &mut self,
+        scene: &RtGiScene,
         g: &mut FrameGraph<'_>,
         area: &AreaLightScene,
         params: &RtGiParams,
@@ -400,17 +408,15 @@ impl RtGiScene {
         let (min_flux, cutoff) = (params.area[1], params.distances[3]);
         let key = crate::lights::grid::LightGridKey::new(
             &area.lights.lights,
-            &self.punctual,
+            &scene.punctual,
             min_flux,
             cutoff,
         );
-        let mut slot = self.light_grid.lock().map_err(|_| {
-            crate::error::RenderError::Graph("ray_traced_gi: light grid lock poisoned".into())
-        })?;
+        let slot = &mut self.light_grid;
         if slot.as_ref().map(|s| s.key) != Some(key) {
             let grid = crate::lights::grid::LightGrid::build(
                 &area.lights.lights,
-                &self.punctual,
+                &scene.punctual,
                 min_flux,
                 crate::lights::grid::grid_cutoff(cutoff),
             );
@@ -450,7 +456,7 @@ impl RtGiScene {
 
     /// The stats of the light grid in use (built by the last frame), `None` before one.
     pub fn light_grid_stats(&self) -> Option<LightGridStats> {
-        Some(self.light_grid.lock().ok()?.as_ref()?.stats)
+        Some(self.light_grid.as_ref()?.stats)
     }
 }
 
@@ -540,11 +546,12 @@ impl RayTracedGi {
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut RtGiState,
         scene: &RtGiScene,
         inputs: &RtGiInputs<'_>,
         reset: bool,
     ) -> Result<(RtGiFrame, RtGiRays)> {
-        let raw = self.record_raw(g, scene, inputs)?;
+        let raw = self.record_raw(g, state, scene, inputs)?;
         let mut params = *inputs.params;
         if reset {
             params.set_flag(FLAG_RESET, true);
@@ -565,6 +572,7 @@ impl RayTracedGi {
     pub fn record_raw<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut RtGiState,
         scene: &RtGiScene,
         inputs: &RtGiInputs<'_>,
     ) -> Result<RtGiRaw> {
@@ -650,7 +658,7 @@ impl RayTracedGi {
         let noise = self.noise_set(g);
         let bvh_set = inputs.shadow_bvh.binding_set(g);
         let (area_lights, area_triangles) = inputs.area.import(g);
-        let (grid_cells, grid_indices) = scene.import_light_grid(g, inputs.area, params)?;
+        let (grid_cells, grid_indices) = state.import_light_grid(scene, g, inputs.area, params)?;
         g.pass("ray_traced_gi.shade")
             .constants(view)
             .constants(params)

@@ -22,7 +22,7 @@
 pub mod reference;
 pub mod settings;
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -216,7 +216,7 @@ struct Uploaded {
     generation: u64,
 }
 
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 struct Progress {
     /// (generation, resolution) the persistent cube maps hold, and which probes they hold.
     captured_with: Option<(u64, u32)>,
@@ -229,13 +229,80 @@ struct Progress {
     relit_all_with: Option<(Vec3, String)>,
 }
 
+/// What the reflection probes keep between frames in the renderer's frame state: the probe
+/// set on the GPU ([`ReflectionProbesState::set_probes`]) and which probes the persistent cube
+/// maps hold and relit.
+#[derive(Clone, Default)]
+pub struct ReflectionProbesState {
+    uploaded: Option<Arc<Uploaded>>,
+    progress: Progress,
+}
+
+impl std::fmt::Debug for ReflectionProbesState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ReflectionProbesState")
+            .field("probes", &self.uploaded.as_ref().map(|u| u.boxes.len()))
+            .field("progress", &self.progress)
+            .finish()
+    }
+}
+
+impl ReflectionProbesState {
+    /// Uses `probes` from the next frame on (captured then). Each is validated; the error
+    /// names the first bad one.
+    pub fn set_probes(&mut self, ctx: &GpuContext, probes: &[ReflectionProbeBox]) -> Result<()> {
+        for p in probes {
+            p.validate()
+                .map_err(|e| RenderError::Graph(format!("reflection probes: {e}")))?;
+        }
+        let guard = &mut self.uploaded;
+        let generation = guard.as_ref().map_or(1, |u| u.generation + 1);
+        if probes.is_empty() {
+            *guard = None;
+            return Ok(());
+        }
+        let mut boxes = probes.to_vec();
+        boxes.sort_by(|a, b| a.volume().total_cmp(&b.volume()));
+        let gpu: Vec<ReflectionProbeGpu> = boxes.iter().map(ReflectionProbeGpu::new).collect();
+        let limit = ctx.limits.max_texture_array_layers / 6;
+        if boxes.len() as u32 > limit {
+            return Err(RenderError::Limit {
+                what: "reflection probes (six texture layers each)".into(),
+                requested: boxes.len() as u64,
+                limit: u64::from(limit),
+            });
+        }
+        *guard = Some(Arc::new(Uploaded {
+            probes: buffer(ctx, "reflection_probes.probes", bytemuck::cast_slice(&gpu)),
+            capture_light: buffer(
+                ctx,
+                "reflection_probes.capture_light",
+                &vec![0u8; boxes.len() * 16],
+            ),
+            relit_list: buffer(
+                ctx,
+                "reflection_probes.relit_list",
+                &vec![0u8; boxes.len() * 4],
+            ),
+            gpu,
+            boxes,
+            generation,
+        }));
+        Ok(())
+    }
+
+    /// Captures the cube maps again next frame (a rasteriser queue overflowed while they were
+    /// drawn).
+    pub fn invalidate_capture(&mut self) {
+        self.progress.captured_with = None;
+    }
+}
+
 pub struct ReflectionProbes {
     capture: ComputePipeline,
     relight: ComputePipeline,
     downsample: ComputePipeline,
     prefilter: ComputePipeline,
-    uploaded: Mutex<Option<Arc<Uploaded>>>,
-    progress: Mutex<Progress>,
     /// Stand-ins for the lookup with no probes.
     empty_probe: wgpu::Buffer,
     empty_light: wgpu::Buffer,
@@ -276,8 +343,6 @@ impl ReflectionProbes {
                 "main",
                 &[],
             )?,
-            uploaded: Mutex::new(None),
-            progress: Mutex::new(Progress::default()),
             empty_probe: buffer(
                 ctx,
                 "reflection_probes.empty",
@@ -285,58 +350,6 @@ impl ReflectionProbes {
             ),
             empty_light: buffer(ctx, "reflection_probes.empty_light", &[0; 16]),
         })
-    }
-
-    /// Uses `probes` from the next frame on (captured then). Each is validated; the error
-    /// names the first bad one.
-    pub fn set_probes(&self, ctx: &GpuContext, probes: &[ReflectionProbeBox]) -> Result<()> {
-        for p in probes {
-            p.validate()
-                .map_err(|e| RenderError::Graph(format!("reflection probes: {e}")))?;
-        }
-        let mut guard = self.uploaded.lock().unwrap_or_else(|e| e.into_inner());
-        let generation = guard.as_ref().map_or(1, |u| u.generation + 1);
-        if probes.is_empty() {
-            *guard = None;
-            return Ok(());
-        }
-        let mut boxes = probes.to_vec();
-        boxes.sort_by(|a, b| a.volume().total_cmp(&b.volume()));
-        let gpu: Vec<ReflectionProbeGpu> = boxes.iter().map(ReflectionProbeGpu::new).collect();
-        let limit = ctx.limits.max_texture_array_layers / 6;
-        if boxes.len() as u32 > limit {
-            return Err(RenderError::Limit {
-                what: "reflection probes (six texture layers each)".into(),
-                requested: boxes.len() as u64,
-                limit: u64::from(limit),
-            });
-        }
-        *guard = Some(Arc::new(Uploaded {
-            probes: buffer(ctx, "reflection_probes.probes", bytemuck::cast_slice(&gpu)),
-            capture_light: buffer(
-                ctx,
-                "reflection_probes.capture_light",
-                &vec![0u8; boxes.len() * 16],
-            ),
-            relit_list: buffer(
-                ctx,
-                "reflection_probes.relit_list",
-                &vec![0u8; boxes.len() * 4],
-            ),
-            gpu,
-            boxes,
-            generation,
-        }));
-        Ok(())
-    }
-
-    /// Captures the cube maps again next frame (a rasteriser queue overflowed while they were
-    /// drawn).
-    pub fn invalidate_capture(&self) {
-        self.progress
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .captured_with = None;
     }
 
     fn disabled_frame(
@@ -376,6 +389,7 @@ impl ReflectionProbes {
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut ReflectionProbesState,
         gbuffer: &'r GBufferPass,
         raster: &'r Rasterizer,
         scene: &SceneInFrame,
@@ -383,11 +397,7 @@ impl ReflectionProbes {
         s: &ReflectionProbesSettings,
         inputs: &ReflectionProbeInputs<'_>,
     ) -> Result<ReflectionProbesFrame> {
-        let uploaded = self
-            .uploaded
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clone();
+        let uploaded = state.uploaded.clone();
         let on = s.enabled && inputs.sky.enabled;
         let Some(u) = uploaded.filter(|_| on) else {
             return self.disabled_frame(g, s);
@@ -416,7 +426,7 @@ impl ReflectionProbes {
         let probes = g.import_buffer("reflection_probes.probes", &u.probes);
         let capture_light = g.import_buffer("reflection_probes.capture_light", &u.capture_light);
 
-        let mut progress = self.progress.lock().unwrap_or_else(|e| e.into_inner());
+        let progress = &mut state.progress;
         let key = (u.generation, n);
         if f0 || f1 || f2 || progress.captured_with != Some(key) {
             progress.captured_with = Some(key);
@@ -502,7 +512,6 @@ impl ReflectionProbes {
             }
         }
         progress.resident = resident.clone();
-        drop(progress);
         let gpu: Vec<ReflectionProbeGpu> = u
             .gpu
             .iter()

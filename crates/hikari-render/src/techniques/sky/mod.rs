@@ -30,7 +30,7 @@ pub mod reference;
 pub mod settings;
 pub mod weather;
 
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -42,10 +42,11 @@ use hikari_scene::Sun;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
+use crate::frame_context::FrameContext;
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
-use crate::techniques::clouds::{CLOUDS_ON, CloudsFrame};
+use crate::techniques::clouds::CloudsFrame;
 use gpu_build::{TableBuilder, TableTargets, WorkLayout};
 use lights::SkyLights;
 use settings::SkySettings;
@@ -102,28 +103,15 @@ pub const MU_S_MIN: f32 = hikari_atmosphere::geometry::MU_S_MIN as f32;
 /// tens of ms once per weather instead of the full build, and within a few per cent of it.
 pub const SCALAR_TABLE_QUALITY: u32 = 0;
 
-/// The CPU atmosphere for `params` at `sizes`, built once and kept while the same parameters are
-/// asked for (the last two builds are kept, so alternating between two weathers does not
-/// rebuild).
+/// The CPU atmosphere for `params` at `sizes`, shared by every caller that asks for the same
+/// ([`Atmosphere::shared`]).
 pub fn atmosphere_for(params: &AtmosphereParams, sizes: TableSizes) -> Result<Arc<Atmosphere>> {
-    type Cache = Vec<(AtmosphereParams, TableSizes, Arc<Atmosphere>)>;
-    static CACHE: Mutex<Cache> = Mutex::new(Vec::new());
-    let mut cache = CACHE.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, _, a)) = cache.iter().find(|(p, s, _)| p == params && *s == sizes) {
-        return Ok(a.clone());
-    }
-    let a = Arc::new(
-        Atmosphere::with_sizes(params.clone(), sizes)
-            .map_err(|e| RenderError::Graph(format!("sky: atmosphere: {e}")))?,
-    );
-    log::info!(
+    let a = Atmosphere::shared(params, sizes)
+        .map_err(|e| RenderError::Graph(format!("sky: atmosphere: {e}")))?;
+    log::debug!(
         "sky: atmosphere tables built in {:.0} ms",
         a.report.build_ms
     );
-    cache.push((params.clone(), sizes, a.clone()));
-    if cache.len() > 2 {
-        cache.remove(0);
-    }
     Ok(a)
 }
 
@@ -389,99 +377,34 @@ fn upload(
     )
 }
 
-pub struct Sky {
-    resample: ComputePipeline,
-    sh: ComputePipeline,
-    /// `sh.wgsl` with CLOUDS: the sky's SH seen through the clouds.
-    sh_clouds: ComputePipeline,
-    uploaded: Mutex<Option<Arc<Uploaded>>>,
-    builder: TableBuilder,
-    /// What the persistent GPU tables hold now.
-    gpu_built: Mutex<Option<(AtmosphereParams, TableSizes)>>,
+/// What the sky keeps between frames in the renderer's frame state: its tables on the GPU.
+#[derive(Clone, Default)]
+pub struct SkyState {
+    /// The CPU-built tables uploaded (`sky.tables_on_gpu` off).
+    uploaded: Option<Arc<Uploaded>>,
+    /// What the persistent GPU-built tables hold now.
+    gpu_built: Option<(AtmosphereParams, TableSizes)>,
 }
 
-impl Sky {
-    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
-        Ok(Self {
-            resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
-            sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project_dering", &[])?,
-            sh_clouds: ComputePipeline::new(
-                ctx,
-                lib,
-                "sky/sh.wgsl",
-                "project_dering",
-                &[("CLOUDS", naga_oil::compose::ShaderDefValue::Bool(true))],
-            )?,
-            uploaded: Mutex::new(None),
-            builder: TableBuilder::new(ctx, lib)?,
-            gpu_built: Mutex::new(None),
-        })
+impl std::fmt::Debug for SkyState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SkyState")
+            .field("uploaded", &self.uploaded.as_ref().map(|u| u.sizes))
+            .field("gpu_built", &self.gpu_built.as_ref().map(|b| b.1))
+            .finish()
     }
+}
 
-    /// The GPU table builder (for tests and timing: [`TableBuilder::build_and_read`]).
-    pub fn table_builder(&self) -> &TableBuilder {
-        &self.builder
-    }
-
-    /// This frame's tables: persistent textures the `sky.tables.*` passes fill when the
-    /// parameters changed (or the textures are new), else CPU-built uploads.
-    fn frame_tables<'r>(
-        &'r self,
-        g: &mut FrameGraph<'r>,
-        s: &SkySettings,
-        fs: &FrameSky,
-    ) -> Result<FrameTables> {
-        let (params, sizes) = (&fs.params, fs.sizes);
-        if !s.tables_on_gpu {
-            let u = self.tables(g.ctx(), params, sizes)?;
-            return Ok(FrameTables {
-                atmosphere: u.atmosphere.clone(),
-                rayleigh: g.import_texture("sky.rayleigh", &u.rayleigh),
-                rayleigh_single: g.import_texture("sky.rayleigh_single", &u.rayleigh_single),
-                mie: g.import_texture("sky.mie", &u.mie),
-                transmittance: g.import_texture("sky.transmittance", &u.transmittance),
-            });
-        }
-        let (d3, d2) = gpu_build::table_descs(&sizes);
-        let layout = WorkLayout::new(&sizes, params.max_scattering_orders);
-        let (rayleigh, fresh_r) = g.persistent_texture("sky.rayleigh", d3)?;
-        let (rayleigh_single, fresh_s) = g.persistent_texture("sky.rayleigh_single", d3)?;
-        let (mie, fresh_m) = g.persistent_texture("sky.mie", d3)?;
-        let (transmittance, fresh_t) = g.persistent_texture("sky.transmittance", d2)?;
-        let (work, fresh_w) = g.persistent_buffer("sky.tables.work", layout.bytes())?;
-        let mut built = self.gpu_built.lock().unwrap_or_else(|e| e.into_inner());
-        let current = built
-            .as_ref()
-            .is_some_and(|(p, z)| p == params && *z == sizes);
-        if !current || fresh_r || fresh_s || fresh_m || fresh_t || fresh_w {
-            let to = TableTargets {
-                rayleigh,
-                rayleigh_single,
-                mie,
-                transmittance,
-                work,
-            };
-            self.builder.record(g, params, &sizes, to)?;
-            *built = Some((params.clone(), sizes));
-        }
-        Ok(FrameTables {
-            atmosphere: fs.atmosphere.clone(),
-            rayleigh,
-            rayleigh_single,
-            mie,
-            transmittance,
-        })
-    }
-
+impl SkyState {
     /// The tables of `params` at `sizes` on the GPU, built (on the CPU) and uploaded only when
     /// they differ from the last frame's.
     fn tables(
-        &self,
+        &mut self,
         ctx: &GpuContext,
         params: &AtmosphereParams,
         sizes: TableSizes,
     ) -> Result<Arc<Uploaded>> {
-        let mut held = self.uploaded.lock().unwrap_or_else(|e| e.into_inner());
+        let held = &mut self.uploaded;
         if let Some(u) = held.as_ref()
             && u.params == *params
             && u.sizes == sizes
@@ -507,27 +430,108 @@ impl Sky {
         *held = Some(u.clone());
         Ok(u)
     }
+}
 
-    /// Adds the sky's passes for the frame context's sky `fs`. `directional` is the frame's
-    /// directional light; `camera_altitude_km` the camera's height above the ground;
-    /// `clouds` this frame's clouds, which enter the sky's SH (the ambient light of every pass
-    /// that reads it) where they are drawn and `clouds_in_sh`.
-    #[allow(clippy::too_many_arguments)]
+pub struct Sky {
+    resample: ComputePipeline,
+    sh: ComputePipeline,
+    /// `sh.wgsl` with CLOUDS: the sky's SH seen through the clouds.
+    sh_clouds: ComputePipeline,
+    builder: TableBuilder,
+}
+
+impl Sky {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Ok(Self {
+            resample: ComputePipeline::new(ctx, lib, "sky/resample.wgsl", "main", &[])?,
+            sh: ComputePipeline::new(ctx, lib, "sky/sh.wgsl", "project_dering", &[])?,
+            sh_clouds: ComputePipeline::new(
+                ctx,
+                lib,
+                "sky/sh.wgsl",
+                "project_dering",
+                &[("CLOUDS", naga_oil::compose::ShaderDefValue::Bool(true))],
+            )?,
+            builder: TableBuilder::new(ctx, lib)?,
+        })
+    }
+
+    /// The GPU table builder (for tests and timing: [`TableBuilder::build_and_read`]).
+    pub fn table_builder(&self) -> &TableBuilder {
+        &self.builder
+    }
+
+    /// This frame's tables: persistent textures the `sky.tables.*` passes fill when the
+    /// parameters changed (or the textures are new), else CPU-built uploads.
+    fn frame_tables<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        state: &mut SkyState,
+        s: &SkySettings,
+        fs: &FrameSky,
+    ) -> Result<FrameTables> {
+        let (params, sizes) = (&fs.params, fs.sizes);
+        if !s.tables_on_gpu {
+            let u = state.tables(g.ctx(), params, sizes)?;
+            return Ok(FrameTables {
+                atmosphere: u.atmosphere.clone(),
+                rayleigh: g.import_texture("sky.rayleigh", &u.rayleigh),
+                rayleigh_single: g.import_texture("sky.rayleigh_single", &u.rayleigh_single),
+                mie: g.import_texture("sky.mie", &u.mie),
+                transmittance: g.import_texture("sky.transmittance", &u.transmittance),
+            });
+        }
+        let (d3, d2) = gpu_build::table_descs(&sizes);
+        let layout = WorkLayout::new(&sizes, params.max_scattering_orders);
+        let (rayleigh, fresh_r) = g.persistent_texture("sky.rayleigh", d3)?;
+        let (rayleigh_single, fresh_s) = g.persistent_texture("sky.rayleigh_single", d3)?;
+        let (mie, fresh_m) = g.persistent_texture("sky.mie", d3)?;
+        let (transmittance, fresh_t) = g.persistent_texture("sky.transmittance", d2)?;
+        let (work, fresh_w) = g.persistent_buffer("sky.tables.work", layout.bytes())?;
+        let built = &mut state.gpu_built;
+        let current = built
+            .as_ref()
+            .is_some_and(|(p, z)| p == params && *z == sizes);
+        if !current || fresh_r || fresh_s || fresh_m || fresh_t || fresh_w {
+            let to = TableTargets {
+                rayleigh,
+                rayleigh_single,
+                mie,
+                transmittance,
+                work,
+            };
+            self.builder.record(g, params, &sizes, to)?;
+            *built = Some((params.clone(), sizes));
+        }
+        Ok(FrameTables {
+            atmosphere: fs.atmosphere.clone(),
+            rayleigh,
+            rayleigh_single,
+            mie,
+            transmittance,
+        })
+    }
+
+    /// Adds the sky's passes for the frame context's sky, seen from its camera and lit by its
+    /// directional light. `clouds` are this frame's clouds, which enter the sky's SH (the
+    /// ambient light of every pass that reads it) where they are drawn and `clouds_in_sh`.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut SkyState,
+        cx: &FrameContext,
         s: &SkySettings,
-        fs: Option<&FrameSky>,
-        directional: Option<&Sun>,
-        camera_altitude_km: f32,
         clouds: &CloudsFrame,
         clouds_in_sh: bool,
     ) -> Result<SkyFrame> {
+        let (fs, directional) = (cx.sky.as_ref(), cx.sun.as_ref());
+        // The camera's height above the ground.
+        let camera_altitude_km = cx.view.position[1].max(0.0) / 1000.0;
         let sh = g.buffer("sky.sh", 18 * 16)?;
         let Some(fs) = fs.filter(|_| s.enabled) else {
             return self.disabled(g, sh);
         };
-        let u = self.frame_tables(g, s, fs)?;
+        let u = self.frame_tables(g, state, s, fs)?;
         let sizes = fs.sizes;
         let (lights, knobs) = (&fs.lights, fs.knobs);
         let mut params = SkyParams::with_sizes(&u.atmosphere, sizes, lights, s, camera_altitude_km);
@@ -567,7 +571,7 @@ impl Sky {
         // 16 workgroups' partial sums, and their count, which the last workgroup resets.
         let partials = g.buffer("sky.sh_partials", 64 * 9 * 16)?;
         let (done, _) = g.persistent_buffer("sky.sh_done", 4)?;
-        let in_sh = clouds_in_sh && clouds.params.march[3] & CLOUDS_ON != 0;
+        let in_sh = clouds_in_sh && clouds.drawn;
         let clear = if in_sh {
             g.buffer("sky.sh_clear", 18 * 16)?
         } else {

@@ -20,7 +20,7 @@ pub mod reference;
 pub mod settings;
 
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
@@ -272,22 +272,25 @@ pub fn graded_by(s: &TonemapSettings) -> Option<&Path> {
     s.lut.as_deref().filter(|_| s.grade).map(Path::new)
 }
 
-pub struct Tonemap {
-    apply: ComputePipeline,
-    lut: Mutex<Option<Arc<LoadedLut>>>,
+/// What the tonemap keeps between frames in the renderer's frame state: the grading LUT on
+/// the GPU, read again only when its file changes.
+#[derive(Clone, Default)]
+pub struct TonemapState {
+    lut: Option<Arc<LoadedLut>>,
 }
 
-impl Tonemap {
-    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
-        Ok(Self {
-            apply: ComputePipeline::new(ctx, lib, "tonemap/apply.wgsl", "main", &[])?,
-            lut: Mutex::new(None),
-        })
+impl std::fmt::Debug for TonemapState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TonemapState")
+            .field("lut", &self.lut.as_ref().map(|l| &l.path))
+            .finish()
     }
+}
 
+impl TonemapState {
     /// The LUT of `path` on the GPU, read again only when the file changes.
-    fn lut(&self, ctx: &GpuContext, path: &Path) -> Result<Arc<LoadedLut>> {
-        let mut held = self.lut.lock().unwrap_or_else(|e| e.into_inner());
+    fn lut(&mut self, ctx: &GpuContext, path: &Path) -> Result<Arc<LoadedLut>> {
+        let held = &mut self.lut;
         let stamp = file_stamp(path);
         if let Some(l) = held.as_ref()
             && l.path == path
@@ -311,10 +314,22 @@ impl Tonemap {
     }
 
     /// The LUT that `s` grades with, read from its file (cached), if any.
-    pub fn grade(&self, ctx: &GpuContext, s: &TonemapSettings) -> Result<Option<CubeLut>> {
+    pub fn grade(&mut self, ctx: &GpuContext, s: &TonemapSettings) -> Result<Option<CubeLut>> {
         Ok(match graded_by(s) {
             Some(p) => Some(self.lut(ctx, p)?.lut.clone()),
             None => None,
+        })
+    }
+}
+
+pub struct Tonemap {
+    apply: ComputePipeline,
+}
+
+impl Tonemap {
+    pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
+        Ok(Self {
+            apply: ComputePipeline::new(ctx, lib, "tonemap/apply.wgsl", "main", &[])?,
         })
     }
 
@@ -322,12 +337,13 @@ impl Tonemap {
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
+        state: &mut TonemapState,
         s: &TonemapSettings,
         inputs: TonemapInputs,
         size: [u32; 2],
     ) -> Result<Tex> {
         let loaded = match graded_by(s) {
-            Some(p) => Some(self.lut(g.ctx(), p)?),
+            Some(p) => Some(state.lut(g.ctx(), p)?),
             None => None,
         };
         let mut params = TonemapParams::new(
