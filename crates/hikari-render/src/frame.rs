@@ -1,9 +1,8 @@
-//! One frame, top to bottom. Each numbered step is the step of the same number in
-//! ARCHITECTURE.md, except 2 to 6: the clouds (ARCHITECTURE.md's 6) come first, before the
-//! atmosphere (its 2 and 3), whose SH sees the sky through them; then the irradiance probes
-//! (its 4), whose sun bounce they shadow, then the reflection probes (its 5), which they
-//! shadow and whose sky they cover. Step 12 ends with the haze-lit particles,
-//! which ARCHITECTURE.md does not list: they read the haze's light and go before TAA.
+//! One frame, top to bottom, its steps numbered in the order they run (docs/architecture.md
+//! lists them). The techniques are recorded in [`crate::techniques::FRAME_ORDER`]; each may
+//! use what the ones before it publish. The G-buffer comes first, as nothing it draws depends
+//! on the lighting; the clouds come before the atmosphere, whose SH sees the sky through them,
+//! and before the probes, whose sun bounce and sky they shadow and cover.
 
 use crate::brdf_tables::BrdfTables;
 use crate::context::GpuContext;
@@ -20,20 +19,17 @@ use crate::techniques::area_lights::{
     ShadowDenoiseParams,
 };
 use crate::techniques::clouds::{CloudParams, Clouds};
-use crate::techniques::direct_lighting::GiLight;
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::overrides::{GBufferTexel, override_gbuffer};
 use crate::techniques::gbuffer::{GBuffer, GBufferPass};
-use crate::techniques::gi_denoiser::{
-    DenoisedGi, GiDenoiser, GiDenoiserGeometry, GiDenoiserInput, RecurrentNames,
-};
+use crate::techniques::gi_denoiser::{self, DenoisedGi, GiDenoiser, RecurrentNames};
 use crate::techniques::haze::{Haze, HazeFrame, HazeInputs, HazeParams};
 use crate::techniques::irradiance_probes::{IrradianceProbes, ProbesFrame};
 use crate::techniques::local_tonemap::{LocalTonemap, LocalTonemapFrame};
 use crate::techniques::particles::{self, ParticleParams, Particles};
 use crate::techniques::ray_traced_gi::{
-    RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene, SkySource,
+    RayTracedGi, RtGiFrame, RtGiInputs, RtGiParams, RtGiRays, SharedRtGiScene,
 };
 use crate::techniques::reflection_probes::{
     ReflectionProbeInputs, ReflectionProbes, ReflectionProbesFrame,
@@ -205,7 +201,7 @@ pub fn record<'r>(
         .record(g, &t.raster, scene, &view, size, &mut state.raster_queues)?;
     override_gbuffer(g, &gbuffer, size, &state.gbuffer_overrides)?;
 
-    // 4. Clouds, before the atmosphere: this frame's share of the paraboloid cloud map and the
+    // 3. Clouds, before the atmosphere: this frame's share of the paraboloid cloud map and the
     //    clouds' shadow map. The sky's SH sees the sky through them, the deferred lighting
     //    draws them over the sky, and they shadow the sun there, in the haze, the GI and the
     //    probes' sun bounce.
@@ -223,8 +219,8 @@ pub fn record<'r>(
         s.camera.position,
     )?;
 
-    // 2. Atmosphere tables (rebuilt when the weather changes) resampled for this frame's sun
-    //    and moon, and 3. the sky's deringed SH, with the clouds in it (`clouds.ambient`).
+    // 4. Atmosphere tables (rebuilt when the weather changes) resampled for this frame's sun
+    //    and moon, and the sky's deringed SH, with the clouds in it (`clouds.ambient`).
     let sky = t.sky.record(
         g,
         &mut state.techniques.sky,
@@ -246,8 +242,7 @@ pub fn record<'r>(
         s.camera.position,
     )?;
 
-    // 6. Reflection probes (ARCHITECTURE.md's step 5, after the clouds, which shadow and
-    //    cover their sky): captured once, this frame's share relit and prefiltered.
+    // 6. Reflection probes (after the clouds, which shadow and cover their sky): captured once, this frame's share relit and prefiltered.
     let reflection_probes = t.reflection_probes.record(
         g,
         &mut state.techniques.reflection_probes,
@@ -256,22 +251,10 @@ pub fn record<'r>(
         scene,
         &mut state.raster_queues,
         &s.settings.reflection_probes,
-        &ReflectionProbeInputs {
-            sky: &sky,
-            probes: &probes,
-            clouds: &clouds,
-            lights: scene.lights,
-            light_count: cx.punctual_lights,
-            sun,
-            cutoff_lux: cx.light_cutoff_lux,
-            weather: &s.settings.sky.weather,
-            relight_all: cx.history.view_changed(),
-            camera: s.camera.position,
-            sky_light: s.settings.sky.sky,
-        },
+        &ReflectionProbeInputs::for_frame(cx, &s.settings, &sky, &probes, &clouds, scene.lights),
     )?;
 
-    // 7. Sun shadow maps.
+    // 7. Sun shadow maps (cascades redrawn only where the view or the sun moved).
     let shadows = t.sun_shadows.record(
         g,
         &t.raster,
@@ -293,9 +276,8 @@ pub fn record<'r>(
         &view,
     )?;
 
-    // 9. Ray-traced GI and AO (issue 18): one ray a pixel, pre-traced in screen space, the
+    // 8. Ray-traced GI and AO: one ray a pixel, pre-traced in screen space, the
     //    rest through the BVH, lit, encoded and accumulated for the denoiser.
-    //    10. Denoising: its issue adds it here.
     let mut ray_traced_gi = None;
     let mut ray_traced_gi_rays = None;
     if s.settings.ray_traced_gi.enabled {
@@ -304,28 +286,7 @@ pub fn record<'r>(
                 "ray_traced_gi: the instance table is not built (the Renderer builds it)".into(),
             )
         })?;
-        let sky_source = match (sky.enabled, s.settings.sky.sky) {
-            (true, true) => SkySource::Atmosphere,
-            (true, false) => SkySource::None,
-            (false, _) if s.settings.direct_lighting.placeholder_ambient => SkySource::Placeholder,
-            (false, _) => SkySource::None,
-        };
-        let params = RtGiParams::new(
-            &s.settings.ray_traced_gi,
-            cx.frame_index,
-            sun,
-            cx.punctual_lights,
-            cx.metered_lux,
-            cx.light_cutoff_lux,
-            sky_source,
-        )
-        .with_hit_lights(
-            s.settings.area_lights.enabled,
-            area.light_count(),
-            s.settings.area_lights.min_flux_lm,
-            s.settings.area_lights.punctual_shadows,
-            s.settings.area_lights.punctual_radius_m,
-        );
+        let params = RtGiParams::for_frame(cx, &s.settings, sky.enabled, area.light_count());
         let recurrent = t
             .gi_denoiser
             .as_ref()
@@ -343,7 +304,7 @@ pub fn record<'r>(
             bvh: rt_bvh.gi,
             shadow_bvh: rt_bvh.shadow,
             area,
-            // Step 14's exposure of the last frame: this frame's is not known yet.
+            // Step 13's exposure of the last frame: this frame's is not known yet.
             exposure: Exposure::previous(g)?,
             denoised_history: match t.gi_denoiser {
                 Some(_) => GiDenoiser::recurrent_history(g, &s.settings.gi_denoiser, size)?,
@@ -361,72 +322,33 @@ pub fn record<'r>(
         ray_traced_gi_rays = Some(rays);
     }
 
-    // 10. Denoising: the two-pass GI denoiser and the AO denoiser, then the signal the deferred
+    // 9. Denoising: the two-pass GI denoiser and the AO denoiser, then the signal the deferred
     //     lighting resolves.
-    let mut denoised_gi = None;
-    let gi_light = match &ray_traced_gi {
-        Some(rt) if t.gi_denoiser.is_some() => {
-            let d = t.gi_denoiser.as_ref().unwrap().record(
-                g,
-                &s.settings.gi_denoiser,
-                &view,
-                GiDenoiserGeometry::from(&gbuffer),
-                &GiDenoiserInput {
-                    gi_y: rt.gi_y,
-                    gi_cocg: rt.gi_cocg,
-                    history_length: rt.history_length,
-                    ao: rt.ao,
-                    hit_distance: rt.hit_distance,
-                },
-                size,
-            )?;
-            denoised_gi = Some(d);
-            Some(GiLight {
-                y: d.gi_y,
-                cocg: d.gi_cocg,
-                ao: d.ao,
-            })
+    let (gi_light, denoised_gi) = match &ray_traced_gi {
+        Some(rt) => {
+            let denoiser = t.gi_denoiser.as_ref();
+            let (light, d) =
+                gi_denoiser::signal(denoiser, g, &s.settings.gi_denoiser, &view, &gbuffer, rt)?;
+            (Some(light), d)
         }
-        Some(rt) => Some(GiLight {
-            y: rt.gi_y,
-            cocg: rt.gi_cocg,
-            ao: rt.ao,
-        }),
-        None => None,
+        None => (None, None),
     };
 
-    // 11. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
+    // 10. Deferred direct lighting (sun, lights, emissive; the sky where depth is 0 and the
     //     sky's SH as ambient light, or the placeholders with the atmosphere off).
     let brdf = t.brdf_tables.binding_set(g);
-    let mut lighting = LightingParams::new(
-        sun,
-        cx.punctual_lights,
-        cx.light_cutoff_lux,
-        &s.settings.direct_lighting,
+    // Area lights, and point and spot lights with ray-traced shadows, added by the deferred
+    // lighting, which then leaves the point and spot lights to them.
+    let area_params = AreaLightParams::for_frame(cx, &s.settings.area_lights, area.light_count());
+    let lighting = LightingParams::for_frame(
+        cx,
+        &s.settings,
+        sky.enabled,
+        probes.present,
+        &reflection_probes.lookup.params,
+        gi_light.is_some(),
+        &area_params,
     );
-    if sky.enabled {
-        lighting.use_sky(s.settings.sky.sky);
-    }
-    lighting.use_probes(probes.present);
-    lighting.use_reflection_probes(&reflection_probes.lookup.params);
-    if gi_light.is_some() {
-        lighting.use_ray_traced_gi(
-            s.settings.ray_traced_gi.near_field_m,
-            s.settings.ray_traced_gi.near_field_blend,
-        );
-    }
-    // Area lights, and point and spot lights with ray-traced shadows (issue 18), added by the
-    // deferred lighting, which then leaves the point and spot lights to them.
-    let area_params = AreaLightParams::new(
-        &s.settings.area_lights,
-        area.light_count(),
-        cx.punctual_lights,
-        cx.light_cutoff_lux,
-        cx.frame_index,
-    );
-    if area_params.shades_punctual() {
-        lighting.skip_punctual();
-    }
     let area_frame = t.area_lights.record(
         g,
         area,
@@ -478,18 +400,11 @@ pub fn record<'r>(
         t.ray_traced_gi.keep_lit(g, lit_frame.radiance, size)?;
     }
 
-    // 12. Haze: the froxel grid lit by the sun or moon (through the shadow maps), the sky and
+    // 11. Haze: the froxel grid lit by the sun or moon (through the shadow maps), the sky and
     //     the local lights, integrated front to back and composited over every pixel. It needs
     //     the atmosphere: the placeholder sky has no SH to light it.
     let haze = if s.settings.haze.enabled && sky.enabled {
-        let params = HazeParams::new(
-            &s.settings.haze,
-            &s.settings.sky.weather,
-            cx.lit_sun(&s.settings),
-            cx.punctual_lights,
-            cx.light_cutoff_lux,
-            cx.metered_lux,
-        );
+        let params = HazeParams::for_frame(cx, &s.settings);
         let frame = t.haze.record(
             g,
             &mut state.techniques.haze,
@@ -517,20 +432,9 @@ pub fn record<'r>(
     //     the hazed image; the haze-lit ones take the haze's froxel light (the talk's "haze
     //     lighting" for particles).
     if s.settings.particles.enabled && !emitters.is_empty() {
-        let mut sprites = particles::sprites(emitters, cx.clock_s, s.camera.position);
-        particles::with_screen_rects(&mut sprites, &view);
-        let sun = cx
-            .lit_sun(&s.settings)
-            .map(|sun| (sun.direction, sun.color * sun.illuminance_lux));
-        // A sky of `sky_lux` on the ground and a dark ground: about sky_lux / 2 pi on average
-        // over the sphere.
-        let sky_mean = glam::Vec3::splat(sky.sky_lux / std::f32::consts::TAU);
-        let params = ParticleParams::new(
-            &s.settings.particles,
-            sun,
-            sky_mean,
-            haze.as_ref().map(|(p, _)| p),
-        );
+        let sprites = particles::frame_sprites(emitters, cx);
+        let haze_params = haze.as_ref().map(|(p, _)| p);
+        let params = ParticleParams::for_frame(cx, &s.settings, sky.sky_lux, haze_params);
         hazed = t.particles.record(
             g,
             &mut state.techniques.particles,
@@ -543,7 +447,7 @@ pub fn record<'r>(
         )?;
     }
 
-    // 13. TAA.
+    // 12. TAA.
     let hdr = if s.settings.taa.enabled {
         t.taa
             .record(g, hazed, gbuffer.motion, size, &s.settings.taa, history)?
@@ -552,7 +456,7 @@ pub fn record<'r>(
         hazed
     };
 
-    // 14. Exposure, metered on the illuminance; the local tonemap's grid; the tonemap: the local
+    // 13. Exposure, metered on the illuminance; the local tonemap's grid; the tonemap: the local
     //     gain from that grid, Purkinje shift, white balance, the curve in the tonemapping
     //     space, LUT grade, dither.
     let exposure = t.exposure.record(

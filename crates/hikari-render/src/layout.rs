@@ -354,11 +354,11 @@ pub fn constants() -> Vec<SharedConstant> {
         ),
         gpu_const!(
             crate::lights::polygon::AREA_LIGHT_DOUBLE_SIDED,
-            "common/area_polygon.wgsl"
+            "lights/area_polygon.wgsl"
         ),
         gpu_const!(
             crate::lights::polygon::AREA_LIGHT_FORCED,
-            "common/area_polygon.wgsl"
+            "lights/area_polygon.wgsl"
         ),
         gpu_const!(
             crate::techniques::area_lights::AREA_POLYGONS,

@@ -53,6 +53,22 @@ pub struct AreaLightParams {
 impl AreaLightParams {
     /// `cutoff_lux`: the frame context's point and spot light cut-off, the deferred
     /// lighting's too.
+    /// This frame's parameters for `area_lights` polygonal lights in the scene, with the
+    /// frame context's point and spot lights and cut-off.
+    pub fn for_frame(
+        cx: &crate::frame_context::FrameContext,
+        s: &AreaLightsSettings,
+        area_lights: u32,
+    ) -> Self {
+        Self::new(
+            s,
+            area_lights,
+            cx.punctual_lights,
+            cx.light_cutoff_lux,
+            cx.frame_index,
+        )
+    }
+
     pub fn new(
         s: &AreaLightsSettings,
         area_lights: u32,

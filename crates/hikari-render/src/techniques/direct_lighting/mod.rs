@@ -42,14 +42,7 @@ pub const LIGHTING_RTGI: u32 = 64;
 /// Indirect specular from the relit reflection probes where they cover a surface.
 pub const LIGHTING_REFLECTION_PROBES: u32 = 128;
 
-/// The ray-traced GI signal the deferred lighting resolves (denoised, or accumulated when the
-/// denoiser is off): luminance L1 SH (Rgba16Float), CoCg (Rg16Float) and AO (R16Float).
-#[derive(Clone, Copy, Debug)]
-pub struct GiLight {
-    pub y: Tex,
-    pub cocg: Tex,
-    pub ao: Tex,
-}
+pub use crate::techniques::ray_traced_gi::GiLight;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -110,6 +103,42 @@ impl LightingParams {
     /// Leaves the point and spot lights out (another pass shades them, with shadows).
     /// Ambient light from the ray-traced GI within `near_field_m` of the camera, blended into
     /// the far field's (probes or sky) over the last `blend` fraction of it.
+    /// This frame's parameters: the frame context's sun, lights and cut-off with the sky (on
+    /// when `sky_enabled`), the irradiance probes (`probes_present`), the reflection probes'
+    /// lookup `reflection`, the ray-traced GI (`gi`), and the punctual lights left to the area
+    /// lights' pass when `area` shades them.
+    pub fn for_frame(
+        cx: &crate::frame_context::FrameContext,
+        s: &crate::settings::Settings,
+        sky_enabled: bool,
+        probes_present: bool,
+        reflection: &ReflectionProbeParams,
+        gi: bool,
+        area: &crate::techniques::area_lights::AreaLightParams,
+    ) -> Self {
+        let mut p = Self::new(
+            cx.sun.as_ref(),
+            cx.punctual_lights,
+            cx.light_cutoff_lux,
+            &s.direct_lighting,
+        );
+        if sky_enabled {
+            p.use_sky(s.sky.sky);
+        }
+        p.use_probes(probes_present);
+        p.use_reflection_probes(reflection);
+        if gi {
+            p.use_ray_traced_gi(
+                s.ray_traced_gi.near_field_m,
+                s.ray_traced_gi.near_field_blend,
+            );
+        }
+        if area.shades_punctual() {
+            p.skip_punctual();
+        }
+        p
+    }
+
     pub fn use_ray_traced_gi(&mut self, near_field_m: f32, blend: f32) {
         self.config[1] |= LIGHTING_RTGI;
         self.cutoff[1] = near_field_m;

@@ -78,7 +78,7 @@ pub struct DenoisedGi {
 /// [`GiDenoiser::recurrent_names`]: the kept GI textures (Y, CoCg) and the kept AO.
 pub type RecurrentNames = (Option<[&'static str; 2]>, Option<&'static str>);
 
-pub use crate::techniques::ray_traced_gi::RecurrentHistory;
+pub use crate::techniques::ray_traced_gi::{GiLight, RecurrentHistory};
 
 pub struct GiDenoiser {
     hit_mean: ComputePipeline,
@@ -278,4 +278,47 @@ impl GiDenoiser {
             ao,
         })
     }
+}
+
+/// The GI signal the deferred lighting resolves from the accumulated `rt`: through the
+/// denoisers when there is one (`denoiser`, with what it wrote), else as accumulated.
+pub fn signal<'r>(
+    denoiser: Option<&'r GiDenoiser>,
+    g: &mut FrameGraph<'r>,
+    s: &GiDenoiserSettings,
+    view: &View,
+    gbuffer: &crate::techniques::gbuffer::GBuffer,
+    rt: &crate::techniques::ray_traced_gi::RtGiFrame,
+) -> Result<(GiLight, Option<DenoisedGi>)> {
+    let Some(denoiser) = denoiser else {
+        return Ok((
+            GiLight {
+                y: rt.gi_y,
+                cocg: rt.gi_cocg,
+                ao: rt.ao,
+            },
+            None,
+        ));
+    };
+    let size = [view.viewport[0] as u32, view.viewport[1] as u32];
+    let d = denoiser.record(
+        g,
+        s,
+        view,
+        GiDenoiserGeometry::from(gbuffer),
+        &GiDenoiserInput {
+            gi_y: rt.gi_y,
+            gi_cocg: rt.gi_cocg,
+            history_length: rt.history_length,
+            ao: rt.ao,
+            hit_distance: rt.hit_distance,
+        },
+        size,
+    )?;
+    let light = GiLight {
+        y: d.gi_y,
+        cocg: d.gi_cocg,
+        ao: d.ao,
+    };
+    Ok((light, Some(d)))
 }

@@ -58,6 +58,19 @@ impl HazeParams {
     /// The parameters for `s` in `weather` (a sky weather name), lit by `sun` (the frame's sun
     /// or moon), `light_count` point and spot lights whose light is cut off below
     /// `cutoff_lux`, with the grids scaled by the reciprocal of `metered_lux`.
+    /// This frame's parameters: the weather's haze, lit by the frame context's sun where
+    /// `direct_lighting.sun` lets it and its point and spot lights.
+    pub fn for_frame(cx: &FrameContext, s: &crate::settings::Settings) -> Self {
+        Self::new(
+            &s.haze,
+            &s.sky.weather,
+            cx.lit_sun(s),
+            cx.punctual_lights,
+            cx.light_cutoff_lux,
+            cx.metered_lux,
+        )
+    }
+
     pub fn new(
         s: &HazeSettings,
         weather: &str,

@@ -52,6 +52,22 @@ pub struct ParticleParams {
 impl ParticleParams {
     /// The frame's parameters: the sun or moon `(towards it, rgb lux)`, the sky's mean radiance
     /// (nits), and the haze's parameters when its light is there to read.
+    /// This frame's parameters: lit by the frame context's sun where `direct_lighting.sun`
+    /// lets it and a sky of `sky_lux` on the ground and a dark ground (about sky_lux / 2π on
+    /// average over the sphere), through the haze `haze`.
+    pub fn for_frame(
+        cx: &crate::frame_context::FrameContext,
+        s: &crate::settings::Settings,
+        sky_lux: f32,
+        haze: Option<&HazeParams>,
+    ) -> Self {
+        let sun = cx
+            .lit_sun(s)
+            .map(|sun| (sun.direction, sun.color * sun.illuminance_lux));
+        let sky_mean = Vec3::splat(sky_lux / std::f32::consts::TAU);
+        Self::new(&s.particles, sun, sky_mean, haze)
+    }
+
     pub fn new(
         s: &ParticlesSettings,
         sun: Option<(Vec3, Vec3)>,
@@ -116,6 +132,18 @@ pub fn sprites(emitters: &[ParticleEmitter], time_s: f64, eye: Vec3) -> Vec<Part
         .collect();
     out.sort_by(|a, b| b.0.total_cmp(&a.0));
     out.into_iter().map(|(_, p)| p).collect()
+}
+
+/// The emitters' sprites at the sky's clock of the frame context, back to front, with their
+/// rectangles on its screen.
+pub fn frame_sprites(
+    emitters: &[ParticleEmitter],
+    cx: &crate::frame_context::FrameContext,
+) -> Vec<ParticleGpu> {
+    let eye = Vec3::from_slice(&cx.view.position[..3]);
+    let mut out = sprites(emitters, cx.clock_s, eye);
+    with_screen_rects(&mut out, &cx.view);
+    out
 }
 
 /// Sets each sprite's screen rectangle for `view`: the pixels its camera-facing square (which

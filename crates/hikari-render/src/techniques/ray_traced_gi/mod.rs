@@ -36,7 +36,7 @@ use super::sky::{PLACEHOLDER_SKY_HORIZON, PLACEHOLDER_SKY_ZENITH};
 use super::sun_shadows::SunShadowMaps;
 use crate::context::GpuContext;
 use crate::error::Result;
-use crate::frame_context::PreviousExposure;
+use crate::frame_context::{FrameContext, PreviousExposure};
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::lights::AreaLightScene;
 use crate::pipeline::ComputePipeline;
@@ -44,6 +44,15 @@ use crate::scene::bvh_trace::BvhBuffers;
 use crate::shader::ShaderLibrary;
 use crate::view::View;
 pub use settings::RayTracedGiSettings;
+
+/// The ray-traced GI signal the deferred lighting resolves (denoised, or accumulated when the
+/// denoiser is off): luminance L1 SH (Rgba16Float), CoCg (Rg16Float) and AO (R16Float).
+#[derive(Clone, Copy, Debug)]
+pub struct GiLight {
+    pub y: Tex,
+    pub cocg: Tex,
+    pub ao: Tex,
+}
 
 /// Last frame's denoised output (the GI denoiser's), for a recurrent accumulation (see
 /// `GiDenoiser::recurrent_history`, which fills it): `(textures, valid)`, `None` where that
@@ -218,6 +227,40 @@ impl RtGiParams {
     /// `area_lights` lights of at least `min_flux_lm` (or flagged) light hits when the pass is
     /// `enabled`, and the point and spot lights' light at hits is shadowed when it shadows
     /// them (`punctual_shadows`).
+    /// This frame's parameters: the frame context's sun, lights, meter and cut-off, the sky
+    /// the misses see (`sky_enabled`: the atmosphere is on this frame), and the lights hits
+    /// are lit by (`area_lights` polygonal lights in the scene).
+    pub fn for_frame(
+        cx: &FrameContext,
+        s: &crate::settings::Settings,
+        sky_enabled: bool,
+        area_lights: u32,
+    ) -> Self {
+        let sky = match (sky_enabled, s.sky.sky) {
+            (true, true) => SkySource::Atmosphere,
+            (true, false) => SkySource::None,
+            (false, _) if s.direct_lighting.placeholder_ambient => SkySource::Placeholder,
+            (false, _) => SkySource::None,
+        };
+        let a = &s.area_lights;
+        Self::new(
+            &s.ray_traced_gi,
+            cx.frame_index,
+            cx.sun.as_ref(),
+            cx.punctual_lights,
+            cx.metered_lux,
+            cx.light_cutoff_lux,
+            sky,
+        )
+        .with_hit_lights(
+            a.enabled,
+            area_lights,
+            a.min_flux_lm,
+            a.punctual_shadows,
+            a.punctual_radius_m,
+        )
+    }
+
     pub fn with_hit_lights(
         mut self,
         enabled: bool,

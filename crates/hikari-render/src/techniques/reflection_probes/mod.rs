@@ -154,6 +154,33 @@ pub struct ReflectionProbeInputs<'a> {
     pub sky_light: bool,
 }
 
+impl<'a> ReflectionProbeInputs<'a> {
+    /// The inputs of a frame: the frame context's sun, lights, cut-off and history, the
+    /// camera where it sees from, and the frame's sky, probes, clouds and light table.
+    pub fn for_frame(
+        cx: &'a crate::frame_context::FrameContext,
+        s: &'a crate::settings::Settings,
+        sky: &'a SkyFrame,
+        probes: &'a ProbesFrame,
+        clouds: &'a CloudsFrame,
+        lights: Buf,
+    ) -> Self {
+        Self {
+            sky,
+            probes,
+            clouds,
+            lights,
+            light_count: cx.punctual_lights,
+            sun: cx.sun.as_ref(),
+            cutoff_lux: cx.light_cutoff_lux,
+            weather: &s.sky.weather,
+            relight_all: cx.history.view_changed(),
+            camera: Vec3::from_slice(&cx.view.position[..3]),
+            sky_light: s.sky.sky,
+        }
+    }
+}
+
 /// What the deferred lighting binds to read the probes, in this order (the numbers go into
 /// its uniform).
 #[derive(Clone, Copy, Debug)]
