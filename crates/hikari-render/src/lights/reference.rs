@@ -1,6 +1,7 @@
 //! CPU twin of the light code every lighting pass shares: `lights/area_polygon.wgsl` (a
 //! polygon's vector irradiance, an area light's reach) and the attenuation of point and spot
-//! lights with the frame's cut-off.
+//! lights with the frame's cut-off (`light_attenuation` of `hikari::scene_gpu`), which the
+//! direct lighting, the area lights, the GI's hits, the haze and the reflection probes use.
 
 use glam::{DVec3, Vec3};
 use hikari_math::color::luminance;

@@ -251,3 +251,27 @@ fn scrolled_shadow_maps_hold_what_a_full_redraw_draws() {
         "a still view keeps its maps"
     );
 }
+
+#[test]
+fn a_sun_turned_less_than_the_hold_keeps_the_cached_maps() {
+    use hikari_render::techniques::sun_shadows::{HELD_SUN_DEG, ShadowCache};
+    let s = hikari_render::techniques::sun_shadows::settings::SunShadowsSettings::default();
+    assert!(s.cache, "the hold applies with caching on, the default");
+    let a = glam::Vec3::new(0.3, 0.8, 0.2).normalize();
+    let axis = a.cross(glam::Vec3::X).normalize();
+    let turned = |deg: f32| glam::Quat::from_axis_angle(axis, deg.to_radians()) * a;
+    let mut cache = ShadowCache::default();
+    assert_eq!(cache.held_sun(a, &s), a);
+    // Below the hold the maps keep the direction they were drawn for...
+    assert_eq!(cache.held_sun(turned(0.5 * HELD_SUN_DEG), &s), a);
+    assert_eq!(cache.held_sun(turned(0.9 * HELD_SUN_DEG), &s), a);
+    // ...past it they follow the sun, and hold from there.
+    let past = turned(1.5 * HELD_SUN_DEG);
+    assert!((cache.held_sun(past, &s) - past).length() < 1e-6);
+    assert!((cache.held_sun(turned(1.6 * HELD_SUN_DEG), &s) - past).length() < 1e-6);
+    // Without caching every frame draws for the sun as it is.
+    let uncached =
+        hikari_render::techniques::sun_shadows::settings::SunShadowsSettings { cache: false, ..s };
+    let b = turned(0.5 * HELD_SUN_DEG);
+    assert!((cache.held_sun(b, &uncached) - b).length() < 1e-6);
+}

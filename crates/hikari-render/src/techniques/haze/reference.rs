@@ -4,6 +4,7 @@
 //! Every function here mirrors a WGSL function of the same name in `common.wgsl` or the pass
 //! shaders, in f32 as the GPU computes.
 
+use crate::lights::reference::light_attenuation;
 pub use crate::reference::phase::hg_phase;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use hikari_math::sh::Sh;
@@ -260,29 +261,14 @@ pub fn inscatter_seeing(
     l
 }
 
-/// One point or spot light's share of [`inscatter`], unshadowed (as `light_attenuation` in
-/// `scene_gpu.wgsl`).
+/// One point or spot light's share of [`inscatter`], unshadowed (the lights' attenuation,
+/// [`crate::lights::reference::light_attenuation`]).
 pub fn local_light(light: &LightGpu, cutoff_lux: f32, x: Vec3, v: Vec3, g: f32) -> Vec3 {
     let intensity = Vec3::from_slice(&light.intensity[..3]);
-    let peak = intensity.max_element();
-    let range = light.position_range[3]
-        .min((peak / cutoff_lux).sqrt())
-        .max(1e-3);
     let to_light = Vec3::from_slice(&light.position_range[..3]) - x;
     let d2 = to_light.length_squared().max(1e-8);
-    let xr = d2 / (range * range);
-    if xr >= 1.0 {
-        return Vec3::ZERO;
-    }
     let l = to_light / d2.sqrt();
-    let window = (1.0 - xr * xr).clamp(0.0, 1.0);
-    let mut a = window * window * (1.0 / d2).min(1e4);
-    if light.direction_kind[3] > 0.5 {
-        let axis = Vec3::from_slice(&light.direction_kind[..3]);
-        let s = ((-l).dot(axis) * light.spot[0] + light.spot[1]).clamp(0.0, 1.0);
-        a *= s * s;
-    }
-    intensity * a * hg_phase(l.dot(v), g)
+    intensity * light_attenuation(cutoff_lux, light, l, d2) * hg_phase(l.dot(v), g)
 }
 
 /// Index of froxel `(i, j, k)` in the grids (x fastest, then y, then slice).

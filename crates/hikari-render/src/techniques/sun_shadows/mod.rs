@@ -256,7 +256,16 @@ pub fn depth_range(to_sun: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
 pub struct ShadowCache {
     /// The cascade each slice of the persistent maps holds.
     drawn: Vec<Option<Cascade>>,
+    /// The direction to the sun the maps were drawn for.
+    sun: Option<Vec3>,
 }
+
+/// A sun (or moon) that turned less than this since the cached maps were drawn keeps them: the
+/// shadows stay where they were drawn until it has turned this far. A tenth of a degree is a
+/// fifth of the sun's own disk (0.53°), whose penumbra is wider than the shift; a playing clock
+/// turns the sun by this in 24 s of its time, so the maps are redrawn every few frames rather
+/// than every frame.
+pub const HELD_SUN_DEG: f32 = 0.1;
 
 /// Part of a cascade to draw this frame: its texels x0..x1, y0..y1 (ends exclusive).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -296,6 +305,19 @@ fn uncovered(held: IVec2, want: IVec2, res: u32) -> Vec<[u32; 4]> {
 }
 
 impl ShadowCache {
+    /// The direction to draw and look up the maps with this frame: the one they hold while
+    /// `to_sun` is within [`HELD_SUN_DEG`] of it (with caching on), else `to_sun`.
+    pub fn held_sun(&mut self, to_sun: Vec3, s: &SunShadowsSettings) -> Vec3 {
+        let want = to_sun.normalize_or_zero();
+        match self.sun {
+            Some(held) if s.cache && held.dot(want) >= HELD_SUN_DEG.to_radians().cos() => held,
+            _ => {
+                self.sun = Some(want);
+                want
+            }
+        }
+    }
+
     /// What to draw this frame so that the maps hold `cascades`: all of every cascade when
     /// the maps are new or caching is off; else all of those that are new or changed shape,
     /// and of those that moved, the strips they uncovered.
@@ -381,6 +403,7 @@ impl SunShadows {
                 });
             }
         };
+        let to_sun = cache.held_sun(to_sun, s);
         let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
         let res = s.resolution as u64;
         let (texels, fresh_texels) =
