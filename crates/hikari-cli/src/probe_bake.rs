@@ -474,7 +474,7 @@ pub fn attach(
     let s = &settings.settings;
     if s.irradiance_probes.enabled && s.sky.enabled && s.sky.sky {
         let bake = for_render(scene, source, given, Some(&renderer.ctx))?;
-        renderer.set_probe_bake(Some(&bake));
+        renderer.set_probe_bake(Some(&bake))?;
     } else if let Some(path) = given {
         log::warn!(
             "--bake {}: not used, the probes or the sky's light are off",

@@ -224,6 +224,35 @@ impl GpuContext {
             .ok_or(RenderError::NoAdapter { backends })
     }
 
+    /// A storage buffer holding `bytes`, uploaded once (also a copy source and destination).
+    /// Empty data gets one zeroed 256-byte row, as wgpu binds no empty buffer; data past the
+    /// device's storage binding or buffer size is an error naming `label`.
+    pub fn storage_buffer(&self, label: &str, bytes: &[u8]) -> Result<wgpu::Buffer, RenderError> {
+        use wgpu::util::DeviceExt;
+        let zeros = [0u8; 256];
+        let contents = if bytes.is_empty() { &zeros[..] } else { bytes };
+        let limit = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
+        if contents.len() as u64 > limit {
+            return Err(RenderError::Limit {
+                what: format!("size in bytes of `{label}`"),
+                requested: contents.len() as u64,
+                limit,
+            });
+        }
+        Ok(self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+            }))
+    }
+
     /// Whether an optional feature was granted.
     pub fn has(&self, f: wgpu::Features) -> bool {
         self.features.contains(f)

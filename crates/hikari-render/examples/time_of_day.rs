@@ -59,7 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     println!("baking the irradiance probes ...");
     let bake = hikari_bake::bake_scene(&scene, &options, &|_| {})?;
-    renderer.set_probe_bake(Some(&bake));
+    renderer.set_probe_bake(Some(&bake))?;
     renderer.set_reflection_probes(&hikari_bake::reflection_probes::builtin_reflection_probes(
         "village",
     ))?;

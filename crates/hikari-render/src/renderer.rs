@@ -309,12 +309,13 @@ impl Renderer {
     }
 
     /// Uses `bake`'s irradiance probes from the next frame on (`None`: none, the sky's SH
-    /// lights surfaces unoccluded). Non-finite numbers in the bake become 0.
-    pub fn set_probe_bake(&mut self, bake: Option<&hikari_probes::Bake>) {
+    /// lights surfaces unoccluded). Non-finite numbers in the bake become 0; a bake past the
+    /// device's buffer limits is an error naming the buffer.
+    pub fn set_probe_bake(&mut self, bake: Option<&hikari_probes::Bake>) -> Result<()> {
         self.state
             .techniques
             .irradiance_probes
-            .set_bake(&self.ctx, bake);
+            .set_bake(&self.ctx, bake)
     }
 
     /// Uses `probes` as the relit reflection probes from the next frame on (captured then);

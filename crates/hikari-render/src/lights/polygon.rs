@@ -13,6 +13,8 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use hikari_scene::Scene;
 
+use crate::reference::textures::address;
+
 /// Triangles of an emissive mesh that the size rule makes a light at most.
 pub const MAX_LIGHT_TRIANGLES: usize = 64;
 /// Triangles of a light forced by its `area_light` flag at most (each pixel integrates every
@@ -264,25 +266,14 @@ impl EmitterTexture {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let at = |i: i64, j: i64| {
-            let i = wrap_index(i, w, self.wrap[0]);
-            let j = wrap_index(j, h, self.wrap[1]);
+            let i = address(i, w, self.wrap[0]);
+            let j = address(j, h, self.wrap[1]);
             self.luminance[(j * w + i) as usize]
         };
         let (i, j) = (x0 as i64, y0 as i64);
         let top = at(i, j) * (1.0 - fx) + at(i + 1, j) * fx;
         let bottom = at(i, j + 1) * (1.0 - fx) + at(i + 1, j + 1) * fx;
         top * (1.0 - fy) + bottom * fy
-    }
-}
-
-fn wrap_index(i: i64, n: i64, wrap: hikari_scene::Wrap) -> i64 {
-    match wrap {
-        hikari_scene::Wrap::Repeat => i.rem_euclid(n),
-        hikari_scene::Wrap::ClampToEdge => i.clamp(0, n - 1),
-        hikari_scene::Wrap::MirroredRepeat => {
-            let m = i.rem_euclid(2 * n);
-            if m < n { m } else { 2 * n - 1 - m }
-        }
     }
 }
 

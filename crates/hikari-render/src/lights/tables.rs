@@ -54,26 +54,17 @@ pub fn shadow_casters(scene: &Scene) -> Vec<u32> {
 impl AreaLightScene {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self> {
         let lights = PolygonLights::for_scene(scene);
-        use wgpu::util::DeviceExt;
-        let buffer = |name: &str, bytes: &[u8]| {
-            let padded = [0u8; 64];
-            ctx.device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(name),
-                    contents: if bytes.is_empty() { &padded } else { bytes },
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                })
-        };
+        let buffer = |name: &str, bytes: &[u8]| ctx.storage_buffer(name, bytes);
         Ok(Self {
-            light_buffer: buffer("area_lights.lights", bytemuck::cast_slice(&lights.lights)),
+            light_buffer: buffer("area_lights.lights", bytemuck::cast_slice(&lights.lights))?,
             triangle_buffer: buffer(
                 "area_lights.triangles",
                 bytemuck::cast_slice(&lights.triangles),
-            ),
+            )?,
             uv_buffer: buffer(
                 "area_lights.triangle_uvs",
                 bytemuck::cast_slice(&lights.uvs),
-            ),
+            )?,
             lights,
         })
     }

@@ -33,7 +33,6 @@ use hikari_bake::transport::{
 use hikari_bake::transport_tables::TransportTables;
 use hikari_bake::{BakeError, ProbeRequest, TransportSettings, TransportTracer};
 use hikari_scene::Scene;
-use wgpu::util::DeviceExt;
 
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
@@ -90,18 +89,6 @@ pub struct GpuTransport<'a> {
     /// Probes per frame: what the storage-buffer limits and the dispatch limit allow.
     max_probes: usize,
     runtime: RefCell<GraphRuntime>,
-}
-
-fn storage(ctx: &GpuContext, label: &str, bytes: &[u8]) -> wgpu::Buffer {
-    // wgpu refuses empty bindings; one zeroed row stands in.
-    let zeros = [0u8; 32];
-    let contents = if bytes.is_empty() { &zeros[..] } else { bytes };
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents,
-            usage: wgpu::BufferUsages::STORAGE,
-        })
 }
 
 fn tracer_error(message: String) -> BakeError {
@@ -170,24 +157,19 @@ impl<'a> GpuTransport<'a> {
         }
         Ok(Self {
             ctx,
-            directions: storage(
-                ctx,
-                "probe_bake.directions",
-                bytemuck::cast_slice(&directions),
-            ),
-            weights: storage(ctx, "probe_bake.weights", bytemuck::cast_slice(&weights)),
-            instances: storage(
-                ctx,
+            directions: ctx
+                .storage_buffer("probe_bake.directions", bytemuck::cast_slice(&directions))?,
+            weights: ctx.storage_buffer("probe_bake.weights", bytemuck::cast_slice(&weights))?,
+            instances: ctx.storage_buffer(
                 "probe_bake.instances",
                 bytemuck::cast_slice(&tables.instances),
-            ),
-            triangles: storage(
-                ctx,
+            )?,
+            triangles: ctx.storage_buffer(
                 "probe_bake.triangles",
                 bytemuck::cast_slice(&tables.triangles),
-            ),
-            empty_rays: storage(ctx, "probe_bake.no_bounce_rays", &[]),
-            empty_hits: storage(ctx, "probe_bake.no_bounce_hits", &[]),
+            )?,
+            empty_rays: ctx.storage_buffer("probe_bake.no_bounce_rays", &[])?,
+            empty_hits: ctx.storage_buffer("probe_bake.no_bounce_hits", &[])?,
             rays,
             settings,
             trace,
@@ -254,12 +236,9 @@ impl<'a> GpuTransport<'a> {
         } else {
             Vec::new()
         };
-        let positions = storage(
-            ctx,
-            "probe_bake.positions",
-            bytemuck::cast_slice(&positions),
-        );
-        let shifts = storage(ctx, "probe_bake.shifts", bytemuck::cast_slice(&shifts));
+        let positions =
+            ctx.storage_buffer("probe_bake.positions", bytemuck::cast_slice(&positions))?;
+        let shifts = ctx.storage_buffer("probe_bake.shifts", bytemuck::cast_slice(&shifts))?;
         let (groups, row_width) = self.groups(count);
         let params = BakeParams {
             probes: p as u32,

@@ -16,7 +16,7 @@ fn srgb_to_linear(c: f64) -> f64 {
 
 /// Texel index `i` (any integer) of a row of `n` texels under `mode`, as the Vulkan spec
 /// addresses texels (repeat: modulo; mirrored: modulo 2n, reflected; clamp: to the edge).
-fn address(i: i64, n: i64, mode: hikari_scene::Wrap) -> i64 {
+pub fn address(i: i64, n: i64, mode: hikari_scene::Wrap) -> i64 {
     match mode {
         hikari_scene::Wrap::Repeat => i.rem_euclid(n),
         hikari_scene::Wrap::MirroredRepeat => {

@@ -12,7 +12,6 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat3, Mat4, Vec3, Vec4};
-use wgpu::util::DeviceExt;
 
 use hikari_scene::{Scene, Wrap};
 
@@ -466,31 +465,8 @@ impl SceneGpu {
             .map_err(|e| RenderError::Graph(format!("scene: {e}")))?;
         let (textures, layers) = TextureArrays::upload(ctx, scene)?;
         let cpu = SceneCpu::build(scene, &layers);
-        let limit = ctx.limits.max_storage_buffer_binding_size;
-        let buffer = |name: &str, bytes: &[u8]| -> Result<wgpu::Buffer> {
-            // Empty scenes still bind a buffer: wgpu refuses zero-sized bindings.
-            let padded;
-            let bytes = if bytes.is_empty() {
-                padded = [0u8; 256];
-                &padded[..]
-            } else {
-                bytes
-            };
-            if bytes.len() as u64 > limit {
-                return Err(RenderError::Limit {
-                    what: format!("scene {name} buffer size in bytes"),
-                    requested: bytes.len() as u64,
-                    limit,
-                });
-            }
-            Ok(ctx
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(name),
-                    contents: bytes,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                }))
-        };
+        // Empty scenes still bind a buffer (a zeroed row); the error names the scene's buffer.
+        let buffer = |name: &str, bytes: &[u8]| ctx.storage_buffer(&format!("scene {name}"), bytes);
         let bounds = scene
             .instances
             .iter()

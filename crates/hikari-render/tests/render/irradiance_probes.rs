@@ -581,7 +581,7 @@ fn the_frame_takes_ambient_light_from_the_probes() {
         "irradiance_probes.pixels".into(),
     ]);
     let mut render = |bake: Option<&Bake>| {
-        r.set_probe_bake(bake);
+        r.set_probe_bake(bake).unwrap();
         let f = r.render(&fs, true).unwrap();
         let hdr = f.hdr.unwrap();
         let sky: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(f.result.buffer("sky.sh").unwrap());

@@ -109,37 +109,6 @@ pub struct SceneRt {
     shown_positions: std::collections::HashMap<usize, Vec<[f32; 4]>>,
 }
 
-fn init_buffer<T: Pod + Zeroable>(
-    ctx: &GpuContext,
-    name: &str,
-    data: &[T],
-) -> Result<wgpu::Buffer> {
-    use wgpu::util::DeviceExt;
-    let zero = [T::zeroed()];
-    let data = if data.is_empty() { &zero[..] } else { data };
-    let bytes: &[u8] = bytemuck::cast_slice(data);
-    let limit = ctx
-        .limits
-        .max_storage_buffer_binding_size
-        .min(ctx.limits.max_buffer_size);
-    if bytes.len() as u64 > limit {
-        return Err(RenderError::Limit {
-            what: format!("size in bytes of `{name}`"),
-            requested: bytes.len() as u64,
-            limit,
-        });
-    }
-    Ok(ctx
-        .device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(name),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        }))
-}
-
 impl SceneRt {
     /// Builds every BLAS in its rest pose, both TLAS over every instance (so that a frame
     /// that never updates still traces the whole scene), and uploads them with the cut-out
@@ -370,4 +339,8 @@ impl SceneRt {
 
 fn bvh_error(e: hikari_bvh::BvhError) -> RenderError {
     RenderError::Graph(format!("scene BVH: {e}"))
+}
+
+fn init_buffer<T: Pod>(ctx: &GpuContext, name: &str, data: &[T]) -> Result<wgpu::Buffer> {
+    ctx.storage_buffer(name, bytemuck::cast_slice(data))
 }

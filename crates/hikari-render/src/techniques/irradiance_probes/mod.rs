@@ -26,7 +26,6 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use wgpu::util::DeviceExt;
 
 use hikari_probes::Bake;
 use hikari_scene::Sun;
@@ -152,7 +151,7 @@ pub const LOOKUP_PASS: &str = "irradiance_probes.lookup";
 impl IrradianceProbesState {
     /// Uploads `bake` (replacing any earlier one; `None` removes it). Non-finite numbers in it
     /// become 0 (logged). The next frame relights every probe.
-    pub fn set_bake(&mut self, ctx: &GpuContext, bake: Option<&Bake>) {
+    pub fn set_bake(&mut self, ctx: &GpuContext, bake: Option<&Bake>) -> Result<()> {
         let uploaded = bake.map(|b| {
             let data = ProbeGpuData::new(b);
             if data.replaced_non_finite > 0 {
@@ -161,10 +160,11 @@ impl IrradianceProbesState {
                     data.replaced_non_finite
                 );
             }
-            Arc::new(upload(ctx, data))
+            upload(ctx, data).map(Arc::new)
         });
-        self.uploaded = uploaded.filter(|u| u.data.probe_count() > 0);
+        self.uploaded = uploaded.transpose()?.filter(|u| u.data.probe_count() > 0);
         self.updates = 0;
+        Ok(())
     }
 
     /// The uploaded bake's layout, if any.
@@ -188,20 +188,7 @@ pub struct IrradianceProbes {
     empty: Arc<Uploaded>,
 }
 
-fn storage(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
-    // wgpu binds no empty buffer: one zero vec4 stands in.
-    let pad = [0u8; 16];
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(name),
-            contents: if bytes.is_empty() { &pad } else { bytes },
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        })
-}
-
-fn upload(ctx: &GpuContext, data: ProbeGpuData) -> Uploaded {
+fn upload(ctx: &GpuContext, data: ProbeGpuData) -> Result<Uploaded> {
     let chunk_capacity = budget::chunks(
         &data,
         &budget::FrameWork {
@@ -212,34 +199,26 @@ fn upload(ctx: &GpuContext, data: ProbeGpuData) -> Uploaded {
     .len()
     .max(1);
     let irradiance = vec![[0.0f32; 4]; data.probe_data.len()];
-    Uploaded {
-        probe_data: storage(
-            ctx,
+    Ok(Uploaded {
+        probe_data: ctx.storage_buffer(
             "irradiance_probes.probes",
             bytemuck::cast_slice(&data.probe_data),
-        ),
-        positions: storage(
-            ctx,
+        )?,
+        positions: ctx.storage_buffer(
             "irradiance_probes.positions",
             bytemuck::cast_slice(&data.positions),
-        ),
-        topology: storage(
-            ctx,
+        )?,
+        topology: ctx.storage_buffer(
             "irradiance_probes.topology",
             bytemuck::cast_slice(&data.topology),
-        ),
-        irradiance: storage(
-            ctx,
+        )?,
+        irradiance: ctx.storage_buffer(
             "irradiance_probes.irradiance",
             bytemuck::cast_slice(&irradiance),
-        ),
-        chunks: storage(
-            ctx,
-            "irradiance_probes.chunks",
-            &vec![0u8; chunk_capacity * 8],
-        ),
+        )?,
+        chunks: ctx.storage_buffer("irradiance_probes.chunks", &vec![0u8; chunk_capacity * 8])?,
         data,
-    }
+    })
 }
 
 impl IrradianceProbes {
@@ -251,12 +230,11 @@ impl IrradianceProbes {
         Ok(Self {
             relight: ComputePipeline::new(ctx, lib, "irradiance_probes/relight.wgsl", "main", &[])?,
             pixels: ComputePipeline::new(ctx, lib, "irradiance_probes/pixels.wgsl", "main", &[])?,
-            gaunt: storage(
-                ctx,
+            gaunt: ctx.storage_buffer(
                 "irradiance_probes.gaunt",
                 bytemuck::cast_slice(&gaunt_table()),
-            ),
-            empty: Arc::new(upload(ctx, ProbeGpuData::new(&empty))),
+            )?,
+            empty: Arc::new(upload(ctx, ProbeGpuData::new(&empty))?),
         })
     }
 

@@ -18,7 +18,6 @@ use glam::Vec3;
 
 use super::budget::{self, CHUNK};
 use super::gpu_data::ProbeGpuData;
-use super::storage;
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 
@@ -158,7 +157,7 @@ impl RelightBench {
                 probes,
                 tiles,
                 chunk_count: chunks.len() as u32,
-                chunks: storage(ctx, pass, bytemuck::cast_slice(&chunks)),
+                chunks: ctx.storage_buffer(pass, bytemuck::cast_slice(&chunks))?,
             });
         }
         let mut sky = [[0.0f32; 4]; 18];
@@ -168,26 +167,20 @@ impl RelightBench {
         }
         Ok(Self {
             workloads,
-            positions: storage(
-                ctx,
+            positions: ctx.storage_buffer(
                 "irradiance_probes.bench_positions",
                 &vec![0u8; probe_data.len() / 9 * 16],
-            ),
-            irradiance: storage(
-                ctx,
+            )?,
+            irradiance: ctx.storage_buffer(
                 "irradiance_probes.bench_irradiance",
                 &vec![0u8; probe_data.len() * 16],
-            ),
-            probe_data: storage(
-                ctx,
+            )?,
+            probe_data: ctx.storage_buffer(
                 "irradiance_probes.bench_probes",
                 bytemuck::cast_slice(&probe_data),
-            ),
-            sky_sh: storage(
-                ctx,
-                "irradiance_probes.bench_sky_sh",
-                bytemuck::cast_slice(&sky),
-            ),
+            )?,
+            sky_sh: ctx
+                .storage_buffer("irradiance_probes.bench_sky_sh", bytemuck::cast_slice(&sky))?,
         })
     }
 }

@@ -339,15 +339,6 @@ impl std::fmt::Debug for RtGiScene {
     }
 }
 
-fn storage_buffer(ctx: &GpuContext, name: &str, bytes: &[u8]) -> wgpu::Buffer {
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(name),
-            contents: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        })
-}
-
 /// Zero-sized bindings are not allowed: an empty list is uploaded as one zeroed record.
 fn non_empty<T: Pod + Zeroable>(v: &[T]) -> Vec<T> {
     if v.is_empty() {
@@ -384,16 +375,12 @@ impl RtGiScene {
         Ok(Self {
             mesh_first,
             punctual: crate::lights::grid::punctual_records(scene),
-            instance_table: storage_buffer(
-                ctx,
-                "ray_traced_gi.instance_table",
-                bytemuck::cast_slice(&table),
-            ),
-            instance_normals: storage_buffer(
-                ctx,
+            instance_table: ctx
+                .storage_buffer("ray_traced_gi.instance_table", bytemuck::cast_slice(&table))?,
+            instance_normals: ctx.storage_buffer(
                 "ray_traced_gi.instance_normals",
                 bytemuck::cast_slice(&non_empty(&instance_normals)),
-            ),
+            )?,
             triangle_normals,
         })
     }
@@ -477,16 +464,14 @@ impl RtGiState {
             let ctx = g.ctx();
             *slot = Some(LightGridGpu {
                 key,
-                cells: storage_buffer(
-                    ctx,
+                cells: ctx.storage_buffer(
                     "ray_traced_gi.light_grid",
                     bytemuck::cast_slice(&grid.cells),
-                ),
-                indices: storage_buffer(
-                    ctx,
+                )?,
+                indices: ctx.storage_buffer(
                     "ray_traced_gi.light_grid_indices",
                     bytemuck::cast_slice(&grid.indices),
-                ),
+                )?,
                 stats: s,
             });
         }
@@ -574,7 +559,7 @@ impl RayTracedGi {
             check: p(lib, "ray_traced_gi/check.wgsl", &[])?,
             resolve_check: p(lib, "ray_traced_gi/resolve_check.wgsl", &[])?,
             keep_lit: p(lib, "ray_traced_gi/keep_lit.wgsl", &[])?,
-            noise: storage_buffer(ctx, "ray_traced_gi.blue_noise", &BLUE_NOISE_64X64X64[..]),
+            noise: ctx.storage_buffer("ray_traced_gi.blue_noise", &BLUE_NOISE_64X64X64[..])?,
         })
     }
 

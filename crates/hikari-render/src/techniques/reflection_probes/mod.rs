@@ -28,7 +28,6 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use hikari_bake::reflection_probes::ReflectionProbeBox;
 use hikari_scene::{Camera, Sun};
-use wgpu::util::DeviceExt;
 
 use super::clouds::CloudsFrame;
 use super::gbuffer::GBufferPass;
@@ -300,17 +299,13 @@ impl ReflectionProbesState {
             });
         }
         *guard = Some(Arc::new(Uploaded {
-            probes: buffer(ctx, "reflection_probes.probes", bytemuck::cast_slice(&gpu)),
-            capture_light: buffer(
-                ctx,
+            probes: ctx.storage_buffer("reflection_probes.probes", bytemuck::cast_slice(&gpu))?,
+            capture_light: ctx.storage_buffer(
                 "reflection_probes.capture_light",
                 &vec![0u8; boxes.len() * 16],
-            ),
-            relit_list: buffer(
-                ctx,
-                "reflection_probes.relit_list",
-                &vec![0u8; boxes.len() * 4],
-            ),
+            )?,
+            relit_list: ctx
+                .storage_buffer("reflection_probes.relit_list", &vec![0u8; boxes.len() * 4])?,
             gpu,
             boxes,
             generation,
@@ -333,17 +328,6 @@ pub struct ReflectionProbes {
     /// Stand-ins for the lookup with no probes.
     empty_probe: wgpu::Buffer,
     empty_light: wgpu::Buffer,
-}
-
-fn buffer(ctx: &GpuContext, label: &str, data: &[u8]) -> wgpu::Buffer {
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: data,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_DST
-                | wgpu::BufferUsages::COPY_SRC,
-        })
 }
 
 /// Mip levels of a cube map `n` texels a side down to 1 x 1.
@@ -370,12 +354,11 @@ impl ReflectionProbes {
                 "main",
                 &[],
             )?,
-            empty_probe: buffer(
-                ctx,
+            empty_probe: ctx.storage_buffer(
                 "reflection_probes.empty",
                 bytemuck::bytes_of(&ReflectionProbeGpu::zeroed()),
-            ),
-            empty_light: buffer(ctx, "reflection_probes.empty_light", &[0; 16]),
+            )?,
+            empty_light: ctx.storage_buffer("reflection_probes.empty_light", &[0; 16])?,
         })
     }
 
