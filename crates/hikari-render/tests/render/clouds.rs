@@ -582,3 +582,42 @@ fn the_map_is_redrawn_only_as_much_as_it_changed() {
         "unlike what every row holds"
     );
 }
+
+#[test]
+fn a_sliced_march_draws_every_row_within_its_slices_and_fills_the_gpu() {
+    use hikari_render::techniques::clouds::{MIN_MARCH_THREADS, march_rows};
+    for size in [64u32, 256, 768, 1024] {
+        for n in [1u32, 2, 3, 6, 7, 16, 60] {
+            for start in [0u64, 5, 123] {
+                let mut drawn = vec![false; size as usize];
+                for f in start..start + u64::from(n) {
+                    let Some([every, first]) = march_rows(size, n, f) else {
+                        continue;
+                    };
+                    assert!(
+                        every >= 1 && first < every,
+                        "{size} {n} {f}: [{every}, {first}]"
+                    );
+                    let threads = size * size.div_ceil(every);
+                    let floor = MIN_MARCH_THREADS.min(size * size.div_ceil(n.max(1)) * n) as f32;
+                    assert!(
+                        threads as f32 >= 0.9 * floor.min((size * size) as f32 / 2.0),
+                        "{size} {n}: a dispatch of {threads} threads"
+                    );
+                    for r in (first..size).step_by(every as usize) {
+                        drawn[r as usize] = true;
+                    }
+                }
+                assert!(
+                    drawn.iter().all(|&d| d),
+                    "{size} texels, {n} slices from frame {start}: rows left undrawn"
+                );
+            }
+        }
+    }
+    // The village's map on a playing clock (6 slices of 128 rows): half the map every third
+    // frame rather than a sixth every frame.
+    assert_eq!(march_rows(768, 6, 0), Some([2, 0]));
+    assert_eq!(march_rows(768, 6, 1), None);
+    assert_eq!(march_rows(768, 6, 3), Some([2, 1]));
+}

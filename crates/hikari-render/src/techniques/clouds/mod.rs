@@ -6,7 +6,9 @@
 //! drawn whole when its shape or lighting changes or the clock jumps, a share of its rows per
 //! frame while the sky's clock moves it (the wind and the sun: at most `time_slices` shares,
 //! fewer when the clock runs fast, so that no row is older than [`STALE_FEATURE`] of a
-//! feature's drift or [`STALE_SUN_DEG`] of the sun's), and not at all while nothing changes.
+//! feature's drift or [`STALE_SUN_DEG`] of the sun's; shares too thin to fill the GPU are
+//! drawn several at a time every few frames, [`march_rows`]), and not at all while nothing
+//! changes.
 //!
 //! * `clouds.march`: the map (`march.wgsl`);
 //! * `clouds.shadow_map`: the sun's transmittance through the layer on a square of its base
@@ -208,6 +210,32 @@ pub fn redraw(
     Redraw::Slice { slices }
 }
 
+/// Threads a march dispatch should have to fill a large GPU (an H200 runs 132 × 2048 at
+/// once): a thinner slice costs about what one this thick does, as the march is bound by
+/// its latency, not its throughput.
+pub const MIN_MARCH_THREADS: u32 = 1 << 18;
+
+/// The rows frame `frame` draws of a `size`-texel map redrawn in `slices` slices: `Some([s,
+/// i])`, every `s`-th row from row `i` (`CloudParams::slice`), or `None` on a frame that
+/// draws nothing. Slices too thin to fill the GPU ([`MIN_MARCH_THREADS`]) are drawn `k` at a
+/// time on every `k`-th frame, so that the same rows are drawn as often for less time:
+/// every row is still drawn within any `slices` frames in a row.
+pub fn march_rows(size: u32, slices: u32, frame: u64) -> Option<[u32; 2]> {
+    let n = slices.max(1);
+    let rows = size.max(1).div_ceil(n);
+    let k = MIN_MARCH_THREADS
+        .div_ceil(size.max(1))
+        .div_ceil(rows)
+        .clamp(1, n);
+    let grouped = (n / k).max(1);
+    (frame % u64::from(k) == 0).then(|| {
+        [
+            grouped,
+            ((frame / u64::from(k)) % u64::from(grouped)) as u32,
+        ]
+    })
+}
+
 /// Where the path from `pos` towards the sun enters the layer's base (world x, z), as
 /// `cloud_shadow_at` marches it: the sun's elevation is floored at sin 0.05 (about 3°).
 /// None above the base.
@@ -340,6 +368,7 @@ impl Clouds {
             )
         };
         let mut p = params;
+        let mut draw = decision != Redraw::Nothing;
         match decision {
             Redraw::Whole => {
                 *state = CloudsState {
@@ -350,7 +379,10 @@ impl Clouds {
             }
             Redraw::Nothing => {}
             Redraw::Slice { slices: n } => {
-                p.slice = [n, (g.frame_index() % u64::from(n)) as u32, 0, 0];
+                match march_rows(size, n, g.frame_index()) {
+                    Some([every, first]) => p.slice = [every, first, 0, 0],
+                    None => draw = false,
+                }
                 state.steady = if state.last == Some(params) {
                     state.steady + 1
                 } else {
@@ -363,7 +395,7 @@ impl Clouds {
                 }
             }
         }
-        if decision != Redraw::Nothing {
+        if draw {
             g.pass("clouds.march")
                 .constants(&p)
                 .write(map)
