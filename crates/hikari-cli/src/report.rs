@@ -7,10 +7,12 @@ use serde_json::json;
 
 use hikari_render::graph::FrameResult;
 
-/// Median, minimum and maximum of a set of samples (in whatever unit they were taken).
+/// Median, mean, minimum and maximum of a set of samples (in whatever unit they were taken).
 #[derive(Default, Clone, Copy, Debug, PartialEq)]
 pub struct Stats {
     pub median: f64,
+    /// What work done every few frames costs on average, which the median hides.
+    pub mean: f64,
     pub min: f64,
     pub max: f64,
 }
@@ -24,13 +26,14 @@ impl Stats {
         v.sort_by(|a, b| a.total_cmp(b));
         Some(Self {
             median: v[v.len() / 2],
+            mean: v.iter().sum::<f64>() / v.len() as f64,
             min: v[0],
             max: v[v.len() - 1],
         })
     }
 
     pub fn json(&self) -> serde_json::Value {
-        json!({ "median": self.median, "min": self.min, "max": self.max })
+        json!({ "median": self.median, "mean": self.mean, "min": self.min, "max": self.max })
     }
 }
 
@@ -164,10 +167,13 @@ impl FrameSummary {
             println!("{:<32} {:>10.4}", format!("{t} (sum of medians)"), ms);
         }
         match self.span_ms {
-            Some(s) => println!(
-                "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
-                "frame (first to last pass)", s.median, s.min, s.max, self.encode_us.median
-            ),
+            Some(s) => {
+                println!(
+                    "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
+                    "frame (first to last pass)", s.median, s.min, s.max, self.encode_us.median
+                );
+                println!("{:<32} {:>10.4}", "frame mean", s.mean);
+            }
             None => println!(
                 "no GPU timestamps on this adapter; CPU encode median {:.1} us",
                 self.encode_us.median
@@ -185,6 +191,8 @@ mod tests {
         assert_eq!(Stats::of(vec![]), None);
         let s = Stats::of(vec![5.0, 1.0, 3.0]).unwrap();
         assert_eq!((s.median, s.min, s.max), (3.0, 1.0, 5.0));
+        assert_eq!(s.mean, 3.0);
+        assert_eq!(Stats::of(vec![1.0, 1.0, 10.0]).unwrap().mean, 4.0);
         let s = Stats::of(vec![4.0, 1.0, 2.0, 3.0]).unwrap();
         assert_eq!(s.median, 3.0);
     }
@@ -195,6 +203,7 @@ mod tests {
             name: name.into(),
             gpu_ms: ms.map(|m| Stats {
                 median: m,
+                mean: m,
                 min: m,
                 max: m,
             }),

@@ -18,7 +18,8 @@ use crate::techniques::area_lights::{
     AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,
     ShadowDenoiseParams,
 };
-use crate::techniques::clouds::{CloudParams, Clouds};
+use crate::techniques::clouds::settings::CloudsSettings;
+use crate::techniques::clouds::{self, CloudParams, Clouds};
 use crate::techniques::direct_lighting::{DirectLighting, LightingParams};
 use crate::techniques::exposure::{Exposure, ExposureFrame, ExposureParams};
 use crate::techniques::gbuffer::overrides::{GBufferTexel, override_gbuffer};
@@ -205,12 +206,16 @@ pub fn record<'r>(
     //    clouds' shadow map. The sky's SH sees the sky through them, the deferred lighting
     //    draws them over the sky, and they shadow the sun there, in the haze, the GI and the
     //    probes' sun bounce.
+    let clouds_settings = CloudsSettings {
+        map_size: clouds::map_size_for(&s.settings.clouds, size[1], s.camera.vfov_deg),
+        ..s.settings.clouds.clone()
+    };
     let clouds = t.clouds.record(
         g,
         &mut state.techniques.clouds,
-        &s.settings.clouds,
+        &clouds_settings,
         CloudParams::new(
-            &s.settings.clouds,
+            &clouds_settings,
             &s.settings.sky.weather,
             sun,
             cx.clock_s,

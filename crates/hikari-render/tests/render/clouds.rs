@@ -621,3 +621,22 @@ fn a_sliced_march_draws_every_row_within_its_slices_and_fills_the_gpu() {
     assert_eq!(march_rows(768, 6, 1), None);
     assert_eq!(march_rows(768, 6, 3), Some([2, 1]));
 }
+
+#[test]
+fn the_map_is_as_fine_as_the_view_needs() {
+    use hikari_render::techniques::clouds::map_size_for;
+    let s = CloudsSettings::default();
+    // 4 h / fov: a texel a pixel at the zenith, where the paraboloid has a quarter of the
+    // map's texels a radian.
+    assert_eq!(map_size_for(&s, 36, 60.0), 144);
+    assert_eq!(map_size_for(&s, 144, 60.0), 560);
+    // Large views take the setting, the most it allows.
+    assert_eq!(map_size_for(&s, 720, 60.0), s.map_size);
+    assert_eq!(map_size_for(&s, 1440, 60.0), s.map_size);
+    // A telephoto view needs more texels than a wide one of the same height.
+    assert!(map_size_for(&s, 72, 20.0) > map_size_for(&s, 72, 90.0));
+    for h in [1u32, 7, 100, 333] {
+        let n = map_size_for(&s, h, 50.0);
+        assert!(n % 16 == 0 && (16..=s.map_size).contains(&n), "{h}: {n}");
+    }
+}

@@ -210,6 +210,16 @@ pub fn redraw(
     Redraw::Slice { slices }
 }
 
+/// The map size a view `height` pixels tall with a vertical field of view of `vfov_deg` needs:
+/// a texel at most a pixel at the zenith, where the paraboloid is coarsest (a quarter of the
+/// map's texels a radian), capped by `s.map_size` and rounded up to 16. A small image (the
+/// CPU driver's, a thumbnail) marches a small map: the map's cost follows the view's.
+pub fn map_size_for(s: &CloudsSettings, height: u32, vfov_deg: f32) -> u32 {
+    let vfov = vfov_deg.clamp(1.0, 179.0).to_radians();
+    let needed = (4.0 * height as f32 / vfov).ceil() as u32;
+    needed.next_multiple_of(16).clamp(16, s.map_size.max(16))
+}
+
 /// Threads a march dispatch should have to fill a large GPU (an H200 runs 132 × 2048 at
 /// once): a thinner slice costs about what one this thick does, as the march is bound by
 /// its latency, not its throughput.

@@ -53,7 +53,8 @@ pub struct CloudsSettings {
     /// Fade the noise octaves a map texel's footprint would alias (the talk's cloud density
     /// anti-aliasing).
     pub density_aa: bool,
-    /// Texels along each side of the paraboloid map.
+    /// Texels along each side of the paraboloid map, at most: a view that needs fewer (a
+    /// texel a pixel at the zenith, `clouds::map_size_for`) marches a smaller map.
     pub map_size: u32,
     /// Samples along each view ray, and towards the light from each.
     pub steps: u32,
