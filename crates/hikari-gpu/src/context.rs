@@ -4,6 +4,9 @@
 //! them checks [`GpuContext::has`] first, so the renderer runs (more slowly, or without GPU
 //! timings) on adapters that lack them.
 
+use std::any::{Any, TypeId};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use crate::error::RenderError;
@@ -65,7 +68,11 @@ impl ContextOptions {
     }
 }
 
-/// Everything a pass needs to talk to the GPU.
+/// Values built once per device ([`GpuContext::shared`]), by type.
+type SharedValues = HashMap<TypeId, Arc<dyn Any + Send + Sync>>;
+
+/// Everything a pass needs to talk to the GPU. A clone talks to the same device.
+#[derive(Clone)]
 pub struct GpuContext {
     pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
@@ -81,6 +88,7 @@ pub struct GpuContext {
     /// and about a second a frame. Storage loads are never inlined. `HIKARI_UNIFORMS_AS_STORAGE`
     /// (`1` or `0`) overrides the choice.
     pub uniforms_as_storage: bool,
+    shared: Arc<Mutex<SharedValues>>,
 }
 
 /// Whether `info` is Mesa's CPU driver, whose shader compiler inlines uniform values that
@@ -169,6 +177,7 @@ impl GpuContext {
         };
 
         Ok(Self {
+            shared: Arc::default(),
             uniforms_as_storage,
             instance,
             adapter,
@@ -222,6 +231,26 @@ impl GpuContext {
             .filter(|a| a.get_info().backend != wgpu::Backend::Noop)
             .min_by_key(rank)
             .ok_or(RenderError::NoAdapter { backends })
+    }
+
+    /// The value of type `T` built once for this device and shared by every clone of the
+    /// context: `make` runs on the first call (the renderer's compiled pipelines, which every
+    /// renderer on one device can share, as a test binary's hundred renderers do). `make` must
+    /// not ask for another shared value.
+    pub fn shared<T: Any + Send + Sync>(
+        &self,
+        make: impl FnOnce() -> Result<T, RenderError>,
+    ) -> Result<Arc<T>, RenderError> {
+        let mut values = self.shared.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(v) = values.get(&TypeId::of::<T>()) {
+            return Ok(v
+                .clone()
+                .downcast::<T>()
+                .expect("stored under its own type"));
+        }
+        let v = Arc::new(make()?);
+        values.insert(TypeId::of::<T>(), v.clone());
+        Ok(v)
     }
 
     /// A storage buffer holding `bytes`, uploaded once (also a copy source and destination).

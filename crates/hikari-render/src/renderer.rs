@@ -44,7 +44,8 @@ const MAX_QUEUE_RETRIES: usize = 4;
 pub struct Renderer {
     pub ctx: GpuContext,
     pub runtime: GraphRuntime,
-    techniques: Techniques,
+    /// The pipelines, compiled once per device and shared by its renderers.
+    techniques: std::sync::Arc<Techniques>,
     scene: SceneGpu,
     /// The scene's area lights.
     area_lights: AreaLightScene,
@@ -71,7 +72,7 @@ const MAX_FRAME_SECONDS: f32 = 8.0;
 
 impl Renderer {
     pub fn new(ctx: GpuContext, scene: &Scene) -> Result<Self> {
-        let techniques = Techniques::new(&ctx)?;
+        let techniques = ctx.shared(|| Techniques::new(&ctx))?;
         let scene_gpu = SceneGpu::upload(&ctx, scene)?;
         let area_lights = AreaLightScene::new(&ctx, scene)?;
         let scene_rt = SceneRt::new(&ctx, scene, &scene_gpu.textures.color)?;

@@ -9,14 +9,22 @@ pub mod probes;
 
 use hikari_render::{ContextOptions, GpuContext};
 
-/// The GPU context for a test; panics (failing the test) when there is no adapter.
+/// The GPU context for a test; panics (failing the test) when there is no adapter. Every
+/// test of the binary talks to one device, so that the renderer's pipelines are compiled
+/// once ([`GpuContext::shared`]) rather than by each of the hundred renderers the tests make:
+/// on the CPU driver that compile is seconds.
 pub fn gpu_context() -> GpuContext {
-    GpuContext::new(&ContextOptions::from_env()).unwrap_or_else(|e| {
-        panic!(
-            "GPU tests need an adapter and fail without one (set WGPU_BACKEND and \
-             VK_ICD_FILENAMES for the CPU Vulkan driver): {e}"
-        )
-    })
+    static CONTEXT: std::sync::OnceLock<GpuContext> = std::sync::OnceLock::new();
+    CONTEXT
+        .get_or_init(|| {
+            GpuContext::new(&ContextOptions::from_env()).unwrap_or_else(|e| {
+                panic!(
+                    "GPU tests need an adapter and fail without one (set WGPU_BACKEND and \
+                     VK_ICD_FILENAMES for the CPU Vulkan driver): {e}"
+                )
+            })
+        })
+        .clone()
 }
 
 /// Pixels (or shadow-map texels) a rasteriser's output may have that disagree with rays cast
