@@ -291,11 +291,15 @@ impl Progress {
         let label = self.label;
         let bar = self
             .bar
-            .get_or_insert_with(|| Counter::start(label, p.probes_total as u64, "probes"));
+            .get_or_insert_with(|| Counter::without_eta(label, p.probes_total as u64, "probes"));
         bar.set_total(p.probes_total as u64);
         bar.set_position(p.probes_done as u64);
+        let eta = match p.eta() {
+            Some(d) => format!("{:.0} s left", d.as_secs_f64()),
+            None => "estimating the time left".into(),
+        };
         bar.set_message(format!(
-            "{label} ({}/{} tiles and meshes)",
+            "{label} ({}/{} tiles and meshes, {eta})",
             p.sections_done, p.sections_total
         ));
     }

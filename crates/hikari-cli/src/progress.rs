@@ -187,11 +187,24 @@ pub struct Counter {
 
 impl Counter {
     pub fn start(message: impl Into<String>, total: u64, unit: &'static str) -> Self {
+        Self::with_template(message, total, unit, "{elapsed} ({eta} left)")
+    }
+
+    /// A count whose message says the time left itself (the bake's, from its own estimate).
+    pub fn without_eta(message: impl Into<String>, total: u64, unit: &'static str) -> Self {
+        Self::with_template(message, total, unit, "{elapsed}")
+    }
+
+    fn with_template(
+        message: impl Into<String>,
+        total: u64,
+        unit: &'static str,
+        time: &str,
+    ) -> Self {
         let bar = multi().add(ProgressBar::new(total));
         bar.set_style(
             ProgressStyle::with_template(&format!(
-                "{{spinner:.cyan}} {{msg}} [{{bar:30.cyan/blue}}] {{pos}}/{{len}} {unit}, \
-                 {{elapsed}} ({{eta}} left)"
+                "{{spinner:.cyan}} {{msg}} [{{bar:30.cyan/blue}}] {{pos}}/{{len}} {unit}, {time}"
             ))
             .expect("a valid template")
             .progress_chars("#>."),

@@ -30,7 +30,7 @@ pub fn renderer(frame: &ResolvedFrame, bake: Option<&Path>) -> anyhow::Result<Re
     let step = Step::start("starting the GPU");
     let ctx = gpu()?;
     step.done(format!("GPU: {}", ctx.info.name));
-    let step = Step::start("preparing the renderer (shaders, scene upload)");
+    let step = Step::start("preparing the renderer");
     let mut renderer = Renderer::new(ctx, &frame.scene)?;
     step.done("renderer ready");
     probe_bake::attach(
