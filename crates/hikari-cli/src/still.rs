@@ -30,6 +30,16 @@ pub fn renderer(frame: &ResolvedFrame, bake: Option<&Path>) -> anyhow::Result<Re
     let step = Step::start("starting the GPU");
     let ctx = gpu()?;
     step.done(format!("GPU: {}", ctx.info.name));
+    // Too large for this GPU: said now, not after the renderer's set-up and the bake.
+    let max = ctx.limits.max_texture_dimension_2d;
+    for (what, v) in [
+        ("width", frame.settings.width),
+        ("height", frame.settings.height),
+    ] {
+        if v > max {
+            anyhow::bail!("image {what} of {v} exceeds this GPU's limit of {max}");
+        }
+    }
     let step = Step::start("preparing the renderer");
     let mut renderer = Renderer::new(ctx, &frame.scene)?;
     step.done("renderer ready");

@@ -235,6 +235,7 @@ fn progress_shows_the_steps_unless_quiet_or_piped() {
         if quiet {
             c.arg("--quiet");
         }
+        c.env("XDG_CACHE_HOME", dir.join("cache"));
         match progress {
             Some(p) => c.env("HIKARI_PROGRESS", p),
             None => c.env_remove("HIKARI_PROGRESS"),

@@ -25,7 +25,7 @@ use hikari_render::graph::{GraphRuntime, TimestampMode};
 use hikari_render::techniques::irradiance_probes::LOOKUP_PASS;
 use hikari_render::techniques::irradiance_probes::relight_bench::{RelightBench, RelightBenchSpec};
 use hikari_render::techniques::sky::{self, SkyParams, reference::SkyTwin};
-use hikari_render::{ContextOptions, FrameSettings, GpuContext, Renderer};
+use hikari_render::{FrameSettings, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
 use crate::probe_bake;
@@ -142,7 +142,7 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         println!("{header}");
     }
     let sky_sh = sky_radiance_sh(&settings)?;
-    let ctx = GpuContext::new(&ContextOptions::from_env())?;
+    let ctx = crate::still::gpu()?;
     let adapter = ctx.describe();
     let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);
     let mut renderer = Renderer::new(ctx, &scene)?;
