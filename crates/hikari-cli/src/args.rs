@@ -9,9 +9,17 @@ use clap::Args;
 /// `--scene`: what to load.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SceneArgs {
-    /// Built-in scene (village, cornell, terrain, boxes) or a .gltf/.glb file [default: village].
-    #[arg(long)]
+    #[arg(long, value_name = "NAME|PATH", help = scene_help())]
     pub scene: Option<String>,
+}
+
+/// `--scene`'s help, naming every built-in scene there is.
+pub fn scene_help() -> String {
+    format!(
+        "Built-in scene ({}) or a .gltf/.glb file [default: {}]",
+        hikari_scene::builtin::NAMES.join(", "),
+        crate::scene_source::DEFAULT_SCENE
+    )
 }
 
 /// `--camera`: which of the scene's cameras looks.
@@ -23,8 +31,7 @@ pub struct CameraArgs {
 }
 
 /// `--date`, `--time`, `--utc-offset`, `--lat`, `--lon`, `--weather`: when and where the sky
-/// is, and its weather; `--no-sun`, `--no-sky`: lights off for scenes lit by their own lamps.
-/// Each wins over the settings file's `[sky]` table (and `time`).
+/// is, and its weather. Each wins over the settings file's `[sky]` table (and `time`).
 #[derive(Args, Debug, Clone, Default)]
 pub struct SkyArgs {
     /// Local date, YYYY-MM-DD, 1900 to 2100 [default: 2024-07-21].
@@ -46,12 +53,30 @@ pub struct SkyArgs {
     /// Weather: clear, hazy or overcast [default: clear].
     #[arg(long)]
     pub weather: Option<String>,
+}
+
+/// `--no-sun`, `--no-sky`: the sky's lights off, for scenes lit by their own lamps. Each wins
+/// over the settings file's `[sky]` table.
+#[derive(Args, Debug, Clone, Default)]
+pub struct LightArgs {
     /// No directional light (sun or moon).
     #[arg(long)]
     pub no_sun: bool,
     /// No sky light: a black sky and no sky ambient light.
     #[arg(long)]
     pub no_sky: bool,
+}
+
+impl LightArgs {
+    /// Turns off in `s` what the flags turn off.
+    pub fn apply(&self, s: &mut hikari_render::settings::SkySettings) {
+        if self.no_sun {
+            s.sun = false;
+        }
+        if self.no_sky {
+            s.sky = false;
+        }
+    }
 }
 
 impl SkyArgs {
@@ -92,12 +117,6 @@ impl SkyArgs {
         if let Some(w) = &self.weather {
             s.weather = w.clone();
             check(s, "--weather", w.clone())?;
-        }
-        if self.no_sun {
-            s.sun = false;
-        }
-        if self.no_sky {
-            s.sky = false;
         }
         Ok(())
     }
@@ -262,6 +281,8 @@ pub struct FrameArgs {
     pub camera: CameraArgs,
     #[command(flatten)]
     pub sky: SkyArgs,
+    #[command(flatten)]
+    pub lights: LightArgs,
     #[command(flatten)]
     pub size: SizeArgs,
     #[command(flatten)]

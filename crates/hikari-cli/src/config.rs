@@ -134,6 +134,142 @@ mod tests {
         }
     }
 
+    /// A number as the example's comments write them: `0.5`, `-10`, `1e-4`, `2^30`.
+    fn comment_number(s: &str) -> Option<f64> {
+        match s.split_once('^') {
+            Some((b, e)) => Some(b.parse::<f64>().ok()?.powf(e.parse().ok()?)),
+            None => s.parse().ok(),
+        }
+    }
+
+    /// The first `LO to HI` in a comment, with whether "power of two" comes before it.
+    fn comment_range(comment: &str) -> Option<(f64, f64, bool)> {
+        let words: Vec<&str> = comment.split_whitespace().collect();
+        let trim = |w: &str| {
+            w.trim_end_matches([':', ',', ';', ')'])
+                .trim_start_matches('(')
+                .to_string()
+        };
+        for i in 1..words.len().saturating_sub(1) {
+            if words[i] != "to" {
+                continue;
+            }
+            if let (Some(lo), Some(hi)) = (
+                comment_number(&trim(words[i - 1])),
+                comment_number(&trim(words[i + 1])),
+            ) {
+                let power = words[..i].join(" ").contains("power of two");
+                return Some((lo, hi, power));
+            }
+        }
+        None
+    }
+
+    /// Every setting's line in the example states in its comment the range the settings
+    /// declare (`Settings::fields`), as `LO to HI` ("a power of two from LO to HI" for powers
+    /// of two), and no comment states a range for a setting that declares none; an optional
+    /// setting written commented out has an example value inside its range; the scene comment
+    /// names every built-in scene; no comment points at work that is done ("until the ...
+    /// issue", "placeholder ... until").
+    #[test]
+    fn the_examples_comments_state_the_declared_ranges() {
+        let text = include_str!("../../../docs/config.example.toml");
+        let declared: std::collections::HashMap<String, hikari_render::settings::Range> =
+            Settings::fields().into_iter().collect();
+        let mut table = String::new();
+        let mut failures = Vec::new();
+        let mut checked = 0;
+        for line in text.lines() {
+            let l = line.trim();
+            if let Some(rest) = l.strip_prefix('[') {
+                table = rest.split(']').next().unwrap_or_default().to_string();
+                continue;
+            }
+            // A commented-out setting: `# key = value  # comment`.
+            let (commented, l) = match l.strip_prefix("# ") {
+                Some(rest) if rest.contains(" = ") => (true, rest),
+                _ => (false, l),
+            };
+            let Some((key, rest)) = l.split_once(" = ") else {
+                continue;
+            };
+            let key = key.trim();
+            if key.contains(' ') || key.starts_with('#') {
+                continue;
+            }
+            let (value, comment) = match rest.split_once('#') {
+                Some((v, c)) => (v.trim(), c.trim()),
+                None => (rest.trim(), ""),
+            };
+            if table.is_empty() {
+                if key == "scene" {
+                    for name in hikari_scene::builtin::NAMES {
+                        if !comment.contains(name) {
+                            failures.push(format!("the scene comment lacks `{name}`"));
+                        }
+                    }
+                }
+                continue;
+            }
+            let field = format!("{table}.{key}");
+            let stated = comment_range(comment);
+            match (declared.get(&field), stated) {
+                (Some(range), Some((lo, hi, power))) => {
+                    checked += 1;
+                    use hikari_render::settings::Range;
+                    let (want_lo, want_hi, want_power) = match *range {
+                        Range::Int { lo, hi } => (lo as f64, hi as f64, false),
+                        Range::PowerOfTwo { lo, hi } => (lo as f64, hi as f64, true),
+                        Range::Float { lo, hi } => (lo, hi, false),
+                    };
+                    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
+                    if !close(lo, want_lo) || !close(hi, want_hi) || power != want_power {
+                        failures.push(format!(
+                            "{field}: the comment says {lo} to {hi}{}, the settings {range:?}",
+                            if power { " (a power of two)" } else { "" },
+                        ));
+                    }
+                    if commented {
+                        let v = comment_number(value).unwrap_or(f64::NAN);
+                        if !(want_lo..=want_hi).contains(&v) {
+                            failures.push(format!("{field}: the example {value} is outside"));
+                        }
+                    }
+                }
+                (Some(range), None) => failures.push(format!(
+                    "{field}: the comment does not state its range, {range:?}"
+                )),
+                // The sky's date is checked by its own validation, not a declared range.
+                (None, Some((1900.0, 2100.0, false))) if field == "sky.date" => {
+                    for (date, ok) in [
+                        ("1899-12-31", false),
+                        ("1900-01-01", true),
+                        ("2100-12-31", true),
+                        ("2101-01-01", false),
+                    ] {
+                        let set = [("sky.date".to_string(), format!("\"{date}\""))];
+                        if Settings::from_toml(None, toml::Table::new(), &set).is_ok() != ok {
+                            failures.push(format!("sky.date {date}: not as the comment says"));
+                        }
+                    }
+                }
+                (None, Some((lo, hi, _))) => failures.push(format!(
+                    "{field}: the comment states {lo} to {hi}, a range the settings do not declare"
+                )),
+                (None, None) => {}
+            }
+        }
+        // Work the comments once waited for is done; the GI's hits shadow point lights.
+        for line in text.lines() {
+            let gi_unshadowed = line.starts_with("punctual = ") && line.contains("unshadowed");
+            if line.contains("until the") || line.contains("issue") || gi_unshadowed {
+                failures.push(format!("stale comment: {line}"));
+            }
+        }
+        assert!(checked >= 100, "only {checked} ranges checked");
+        assert!(failures.is_empty(), "{}", failures.join("\n"));
+    }
+
     #[test]
     fn an_out_of_range_value_names_the_field_and_the_range() {
         let e = parse("[sun_shadows]\ncascades = 7\n").unwrap_err();

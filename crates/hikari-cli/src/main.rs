@@ -3,7 +3,9 @@
 mod args;
 mod commands;
 mod config;
+mod gpu_check;
 mod probe_bake;
+mod progress;
 mod report;
 mod scene_source;
 mod still;
@@ -46,14 +48,16 @@ enum Command {
     Sky(sky::SkyCommandArgs),
     /// Bake a scene's irradiance probes (on the GPU when there is one, else the CPU) into a bake file, by default the render cache.
     Bake(bake::BakeArgs),
-    /// Print a scene's baked probes, or their values interpolated (and relit) at points, as JSON.
+    /// Count a scene's baked probes (`--json`: list every one, with its SH), or print their
+    /// values interpolated at `--at` points, relit with `--date`/`--time`/`--weather`.
     Probes(probes::ProbesArgs),
     /// Benchmarks that print per-pass GPU timings.
     #[command(subcommand)]
     Bench(BenchCommand),
     /// Print the derived colour, spectral and scattering constants (no GPU needed).
     Constants(constants::ConstantsArgs),
-    /// Print the GPU adapter, its features and limits.
+    /// Print the GPU adapter, whether it can run hikari (and which feature it lacks if not),
+    /// its features and limits.
     Info,
     /// Grading with 3D LUTs: read a grade back from a graded screenshot, or apply one.
     #[command(subcommand)]
@@ -89,7 +93,10 @@ fn ensure_runtime_dir() {
 
 fn main() -> ExitCode {
     ensure_runtime_dir();
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    // Log lines go above the progress bars, not through them.
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn"))
+        .target(env_logger::Target::Pipe(Box::new(progress::LogWriter)))
+        .init();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render::run(*args),

@@ -9,7 +9,6 @@
 //! cache is baked again with a warning saying why.
 
 use std::cell::RefCell;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -22,6 +21,7 @@ use hikari_render::GpuContext;
 use hikari_render::probe_bake_gpu::{GpuTransport, is_real_gpu};
 use hikari_scene::Scene;
 
+use crate::progress::{Counter, Step};
 use crate::scene_source::SceneSource;
 
 /// Bumped when the baker's output changes for the same scene and options, so that caches made
@@ -265,11 +265,11 @@ impl Drop for InterruptGuard {
     }
 }
 
-/// A progress bar on stderr (only on a terminal): probes done, sections, the time left.
+/// The bake's progress bar (`crate::progress`: on a terminal, not with `--quiet`): probes
+/// done of all, tiles and meshes, the time left.
 pub struct Progress {
     label: &'static str,
-    last: Option<Instant>,
-    tty: bool,
+    bar: Option<Counter>,
     /// The latest report, for the summary.
     pub latest: Option<BakeProgress>,
 }
@@ -278,46 +278,36 @@ impl Progress {
     pub fn new(label: &'static str) -> Self {
         Self {
             label,
-            last: None,
-            tty: std::io::stderr().is_terminal(),
+            bar: None,
             latest: None,
         }
     }
 
     pub fn update(&mut self, p: BakeProgress) {
         self.latest = Some(p);
-        if !self.tty || p.probes_total == 0 {
+        if p.probes_total == 0 {
             return;
         }
-        let now = Instant::now();
-        let finished = p.sections_done >= p.sections_total;
-        if !finished
-            && self
-                .last
-                .is_some_and(|t| now - t < Duration::from_millis(100))
-        {
-            return;
-        }
-        self.last = Some(now);
-        let f = (p.probes_done as f64 / p.probes_total as f64).min(1.0);
+        let label = self.label;
+        let bar = self
+            .bar
+            .get_or_insert_with(|| Counter::without_eta(label, p.probes_total as u64, "probes"));
+        bar.set_total(p.probes_total as u64);
+        bar.set_position(p.probes_done as u64);
         let eta = match p.eta() {
-            Some(d) => format!("{:.1} s left", d.as_secs_f64()),
-            None => "estimating".into(),
+            Some(d) => format!("{:.0} s left", d.as_secs_f64()),
+            None => "estimating the time left".into(),
         };
-        let bar: String = (0..30)
-            .map(|i| if (i as f64) < f * 30.0 { '#' } else { '.' })
-            .collect();
-        eprint!(
-            "\r{} [{bar}] {:3.0}% {}/{} probes, {}/{} tiles+meshes, {eta}   ",
-            self.label,
-            f * 100.0,
-            p.probes_done,
-            p.probes_total,
-            p.sections_done,
-            p.sections_total,
-        );
-        if finished {
-            eprintln!();
+        bar.set_message(format!(
+            "{label} ({}/{} tiles and meshes, {eta})",
+            p.sections_done, p.sections_total
+        ));
+    }
+
+    /// Leaves the bar as a line: probes baked and the time.
+    pub fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.done("baked the irradiance probes");
         }
     }
 }
@@ -363,9 +353,6 @@ pub fn bake_into(
     let baked = match result {
         Ok(b) => b,
         Err(BakeError::Cancelled) => {
-            if progress.borrow().tty {
-                eprintln!();
-            }
             anyhow::bail!(
                 "the bake of {} was interrupted; its checkpoint {} resumes it on the next run",
                 path.display(),
@@ -377,6 +364,7 @@ pub fn bake_into(
                 .with_context(|| format!("baking the irradiance probes into {}", path.display()));
         }
     };
+    progress.borrow_mut().finish();
     if let Some(why) = &baked.discarded_checkpoint {
         log::warn!("probes: an old checkpoint was not used: {why}");
     }
@@ -415,9 +403,11 @@ pub fn for_render(
             .context("--bake");
     }
     let path = cache_path(&key);
+    let step = Step::start("reading the probe bake from the cache");
     match hikari_probes::read_bake(&path, &key) {
         Ok(b) => {
             log::info!("probes: cached bake {}", path.display());
+            step.done(format!("probe bake from the cache, {}", path.display()));
             return Ok(b);
         }
         Err(e) if matches!(e.problem, Problem::Missing) => {
@@ -428,6 +418,7 @@ pub fn for_render(
         }
         Err(e) => log::warn!("{e}; baking the probes again"),
     }
+    step.clear();
     let gpu = gpu_tracer(TracerChoice::from_env()?, ctx, scene, &options)?;
     let run = bake_into(
         scene,

@@ -27,18 +27,37 @@ pub enum SceneSource {
 }
 
 impl SceneSource {
-    /// A built-in scene name, or a path ending in `.gltf` / `.glb` (any case).
+    /// A built-in scene name, or a path ending in `.gltf` / `.glb` (any case). Anything else
+    /// is an error that says what it is (a folder, a file of another kind) or, for a name,
+    /// the nearest built-in one.
     pub fn parse(name: &str) -> anyhow::Result<Self> {
-        if hikari_scene::builtin::NAMES.contains(&name) {
+        let builtin = hikari_scene::builtin::NAMES;
+        if builtin.contains(&name) {
             return Ok(Self::Builtin(name.to_string()));
+        }
+        let path = std::path::Path::new(name);
+        if path.is_dir() {
+            bail!(
+                "--scene {name}: is a folder; give a .gltf or .glb file in it, or a built-in \
+                 scene ({})",
+                builtin.join(", ")
+            );
         }
         let lower = name.to_ascii_lowercase();
         if lower.ends_with(".gltf") || lower.ends_with(".glb") {
             return Ok(Self::Gltf(PathBuf::from(name)));
         }
+        if path.is_file() {
+            bail!(
+                "--scene {name}: hikari reads glTF 2.0 scenes, files ending in .gltf or .glb; \
+                 or give a built-in scene ({})",
+                builtin.join(", ")
+            );
+        }
         bail!(
-            "unknown scene `{name}`; built-in scenes: {}, or a path to a .gltf or .glb file",
-            hikari_scene::builtin::NAMES.join(", ")
+            "unknown scene `{name}`{}; built-in scenes: {}, or a path to a .gltf or .glb file",
+            nearest(name, builtin).map_or(String::new(), |n| format!(" (did you mean `{n}`?)")),
+            builtin.join(", ")
         )
     }
 
@@ -66,6 +85,19 @@ impl SceneSource {
             Self::Gltf(_) => "glTF",
         }
     }
+}
+
+/// The name of `names` nearest to `name` when it is a likely misspelling: at most a third
+/// of its letters edited (at least one), case aside.
+pub fn nearest<'a>(name: &str, names: &[&'a str]) -> Option<&'a str> {
+    let name = name.to_lowercase();
+    let limit = (name.chars().count() / 3).max(1);
+    names
+        .iter()
+        .map(|n| (strsim::levenshtein(&name, &n.to_lowercase()), *n))
+        .filter(|(d, _)| *d <= limit)
+        .min()
+        .map(|(_, n)| n)
 }
 
 /// A built-in scene by name, or a `.gltf` / `.glb` file by path.
@@ -241,6 +273,25 @@ fn choose_light(
     })
 }
 
+/// An image is at least a pixel each way: checked here, before the GPU starts (its upper
+/// limit is the GPU's, checked when the renderer sizes its textures).
+fn check_size(args: &FrameArgs, width: u32, height: u32) -> anyhow::Result<()> {
+    for (what, flag, given, v) in [
+        ("width", "--width", args.size.width.is_some(), width),
+        ("height", "--height", args.size.height.is_some(), height),
+    ] {
+        if v == 0 {
+            let from = if given {
+                format!("{flag} 0")
+            } else {
+                format!("the config file's `{what} = 0`")
+            };
+            bail!("{from}: the image {what} must be at least 1 pixel");
+        }
+    }
+    Ok(())
+}
+
 /// The scene and the frame settings: from the flags, then the config file, then defaults.
 pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
     let file = match &args.config.config {
@@ -254,6 +305,9 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
         .or(file.scene.clone())
         .unwrap_or_else(|| DEFAULT_SCENE.into());
     let source = SceneSource::parse(&scene_name)?;
+    let width = args.size.width.or(file.width).unwrap_or(DEFAULT_SIZE.0);
+    let height = args.size.height.or(file.height).unwrap_or(DEFAULT_SIZE.1);
+    check_size(args, width, height)?;
     let scene = source.load()?;
     let (camera, camera_origin) = choose_camera(
         &scene,
@@ -282,6 +336,7 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
             .context("the config file's `time`")?;
     }
     args.sky.apply(&mut settings.sky)?;
+    args.lights.apply(&mut settings.sky);
     if let Some(ev) = args.exposure.ev100 {
         if !ev.is_finite() || !(-10.0..=30.0).contains(&ev) {
             bail!("--ev100 {ev} is outside the range -10 to 30");
@@ -290,8 +345,6 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
     }
     settings.validate().context("settings")?;
     let (sun, time) = choose_light(&source, &scene, &mut settings, args, &file)?;
-    let width = args.size.width.or(file.width).unwrap_or(DEFAULT_SIZE.0);
-    let height = args.size.height.or(file.height).unwrap_or(DEFAULT_SIZE.1);
     let description = FrameDescription {
         source,
         camera: camera.name.clone(),
@@ -331,6 +384,26 @@ mod tests {
         );
         let e = SceneSource::parse("atlantis").unwrap_err().to_string();
         assert!(e.contains("`atlantis`") && e.contains("village"), "{e}");
+        assert!(!e.contains("did you mean"), "{e}");
+    }
+
+    #[test]
+    fn a_misspelled_scene_gets_the_nearest_built_in_name() {
+        for (typo, want) in [
+            ("vilage", "village"),
+            ("Village", "village"),
+            ("cornel", "cornell"),
+            ("cutuot", "cutout"),
+        ] {
+            assert_eq!(
+                nearest(typo, hikari_scene::builtin::NAMES),
+                Some(want),
+                "{typo}"
+            );
+            let e = SceneSource::parse(typo).unwrap_err().to_string();
+            assert!(e.contains(&format!("did you mean `{want}`?")), "{e}");
+        }
+        assert_eq!(nearest("atlantis", hikari_scene::builtin::NAMES), None);
     }
 
     #[test]

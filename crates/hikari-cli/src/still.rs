@@ -8,22 +8,41 @@ use std::path::Path;
 use anyhow::Context;
 
 use hikari_render::graph::ImageRgba32;
-use hikari_render::{ContextOptions, GpuContext, RenderedFrame, Renderer, output};
+use hikari_render::{ContextOptions, FrameSettings, GpuContext, RenderedFrame, Renderer, output};
 
 use crate::probe_bake;
+use crate::progress::{Counter, Step};
 use crate::scene_source::ResolvedFrame;
 
-/// The GPU the environment picks (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`).
+/// The GPU the environment picks (`WGPU_BACKEND`, `WGPU_ADAPTER_NAME`), checked for what
+/// hikari needs ([`crate::gpu_check`]).
 pub fn gpu() -> anyhow::Result<GpuContext> {
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     log::info!("adapter: {}", ctx.describe());
+    crate::gpu_check::ensure_can_run(&ctx)?;
     Ok(ctx)
 }
 
 /// A renderer of `frame`'s scene on a new GPU context, with the scene's probe bake attached
-/// when its settings use the probes (`bake`: `--bake`, else the cache, baked on a miss).
+/// when its settings use the probes (`bake`: `--bake`, else the cache, baked on a miss);
+/// each step shown as progress.
 pub fn renderer(frame: &ResolvedFrame, bake: Option<&Path>) -> anyhow::Result<Renderer> {
-    let mut renderer = Renderer::new(gpu()?, &frame.scene)?;
+    let step = Step::start("starting the GPU");
+    let ctx = gpu()?;
+    step.done(format!("GPU: {}", ctx.info.name));
+    // Too large for this GPU: said now, not after the renderer's set-up and the bake.
+    let max = ctx.limits.max_texture_dimension_2d;
+    for (what, v) in [
+        ("width", frame.settings.width),
+        ("height", frame.settings.height),
+    ] {
+        if v > max {
+            anyhow::bail!("image {what} of {v} exceeds this GPU's limit of {max}");
+        }
+    }
+    let step = Step::start("preparing the renderer");
+    let mut renderer = Renderer::new(ctx, &frame.scene)?;
+    step.done("renderer ready");
     probe_bake::attach(
         &mut renderer,
         &frame.scene,
@@ -32,6 +51,39 @@ pub fn renderer(frame: &ResolvedFrame, bake: Option<&Path>) -> anyhow::Result<Re
         bake,
     )?;
     Ok(renderer)
+}
+
+/// Renders `frames` frames of `settings` on `renderer` with a progress bar ("rendering
+/// {what}"), `before` called ahead of each with the frame's number from 1 (to move the
+/// camera); the last is read back and returned.
+pub fn render_frames(
+    renderer: &mut Renderer,
+    settings: &mut FrameSettings,
+    frames: u32,
+    what: &str,
+    mut before: impl FnMut(u32, &mut FrameSettings),
+) -> anyhow::Result<RenderedFrame> {
+    let label = format!("rendering {what}");
+    // The first frame compiles the shaders: on the CPU driver most of a short render.
+    let bar = Counter::start(
+        format!("{label} (the first frame compiles the shaders)"),
+        u64::from(frames),
+        "frames",
+    );
+    for f in 1..frames {
+        before(f, settings);
+        renderer.render(settings, false)?;
+        bar.inc();
+        if f == 1 {
+            bar.set_message(label.clone());
+            bar.reset_eta();
+        }
+    }
+    before(frames, settings);
+    let frame = renderer.render(settings, true)?;
+    bar.inc();
+    bar.done(format!("rendered {what}"));
+    Ok(frame)
 }
 
 /// Frames `render` draws of a still view when `--frames` is not given: the larger of what TAA
@@ -111,6 +163,49 @@ pub fn check_output_file(flag: &str, file: &Path) -> anyhow::Result<()> {
         anyhow::bail!("{flag} {}: is a folder, not a file", file.display());
     }
     Ok(())
+}
+
+/// The image files hikari writes, each by the extension its name must end in: hikari writes
+/// no other format, and never one format under another's name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFile {
+    /// 8-bit sRGB, display-encoded.
+    Png,
+    /// OpenEXR, linear radiance in nits.
+    Exr,
+}
+
+impl ImageFile {
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Png => "png",
+            Self::Exr => "exr",
+        }
+    }
+
+    fn describe(self) -> &'static str {
+        match self {
+            Self::Png => "PNG (8-bit sRGB)",
+            Self::Exr => "OpenEXR (linear radiance in nits)",
+        }
+    }
+}
+
+/// [`check_output_file`], and that `file`'s name ends in `kind`'s extension (any case): an
+/// error naming the flag, the format written and the extension otherwise.
+pub fn check_image_file(flag: &str, file: &Path, kind: ImageFile) -> anyhow::Result<()> {
+    let ext = kind.extension();
+    if !file
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    {
+        anyhow::bail!(
+            "{flag} {}: this writes {}; give a file name ending in .{ext}",
+            file.display(),
+            kind.describe()
+        );
+    }
+    check_output_file(flag, file)
 }
 
 /// Creates the output folder `dir` (named by `flag`) with its parents if it is missing; an
@@ -199,5 +294,21 @@ mod tests {
         assert!(e.contains("--exr-a") && e.contains("does not exist"), "{e}");
         assert!(check_output_file("-o", &dir).is_err());
         check_output_file("-o", &file).unwrap();
+
+        let png = dir.join("a.PNG");
+        check_image_file("-o", &png, ImageFile::Png).unwrap();
+        check_image_file("--exr", &dir.join("a.exr"), ImageFile::Exr).unwrap();
+        for (name, kind) in [
+            ("x.jpg", ImageFile::Png),
+            ("x", ImageFile::Png),
+            ("x.exr", ImageFile::Png),
+            ("x.png", ImageFile::Exr),
+        ] {
+            let e = check_image_file("-o", &dir.join(name), kind)
+                .unwrap_err()
+                .to_string();
+            let want = format!("ending in .{}", kind.extension());
+            assert!(e.contains(name) && e.contains(&want), "{e}");
+        }
     }
 }

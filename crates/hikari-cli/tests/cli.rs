@@ -70,29 +70,61 @@ fn render_writes_png_exr_and_dumps() {
 #[test]
 fn render_dolly_arrives_at_the_view_in_motion() {
     let dir = tmp("dolly");
-    let run = |name: &str, dolly: &str| {
+    let run = |name: &str, dolly: &str, progress: Option<&str>| {
         let png = dir.join(name);
-        let o = hikari(&[
-            "render",
-            "--scene",
-            "boxes",
-            "--width",
-            "48",
-            "--height",
-            "32",
-            "--frames",
-            "4",
-            "--dolly",
-            dolly,
-            "--no-exr",
-            "-o",
-            png.to_str().unwrap(),
-        ]);
+        let mut command = Command::new(env!("CARGO_BIN_EXE_hikari"));
+        match progress {
+            Some(p) => command.env("HIKARI_PROGRESS", p),
+            None => command.env_remove("HIKARI_PROGRESS"),
+        };
+        let o = command
+            .args([
+                "render",
+                "--scene",
+                "boxes",
+                "--width",
+                "48",
+                "--height",
+                "32",
+                "--frames",
+                "4",
+                "--dolly",
+                dolly,
+                "--no-exr",
+                "-o",
+                png.to_str().unwrap(),
+            ])
+            .output()
+            .expect("run hikari");
         assert!(o.status.success(), "{}", text(&o));
-        image::open(&png).unwrap().to_rgb8()
+        (image::open(&png).unwrap().to_rgb8(), o)
     };
-    let still = run("still.png", "0");
-    let moving = run("moving.png", "1.5");
+    // A script's run (stderr a pipe): no progress. With HIKARI_PROGRESS=always, as on a
+    // terminal: each step, the frames of N, the writing.
+    let (still, quiet) = run("still.png", "0", None);
+    let said = String::from_utf8_lossy(&quiet.stderr);
+    assert!(
+        !said.contains("frames") && !said.contains("GPU"),
+        "progress on a pipe: {said}"
+    );
+    let (moving, shown) = run("moving.png", "1.5", Some("always"));
+    let said = String::from_utf8_lossy(&shown.stderr);
+    for step in [
+        "scene boxes (built-in)",
+        "starting the GPU",
+        "✓ GPU: ",
+        "renderer ready",
+        "the first frame compiles the shaders",
+        "rendered the view: 4 frames",
+        "writing ",
+    ] {
+        assert!(said.contains(step), "`{step}` not in the progress: {said}");
+    }
+    assert!(
+        String::from_utf8_lossy(&shown.stdout).contains("wrote "),
+        "{}",
+        text(&shown)
+    );
     let diffs: Vec<i32> = still
         .pixels()
         .zip(moving.pixels())
@@ -179,6 +211,56 @@ fn bad_arguments_fail_with_a_message_and_no_panic() {
         ],
         "does not exist",
     );
+}
+
+/// Progress: drawn with `HIKARI_PROGRESS=always` (as on a terminal), not with `--quiet`, and
+/// not on a pipe; a failure clears the step it stopped in and prints the error alone.
+#[test]
+fn progress_shows_the_steps_unless_quiet_or_piped() {
+    let dir = tmp("progress");
+    let png = dir.join("x.png");
+    let run = |progress: Option<&str>, quiet: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_hikari"));
+        c.args([
+            "render",
+            "--scene",
+            "boxes",
+            "--width",
+            "100000",
+            "--height",
+            "8",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        if quiet {
+            c.arg("--quiet");
+        }
+        c.env("XDG_CACHE_HOME", dir.join("cache"));
+        match progress {
+            Some(p) => c.env("HIKARI_PROGRESS", p),
+            None => c.env_remove("HIKARI_PROGRESS"),
+        };
+        let o = c.output().expect("run hikari");
+        assert!(!o.status.success(), "{}", text(&o));
+        let said = String::from_utf8_lossy(&o.stderr).into_owned();
+        assert!(said.contains("exceeds this GPU's limit"), "{said}");
+        said
+    };
+    let shown = run(Some("always"), false);
+    assert!(
+        shown.contains("starting the GPU") && shown.contains("✓ GPU: "),
+        "{shown}"
+    );
+    for said in [
+        run(Some("always"), true),
+        run(None, false),
+        run(Some("never"), false),
+    ] {
+        assert!(
+            !said.contains("starting the GPU") && !said.contains('✓'),
+            "progress drawn: {said}"
+        );
+    }
 }
 
 #[test]

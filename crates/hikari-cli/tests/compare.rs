@@ -28,8 +28,18 @@ fn compare(dir: &Path, name: &str, args: &[&str]) -> (serde_json::Value, image::
         png.to_str().unwrap(),
     ];
     all.extend_from_slice(args);
-    let o = hikari(&all);
+    // Progress drawn as on a terminal: on stderr, the JSON on stdout untouched.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(&all)
+        .env("HIKARI_PROGRESS", "always")
+        .output()
+        .expect("run hikari");
     assert!(o.status.success(), "{}", text(&o));
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        said.contains("rendered A: 2 frames") && said.contains("rendered B: 2 frames"),
+        "progress: {said}"
+    );
     let json: serde_json::Value =
         serde_json::from_slice(&o.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&o)));
     (json, image::open(&png).unwrap().to_rgba8())

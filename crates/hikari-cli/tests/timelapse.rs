@@ -9,10 +9,11 @@ use std::process::{Command, Output};
 use common::{hikari, text, tmp};
 
 /// `hikari timelapse` of the boxes (which get the sky's sun once a time is given) at 64x36,
-/// with the bake cache in `dir`.
+/// with the bake cache in `dir`, its progress drawn on stderr as on a terminal.
 fn timelapse(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_hikari"))
         .env("XDG_CACHE_HOME", dir.join("cache"))
+        .env("HIKARI_PROGRESS", "always")
         .args([
             "timelapse",
             "--scene",
@@ -72,6 +73,10 @@ fn frames_are_written_numbered_and_the_sun_moves_between_them() {
             && said.contains("2024-07-21 05:00:00 to 2024-07-21 12:00:00")
             && said.contains("6 frames rendered"),
         "{said}"
+    );
+    assert!(
+        said.contains("rendered the time-lapse: 6 frames") && said.contains("3 of 3 written"),
+        "progress: {said}"
     );
     let mut lum = Vec::new();
     for k in 0..3 {

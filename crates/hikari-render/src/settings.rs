@@ -195,6 +195,45 @@ macro_rules! register_settings {
                 out
             }
 
+            /// The names of the settings tables, in registration order.
+            pub fn tables() -> &'static [&'static str] {
+                &[$(stringify!($name),)*]
+            }
+
+            /// Reads each technique's table of `merged` on its own, so that a key the
+            /// technique does not have is named with its table and the keys it does have.
+            fn check_keys(merged: &toml::Table) -> Result<(), SettingError> {
+                $(if let Some(t) = merged.get(stringify!($name))
+                    && let Err(e) = t.clone().try_into::<$ty>()
+                    && let Some(err) = unknown_key(stringify!($name), e.message())
+                {
+                    return Err(err);
+                })*
+                Ok(())
+            }
+
+            /// The first `table.key` of `merged` that its technique cannot read on its own
+            /// (serde's message names no key), with what serde expected.
+            fn unreadable(merged: &toml::Table) -> Option<SettingError> {
+                $(for (key, v) in merged
+                    .get(stringify!($name))
+                    .and_then(|t| t.as_table())
+                    .into_iter()
+                    .flatten()
+                {
+                    let alone = toml::Table::from_iter([(key.clone(), v.clone())]);
+                    if let Err(e) = toml::Value::Table(alone).try_into::<$ty>() {
+                        let m = e.message().trim();
+                        return Some(SettingError {
+                            field: format!("{}.{key}", stringify!($name)),
+                            value: v.to_string(),
+                            allowed: m.split_once("expected ").map_or(m, |(_, x)| x).to_string(),
+                        });
+                    }
+                })*
+                None
+            }
+
             /// Every bounded field as `table.key` with its range, for documentation and tests.
             pub fn fields() -> Vec<(String, Range)> {
                 let mut out = Vec::new();
@@ -253,13 +292,27 @@ impl Settings {
             value: "?".into(),
             allowed: e.to_string(),
         })?;
-        let mut merged = match base {
+        let mut merged = match base.clone() {
             toml::Value::Table(t) => t,
             _ => unreachable!("a struct serialises to a table"),
         };
         merge(&mut merged, table);
         for (key, value) in overrides {
-            set_path(&mut merged, key, value)?;
+            set_path(&mut merged, &base, key, value)?;
+        }
+        // A table no technique has (a typo in the file or in `--set`), named with the
+        // nearest one.
+        for (name, v) in &merged {
+            if !Self::tables().contains(&name.as_str()) {
+                return Err(unknown_table(name));
+            }
+            if !v.is_table() {
+                return Err(SettingError {
+                    field: name.clone(),
+                    value: v.to_string(),
+                    allowed: format!("a table of settings, `[{name}]`"),
+                });
+            }
         }
         // Ranges first: a value of the wrong kind (`nan` for a count) would otherwise fail in
         // serde, whose error does not name the field.
@@ -275,6 +328,7 @@ impl Settings {
                 });
             }
         }
+        Self::check_keys(&merged)?;
         // A value of the wrong type: name the first field whose TOML type differs from the
         // preset's (serde's own message names no field).
         let reference = base_types(&Self::preset(preset));
@@ -282,11 +336,13 @@ impl Settings {
             toml::Value::Table(merged.clone())
                 .try_into()
                 .map_err(|e: toml::de::Error| {
-                    wrong_type(&merged, &reference).unwrap_or_else(|| SettingError {
-                        field: "settings".into(),
-                        value: "?".into(),
-                        allowed: e.message().trim().to_string(),
-                    })
+                    wrong_type(&merged, &reference)
+                        .or_else(|| Self::unreadable(&merged))
+                        .unwrap_or_else(|| SettingError {
+                            field: "settings".into(),
+                            value: "not readable".into(),
+                            allowed: e.message().trim().to_string(),
+                        })
                 })?;
         settings.validate()?;
         Ok(settings)
@@ -344,22 +400,50 @@ fn merge(base: &mut toml::Table, over: toml::Table) {
     }
 }
 
-/// Sets `table.key` (dotted) to `value`, parsed as a TOML value.
-fn set_path(root: &mut toml::Table, key: &str, value: &str) -> Result<(), SettingError> {
+/// Sets `table.key` (dotted) to `value`, parsed as a TOML value. `reference` (the preset's
+/// settings) gives the type the key expects, for the error when `value` is not TOML, and lets
+/// a string setting take a bare word (`--set sky.weather=hazy`).
+fn set_path(
+    root: &mut toml::Table,
+    reference: &toml::Value,
+    key: &str,
+    value: &str,
+) -> Result<(), SettingError> {
     let err = |allowed: String| SettingError {
         field: key.into(),
         value: format!("{value:?}"),
         allowed,
     };
-    let parsed: toml::Table = format!("v = {value}")
-        .parse()
-        .map_err(|_| err("a TOML value: a number, true or false, or a \"string\"".into()))?;
-    let v = parsed
-        .get("v")
-        .cloned()
-        .ok_or_else(|| err("a value".into()))?;
     let parts: Vec<&str> = key.split('.').collect();
     let (last, tables) = parts.split_last().ok_or_else(|| err("table.key".into()))?;
+    if let Some(table) = tables.first()
+        && !Settings::tables().contains(table)
+    {
+        return Err(unknown_table(table));
+    }
+    if tables.is_empty() {
+        return Err(err(format!(
+            "a setting as table.key, e.g. `taa.enabled`; the tables are {}",
+            Settings::tables().join(", ")
+        )));
+    }
+    let expected = parts.iter().try_fold(reference, |v, p| v.get(p));
+    let v = match format!("v = {value}").parse::<toml::Table>() {
+        Ok(parsed) => parsed
+            .get("v")
+            .cloned()
+            .ok_or_else(|| err("a value".into()))?,
+        Err(_) => match expected {
+            // A bare word where a string is expected: the string.
+            Some(toml::Value::String(_)) => toml::Value::String(value.to_string()),
+            Some(w) => return Err(err(expected_kind(w))),
+            None => {
+                return Err(err(
+                    "a TOML value: a number, true or false, or a \"string\"".into(),
+                ));
+            }
+        },
+    };
     let mut t = root;
     for p in tables {
         t = match t
@@ -372,4 +456,96 @@ fn set_path(root: &mut toml::Table, key: &str, value: &str) -> Result<(), Settin
     }
     t.insert(last.to_string(), v);
     Ok(())
+}
+
+/// What a value of the type of `example` is, for an error: "a boolean, true or false".
+fn expected_kind(example: &toml::Value) -> String {
+    match example {
+        toml::Value::Boolean(_) => "a boolean, true or false".into(),
+        toml::Value::Integer(_) => format!("an integer, like {example}"),
+        toml::Value::Float(_) => format!("a number, like {example}"),
+        toml::Value::String(_) => format!("a string, like {example}"),
+        _ => format!("a {}, like {example}", example.type_str()),
+    }
+}
+
+/// The error for a table that no technique registers, with the nearest name if one is near.
+fn unknown_table(name: &str) -> SettingError {
+    let tables = Settings::tables();
+    SettingError {
+        field: name.into(),
+        value: "not a settings table".into(),
+        allowed: format!("{}{}", tables.join(", "), did_you_mean(name, tables)),
+    }
+}
+
+/// The error for serde's "unknown field `x`, expected one of `a`, `b`" in `table`: the key
+/// as `table.x`, the keys there are and the nearest one. `None` for any other message.
+fn unknown_key(table: &str, message: &str) -> Option<SettingError> {
+    let rest = message.trim().strip_prefix("unknown field `")?;
+    let (key, rest) = rest.split_once('`')?;
+    let keys: Vec<&str> = rest
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|k| !k.is_empty())
+        .collect();
+    Some(SettingError {
+        field: format!("{table}.{key}"),
+        value: format!("not a setting of `{table}`"),
+        allowed: if keys.is_empty() {
+            format!("`{table}` has no settings")
+        } else {
+            format!("{}{}", keys.join(", "), did_you_mean(key, &keys))
+        },
+    })
+}
+
+/// " (did you mean `x`?)" when one of `names` is within a third of `name`'s length in edits
+/// (at least one edit), else "".
+fn did_you_mean(name: &str, names: &[&str]) -> String {
+    let limit = (name.chars().count() / 3).max(1);
+    names
+        .iter()
+        .map(|n| (edit_distance(name, n), *n))
+        .filter(|(d, _)| *d <= limit)
+        .min()
+        .map_or(String::new(), |(_, n)| format!(" (did you mean `{n}`?)"))
+}
+
+/// Levenshtein distance in characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (diagonal + usize::from(ca != *cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            diagonal = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_distance_counts_insertions_deletions_and_substitutions() {
+        assert_eq!(edit_distance("village", "village"), 0);
+        assert_eq!(edit_distance("vilage", "village"), 1);
+        assert_eq!(edit_distance("cascade", "cascades"), 1);
+        assert_eq!(edit_distance("taa", "haze"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(
+            did_you_mean("cascade", &["resolution", "cascades"]),
+            " (did you mean `cascades`?)"
+        );
+        assert_eq!(did_you_mean("nonexistent", &["taa", "haze"]), "");
+    }
 }

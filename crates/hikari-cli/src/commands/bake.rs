@@ -12,6 +12,7 @@ use serde_json::json;
 
 use crate::args::{JsonArgs, SceneArgs};
 use crate::probe_bake::{self, TracerChoice};
+use crate::progress::{self, ProgressArgs};
 use crate::scene_source::{DEFAULT_SCENE, SceneSource};
 use hikari_bake::TransportTracer;
 use hikari_render::{ContextOptions, GpuContext};
@@ -29,9 +30,12 @@ pub struct BakeArgs {
     pub tracer: TracerChoice,
     #[command(flatten)]
     pub json: JsonArgs,
+    #[command(flatten)]
+    pub progress: ProgressArgs,
 }
 
 pub fn run(a: BakeArgs) -> anyhow::Result<()> {
+    progress::set_quiet(a.progress.quiet);
     let name = a
         .scene
         .scene

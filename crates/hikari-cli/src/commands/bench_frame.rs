@@ -6,9 +6,9 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 
+use hikari_render::Renderer;
 use hikari_render::graph::TimestampMode;
 use hikari_render::techniques::ray_traced_gi::reference::HIT_NOT_TRACED;
-use hikari_render::{ContextOptions, GpuContext, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
 use crate::probe_bake;
@@ -91,7 +91,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
     if !a.output.json {
         println!("{header}");
     }
-    let ctx = GpuContext::new(&ContextOptions::from_env())?;
+    let ctx = crate::still::gpu()?;
     let adapter = ctx.describe();
     let startup = ctx.startup;
     let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);

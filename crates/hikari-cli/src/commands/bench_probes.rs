@@ -25,14 +25,19 @@ use hikari_render::graph::{GraphRuntime, TimestampMode};
 use hikari_render::techniques::irradiance_probes::LOOKUP_PASS;
 use hikari_render::techniques::irradiance_probes::relight_bench::{RelightBench, RelightBenchSpec};
 use hikari_render::techniques::sky::{self, SkyParams, reference::SkyTwin};
-use hikari_render::{ContextOptions, FrameSettings, GpuContext, Renderer};
+use hikari_render::{FrameSettings, Renderer};
 
 use crate::args::{FrameArgs, JsonArgs};
 use crate::probe_bake;
 use crate::report::{FrameTimings, PassRow};
 use crate::scene_source::{self, ResolvedFrame};
 
+/// The lookup is timed at 3840x2160 unless `--width`/`--height` say otherwise: the help says so.
 #[derive(Args, Debug)]
+#[command(
+    mut_arg("width", |a| a.help("Image width in pixels [default: 3840]")),
+    mut_arg("height", |a| a.help("Image height in pixels [default: 2160]"))
+)]
 pub struct BenchProbesArgs {
     #[command(flatten)]
     pub frame: FrameArgs,
@@ -56,6 +61,9 @@ pub struct BenchProbesArgs {
     #[command(flatten)]
     pub output: JsonArgs,
 }
+
+/// The frame the lookup is timed on, unless `--width`/`--height` say otherwise.
+const LOOKUP_SIZE: (u32, u32) = (3840, 2160);
 
 /// The passes reported, in this order, with what each one is.
 const REPORTED: [(&str, &str); 6] = [
@@ -111,8 +119,8 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         a.mesh_probes
     );
     // The size for the lookup, unless asked otherwise.
-    a.frame.size.width.get_or_insert(3840);
-    a.frame.size.height.get_or_insert(2160);
+    a.frame.size.width.get_or_insert(LOOKUP_SIZE.0);
+    a.frame.size.height.get_or_insert(LOOKUP_SIZE.1);
     let ResolvedFrame {
         scene,
         settings,
@@ -134,7 +142,7 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         println!("{header}");
     }
     let sky_sh = sky_radiance_sh(&settings)?;
-    let ctx = GpuContext::new(&ContextOptions::from_env())?;
+    let ctx = crate::still::gpu()?;
     let adapter = ctx.describe();
     let has_timestamps = ctx.has(hikari_render::wgpu::Features::TIMESTAMP_QUERY);
     let mut renderer = Renderer::new(ctx, &scene)?;

@@ -21,8 +21,9 @@ use hikari_render::graph::ImageRgba32;
 use hikari_render::{FrameSettings, RenderedFrame, output};
 
 use crate::args::{FrameArgs, JsonArgs};
+use crate::progress::{self, ProgressArgs, Step};
 use crate::scene_source::{self, ResolvedFrame};
-use crate::still;
+use crate::still::{self, ImageFile};
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
@@ -60,6 +61,8 @@ pub struct CompareArgs {
     pub bake: Option<PathBuf>,
     #[command(flatten)]
     pub json: JsonArgs,
+    #[command(flatten)]
+    pub progress: ProgressArgs,
 }
 
 /// The settings tables as TOML.
@@ -195,19 +198,18 @@ fn side_by_side(a: &ImageRgba32, b: &ImageRgba32, map: &nv_flip::FlipImageRgb8) 
 }
 
 /// `frames` frames of `settings` on a renderer of its own; the last one read back, and the
-/// EV100 it was shown at.
+/// EV100 it was shown at. `what` names the run in the progress ("A", "B").
 fn render_view(
     view: &ResolvedFrame,
     settings: &FrameSettings,
     frames: u32,
     bake: Option<&std::path::Path>,
+    what: &str,
 ) -> anyhow::Result<(RenderedFrame, f32)> {
     let mut renderer = still::renderer(view, bake)?;
     still::read_exposure(&mut renderer);
-    for _ in 1..frames {
-        renderer.render(settings, false)?;
-    }
-    let frame = renderer.render(settings, true)?;
+    let mut settings = settings.clone();
+    let frame = still::render_frames(&mut renderer, &mut settings, frames, what, |_, _| {})?;
     let ev100 = still::ev100(&frame)?;
     Ok((frame, ev100))
 }
@@ -217,10 +219,11 @@ fn show(v: &Option<toml::Value>) -> String {
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
-    still::check_output_file("-o", &args.output)?;
+    progress::set_quiet(args.progress.quiet);
+    still::check_image_file("-o", &args.output, ImageFile::Png)?;
     for (flag, p) in [("--exr-a", &args.exr_a), ("--exr-b", &args.exr_b)] {
         if let Some(p) = p {
-            still::check_output_file(flag, p)?;
+            still::check_image_file(flag, p, ImageFile::Exr)?;
         }
     }
     let valid = toggles();
@@ -258,14 +261,14 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
 
     let ((a_frame, ev_a), (b_frame, ev_b)) = if args.own_exposure {
         (
-            render_view(&a, &a.settings, frames, bake)?,
-            render_view(&b, &b.settings, frames, bake)?,
+            render_view(&a, &a.settings, frames, bake, "A")?,
+            render_view(&b, &b.settings, frames, bake, "B")?,
         )
     } else {
         // A's EV100: fixed by its settings, else metered on a first run of A.
         let ev100 = match a.settings.settings.exposure.ev100 {
             Some(ev) => ev,
-            None => render_view(&a, &a.settings, frames, bake)?.1,
+            None => render_view(&a, &a.settings, frames, bake, "A to meter its exposure")?.1,
         };
         if b.settings
             .settings
@@ -281,10 +284,11 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             s
         };
         (
-            render_view(&a, &fixed(&a), frames, bake)?,
-            render_view(&b, &fixed(&b), frames, bake)?,
+            render_view(&a, &fixed(&a), frames, bake, "A")?,
+            render_view(&b, &fixed(&b), frames, bake, "B")?,
         )
     };
+    let step = Step::start(format!("comparing, writing {}", args.output.display()));
 
     let ((a_hdr, a_ldr), (b_hdr, b_ldr)) = (still::images(&a_frame)?, still::images(&b_frame)?);
     let errors = flip(a_ldr, b_ldr);
@@ -299,6 +303,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let (lum_a, lum_b) = (mean_luminance(a_hdr), mean_luminance(b_hdr));
     let ratio = lum_b / lum_a;
     let exposure = if args.own_exposure { "own" } else { "A's" };
+    step.clear();
 
     if args.json.json {
         let settings = |pick: fn(&Difference) -> &Option<toml::Value>| {

@@ -1,10 +1,18 @@
-//! `hikari info`: the GPU adapter, its features and limits.
+//! `hikari info`: the GPU adapter, whether it can run hikari (and if not, which feature it
+//! lacks), its features and limits.
 
 use hikari_render::{ContextOptions, GpuContext};
+
+use crate::gpu_check;
 
 pub fn run() -> anyhow::Result<()> {
     let ctx = GpuContext::new(&ContextOptions::from_env())?;
     println!("adapter:  {}", ctx.describe());
+    let verdict = gpu_check::why_not(&ctx.info.name, ctx.info.backend, ctx.adapter.features());
+    match &verdict {
+        None => println!("hikari:   can run on this adapter (64-bit integer atomics present)"),
+        Some(why) => println!("hikari:   cannot run: {why}"),
+    }
     println!(
         "startup:  {:.1} ms (instance {:.1}, adapter {:.1}, device {:.1})",
         ctx.startup.total().as_secs_f64() * 1e3,
@@ -25,7 +33,11 @@ pub fn run() -> anyhow::Result<()> {
         ctx.limits.max_texture_dimension_3d,
         ctx.limits.max_storage_buffer_binding_size
     );
-    Ok(())
+    // A script can ask `hikari info` whether hikari runs here by its exit status.
+    match verdict {
+        None => Ok(()),
+        Some(_) => anyhow::bail!("this adapter cannot run hikari (see above)"),
+    }
 }
 
 mod wgpu_fmt {

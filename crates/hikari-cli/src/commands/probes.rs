@@ -18,14 +18,21 @@ use hikari_render::techniques::irradiance_probes::gpu_data::ProbeGpuData;
 use hikari_render::techniques::irradiance_probes::{RelightParams, reference};
 use hikari_render::techniques::sky::{self, SkyParams, reference::SkyTwin};
 
-use crate::args::{FrameArgs, JsonArgs};
+use crate::args::{ConfigArgs, FrameArgs, JsonArgs, SceneArgs, SkyArgs};
 use crate::probe_bake;
+use crate::progress::{self, ProgressArgs};
 use crate::scene_source;
 
+/// Only the flags that change what `probes` prints: the scene, its bake, the settings (the
+/// probes' relight) and the sky's instant for the relit irradiance.
 #[derive(Args, Debug)]
 pub struct ProbesArgs {
     #[command(flatten)]
-    pub frame: FrameArgs,
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub sky: SkyArgs,
+    #[command(flatten)]
+    pub config: ConfigArgs,
     /// Bake file to read [default: the cache; baked on a miss].
     #[arg(long)]
     pub bake: Option<PathBuf>,
@@ -34,6 +41,8 @@ pub struct ProbesArgs {
     pub at: Vec<String>,
     #[command(flatten)]
     pub json: JsonArgs,
+    #[command(flatten)]
+    pub progress: ProgressArgs,
 }
 
 fn parse_point(s: &str) -> anyhow::Result<Vec3> {
@@ -110,11 +119,18 @@ fn holder(data: &ProbeGpuData, bake: &hikari_probes::Bake, probe: u32) -> Value 
 }
 
 pub fn run(a: ProbesArgs) -> anyhow::Result<()> {
+    progress::set_quiet(a.progress.quiet);
     let points: Vec<Vec3> =
         a.at.iter()
             .map(|s| parse_point(s))
             .collect::<Result<_, _>>()?;
-    let frame = scene_source::resolve(&a.frame)?;
+    let frame_args = FrameArgs {
+        scene: a.scene.clone(),
+        sky: a.sky.clone(),
+        config: a.config.clone(),
+        ..FrameArgs::default()
+    };
+    let frame = scene_source::resolve(&frame_args)?;
     let bake = probe_bake::for_render(
         &frame.scene,
         &frame.description.source,
@@ -137,7 +153,7 @@ pub fn run(a: ProbesArgs) -> anyhow::Result<()> {
     }
 
     let data = ProbeGpuData::new(&bake);
-    let relit = a.frame.sky.sets_time() || a.frame.sky.weather.is_some();
+    let relit = a.sky.sets_time() || a.sky.weather.is_some();
     let relight = if relit {
         let s = &frame.settings.settings.sky;
         let (params, sizes) = s.table_key().map_err(|e| anyhow::anyhow!("{e}"))?;

@@ -10,9 +10,10 @@ use hikari_render::output;
 use hikari_render::techniques::tonemap::{self, cube::CubeLut, lut_strip, lut_strip::StripLayout};
 
 use crate::args::FrameArgs;
+use crate::progress::{self, ProgressArgs, Step};
 use crate::report;
 use crate::scene_source;
-use crate::still;
+use crate::still::{self, ImageFile};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -57,20 +58,25 @@ pub struct RenderArgs {
     /// grade in a photo editor; `hikari lut extract` reads the grade back (docs/tonemapping.md).
     #[arg(long)]
     pub lut_screenshot: bool,
+    #[command(flatten)]
+    pub progress: ProgressArgs,
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    progress::set_quiet(args.progress.quiet);
     anyhow::ensure!(
         args.dolly.is_finite() && args.dolly.abs() <= 100.0,
         "--dolly {} is outside -100 to 100 metres a frame",
         args.dolly
     );
+    still::check_image_file("-o", &args.output, ImageFile::Png)?;
+    if let Some(exr) = args.exr.as_ref().filter(|_| !args.no_exr) {
+        still::check_image_file("--exr", exr, ImageFile::Exr)?;
+    }
+    let step = Step::start("reading the scene and the settings");
     let resolved = scene_source::resolve(&args.frame)?;
     log::info!("{}", resolved.description.line());
-    still::check_output_file("-o", &args.output)?;
-    if let Some(exr) = args.exr.as_ref().filter(|_| !args.no_exr) {
-        still::check_output_file("--exr", exr)?;
-    }
+    step.done(resolved.description.line());
     let mut settings = resolved.settings.clone();
     let strip_lut = if args.lut_screenshot {
         if StripLayout::for_width(settings.width).is_none() {
@@ -101,20 +107,20 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .unwrap_or_else(|| still::default_frames(&settings.settings));
     let view = settings.camera.clone();
     let forward = view.forward();
-    for f in 1..=frames {
-        if args.dolly != 0.0 {
-            let back = forward * (args.dolly * (frames - f) as f32);
-            settings.prev_camera = (f > 1).then(|| settings.camera.clone());
-            settings.camera.position = view.position - back;
-            settings.camera.target = view.target - back;
+    let dolly = args.dolly;
+    let frame = still::render_frames(&mut renderer, &mut settings, frames, "the view", |f, s| {
+        if dolly != 0.0 {
+            let back = forward * (dolly * (frames - f) as f32);
+            s.prev_camera = (f > 1).then(|| s.camera.clone());
+            s.camera.position = view.position - back;
+            s.camera.target = view.target - back;
         }
-        if f < frames {
-            renderer.render(&settings, false)?;
-        }
-    }
-    let frame = renderer.render(&settings, true)?;
+    })?;
 
     let png = &args.output;
+    let step = Step::start(format!("writing {}", png.display()));
+    // Printed once the step's line is gone, so that stdout and the bar do not mix.
+    let mut wrote = Vec::new();
     let (hdr, ldr) = still::images(&frame)?;
     match &strip_lut {
         Some(lut) => {
@@ -123,14 +129,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
         None => output::write_png(png, ldr)?,
     }
-    println!("wrote {}", png.display());
+    wrote.push(png.display().to_string());
     if !args.no_exr {
         let exr = args
             .exr
             .clone()
             .unwrap_or_else(|| png.with_extension("exr"));
         output::write_exr(&exr, hdr)?;
-        println!("wrote {}", exr.display());
+        wrote.push(exr.display().to_string());
     }
     let dump_dir = args
         .dump_dir
@@ -140,7 +146,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let asked = |name: &str| args.dumps.iter().any(|d| d == name);
     for img in frame.result.images.iter().filter(|i| asked(&i.name)) {
         let p = output::write_dump(&dump_dir, img)?;
-        println!("wrote {}", p.display());
+        wrote.push(p.display().to_string());
     }
     for (name, bytes) in frame.result.buffers.iter().filter(|(n, _)| asked(n)) {
         let p = dump_dir.join(format!("{name}.bin"));
@@ -150,7 +156,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
                 message: e.to_string(),
             })
         })?;
-        println!("wrote {}", p.display());
+        wrote.push(p.display().to_string());
+    }
+    step.clear();
+    for p in wrote {
+        println!("wrote {p}");
     }
     if args.timings {
         report::print_single_frame(&frame.result);

@@ -119,11 +119,7 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
     }
     let params = s.atmosphere().map_err(|e| anyhow::anyhow!("{e}"))?;
     let atmosphere = sky::atmosphere_for(&params, s.table_sizes())?;
-    let mut l = SkyLights::new(&s).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if !s.sky {
-        l.sun.extraterrestrial_lux = 0.0;
-        l.moon.extraterrestrial_lux = 0.0;
-    }
+    let l = SkyLights::new(&s).map_err(|e| anyhow::anyhow!("{e}"))?;
     let params = SkyParams::new(&atmosphere, &l, &s, 0.0);
     let twin = SkyTwin::new(&atmosphere, params);
 
@@ -173,8 +169,8 @@ pub fn run(a: SkyCommandArgs) -> anyhow::Result<()> {
             "illuminance_lux": lux,
         })
     };
-    let sun_lux = if s.sun { l.sun.horizontal_lux() } else { 0.0 };
-    let moon_lux = if s.sun { l.moon.horizontal_lux() } else { 0.0 };
+    let sun_lux = l.sun.horizontal_lux();
+    let moon_lux = l.moon.horizontal_lux();
     if a.json.json {
         let mut moon = body(&l.moon, moon_lux);
         moon["illuminated_fraction"] = json!(l.moon_illuminated_fraction);

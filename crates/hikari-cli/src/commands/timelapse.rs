@@ -2,7 +2,6 @@
 //! on one renderer, so that TAA, the GI's accumulation, the shadow denoiser and the exposure
 //! follow the light as they would on screen; `--count` frames written, evenly spaced.
 
-use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -12,10 +11,13 @@ use clap::Args;
 use hikari_math::astro::DateTime;
 
 use crate::args::FrameArgs;
+use crate::progress::{self, Counter, ProgressArgs};
 use crate::scene_source;
 use crate::still;
 
+/// `--time` is `--from` and `--to` here: hidden from the help (and refused if given).
 #[derive(Args, Debug)]
+#[command(mut_arg("time", |a| a.hide(true)))]
 pub struct TimelapseArgs {
     #[command(flatten)]
     pub frame: FrameArgs,
@@ -46,6 +48,8 @@ pub struct TimelapseArgs {
     /// Irradiance-probe bake file [default: the cache, baked on a miss].
     #[arg(long)]
     pub bake: Option<PathBuf>,
+    #[command(flatten)]
+    pub progress: ProgressArgs,
 }
 
 /// The clock of a time-lapse: the first written frame's date and time and the seconds to the
@@ -85,6 +89,7 @@ impl Span {
 }
 
 pub fn run(args: TimelapseArgs) -> anyhow::Result<()> {
+    progress::set_quiet(args.progress.quiet);
     if let Some(t) = &args.frame.sky.time {
         anyhow::bail!("--time {t}: a time-lapse runs from --from to --to; give those instead");
     }
@@ -115,12 +120,12 @@ pub fn run(args: TimelapseArgs) -> anyhow::Result<()> {
         }
     }
     let digits = (args.count - 1).to_string().len().max(4);
-    let tty = std::io::stderr().is_terminal();
     let started = Instant::now();
     let mut renderer = still::renderer(&resolved, args.bake.as_deref())?;
     renderer.set_frame(settings.clone())?;
     let mut last_time = String::new();
-    for (n, &(fraction, written)) in plan.iter().enumerate() {
+    let bar = Counter::start("rendering the time-lapse", plan.len() as u64, "frames");
+    for &(fraction, written) in &plan {
         let when = span.at(fraction)?;
         let sky = &mut settings.settings.sky;
         sky.date = when.date_string();
@@ -136,24 +141,17 @@ pub fn run(args: TimelapseArgs) -> anyhow::Result<()> {
             still::write_images(&png, (!args.no_exr).then_some(exr.as_path()), &frame)?;
             log::info!("wrote {} ({now})", png.display());
         }
-        last_time = now;
-        if tty {
-            let done = n + 1;
-            let bar: String = (0..30)
-                .map(|i| if i * plan.len() < done * 30 { '#' } else { '.' })
-                .collect();
-            eprint!(
-                "\rtimelapse [{bar}] frame {done}/{} (written {}/{}) {last_time}   ",
-                plan.len(),
-                written.map_or_else(|| "-".to_string(), |k| (k + 1).to_string()),
+        bar.inc();
+        if let Some(k) = written {
+            bar.set_message(format!(
+                "rendering the time-lapse, {} of {} written, at {now}",
+                k + 1,
                 args.count
-            );
-            let _ = std::io::stderr().flush();
+            ));
         }
+        last_time = now;
     }
-    if tty {
-        eprintln!();
-    }
+    bar.done("rendered the time-lapse");
     let first = span.start;
     println!(
         "wrote {} frames{} to {}, {} {} to {last_time}, {} frames rendered in {:.1} s",

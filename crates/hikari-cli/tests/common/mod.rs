@@ -3,9 +3,12 @@
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
+/// `hikari args`, as a script runs it: stderr is a pipe, so no progress is drawn (whatever
+/// `HIKARI_PROGRESS` the test's own environment has).
 pub fn hikari(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_hikari"))
         .args(args)
+        .env_remove("HIKARI_PROGRESS")
         .output()
         .expect("run hikari")
 }

@@ -44,9 +44,10 @@ use variants::parse_variant;
 pub struct RaysArgs {
     // Not `args::SceneArgs`: here `terrain` means issue 5's height field, not the built-in
     // scene of that name, and the default differs.
-    /// `terrain` (issue 5's benchmark), another built-in scene (`village`, `boxes`, ...) or a
-    /// .gltf/.glb file.
-    #[arg(long, default_value = "terrain")]
+    /// `terrain` (the benchmark's own: a 1M-triangle height field, not the built-in scene of
+    /// that name), another built-in scene (village, boxes, cornell, cutout) or a .gltf/.glb
+    /// file.
+    #[arg(long, value_name = "NAME|PATH", default_value = "terrain")]
     pub scene: String,
     /// Rays per workload. The coherent image keeps its 2:1 shape and gets about this many
     /// pixels (4096 x 2048 at the default).

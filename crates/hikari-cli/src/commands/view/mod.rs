@@ -67,7 +67,7 @@ fn check_display() -> anyhow::Result<()> {
 
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.screenshot {
-        still::check_output_file("--screenshot", p)?;
+        still::check_image_file("--screenshot", p, still::ImageFile::Png)?;
     }
     check_display()?;
     let resolved = scene_source::resolve(&args.frame)?;
