@@ -254,24 +254,38 @@ fn scrolled_shadow_maps_hold_what_a_full_redraw_draws() {
 
 #[test]
 fn a_sun_turned_less_than_the_hold_keeps_the_cached_maps() {
-    use hikari_render::techniques::sun_shadows::{HELD_SUN_DEG, ShadowCache};
+    use hikari_render::techniques::sun_shadows::{
+        HELD_SUN_DEG, HOLD_CASTER_M, ShadowCache, hold_deg,
+    };
     let s = hikari_render::techniques::sun_shadows::settings::SunShadowsSettings::default();
     assert!(s.cache, "the hold applies with caching on, the default");
     let a = glam::Vec3::new(0.3, 0.8, 0.2).normalize();
     let axis = a.cross(glam::Vec3::X).normalize();
     let turned = |deg: f32| glam::Quat::from_axis_angle(axis, deg.to_radians()) * a;
+    let hold = HELD_SUN_DEG;
     let mut cache = ShadowCache::default();
-    assert_eq!(cache.held_sun(a, &s), a);
-    // Below the hold the maps keep the direction they were drawn for...
-    assert_eq!(cache.held_sun(turned(0.5 * HELD_SUN_DEG), &s), a);
-    assert_eq!(cache.held_sun(turned(0.9 * HELD_SUN_DEG), &s), a);
-    // ...past it they follow the sun, and hold from there.
-    let past = turned(1.5 * HELD_SUN_DEG);
-    assert!((cache.held_sun(past, &s) - past).length() < 1e-6);
-    assert!((cache.held_sun(turned(1.6 * HELD_SUN_DEG), &s) - past).length() < 1e-6);
+    assert_eq!(cache.held_sun(0, a, hold, &s), a);
+    // Below the hold the cascade keeps the direction it was drawn for...
+    assert_eq!(cache.held_sun(0, turned(0.5 * hold), hold, &s), a);
+    assert_eq!(cache.held_sun(0, turned(0.9 * hold), hold, &s), a);
+    // ...past it, it follows the sun, and holds from there.
+    let past = turned(1.5 * hold);
+    assert!((cache.held_sun(0, past, hold, &s) - past).length() < 1e-6);
+    assert!((cache.held_sun(0, turned(1.6 * hold), hold, &s) - past).length() < 1e-6);
+    // Each cascade holds its own: a coarse one (a longer hold) keeps what it was drawn for
+    // where the fine one above moved on.
+    let coarse = hold_deg(0.5);
+    assert_eq!(cache.held_sun(3, a, coarse, &s), a);
+    assert_eq!(cache.held_sun(3, turned(1.6 * hold), coarse, &s), a);
     // Without caching every frame draws for the sun as it is.
     let uncached =
         hikari_render::techniques::sun_shadows::settings::SunShadowsSettings { cache: false, ..s };
-    let b = turned(0.5 * HELD_SUN_DEG);
-    assert!((cache.held_sun(b, &uncached) - b).length() < 1e-6);
+    let b = turned(0.5 * hold);
+    assert!((cache.held_sun(0, b, hold, &uncached) - b).length() < 1e-6);
+    // The hold: at least a tenth of a degree, and the turn that moves a 10 m caster's shadow
+    // by half a texel where texels are coarse.
+    assert_eq!(hold_deg(0.005), HELD_SUN_DEG);
+    let half_texel = HOLD_CASTER_M * hold_deg(0.5).to_radians().tan();
+    assert!((half_texel - 0.25).abs() < 1e-4, "{half_texel}");
+    assert!(hold_deg(0.5) > 1.0 && hold_deg(0.5) < 2.0);
 }

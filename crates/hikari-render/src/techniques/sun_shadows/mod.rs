@@ -256,16 +256,27 @@ pub fn depth_range(to_sun: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
 pub struct ShadowCache {
     /// The cascade each slice of the persistent maps holds.
     drawn: Vec<Option<Cascade>>,
-    /// The direction to the sun the maps were drawn for.
-    sun: Option<Vec3>,
+    /// The direction to the sun each cascade was drawn for.
+    sun: Vec<Option<Vec3>>,
 }
 
-/// A sun (or moon) that turned less than this since the cached maps were drawn keeps them: the
-/// shadows stay where they were drawn until it has turned this far. A tenth of a degree is a
+/// A sun (or moon) that turned less than this since a cascade was drawn keeps it: its shadows
+/// stay where they were drawn until the sun has turned this far. A tenth of a degree is a
 /// fifth of the sun's own disk (0.53°), whose penumbra is wider than the shift; a playing clock
-/// turns the sun by this in 24 s of its time, so the maps are redrawn every few frames rather
+/// turns the sun by this in 24 s of its time, so cascades are redrawn every few frames rather
 /// than every frame.
 pub const HELD_SUN_DEG: f32 = 0.1;
+
+/// The caster height whose shadow a held cascade may shift by at most half a texel: coarse
+/// cascades, whose texels are larger, hold the sun longer ([`hold_deg`]).
+pub const HOLD_CASTER_M: f32 = 10.0;
+
+/// How far the sun may turn before a cascade of `texel_world`-metre texels is redrawn: the
+/// larger of [`HELD_SUN_DEG`] and the turn that moves the shadow of a [`HOLD_CASTER_M`] caster
+/// by half a texel.
+pub fn hold_deg(texel_world: f32) -> f32 {
+    HELD_SUN_DEG.max((0.5 * texel_world / HOLD_CASTER_M).atan().to_degrees())
+}
 
 /// Part of a cascade to draw this frame: its texels x0..x1, y0..y1 (ends exclusive).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -305,14 +316,23 @@ fn uncovered(held: IVec2, want: IVec2, res: u32) -> Vec<[u32; 4]> {
 }
 
 impl ShadowCache {
-    /// The direction to draw and look up the maps with this frame: the one they hold while
-    /// `to_sun` is within [`HELD_SUN_DEG`] of it (with caching on), else `to_sun`.
-    pub fn held_sun(&mut self, to_sun: Vec3, s: &SunShadowsSettings) -> Vec3 {
+    /// The direction to draw and look up `cascade` with this frame: the one it holds while
+    /// `to_sun` is within `hold_deg` of it (with caching on), else `to_sun`.
+    pub fn held_sun(
+        &mut self,
+        cascade: usize,
+        to_sun: Vec3,
+        hold_deg: f32,
+        s: &SunShadowsSettings,
+    ) -> Vec3 {
+        if self.sun.len() <= cascade {
+            self.sun.resize(cascade + 1, None);
+        }
         let want = to_sun.normalize_or_zero();
-        match self.sun {
-            Some(held) if s.cache && held.dot(want) >= HELD_SUN_DEG.to_radians().cos() => held,
+        match self.sun[cascade] {
+            Some(held) if s.cache && held.dot(want) >= hold_deg.to_radians().cos() => held,
             _ => {
-                self.sun = Some(want);
+                self.sun[cascade] = Some(want);
                 want
             }
         }
@@ -403,8 +423,21 @@ impl SunShadows {
                 });
             }
         };
-        let to_sun = cache.held_sun(to_sun, s);
-        let cascades = fit_cascades(camera, aspect, to_sun, bounds, s);
+        // Each cascade fitted for the sun it holds (the sun as it is when it has turned past
+        // the cascade's hold).
+        let fitted = fit_cascades(camera, aspect, to_sun, bounds, s);
+        let cascades: Vec<Cascade> = fitted
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let sun = cache.held_sun(i, to_sun, hold_deg(c.texel_world), s);
+                if sun == to_sun.normalize_or_zero() {
+                    *c
+                } else {
+                    fit_cascades(camera, aspect, sun, bounds, s)[i]
+                }
+            })
+            .collect();
         let res = s.resolution as u64;
         let (texels, fresh_texels) =
             g.persistent_buffer("sun_shadows.texels", res * res * cascades.len() as u64 * 4)?;
