@@ -12,7 +12,9 @@
 //! the camera moves and a cascade's centre moves by whole texels, only the strips it uncovers
 //! are drawn ([`ShadowCache`]); every cascade is always where the camera wants it. The whole
 //! cascade is drawn when it is new or when the sun or the settings change its shape
-//! (`sun_shadows.cache = false`: every frame). The rasteriser's atomics need a buffer; what was
+//! (`sun_shadows.cache = false`: every frame); a sun that turns by less than the cascade's
+//! hold ([`hold_deg`]: 0.1° or half a texel of a 10 m caster's shadow, whichever is more)
+//! keeps the cascade, so a playing clock redraws each cascade every few frames. The rasteriser's atomics need a buffer; what was
 //! drawn is then copied into a layer of an R32Uint texture array, which the lookup gathers
 //! 2x2 texels at a time from (a quarter of the loads, and a texture cache laid out for 2D
 //! neighbourhoods), through a repeating sampler that does the wrap-around.
