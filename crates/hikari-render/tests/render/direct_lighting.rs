@@ -43,7 +43,7 @@ fn lit_boxes() -> hikari_scene::Scene {
 
 fn settings_for(scene: &hikari_scene::Scene, w: u32, h: u32) -> FrameSettings {
     let mut s = common::small_frame_settings(scene, w, h);
-    // The twin is of this pass alone: the area lights (tests/render/area_lights.rs) off, so the point
+    // The twin is of this pass alone: the area lights (tests/render/area_lights/) off, so the point
     // and spot lights stay here, unshadowed.
     s.settings.area_lights.enabled = false;
     s

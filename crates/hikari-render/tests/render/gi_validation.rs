@@ -218,7 +218,7 @@ fn cornell_gi_flip(frames: &[u32]) -> Vec<f32> {
     // One bounce, as the reference: hits on screen reuse last frame's lit image, which holds
     // last frame's GI too, so with it the estimate converges towards every bounce (1.04 to
     // 1.10 of Mitsuba's luminance after 16 frames); computing every hit's light keeps it to
-    // one. The reuse is checked against computed light in `tests/render/ray_traced_gi.rs`.
+    // one. The reuse is checked against computed light in `tests/render/ray_traced_gi/`.
     s.settings.ray_traced_gi.reuse_lit = false;
     let kept = render_frames(&s, *frames.iter().max().unwrap(), frames).hdr;
     let k = exposure_of(&mitsuba);

@@ -82,7 +82,7 @@ pub fn small_frame_settings(
     settings.sun_shadows.max_distance_m = 40.0;
     // The atmosphere has its own tests (tests/sky.rs); here the placeholders light the frame.
     settings.sky.enabled = false;
-    // Ray-traced GI has its own tests (tests/ray_traced_gi.rs, gi_validation.rs): here the
+    // Ray-traced GI has its own tests (tests/render/ray_traced_gi/, gi_validation.rs): here the
     // frame's other techniques are checked against their twins, which leave it out.
     settings.ray_traced_gi.enabled = false;
     // The haze and the clouds have their own tests (tests/haze.rs, clouds.rs), which hold the
