@@ -113,7 +113,7 @@ pub fn struct_differences(l: &StructLayout, module: &naga::Module) -> Vec<String
     }
     // A uniform's size must be a multiple of its alignment for arrays and bindings.
     let align = layouter[handle].alignment.round_up(1) as usize;
-    if l.size % align != 0 {
+    if !l.size.is_multiple_of(align) {
         failures.push(format!(
             "{}: size {} not a multiple of alignment {align}",
             l.name, l.size

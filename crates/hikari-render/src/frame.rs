@@ -240,14 +240,14 @@ pub fn record<'r>(
     let probes = t.irradiance_probes.record(
         g,
         &mut state.techniques.irradiance_probes,
+        cx,
         &s.settings.irradiance_probes,
         &sky,
         clouds.lookup,
-        sun,
-        s.camera.position,
     )?;
 
-    // 6. Reflection probes (after the clouds, which shadow and cover their sky): captured once, this frame's share relit and prefiltered.
+    // 6. Reflection probes (after the clouds, which shadow and cover their sky): captured
+    //    once, this frame's share relit and prefiltered.
     let reflection_probes = t.reflection_probes.record(
         g,
         &mut state.techniques.reflection_probes,

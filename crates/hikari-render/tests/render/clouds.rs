@@ -637,6 +637,9 @@ fn the_map_is_as_fine_as_the_view_needs() {
     assert!(map_size_for(&s, 72, 20.0) > map_size_for(&s, 72, 90.0));
     for h in [1u32, 7, 100, 333] {
         let n = map_size_for(&s, h, 50.0);
-        assert!(n % 16 == 0 && (16..=s.map_size).contains(&n), "{h}: {n}");
+        assert!(
+            n.is_multiple_of(16) && (16..=s.map_size).contains(&n),
+            "{h}: {n}"
+        );
     }
 }

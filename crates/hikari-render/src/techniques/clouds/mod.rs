@@ -238,7 +238,7 @@ pub fn march_rows(size: u32, slices: u32, frame: u64) -> Option<[u32; 2]> {
         .div_ceil(rows)
         .clamp(1, n);
     let grouped = (n / k).max(1);
-    (frame % u64::from(k) == 0).then(|| {
+    frame.is_multiple_of(u64::from(k)).then(|| {
         [
             grouped,
             ((frame / u64::from(k)) % u64::from(grouped)) as u32,

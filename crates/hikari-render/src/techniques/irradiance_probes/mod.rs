@@ -238,24 +238,24 @@ impl IrradianceProbes {
         })
     }
 
-    /// Relights this frame's share of the probes and makes the lookup's binding set.
-    /// `light` is the frame's sun or moon; `camera` the camera's position (metres).
+    /// Relights this frame's share of the probes, lit by the frame context's sun or moon and
+    /// chosen around its camera, and makes the lookup's binding set.
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
         state: &mut IrradianceProbesState,
+        cx: &crate::frame_context::FrameContext,
         s: &IrradianceProbesSettings,
         sky: &SkyFrame,
         clouds: BindingSet,
-        light: Option<&Sun>,
-        camera: Vec3,
     ) -> Result<ProbesFrame> {
+        let light = cx.sun.as_ref();
+        let camera = Vec3::from_slice(&cx.view.position[..3]);
         let (u, update) = {
-            let st = state;
-            match (&st.uploaded, s.enabled && sky.enabled) {
+            match (&state.uploaded, s.enabled && sky.enabled) {
                 (Some(u), true) => {
-                    let out = (u.clone(), Some(st.updates));
-                    st.updates += 1;
+                    let out = (u.clone(), Some(state.updates));
+                    state.updates += 1;
                     out
                 }
                 _ => (self.empty.clone(), None),
