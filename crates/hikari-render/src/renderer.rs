@@ -570,20 +570,24 @@ impl Renderer {
                 .raster_queues
                 .grow(&result, binding_limit)?
                 .is_empty();
+            // Interactive frames (the runtime does not wait for their counts) are shown as drawn.
+            let shown = !overflowed || !self.runtime.waits_for_readbacks();
+            if !shown {
+                // Drawn again: the techniques start from their states before this try.
+                self.runtime.discard_frame();
+                self.state.techniques = before;
+            }
             if overflowed {
                 // Cascades and cube maps drawn into an overflowing queue lack triangles: draw
-                // them all again.
+                // them all again (after the restore above, which would undo it).
                 self.state.shadow_cache = Default::default();
                 self.state.techniques.reflection_probes.invalidate_capture();
             }
-            // Interactive frames (the runtime does not wait for their counts) are shown as drawn.
-            if !overflowed || !self.runtime.waits_for_readbacks() {
+            if shown {
                 self.runtime.commit_frame();
                 self.last_context = Some(cx);
                 return Ok(result);
             }
-            self.runtime.discard_frame();
-            self.state.techniques = before;
         }
         Err(RenderError::Graph(format!(
             "the rasteriser's queues still overflowed after {MAX_QUEUE_RETRIES} tries"
