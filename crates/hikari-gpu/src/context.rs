@@ -88,6 +88,8 @@ pub struct GpuContext {
     /// and about a second a frame. Storage loads are never inlined. `HIKARI_UNIFORMS_AS_STORAGE`
     /// (`1` or `0`) overrides the choice.
     pub uniforms_as_storage: bool,
+    /// Errors the device raised after the fact, and its loss ([`crate::faults`]).
+    pub faults: crate::faults::GpuFaults,
     shared: Arc<Mutex<SharedValues>>,
 }
 
@@ -176,8 +178,10 @@ impl GpuContext {
             _ => inlines_uniforms(&info),
         };
 
+        let faults = crate::faults::GpuFaults::install(&device);
         Ok(Self {
             shared: Arc::default(),
+            faults,
             uniforms_as_storage,
             instance,
             adapter,
@@ -310,10 +314,48 @@ impl GpuContext {
     }
 
     /// Blocks until the GPU is idle.
+    /// A GPU that has not finished after [`GpuContext::wait_limit`] is taken for hung: the
+    /// wait ends with an error rather than never. A lost device ends it at once.
+    /// Other errors the device raised stay recorded for the frame's own check.
     pub fn wait_idle(&self) -> Result<(), RenderError> {
+        let lost = |reason| RenderError::DeviceLost {
+            during: "waiting for the GPU".into(),
+            reason,
+        };
+        let limit = self.wait_limit();
         self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| RenderError::Device(e.to_string()))
+            .poll(wgpu::PollType::Wait {
+                submission_index: None,
+                timeout: Some(limit),
+            })
+            .map_err(|e| {
+                if let Some(why) = self.faults.lost() {
+                    return lost(why);
+                }
+                match e {
+                    wgpu::PollError::Timeout => RenderError::Gpu {
+                        during: "waiting for the GPU".into(),
+                        message: format!(
+                            "the GPU did not finish its work in {} s; it may have hung",
+                            limit.as_secs()
+                        ),
+                    },
+                    e => RenderError::Device(e.to_string()),
+                }
+            })?;
+        match self.faults.lost() {
+            Some(why) => Err(lost(why)),
+            None => Ok(()),
+        }
+    }
+
+    /// How long one wait for the GPU may take: a real GPU resets itself after seconds when a
+    /// submission hangs (the driver then reports the device lost); a CPU driver renders a large
+    /// frame in minutes.
+    pub fn wait_limit(&self) -> Duration {
+        match self.info.device_type {
+            wgpu::DeviceType::Cpu => Duration::from_secs(3600),
+            _ => Duration::from_secs(120),
+        }
     }
 }

@@ -57,6 +57,18 @@ pub enum RenderError {
     #[error("GPU error during {during}: {message}")]
     Gpu { during: String, message: String },
 
+    /// The GPU ran out of memory: the last change asked for more than it has.
+    #[error("the GPU ran out of memory during {during}: {message}")]
+    OutOfMemory { during: String, message: String },
+
+    /// The device is gone (a driver reset, a removed GPU, a timeout): nothing more renders
+    /// on it.
+    #[error(
+        "the GPU device was lost during {during} ({reason}); nothing more can render on it: \
+         restart hikari (a driver reset or a GPU timeout causes this)"
+    )]
+    DeviceLost { during: String, reason: String },
+
     #[error("writing {path}: {message}")]
     Output { path: String, message: String },
 }

@@ -23,7 +23,7 @@ pub mod view;
 
 pub use error::{RenderError, Result};
 pub use frame_context::{FrameContext, FrameSettings, HistoryReset, SunSource};
-pub use hikari_gpu::{ContextOptions, GpuContext, context, graph, pipeline};
+pub use hikari_gpu::{ContextOptions, GpuContext, context, faults, graph, pipeline};
 pub use renderer::{Display, DisplayedFrame, RenderedFrame, Renderer};
 pub use settings::{Preset, Settings};
 pub use wgpu;

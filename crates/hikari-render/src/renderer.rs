@@ -498,6 +498,12 @@ impl Renderer {
             _ => settings,
         };
         self.validate(settings)?;
+        if let Some(why) = self.ctx.faults.lost() {
+            return Err(RenderError::DeviceLost {
+                during: "starting a frame".into(),
+                reason: why,
+            });
+        }
         if settings.settings.ray_traced_gi.enabled && self.state.rtgi_scene.is_none() {
             let rtgi =
                 crate::techniques::ray_traced_gi::RtGiScene::new(&self.ctx, &self.scene_source)?;
@@ -565,6 +571,14 @@ impl Renderer {
                 g.readback(r);
             }
             let result = g.execute_uncommitted()?;
+            // Errors the device raised while recording or running the frame (out of memory,
+            // a lost device): the frame is dropped and the states stay as they were, so the
+            // caller can change back what asked too much and go on.
+            if let Err(e) = self.ctx.faults.check(&format!("frame {}", cx.frame_index)) {
+                self.runtime.discard_frame();
+                self.state.techniques = before;
+                return Err(e);
+            }
             let overflowed = !self
                 .state
                 .raster_queues

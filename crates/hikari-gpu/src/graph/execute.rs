@@ -6,6 +6,7 @@
 
 use std::time::Instant;
 
+use super::poison;
 use super::readback::{self, ImageRgba32};
 use super::resources::{PhysicalBuffer, ViewKey};
 use super::runtime::{FrameResult, GraphRuntime, TimestampMode};
@@ -47,7 +48,7 @@ pub(crate) fn execute(mut g: FrameGraph<'_>, commit: bool) -> Result<FrameResult
         .create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("hikari.frame"),
         });
-    let encoded = encode_passes(
+    let mut encoded = encode_passes(
         rt,
         ctx,
         &mut encoder,
@@ -71,6 +72,8 @@ pub(crate) fn execute(mut g: FrameGraph<'_>, commit: bool) -> Result<FrameResult
     let cpu_encode_us = t_start.elapsed().as_secs_f64() * 1e6;
     ctx.queue.submit([encoder.finish()]);
 
+    let reads = std::mem::take(&mut encoded.reads);
+    let poisoned = encoded.poisoned.take();
     let (timings, gpu_span_ms) = read_timings(rt, ctx, &timing, encoded)?;
     let (images, mut out_buffers) = read_back(ctx, staging, &textures, &buffers)?;
     out_buffers.extend(collect_late(rt, ctx)?);
@@ -96,6 +99,8 @@ pub(crate) fn execute(mut g: FrameGraph<'_>, commit: bool) -> Result<FrameResult
         images,
         buffers: out_buffers,
         allocations,
+        reads,
+        poisoned,
     };
     if commit {
         rt.commit_frame();
@@ -355,6 +360,8 @@ impl Lifetimes {
 struct Encoded {
     passes: Vec<(String, Option<u32>, f64)>,
     slots: u32,
+    reads: Vec<poison::PassReads>,
+    poisoned: Option<poison::Poison>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -372,6 +379,8 @@ fn encode_passes(
     let mut out = Vec::with_capacity(n);
     let mut slot = 0u32;
     let mut open_compute: Option<wgpu::ComputePass<'static>> = None;
+    let mut reads_out = Vec::new();
+    let mut poisoned = None;
     for (i, pass) in passes.into_iter().enumerate() {
         let PassNode {
             name,
@@ -380,6 +389,29 @@ fn encode_passes(
             set_bindings,
         } = pass;
         lifetimes.acquire(i, rt, ctx, textures, buffers);
+        let info = match &kind {
+            PassKind::Compute { pipeline, .. } => Some(&pipeline.info),
+            PassKind::Raster { pipeline, .. } => Some(&pipeline.info),
+            PassKind::Encoder { .. } => None,
+        };
+        if let Some(info) = info.filter(|_| rt.record_reads || rt.poison.is_some()) {
+            let reads = poison::reads_of(&name, info, &bindings, &set_bindings, textures);
+            let target = rt.poison.as_ref().filter(|p| p.pass == name).and_then(|p| {
+                textures
+                    .iter()
+                    .position(|v| v.name == p.texture)
+                    .filter(|_| reads.textures.iter().any(|r| r.name == p.texture))
+            });
+            if let Some(t) = target {
+                drop(open_compute.take());
+                if poison::poison(ctx, encoder, &textures[t]) {
+                    poisoned = rt.poison.take();
+                }
+            }
+            if rt.record_reads {
+                reads_out.push(reads);
+            }
+        }
         let tp = Instant::now();
         let res = PassResources { textures, buffers };
         let timed = is_timed(&kind);
@@ -504,6 +536,8 @@ fn encode_passes(
     Encoded {
         passes: out,
         slots: slot,
+        reads: reads_out,
+        poisoned,
     }
 }
 

@@ -20,11 +20,13 @@
 //! memory may have held another texture a moment ago.
 
 mod execute;
+mod poison;
 mod readback;
 mod resources;
 mod runtime;
 mod timing;
 
+pub use poison::{PassReads, Poison, ReadTexture};
 pub use readback::ImageRgba32;
 pub use resources::{Buf, PoolStats, Res, Tex, TextureDesc};
 pub use runtime::{FrameResult, GraphRuntime, History, TimestampMode};

@@ -38,6 +38,11 @@ pub struct FrameResult {
     pub buffers: Vec<(String, Vec<u8>)>,
     /// Which physical texture each used texture got, by name: equal ids share memory.
     pub allocations: Vec<(String, u64)>,
+    /// What each pass read, with [`GraphRuntime::set_record_reads`].
+    pub reads: Vec<super::PassReads>,
+    /// The texture overwritten with NaN and infinities this frame
+    /// ([`GraphRuntime::poison_next_frame`]), if the pass and texture were found.
+    pub poisoned: Option<super::Poison>,
 }
 
 impl FrameResult {
@@ -94,6 +99,8 @@ pub struct GraphRuntime {
     pub(crate) wait_for_readbacks: bool,
     /// Late read-backs in flight: name, staging buffer, set once it is mapped.
     pub(crate) pending: Vec<(String, wgpu::Buffer, Arc<std::sync::atomic::AtomicBool>)>,
+    pub(crate) record_reads: bool,
+    pub(crate) poison: Option<super::Poison>,
 }
 
 /// How much of the frame gets GPU timestamps.
@@ -137,7 +144,21 @@ impl GraphRuntime {
             dumps: Vec::new(),
             wait_for_readbacks: true,
             pending: Vec::new(),
+            record_reads: false,
+            poison: None,
         }
+    }
+
+    /// Lists what each pass reads in every frame's [`FrameResult::reads`] (costs CPU time:
+    /// for tests and the soak).
+    pub fn set_record_reads(&mut self, on: bool) {
+        self.record_reads = on;
+    }
+
+    /// Overwrites `poison.texture` with NaN, +Inf and -Inf before `poison.pass` runs in the
+    /// next frame that has both ([`FrameResult::poisoned`] tells when it happened).
+    pub fn poison_next_frame(&mut self, poison: super::Poison) {
+        self.poison = Some(poison);
     }
 
     /// Whether `execute` waits for [`FrameGraph::readback_late`] buffers (the default, for

@@ -13,6 +13,7 @@ mod common;
 mod debug_view;
 mod direct_lighting;
 mod exposure;
+mod faults;
 mod frame;
 mod gbuffer;
 mod gi_denoiser;
