@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    bake, bench_frame, bench_overhead, bench_probes, bench_rays, compare, constants, info, lut,
+    bake, bench_frame, bench_overhead, bench_probes, bench_rays, bench_soak, compare, constants, info, lut,
     probes, render, sky, timelapse, view,
 };
 
@@ -76,6 +76,9 @@ enum BenchCommand {
     /// The irradiance probes' relight (73 grid tiles, a 5000-probe mesh) and lookup (every
     /// pixel), each timed on its own.
     Probes(Box<bench_probes::BenchProbesArgs>),
+    /// Many frames through the live path (clock, switches, camera cuts, resizes, scene
+    /// reloads): memory sampled each cycle must stay flat, every output finite.
+    Soak(Box<bench_soak::SoakArgs>),
 }
 
 /// Mesa's drivers complain on every start when XDG_RUNTIME_DIR is unset (containers, CI);
@@ -110,6 +113,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Overhead(args)) => bench_overhead::run(args),
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
         Command::Bench(BenchCommand::Probes(args)) => bench_probes::run(*args),
+        Command::Bench(BenchCommand::Soak(args)) => bench_soak::run(*args),
         Command::Constants(args) => constants::run(args),
         Command::Info => info::run(),
         Command::Lut(command) => lut::run(command),

@@ -951,3 +951,26 @@ fn sky_runs_in_either_colour_space() {
     };
     assert_ne!(run("lms_rayleigh"), run("rec709"));
 }
+
+/// The soak's CI version: two cycles (the first the warm-up) through the live path, with a
+/// NaN written each cycle; memory flat, outputs finite. The 10,000-frame run is in
+/// docs/reliability.md.
+#[test]
+fn bench_soak_keeps_memory_flat_through_the_live_path() {
+    let o = hikari(&[
+        "bench", "soak", "--scene", "boxes", "--width", "16", "--height", "12", "--frames",
+        "128", "--cycle", "64", "--poison", "--preset", "low", "--json",
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["flat"], true, "{v}");
+    assert_eq!(v["samples"].as_array().unwrap().len(), 2, "{v}");
+    assert_eq!(v["poisoned"], 2, "{v}");
+    for s in v["samples"].as_array().unwrap() {
+        assert!(s["resident_mb"].as_f64().unwrap() > 10.0, "{v}");
+    }
+    let switches = v["switches"].as_array().unwrap();
+    for t in ["taa", "ray_traced_gi", "exposure"] {
+        assert!(switches.iter().any(|s| s == t), "`{t}` not switched: {v}");
+    }
+}

@@ -6,6 +6,9 @@
 //! exits with status 0 and `--screenshot` is written. `./x test` installs Xvfb, xdotool and
 //! xwd (x11-apps); this test fails, not skips, without them.
 //!
+//! A fault switch makes the surface lost once and the GPU run out of memory after a settings
+//! change: the viewer makes a new surface, goes back to the settings before, and goes on.
+//!
 //! Also: without a display, `hikari view` says which variables are unset and how to get one.
 
 use std::io::{BufRead, BufReader};
@@ -218,6 +221,9 @@ fn start_viewer(x: &Xvfb, dir: &Path) -> Viewer {
         .env_remove("WAYLAND_DISPLAY")
         .env("XDG_CACHE_HOME", dir.join("cache"))
         .env("RUST_LOG", "hikari::commands::view=info")
+        // The surface is taken for lost at the 8th paint, and the GPU for out of memory after
+        // the second settings change: the viewer must make a new surface and go back.
+        .env("HIKARI_VIEW_FAULT", "surface-lost@8,oom@change-2")
         .args([
             "view",
             "--scene",
@@ -324,6 +330,22 @@ fn the_viewer_is_driven_by_keys_and_mouse_and_exits_on_esc() {
     v.wait_log("ray-traced GI off", Duration::from_secs(30));
     let d = v.settle_and_capture(settle);
     changed("T (ray-traced GI off)", &c2, &d, &v.lines);
+
+    // T again, with the GPU out of memory after it (the fault switch): the viewer goes back
+    // to the settings before it, GI off, and goes on.
+    v.key("t");
+    v.wait_log("went back to the settings before the last change", Duration::from_secs(60));
+    v.frames(2);
+    // Back means GI off: the next T turns it on.
+    v.key("t");
+    v.wait_log("ray-traced GI on", Duration::from_secs(30));
+    v.key("t");
+    v.wait_log("ray-traced GI off", Duration::from_secs(30));
+    let d = v.settle_and_capture(settle);
+    // The surface lost at the 8th paint was made anew, and frames went on.
+    if !v.lines.iter().any(|l| l.contains("surface was lost; made a new one")) {
+        v.wait_log("surface was lost; made a new one", Duration::from_secs(10));
+    }
 
     // ]: the clock 30 minutes on, four times: the light changes.
     for _ in 0..4 {

@@ -261,3 +261,19 @@ fn hikari_fuzz_glb_fixup(data: &[u8]) -> Vec<u8> {
     b[8..12].copy_from_slice(&len.to_le_bytes());
     b
 }
+
+/// Found by `lut_strip_png` on the H200's 16 cores (session 21): a palette PNG with two PLTE
+/// chunks whose lengths are not whole RGB entries made `png` 0.18.1 panic
+/// (`decoder/transform/palette.rs:74`, a slice out of range). Now an error naming the chunk.
+#[test]
+fn a_png_with_two_partial_palettes_is_an_error() {
+    let data = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/regressions/lut_strip_png/two_palettes_of_partial_entries.png"),
+    )
+    .unwrap();
+    let Err(e) = hikari_render::techniques::tonemap::lut_strip::decode_png(&data, "x.png") else {
+        panic!("accepted")
+    };
+    assert!(e.to_string().contains("PLTE (palette) chunk"), "{e}");
+}

@@ -7,6 +7,7 @@ pub mod bench_frame;
 pub mod bench_overhead;
 pub mod bench_probes;
 pub mod bench_rays;
+pub mod bench_soak;
 pub mod compare;
 pub mod constants;
 pub mod info;

@@ -65,6 +65,27 @@ struct Live {
     last_rays: Instant,
     screenshot: bool,
     drop: Option<PathBuf>,
+    /// The settings before the last change, until a frame has rendered with the new ones: an
+    /// out-of-memory frame goes back to them.
+    undo: Option<Settings>,
+    changes: u64,
+}
+
+/// Applies a settings change, keeping what it replaced for [`Live::undo`].
+fn change_settings(live: &mut Live, s: Settings) -> hikari_render::Result<()> {
+    let before = live.renderer.live_frame().expect("set").settings.clone();
+    live.renderer.set_settings(s)?;
+    live.undo = Some(before);
+    live.changes += 1;
+    if super::faults::oom_on_change() == Some(live.changes) {
+        live.renderer
+            .ctx
+            .faults
+            .record(hikari_render::faults::Fault::OutOfMemory(
+                "pretended by HIKARI_VIEW_FAULT".into(),
+            ));
+    }
+    Ok(())
 }
 
 pub struct App {
@@ -245,6 +266,8 @@ impl App {
             last_rays: now - RAYS_EVERY,
             screenshot: false,
             drop: None,
+            undo: None,
+            changes: 0,
             renderer,
         });
     }
@@ -276,7 +299,7 @@ impl App {
                         let mut s = live.renderer.live_frame().unwrap().settings.clone();
                         s.ray_traced_gi.enabled = !s.ray_traced_gi.enabled;
                         let on = s.ray_traced_gi.enabled;
-                        let r = live.renderer.set_settings(s);
+                        let r = change_settings(live, s);
                         live.stats.clear_passes();
                         match r {
                             Ok(()) => self.say(
@@ -470,6 +493,7 @@ impl App {
         let mut gpu_span = None;
         match shown {
             Ok(shown) => {
+                live.undo = None;
                 live.names = shown.names;
                 let r = &shown.result;
                 gpu_span = r.gpu_span_ms.filter(|_| timed);
@@ -484,6 +508,16 @@ impl App {
                 if rays {
                     live.stats.rays = ray_stats(r, f.width as u64 * f.height as u64);
                 }
+            }
+            Err(e @ hikari_render::RenderError::OutOfMemory { .. }) if live.undo.is_some() => {
+                let back = live.renderer.set_settings(live.undo.take().unwrap());
+                messages.push((
+                    match back {
+                        Ok(()) => format!("{e}; went back to the settings before the last change"),
+                        Err(b) => format!("{e}; going back to the settings before failed: {b}"),
+                    },
+                    true,
+                ));
             }
             Err(e) => messages.push((format!("frame: {e}"), true)),
         }
@@ -557,7 +591,7 @@ impl App {
         }
         if settings != live_settings {
             let switched = settings.switches() != live_settings.switches();
-            match live.renderer.set_settings(settings.clone()) {
+            match change_settings(live, settings.clone()) {
                 Ok(()) => {
                     if switched {
                         live.stats.clear_passes();

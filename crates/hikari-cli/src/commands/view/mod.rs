@@ -4,10 +4,12 @@
 //! * `camera`: the fly camera; `keys`: the key bindings;
 //! * `panel`: the panel's state and edits; `ui`: its widgets (egui);
 //! * `present`: the surface, the frame's picture and egui's paint;
-//! * `stats`: the numbers; `shot`: screenshot names.
+//! * `stats`: the numbers; `shot`: screenshot names;
+//! * `faults`: the fault switch that tests the viewer's recovery (`HIKARI_VIEW_FAULT`).
 
 mod app;
 mod camera;
+mod faults;
 mod keys;
 mod panel;
 mod present;

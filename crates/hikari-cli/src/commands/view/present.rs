@@ -24,6 +24,9 @@ struct UiTimer {
 }
 
 pub struct Presenter {
+    instance: wgpu::Instance,
+    adapter: wgpu::Adapter,
+    window: Arc<Window>,
     device: wgpu::Device,
     queue: wgpu::Queue,
     surface: wgpu::Surface<'static>,
@@ -31,6 +34,12 @@ pub struct Presenter {
     pub egui: egui_wgpu::Renderer,
     timer: Option<UiTimer>,
     pub picture: Option<Picture>,
+    /// Paints so far, and the one at which `HIKARI_VIEW_FAULT=surface-lost@N` pretends the
+    /// surface was lost.
+    paints: u64,
+    lose_at: Option<u64>,
+    /// Times the surface was lost and made anew.
+    pub recreated: u32,
 }
 
 /// The surface format: a non-sRGB one, so that the display-encoded frame shows as it is;
@@ -57,7 +66,7 @@ impl Presenter {
         window: Arc<Window>,
     ) -> anyhow::Result<Self> {
         let size = window.inner_size();
-        let surface = instance.create_surface(window).context(
+        let surface = instance.create_surface(window.clone()).context(
             "cannot show a window on this GPU (wgpu found no surface for it): try another \
              adapter (WGPU_ADAPTER_NAME) or the CPU Vulkan driver (mesa-vulkan-drivers)",
         )?;
@@ -112,6 +121,12 @@ impl Presenter {
                 period_ns: queue.get_timestamp_period(),
             });
         Ok(Self {
+            instance: instance.clone(),
+            adapter: adapter.clone(),
+            window,
+            paints: 0,
+            lose_at: super::faults::surface_lost_at(),
+            recreated: 0,
             device: device.clone(),
             queue: queue.clone(),
             surface,
@@ -120,6 +135,26 @@ impl Presenter {
             timer,
             picture: None,
         })
+    }
+
+    /// A new surface for the window, configured as the lost one was.
+    fn recreate(&mut self) -> anyhow::Result<()> {
+        let surface = self
+            .instance
+            .create_surface(self.window.clone())
+            .context("the window's surface was lost and a new one could not be made")?;
+        let caps = surface.get_capabilities(&self.adapter);
+        if !caps.formats.contains(&self.config.format) {
+            anyhow::bail!(
+                "the window's surface was lost and the new one lacks the format {:?}",
+                self.config.format
+            );
+        }
+        surface.configure(&self.device, &self.config);
+        self.surface = surface;
+        self.recreated += 1;
+        log::info!("the window's surface was lost; made a new one");
+        Ok(())
     }
 
     /// Follows the window's new size.
@@ -199,15 +234,26 @@ impl Presenter {
             }
         }
         textures.set.clear();
-        let frame = match self.surface.get_current_texture() {
+        self.paints += 1;
+        let current = if self.lose_at == Some(self.paints) {
+            wgpu::CurrentSurfaceTexture::Lost
+        } else {
+            self.surface.get_current_texture()
+        };
+        let frame = match current {
             wgpu::CurrentSurfaceTexture::Success(f)
             | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             other => {
-                if matches!(
-                    other,
-                    wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost
-                ) {
-                    self.surface.configure(&self.device, &self.config);
+                match other {
+                    // The window changed under the surface (a resize the event has not
+                    // reached yet): configure it again.
+                    wgpu::CurrentSurfaceTexture::Outdated => {
+                        self.surface.configure(&self.device, &self.config)
+                    }
+                    // The surface itself is gone (the compositor restarted, the display
+                    // changed): make a new one for the same window.
+                    wgpu::CurrentSurfaceTexture::Lost => self.recreate()?,
+                    _ => {}
                 }
                 // Occluded, a timeout, or reconfigured: skip this paint.
                 for id in textures.free.drain() {
