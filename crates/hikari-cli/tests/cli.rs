@@ -958,8 +958,8 @@ fn sky_runs_in_either_colour_space() {
 #[test]
 fn bench_soak_keeps_memory_flat_through_the_live_path() {
     let o = hikari(&[
-        "bench", "soak", "--scene", "boxes", "--width", "16", "--height", "12", "--frames",
-        "128", "--cycle", "64", "--poison", "--preset", "low", "--json",
+        "bench", "soak", "--scene", "boxes", "--width", "16", "--height", "12", "--frames", "128",
+        "--cycle", "64", "--poison", "--preset", "low", "--json",
     ]);
     assert!(o.status.success(), "{}", text(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();

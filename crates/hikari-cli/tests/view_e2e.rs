@@ -334,7 +334,10 @@ fn the_viewer_is_driven_by_keys_and_mouse_and_exits_on_esc() {
     // T again, with the GPU out of memory after it (the fault switch): the viewer goes back
     // to the settings before it, GI off, and goes on.
     v.key("t");
-    v.wait_log("went back to the settings before the last change", Duration::from_secs(60));
+    v.wait_log(
+        "went back to the settings before the last change",
+        Duration::from_secs(60),
+    );
     v.frames(2);
     // Back means GI off: the next T turns it on.
     v.key("t");
@@ -343,7 +346,11 @@ fn the_viewer_is_driven_by_keys_and_mouse_and_exits_on_esc() {
     v.wait_log("ray-traced GI off", Duration::from_secs(30));
     let d = v.settle_and_capture(settle);
     // The surface lost at the 8th paint was made anew, and frames went on.
-    if !v.lines.iter().any(|l| l.contains("surface was lost; made a new one")) {
+    if !v
+        .lines
+        .iter()
+        .any(|l| l.contains("surface was lost; made a new one"))
+    {
         v.wait_log("surface was lost; made a new one", Duration::from_secs(10));
     }
 

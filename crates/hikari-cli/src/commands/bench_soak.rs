@@ -160,14 +160,23 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
     );
     if !a.output.json {
         println!(
-            "bench soak: {}, {} frames in cycles of {}, clock {} s a frame, {} technique \
+            "bench soak: {}{}, {} frames in cycles of {}, clock {} s a frame, {} technique \
              switches{}",
             description.line(),
+            if settings.settings.sky.enabled {
+                " (the sky's sun or moon follows the clock)"
+            } else {
+                ""
+            },
             a.frames,
             a.cycle,
             a.clock_step,
             switches.len(),
-            if a.poison { ", NaN written each cycle" } else { "" }
+            if a.poison {
+                ", NaN written each cycle"
+            } else {
+                ""
+            }
         );
     }
     let ctx = crate::still::gpu()?;
@@ -372,9 +381,12 @@ mod tests {
         let (c, n) = (100, 10);
         let events: Vec<Event> = (0..c).map(|p| event_at(p, c, n)).collect();
         for k in 0..n {
-            let off = events
-                .iter()
-                .position(|e| *e == Event::Switch { index: k, on: false });
+            let off = events.iter().position(|e| {
+                *e == Event::Switch {
+                    index: k,
+                    on: false,
+                }
+            });
             let on = events
                 .iter()
                 .position(|e| *e == Event::Switch { index: k, on: true });

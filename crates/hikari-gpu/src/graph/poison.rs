@@ -105,7 +105,11 @@ pub(crate) fn reads_of(
 
 /// Overwrites mip 0 of `v` (every layer) with NaN, +Inf and -Inf in turn. Returns whether
 /// it could.
-pub(crate) fn poison(ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, v: &VirtualTexture) -> bool {
+pub(crate) fn poison(
+    ctx: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    v: &VirtualTexture,
+) -> bool {
     use wgpu::util::DeviceExt;
     let (Some((bytes, components)), Some(p)) = (float_element(v.desc.format), v.physical.as_ref())
     else {

@@ -23,20 +23,25 @@ fn a_validation_error_is_recorded_and_reported_not_a_panic() {
     assert!(ctx.faults.check("nothing yet").is_ok());
     // MAP_READ with STORAGE is invalid without MAPPABLE_PRIMARY_BUFFERS: wgpu reports it
     // through the uncaptured-error handler, whose default panics.
-    let _ = ctx.device.create_buffer(&hikari_render::wgpu::BufferDescriptor {
-        label: Some("invalid on purpose"),
-        size: 64,
-        usage: hikari_render::wgpu::BufferUsages::MAP_READ
-            | hikari_render::wgpu::BufferUsages::STORAGE,
-        mapped_at_creation: false,
-    });
+    let _ = ctx
+        .device
+        .create_buffer(&hikari_render::wgpu::BufferDescriptor {
+            label: Some("invalid on purpose"),
+            size: 64,
+            usage: hikari_render::wgpu::BufferUsages::MAP_READ
+                | hikari_render::wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
     let e = ctx.faults.check("the test").unwrap_err();
     assert!(
         matches!(&e, RenderError::Gpu { during, message } if during == "the test"
             && message.contains("invalid on purpose")),
         "{e}"
     );
-    assert!(ctx.faults.check("again").is_ok(), "an error is reported once");
+    assert!(
+        ctx.faults.check("again").is_ok(),
+        "an error is reported once"
+    );
 }
 
 #[test]
@@ -45,11 +50,7 @@ fn a_lost_device_ends_a_wait_with_an_error_at_once() {
     ctx.device.destroy();
     let t0 = Instant::now();
     let e = ctx.wait_idle().unwrap_err();
-    assert!(
-        t0.elapsed() < Duration::from_secs(10),
-        "{:?}",
-        t0.elapsed()
-    );
+    assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
     assert!(matches!(e, RenderError::DeviceLost { .. }), "{e}");
     assert!(e.to_string().contains("restart hikari"), "{e}");
 }

@@ -118,7 +118,7 @@ fn check_png_palette(bytes: &[u8]) -> Result<(), String> {
             if palettes > 1 {
                 return Err("malformed PNG: more than one PLTE (palette) chunk".into());
             }
-            if len % 3 != 0 || !(3..=768).contains(&len) {
+            if !len.is_multiple_of(3) || !(3..=768).contains(&len) {
                 return Err(format!(
                     "malformed PNG: its PLTE (palette) chunk has {len} bytes, not 1 to 256 \
                      RGB entries"
