@@ -90,6 +90,9 @@ pub struct GpuContext {
     pub uniforms_as_storage: bool,
     /// Errors the device raised after the fact, and its loss ([`crate::faults`]).
     pub faults: crate::faults::GpuFaults,
+    /// The size of the adapter's largest device-local memory heap, bytes, where the backend
+    /// tells it (Vulkan); a frame that needs more is refused before it runs.
+    pub memory_bytes: Option<u64>,
     shared: Arc<Mutex<SharedValues>>,
 }
 
@@ -101,6 +104,25 @@ fn inlines_uniforms(info: &wgpu::AdapterInfo) -> bool {
         s.contains("llvmpipe") || s.contains("lavapipe")
     };
     info.device_type == wgpu::DeviceType::Cpu && (mesa_cpu(&info.name) || mesa_cpu(&info.driver))
+}
+
+/// The largest device-local heap of a Vulkan adapter (wgpu itself does not report memory).
+fn device_memory(adapter: &wgpu::Adapter) -> Option<u64> {
+    // SAFETY: the raw handles are only read, while `adapter` keeps them alive.
+    let hal = unsafe { adapter.as_hal::<wgpu::hal::api::Vulkan>() }?;
+    let properties = unsafe {
+        hal.shared_instance()
+            .raw_instance()
+            .get_physical_device_memory_properties(hal.raw_physical_device())
+    };
+    const DEVICE_LOCAL: u32 = 0x1;
+    properties
+        .memory_heaps
+        .iter()
+        .take(properties.memory_heap_count as usize)
+        .filter(|h| h.flags.as_raw() & DEVICE_LOCAL != 0)
+        .map(|h| h.size)
+        .max()
 }
 
 impl GpuContext {
@@ -179,7 +201,9 @@ impl GpuContext {
         };
 
         let faults = crate::faults::GpuFaults::install(&device);
+        let memory_bytes = device_memory(&adapter);
         Ok(Self {
+            memory_bytes,
             shared: Arc::default(),
             faults,
             uniforms_as_storage,

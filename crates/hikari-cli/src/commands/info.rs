@@ -33,6 +33,13 @@ pub fn run() -> anyhow::Result<()> {
         ctx.limits.max_texture_dimension_3d,
         ctx.limits.max_storage_buffer_binding_size
     );
+    match ctx.memory_bytes {
+        Some(b) => println!(
+            "memory:   {} MB device-local (a frame that needs more is refused before it runs)",
+            b / 1_000_000
+        ),
+        None => println!("memory:   not reported by this backend"),
+    }
     // A script can ask `hikari info` whether hikari runs here by its exit status.
     match verdict {
         None => Ok(()),

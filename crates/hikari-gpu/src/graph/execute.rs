@@ -42,6 +42,7 @@ pub(crate) fn execute(mut g: FrameGraph<'_>, commit: bool) -> Result<FrameResult
     upload_constants(rt, ctx, &constants);
     let timing = TimestampPlan::new(rt, ctx, &passes);
     let lifetimes = Lifetimes::of(&textures, &buffers, passes.len());
+    check_memory(ctx, &textures, &buffers, &lifetimes)?;
 
     let mut encoder = ctx
         .device
@@ -353,6 +354,97 @@ impl Lifetimes {
             }
         }
     }
+}
+
+/// Bytes a texture takes, every mip level and layer (formats without a copy size, depth and
+/// stencil, counted at 4 bytes a texel).
+fn texture_bytes(v: &VirtualTexture) -> u64 {
+    let block = u64::from(v.desc.format.block_copy_size(None).unwrap_or(4));
+    let [w, h, d] = v.desc.size.map(u64::from);
+    (0..v.desc.mip_levels)
+        .map(|m| {
+            let depth = if v.desc.dimension == wgpu::TextureDimension::D3 {
+                (d >> m).max(1)
+            } else {
+                d
+            };
+            (w >> m).max(1) * (h >> m).max(1) * depth * block
+        })
+        .sum()
+}
+
+/// Refuses a frame whose resources need more memory than the GPU has, before it runs: what
+/// lives across frames, plus the most the transients need at once (they share memory by
+/// lifetime, as the pool hands them out). Imported resources are the owner's and not counted.
+fn check_memory(
+    ctx: &GpuContext,
+    textures: &[VirtualTexture],
+    buffers: &[VirtualBuffer],
+    lifetimes: &Lifetimes,
+) -> Result<()> {
+    let Some(limit) = ctx.memory_bytes else {
+        return Ok(());
+    };
+    let mut kept = 0u64;
+    let mut largest_name = String::new();
+    let mut largest_bytes = 0u64;
+    let mut consider = |bytes: u64, name: &str| {
+        if bytes > largest_bytes {
+            largest_bytes = bytes;
+            largest_name = name.to_string();
+        }
+    };
+    for t in textures {
+        if matches!(
+            t.source,
+            TexSource::Persistent | TexSource::HistoryPrev | TexSource::HistoryCur
+        ) {
+            let b = texture_bytes(t);
+            kept += b;
+            consider(b, &t.name);
+        }
+    }
+    for b in buffers
+        .iter()
+        .filter(|b| !b.transient && b.physical.is_some())
+    {
+        kept += b.size;
+        consider(b.size, &b.name);
+    }
+    let (mut live, mut peak) = (0u64, 0u64);
+    for at in 0..lifetimes.acquire_at.len() {
+        for r in &lifetimes.acquire_at[at] {
+            let bytes = match *r {
+                Res::Tex(t) => texture_bytes(&textures[t.0 as usize]),
+                Res::Buf(b) => buffers[b.0 as usize].size,
+            };
+            live += bytes;
+            match *r {
+                Res::Tex(t) => consider(bytes, &textures[t.0 as usize].name),
+                Res::Buf(b) => consider(bytes, &buffers[b.0 as usize].name),
+            }
+        }
+        peak = peak.max(live);
+        for r in &lifetimes.release_at[at] {
+            live -= match *r {
+                Res::Tex(t) => texture_bytes(&textures[t.0 as usize]),
+                Res::Buf(b) => buffers[b.0 as usize].size,
+            };
+        }
+    }
+    let need = kept + peak;
+    if need > limit {
+        return Err(RenderError::Limit {
+            what: format!(
+                "GPU memory in bytes that this frame's textures and buffers need (the largest: \
+                 `{largest_name}`, {} MB)",
+                largest_bytes / 1_000_000
+            ),
+            requested: need,
+            limit,
+        });
+    }
+    Ok(())
 }
 
 /// What encoding the passes leaves for reading timings: per pass its name, its timestamp

@@ -229,3 +229,36 @@ const SETTLE_FRAMES: usize = 8;
 const MEAN_FRAMES: usize = 6;
 /// How far the mean after the sweep may be from the mean before.
 const RECOVERY_TOLERANCE: f64 = 0.1;
+
+/// A frame whose textures and buffers need more memory than the GPU has is refused before it
+/// runs, naming the memory and the largest resource. The adapter's real heap (the CPU driver's
+/// is the machine's memory) is replaced by a small one.
+#[test]
+fn a_frame_larger_than_the_gpu_memory_is_refused_before_it_runs() {
+    let mut ctx = private_faults();
+    assert!(
+        ctx.memory_bytes.is_some_and(|m| m > 100_000_000),
+        "the Vulkan adapter's memory is known: {:?}",
+        ctx.memory_bytes
+    );
+    ctx.memory_bytes = Some(2_000_000);
+    let scene = hikari_scene::builtin::boxes();
+    let s = common::small_frame_settings(&scene, 64, 48);
+    let mut r = Renderer::new(ctx.clone(), &scene).unwrap();
+    r.set_frame(s).unwrap();
+    let Err(e) = r.frame(false) else {
+        panic!("a frame needing more than 2 MB rendered")
+    };
+    let text = e.to_string();
+    assert!(
+        matches!(
+            e,
+            RenderError::Limit {
+                limit: 2_000_000,
+                ..
+            }
+        ) && text.contains("GPU memory"),
+        "{text}"
+    );
+    assert!(text.contains("the largest: `"), "{text}");
+}
