@@ -389,7 +389,7 @@ impl App {
         time: bool,
         mut build: impl FnMut(&mut egui::Ui, &egui::Context),
     ) -> (Option<f64>, f64) {
-        let t0 = Instant::now();
+        let t0 = super::stats::thread_cpu_us();
         let Some(state) = self.egui_state.as_mut() else {
             return (None, 0.0);
         };
@@ -398,7 +398,7 @@ impl App {
         let mut out = self.egui.run_ui(input, |ui| build(ui, &ctx));
         state.handle_platform_output(window, out.platform_output);
         let prims = self.egui.tessellate(out.shapes, out.pixels_per_point);
-        let cpu_us = t0.elapsed().as_secs_f64() * 1e6;
+        let cpu_us = super::stats::thread_cpu_us() - t0;
         let Some(presenter) = self.presenter.as_mut() else {
             return (None, cpu_us);
         };
@@ -556,7 +556,7 @@ impl App {
             message: message.as_ref().map(|(t, e)| (t.as_str(), *e)),
             screenshot: false,
         };
-        let t_ui = Instant::now();
+        let t_ui = super::stats::thread_cpu_us();
         let Some(state) = self.egui_state.as_mut() else {
             return Ok(());
         };
@@ -566,7 +566,7 @@ impl App {
             .run_ui(input, |ui| super::ui::draw(ui, &mut model));
         state.handle_platform_output(window, out.platform_output);
         let prims = self.egui.tessellate(out.shapes, out.pixels_per_point);
-        let ui_layout_us = t_ui.elapsed().as_secs_f64() * 1e6;
+        let ui_layout_us = super::stats::thread_cpu_us() - t_ui;
         let (ui_gpu, encode_us) =
             presenter.paint(&mut out.textures_delta, &prims, out.pixels_per_point, timed)?;
         let ui_cpu_us = ui_layout_us + encode_us;

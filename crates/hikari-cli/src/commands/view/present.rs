@@ -217,8 +217,8 @@ impl Presenter {
     }
 
     /// Paints egui's output on the window and presents it. Returns the paint's GPU time in ms
-    /// with `time` (waiting for it), and the CPU time its recording took in µs (from the
-    /// surface's texture acquired to the submission).
+    /// with `time` (waiting for it), and the CPU time its recording took on this thread in µs
+    /// (from the surface's texture acquired to the submission).
     pub fn paint(
         &mut self,
         textures: &mut egui::TexturesDelta,
@@ -262,7 +262,7 @@ impl Presenter {
                 return Ok((None, 0.0));
             }
         };
-        let t0 = std::time::Instant::now();
+        let t0 = super::stats::thread_cpu_us();
         let view = frame.texture.create_view(&Default::default());
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],
@@ -306,13 +306,18 @@ impl Presenter {
             encoder.resolve_query_set(&t.queries, 0..2, &t.resolve, 0);
             encoder.copy_buffer_to_buffer(&t.resolve, 0, &t.read, 0, 16);
         }
-        self.queue
-            .submit(extra.into_iter().chain([encoder.finish()]));
+        let commands = extra
+            .into_iter()
+            .chain([encoder.finish()])
+            .collect::<Vec<_>>();
+        // The recording's CPU time, on this thread; the submission and the present are the
+        // driver's and the window system's.
+        let cpu_us = super::stats::thread_cpu_us() - t0;
+        self.queue.submit(commands);
         self.queue.present(frame);
         for id in textures.free.drain() {
             self.egui.free_texture(&id);
         }
-        let cpu_us = t0.elapsed().as_secs_f64() * 1e6;
         let Some(t) = timer else {
             return Ok((None, cpu_us));
         };
