@@ -15,7 +15,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    bake, bench_frame, bench_overhead, bench_probes, bench_rays, bench_soak, compare, constants,
+    bake, bc6h, bench_frame, bench_overhead, bench_probes, bench_rays, bench_soak, compare, constants,
     info, lut, probes, render, sky, timelapse, view,
 };
 
@@ -54,6 +54,9 @@ enum Command {
     /// Benchmarks that print per-pass GPU timings.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Compress an HDR image (EXR) to BC6H_UF16 in a DDS file, as the reflection probes are,
+    /// and print its error.
+    Bc6h(bc6h::Bc6hArgs),
     /// Print the derived colour, spectral and scattering constants (no GPU needed).
     Constants(constants::ConstantsArgs),
     /// Print the GPU adapter, whether it can run hikari (and which feature it lacks if not),
@@ -114,6 +117,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Rays(args)) => bench_rays::run(args),
         Command::Bench(BenchCommand::Probes(args)) => bench_probes::run(*args),
         Command::Bench(BenchCommand::Soak(args)) => bench_soak::run(*args),
+        Command::Bc6h(args) => bc6h::run(args),
         Command::Constants(args) => constants::run(args),
         Command::Info => info::run(),
         Command::Lut(command) => lut::run(command),

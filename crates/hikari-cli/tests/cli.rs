@@ -974,3 +974,32 @@ fn bench_soak_keeps_memory_flat_through_the_live_path() {
         assert!(switches.iter().any(|s| s == t), "`{t}` not switched: {v}");
     }
 }
+
+/// `hikari bc6h`: an EXR (the sky's) to a DDS file as the DDS specification lays it out (magic,
+/// a DX10 extension header naming DXGI_FORMAT_BC6H_UF16 = 95, then 16 bytes a 4x4 block), the
+/// GPU's blocks equal to the CPU twin's, and the error printed.
+#[test]
+fn bc6h_writes_a_dx10_dds_and_its_error() {
+    let dir = tmp("bc6h");
+    let exr = dir.join("sky.exr");
+    let o = hikari(&["sky", "-o", exr.to_str().unwrap(), "--width", "64"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let gpu = dir.join("gpu.dds");
+    let o = hikari(&["bc6h", exr.to_str().unwrap(), "-o", gpu.to_str().unwrap()]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("error against the input: RMS of log2"), "{t}");
+    let bytes = std::fs::read(&gpu).unwrap();
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap());
+    assert_eq!(&bytes[0..4], b"DDS ");
+    assert_eq!((u32_at(12), u32_at(16)), (32, 64), "height, width");
+    assert_eq!(&bytes[84..88], b"DX10");
+    assert_eq!(u32_at(128), 95, "DXGI_FORMAT_BC6H_UF16");
+    assert_eq!(bytes.len(), 148 + 16 * 16 * 8);
+    let cpu = dir.join("cpu.dds");
+    let o = hikari(&["bc6h", exr.to_str().unwrap(), "-o", cpu.to_str().unwrap(), "--cpu"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(std::fs::read(&cpu).unwrap(), bytes, "the GPU's blocks are the twin's");
+    let o = hikari(&["bc6h", exr.to_str().unwrap(), "-o", "x.png"]);
+    assert!(!o.status.success() && text(&o).contains("must be a .dds file"));
+}

@@ -71,6 +71,9 @@ pub enum RenderError {
 
     #[error("writing {path}: {message}")]
     Output { path: String, message: String },
+
+    #[error("reading {path}: {message}")]
+    Input { path: String, message: String },
 }
 
 pub type Result<T, E = RenderError> = std::result::Result<T, E>;

@@ -4,6 +4,7 @@
 //! technique under `techniques/` (passes, WGSL, CPU twin, settings), and `frame.rs`, where one
 //! frame reads top to bottom.
 
+pub mod bc6h;
 pub mod brdf_tables;
 pub mod checks;
 pub mod error;

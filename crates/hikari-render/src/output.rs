@@ -79,3 +79,23 @@ pub fn write_dump(dir: &Path, img: &ImageRgba32) -> Result<PathBuf> {
     write_exr(&path, img)?;
     Ok(path)
 }
+
+/// The first RGBA layer of an OpenEXR file as RGB floats, row by row (alpha dropped):
+/// (width, height, pixels).
+pub fn read_exr_rgb(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |size, _| (size.width(), vec![[0.0f32; 3]; size.width() * size.height()]),
+        |(w, px): &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b];
+        },
+    )
+    .map_err(|e| RenderError::Input {
+        path: path.display().to_string(),
+        message: format!("not a readable OpenEXR image: {e}"),
+    })?;
+    let size = image.layer_data.size;
+    let (_, pixels) = image.layer_data.channel_data.pixels;
+    Ok((size.width() as u32, size.height() as u32, pixels))
+}

@@ -53,8 +53,16 @@ struct Sample {
     frame_ms: f64,
 }
 
-/// This process's resident set, MB (Linux; `None` elsewhere).
+/// This process's resident set, MB (Linux; `None` elsewhere). glibc's allocator first gives
+/// the heap's free pages back (`malloc_trim`): what it keeps for reuse varies from cycle to
+/// cycle by tens of MB (a scene reload frees and allocates its upload copies) and would hide a
+/// leak or fake one; what is left is what the process holds.
 fn resident_mb() -> Option<f64> {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free memory of the allocator's heaps to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
     let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
     let pages: f64 = statm.split_whitespace().nth(1)?.parse().ok()?;
     Some(pages * 4096.0 / 1e6)

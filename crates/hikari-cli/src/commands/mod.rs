@@ -3,6 +3,7 @@
 //! share moves into a shared module (`tests/command_modules.rs` checks this).
 
 pub mod bake;
+pub mod bc6h;
 pub mod bench_frame;
 pub mod bench_overhead;
 pub mod bench_probes;

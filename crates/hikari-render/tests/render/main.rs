@@ -6,6 +6,7 @@
 mod alpha;
 mod area_lights;
 mod atmosphere_gpu;
+mod bc6h;
 mod bvh_alpha;
 mod bvh_trace;
 mod clouds;
