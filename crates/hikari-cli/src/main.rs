@@ -15,8 +15,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use commands::{
-    bake, bc6h, bench_frame, bench_overhead, bench_probes, bench_rays, bench_soak, compare, constants,
-    info, lut, probes, render, sky, timelapse, view,
+    bake, bc6h, bench_frame, bench_overhead, bench_probes, bench_rays, bench_soak, compare,
+    constants, info, lut, probes, render, sky, timelapse, view,
 };
 
 #[derive(Parser)]

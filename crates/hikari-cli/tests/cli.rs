@@ -997,9 +997,19 @@ fn bc6h_writes_a_dx10_dds_and_its_error() {
     assert_eq!(u32_at(128), 95, "DXGI_FORMAT_BC6H_UF16");
     assert_eq!(bytes.len(), 148 + 16 * 16 * 8);
     let cpu = dir.join("cpu.dds");
-    let o = hikari(&["bc6h", exr.to_str().unwrap(), "-o", cpu.to_str().unwrap(), "--cpu"]);
+    let o = hikari(&[
+        "bc6h",
+        exr.to_str().unwrap(),
+        "-o",
+        cpu.to_str().unwrap(),
+        "--cpu",
+    ]);
     assert!(o.status.success(), "{}", text(&o));
-    assert_eq!(std::fs::read(&cpu).unwrap(), bytes, "the GPU's blocks are the twin's");
+    assert_eq!(
+        std::fs::read(&cpu).unwrap(),
+        bytes,
+        "the GPU's blocks are the twin's"
+    );
     let o = hikari(&["bc6h", exr.to_str().unwrap(), "-o", "x.png"]);
     assert!(!o.status.success() && text(&o).contains("must be a .dds file"));
 }

@@ -317,7 +317,11 @@ fn readme_rows() -> Vec<(Vec<String>, String)> {
             let words: Vec<String> = sig
                 .split_whitespace()
                 .skip(1)
-                .take_while(|w| w.chars().all(|c| c.is_ascii_lowercase() || c == '_'))
+                .take_while(|w| {
+                    w.starts_with(|c: char| c.is_ascii_lowercase())
+                        && w.chars()
+                            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+                })
                 .map(String::from)
                 .collect();
             rows.push((words, sig));

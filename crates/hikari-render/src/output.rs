@@ -86,7 +86,12 @@ pub fn read_exr_rgb(path: &Path) -> Result<(u32, u32, Vec<[f32; 3]>)> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
         path,
-        |size, _| (size.width(), vec![[0.0f32; 3]; size.width() * size.height()]),
+        |size, _| {
+            (
+                size.width(),
+                vec![[0.0f32; 3]; size.width() * size.height()],
+            )
+        },
         |(w, px): &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
             px[pos.y() * *w + pos.x()] = [r, g, b];
         },

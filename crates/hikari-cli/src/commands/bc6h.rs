@@ -42,7 +42,10 @@ pub fn run(a: Bc6hArgs) -> anyhow::Result<()> {
     anyhow::ensure!(w > 0 && h > 0, "{}: an empty image", a.input.display());
     let t0 = Instant::now();
     let (blocks, encoder) = if a.cpu {
-        (reference::encode_image(&rgb, w, h, a.quality), "CPU".to_string())
+        (
+            reference::encode_image(&rgb, w, h, a.quality),
+            "CPU".to_string(),
+        )
     } else {
         let ctx = crate::still::gpu()?;
         let enc = Bc6hEncoder::new(&ctx)?;

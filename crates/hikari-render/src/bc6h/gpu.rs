@@ -52,7 +52,10 @@ impl Bc6hEncoder {
         let mut rt = GraphRuntime::new();
         let mut g = rt.begin_frame(ctx);
         let source = g.import_texture("bc6h.source", texture);
-        let blocks = g.buffer("bc6h.blocks", per_layer * u64::from(layers) * BLOCK_BYTES as u64)?;
+        let blocks = g.buffer(
+            "bc6h.blocks",
+            per_layer * u64::from(layers) * BLOCK_BYTES as u64,
+        )?;
         for layer in 0..layers {
             let params = Bc6hParams {
                 blocks_x: bx,

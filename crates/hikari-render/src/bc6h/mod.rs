@@ -35,8 +35,7 @@ pub fn decode_image(blocks: &[u8], width: u32, height: u32) -> Option<Vec<[f32; 
         for (t, h) in texels.iter().enumerate() {
             let (x, y) = (cx * 4 + t as u32 % 4, cy * 4 + t as u32 / 4);
             if x < width && y < height {
-                out[(y * width + x) as usize] =
-                    h.map(|b| half::f16::from_bits(b as u16).to_f32());
+                out[(y * width + x) as usize] = h.map(|b| half::f16::from_bits(b as u16).to_f32());
             }
         }
     }

@@ -248,7 +248,10 @@ mod tests {
             let at = |q: u32| unquantize(q) as f64 * 31.0 / 64.0;
             let d = (at(q) - h as f64).abs();
             for other in [q.saturating_sub(1), (q + 1).min(1023)] {
-                assert!(d <= (at(other) - h as f64).abs() + 1e-9, "h {h}: {q} vs {other}");
+                assert!(
+                    d <= (at(other) - h as f64).abs() + 1e-9,
+                    "h {h}: {q} vs {other}"
+                );
             }
         }
     }

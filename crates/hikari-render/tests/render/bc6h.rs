@@ -23,7 +23,11 @@ fn image(w: u32, h: u32, seed: u64, specials: bool) -> Vec<[f32; 3]> {
             // Noise only with `specials`: colours off any line are the single-subset mode's
             // worst case, which the twin tests want and the error bound does not.
             let noise = |rng: &mut SmallRng, lo: f32| {
-                if specials { rng.random_range(lo..1.0) } else { 1.0 }
+                if specials {
+                    rng.random_range(lo..1.0)
+                } else {
+                    1.0
+                }
             };
             let mut c = [
                 base * (0.5 + y),
