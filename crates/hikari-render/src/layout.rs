@@ -16,6 +16,24 @@ pub fn all() -> Vec<StructLayout> {
     use crate::view;
     vec![
         gpu_layout!(
+            crate::bc6h::gpu::Bc6hParams,
+            "bc6h/encode.wgsl",
+            [
+                blocks_x,
+                blocks_y,
+                layer,
+                quality,
+                width,
+                height,
+                first_block,
+                level,
+                row_stride,
+                layer_stride,
+                _pad0,
+                _pad1
+            ]
+        ),
+        gpu_layout!(
             reflection_probes::ReflectionProbeGpu,
             "reflection_probes/relight.wgsl",
             [to_box, capture, half_m]
@@ -348,6 +366,7 @@ pub fn all() -> Vec<StructLayout> {
 /// no constant declared in both languages is missing here.
 pub fn constants() -> Vec<SharedConstant> {
     vec![
+        gpu_const!(crate::bc6h::reference::MAX_HALF_BITS, "bc6h/encode.wgsl"),
         gpu_const!(
             crate::techniques::haze::reference::AIR_INTERIOR_MASK,
             "haze/light.wgsl"

@@ -1,4 +1,5 @@
-// BC6H_UF16 encoding, one thread a 4x4 block (twin: bc6h/reference.rs, integer for integer).
+// BC6H_UF16 encoding, one thread a 4x4 block of a layer (z) of one mip level of a texture
+// array (twin: bc6h/reference.rs, integer for integer).
 // The single-subset 10-bit mode: endpoints from the block's bounding box in half-float bit
 // space, each channel's diagonal turned to follow the block's brightness, each texel's index
 // the nearest of the 16 interpolated colours; with `quality` 1 also the box inset by 1/32 and
@@ -9,11 +10,18 @@ struct Bc6hParams {
     blocks_y: u32,
     layer: u32,
     quality: u32,
+    // The mip level's size in texels.
     width: u32,
     height: u32,
-    // Where this layer's blocks start in `blocks`.
+    // Where the first layer's blocks start in `blocks`; each layer's follow (z: the layer).
     first_block: u32,
-    _pad: u32,
+    level: u32,
+    // Blocks from one row to the next and from one layer to the next in `blocks` (rows padded
+    // where the blocks are copied into a texture, whose rows start every 256 bytes).
+    row_stride: u32,
+    layer_stride: u32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Bc6hParams;
@@ -154,7 +162,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var t = 0u; t < 16u; t++) {
         let x = min(id.x * 4u + t % 4u, params.width - 1u);
         let y = min(id.y * 4u + t / 4u, params.height - 1u);
-        let c = textureLoad(source, vec2<u32>(x, y), params.layer, 0).rgb;
+        let c = textureLoad(source, vec2<u32>(x, y), params.layer + id.z, params.level).rgb;
         texels[t] = vec3<u32>(half_bits(c.r), half_bits(c.g), half_bits(c.b));
         lo = min(lo, texels[t]);
         hi = max(hi, texels[t]);
@@ -195,5 +203,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var t = 1u; t < 16u; t++) {
         put(&words, 68u + 4u * (t - 1u), 4u, best.indices[t]);
     }
-    blocks[params.first_block + id.y * params.blocks_x + id.x] = words;
+    blocks[params.first_block + id.z * params.layer_stride + id.y * params.row_stride + id.x] =
+        words;
 }

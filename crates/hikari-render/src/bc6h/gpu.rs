@@ -4,7 +4,7 @@ use bytemuck::{Pod, Zeroable};
 
 use super::reference::{BLOCK_BYTES, Quality};
 use crate::error::{RenderError, Result};
-use crate::graph::GraphRuntime;
+use crate::graph::{Buf, FrameGraph, GraphRuntime, Tex};
 use crate::pipeline::ComputePipeline;
 use crate::{GpuContext, shader};
 
@@ -18,7 +18,44 @@ pub struct Bc6hParams {
     pub width: u32,
     pub height: u32,
     pub first_block: u32,
-    pub _pad: u32,
+    pub level: u32,
+    pub row_stride: u32,
+    pub layer_stride: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+/// Where [`Bc6hEncoder::record`] puts the blocks: from `first_block`, rows `row_stride`
+/// blocks apart, layers `layer_stride` blocks apart.
+#[derive(Clone, Copy, Debug)]
+pub struct BlockLayout {
+    pub first_block: u32,
+    pub row_stride: u32,
+    pub layer_stride: u32,
+}
+
+impl BlockLayout {
+    /// Rows and layers packed tight, for a `size` texel image.
+    pub fn tight(size: [u32; 2]) -> Self {
+        let (bx, by) = (size[0].div_ceil(4), size[1].div_ceil(4));
+        Self {
+            first_block: 0,
+            row_stride: bx,
+            layer_stride: bx * by,
+        }
+    }
+
+    /// Rows padded to whole 256-byte copy rows, as `copy_buffer_to_texture` wants them.
+    pub fn for_copy(size: [u32; 2]) -> Self {
+        let (bx, by) = (size[0].div_ceil(4), size[1].div_ceil(4));
+        let per_row = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT / BLOCK_BYTES as u32;
+        let row_stride = bx.next_multiple_of(per_row);
+        Self {
+            first_block: 0,
+            row_stride,
+            layer_stride: row_stride * by,
+        }
+    }
 }
 
 /// The compiled encoder.
@@ -29,8 +66,13 @@ pub struct Bc6hEncoder {
 impl Bc6hEncoder {
     pub fn new(ctx: &GpuContext) -> Result<Self> {
         let mut lib = shader::library(shader::capabilities_for(ctx.features))?;
+        Self::with_library(ctx, &mut lib)
+    }
+
+    /// The encoder compiled from a library the caller already has (the frame's).
+    pub fn with_library(ctx: &GpuContext, lib: &mut shader::ShaderLibrary) -> Result<Self> {
         Ok(Self {
-            pipeline: ComputePipeline::new(ctx, &mut lib, "bc6h/encode.wgsl", "main", &[])?,
+            pipeline: ComputePipeline::new(ctx, lib, "bc6h/encode.wgsl", "main", &[])?,
         })
     }
 
@@ -56,29 +98,16 @@ impl Bc6hEncoder {
             "bc6h.blocks",
             per_layer * u64::from(layers) * BLOCK_BYTES as u64,
         )?;
-        for layer in 0..layers {
-            let params = Bc6hParams {
-                blocks_x: bx,
-                blocks_y: by,
-                layer,
-                quality: u32::from(quality == Quality::High),
-                width: w,
-                height: h,
-                first_block: u32::try_from(per_layer * u64::from(layer)).map_err(|_| {
-                    RenderError::Limit {
-                        what: "BC6H blocks of one texture".into(),
-                        requested: per_layer * u64::from(layers),
-                        limit: u64::from(u32::MAX),
-                    }
-                })?,
-                _pad: 0,
-            };
-            g.pass("bc6h.encode")
-                .constants(&params)
-                .read(source)
-                .write(blocks)
-                .dispatch_threads(&self.pipeline, [bx, by, 1])?;
-        }
+        self.record(
+            &mut g,
+            "bc6h.encode",
+            source,
+            blocks,
+            [w, h],
+            (0, layers, 0),
+            BlockLayout::tight([w, h]),
+            quality,
+        )?;
         g.readback(blocks);
         let result = g.execute()?;
         ctx.faults.check("BC6H encoding")?;
@@ -86,6 +115,41 @@ impl Bc6hEncoder {
             .buffer("bc6h.blocks")
             .map(<[u8]>::to_vec)
             .ok_or_else(|| RenderError::Graph("bc6h.blocks was not read back".into()))
+    }
+
+    /// Records pass `name`: layers `layer..layer + layers` of mip `level` (`size` texels) of
+    /// `source` encoded into `blocks`, laid out as `out` says.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        name: &str,
+        source: Tex,
+        blocks: Buf,
+        size: [u32; 2],
+        (layer, layers, level): (u32, u32, u32),
+        out: BlockLayout,
+        quality: Quality,
+    ) -> Result<()> {
+        let (bx, by) = (size[0].div_ceil(4), size[1].div_ceil(4));
+        g.pass(name)
+            .constants(&Bc6hParams {
+                blocks_x: bx,
+                blocks_y: by,
+                layer,
+                quality: u32::from(quality == Quality::High),
+                width: size[0],
+                height: size[1],
+                first_block: out.first_block,
+                level,
+                row_stride: out.row_stride,
+                layer_stride: out.layer_stride,
+                _pad0: 0,
+                _pad1: 0,
+            })
+            .read(source)
+            .write(blocks)
+            .dispatch_threads(&self.pipeline, [bx, by, layers])
     }
 
     /// An RGB image as BC6H_UF16 blocks. The texels go to the GPU as halves (what BC6H holds),

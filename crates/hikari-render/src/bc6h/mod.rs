@@ -7,7 +7,7 @@ pub mod dds;
 pub mod gpu;
 pub mod reference;
 
-pub use gpu::Bc6hEncoder;
+pub use gpu::{Bc6hEncoder, BlockLayout};
 pub use reference::Quality;
 
 /// How far decoded texels are from the input, over the channels of every texel.

@@ -763,3 +763,95 @@ fn only_probes_near_the_camera_are_captured_and_relit() {
         "{got}"
     );
 }
+
+/// With `compress`, each relit probe's prefiltered levels are encoded to BC6H on the GPU as
+/// the CPU twin encodes the same texels (block for block), and the lighting read through the
+/// compressed maps stays within BC6H's error of the uncompressed lighting.
+#[test]
+fn the_compressed_maps_are_the_twins_blocks_of_the_prefiltered_maps() {
+    use hikari_render::bc6h::{Quality, reference as bc6h};
+    let scene = hikari_scene::builtin::boxes();
+    let mut s = common::small_frame_settings(&scene, 32, 24);
+    s.settings.sky.enabled = true;
+    s.settings.sky.table_quality = 0;
+    s.settings.sky.time = "10:00".into();
+    s.sun = hikari_render::SunSource::Sky;
+    s.settings.area_lights.enabled = false;
+    s.settings.taa.enabled = false;
+    let n = 32;
+    s.settings.reflection_probes.resolution = n;
+    s.settings.reflection_probes.levels = 2;
+    s.settings.reflection_probes.samples = 4;
+    let b = probe(
+        Vec3::new(-6.0, -0.5, -5.0),
+        Vec3::new(6.0, 6.0, 6.0),
+        Vec3::new(0.5, 1.2, 0.8),
+        1.0,
+    );
+    let ctx = common::gpu_context();
+    assert!(
+        hikari_render::techniques::reflection_probes::compresses(
+            &ctx,
+            &s.settings.reflection_probes
+        ),
+        "the CPU driver samples BC formats: the compressed path runs in CI"
+    );
+    let mut r = Renderer::new(ctx.clone(), &scene).unwrap();
+    r.set_reflection_probes(std::slice::from_ref(&b)).unwrap();
+    r.runtime.set_dumps(vec!["reflection_probes.bc6h0".into()]);
+    let mut out = r
+        .render_reading(&s, |o| {
+            vec![o.reflection_probes.radiance.unwrap().into(), o.lit.into()]
+        })
+        .unwrap();
+    let radiance = out.take_image("reflection_probes.radiance").unwrap();
+    // The encoder pads each row of blocks to a 256-byte copy row: keep the image's blocks.
+    let layout = hikari_render::bc6h::BlockLayout::for_copy([n, n]);
+    let padded = out.buffer("reflection_probes.bc6h0").unwrap();
+    let (bx, by) = (n as usize / 4, n as usize / 4);
+    let mut blocks = Vec::new();
+    for face in 0..6 {
+        for row in 0..by {
+            let at = 16 * (face * layout.layer_stride as usize + row * layout.row_stride as usize);
+            blocks.extend_from_slice(&padded[at..at + 16 * bx]);
+        }
+    }
+    let compressed_lit = out.take_image("direct_lighting.radiance").unwrap();
+    // Level 0 of the six faces, as the twin sees them: the faces are stacked in the image.
+    let rgb: Vec<[f32; 3]> = radiance.rgba.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let face_texels = (n * n) as usize;
+    let mut want = Vec::new();
+    for face in 0..6 {
+        let texels = &rgb[face * face_texels..(face + 1) * face_texels];
+        want.extend(bc6h::encode_image(texels, n, n, Quality::Fast));
+    }
+    assert_eq!(blocks.len(), want.len());
+    let differ = blocks
+        .chunks(16)
+        .zip(want.chunks(16))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differ, 0, "{differ} of {} blocks differ", want.len() / 16);
+
+    // The same frame with the maps uncompressed.
+    s.settings.reflection_probes.compress = false;
+    let mut r = Renderer::new(ctx, &scene).unwrap();
+    r.set_reflection_probes(std::slice::from_ref(&b)).unwrap();
+    let mut out = r.render_reading(&s, |o| vec![o.lit.into()]).unwrap();
+    let plain_lit = out.take_image("direct_lighting.radiance").unwrap();
+    let (mut diff, mut total) = (0.0f64, 0.0f64);
+    for (a, b) in compressed_lit.rgba.iter().zip(&plain_lit.rgba) {
+        for c in 0..3 {
+            diff += f64::from((a[c] - b[c]).abs());
+            total += f64::from(b[c].abs());
+        }
+    }
+    assert!(total > 0.0);
+    // BC6H's endpoints step about 3 %; the specular share of the lighting is a fraction of it.
+    assert!(
+        diff / total < 0.03,
+        "the lighting through BC6H differs by {:.2} %",
+        100.0 * diff / total
+    );
+    assert!(diff > 0.0, "the lookup read the compressed maps");
+}

@@ -162,6 +162,26 @@ impl Stats {
     }
 }
 
+/// This thread's CPU time, µs: what the viewer's own work costs, without the time it spends
+/// blocked (a driver's queue, the window system). Wall time where the platform has no thread
+/// clock.
+pub fn thread_cpu_us() -> f64 {
+    #[cfg(unix)]
+    {
+        let mut t = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: `t` is a valid timespec for the call to fill.
+        if unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) } == 0 {
+            return t.tv_sec as f64 * 1e6 + t.tv_nsec as f64 / 1e3;
+        }
+    }
+    use std::sync::OnceLock;
+    static START: OnceLock<Instant> = OnceLock::new();
+    START.get_or_init(Instant::now).elapsed().as_secs_f64() * 1e6
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -227,24 +247,4 @@ mod tests {
         slow.add_frame(t0, frame);
         assert!((slow.fps(t0 + Duration::from_secs(2)) - 0.4).abs() < 1e-9);
     }
-}
-
-/// This thread's CPU time, µs: what the viewer's own work costs, without the time it spends
-/// blocked (a driver's queue, the window system). Wall time where the platform has no thread
-/// clock.
-pub fn thread_cpu_us() -> f64 {
-    #[cfg(unix)]
-    {
-        let mut t = libc::timespec {
-            tv_sec: 0,
-            tv_nsec: 0,
-        };
-        // SAFETY: `t` is a valid timespec for the call to fill.
-        if unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) } == 0 {
-            return t.tv_sec as f64 * 1e6 + t.tv_nsec as f64 / 1e3;
-        }
-    }
-    use std::sync::OnceLock;
-    static START: OnceLock<Instant> = OnceLock::new();
-    START.get_or_init(Instant::now).elapsed().as_secs_f64() * 1e6
 }

@@ -12,7 +12,10 @@
 //!   round robin; all of them when the sun jumps) into level 0 of `reflection_probes.relit`.
 //! * `reflection_probes.downsample{m}`: level m of the relit maps' mip chain.
 //! * `reflection_probes.prefilter{k}` (`prefilter.wgsl`): GGX filtered importance sampling
-//!   into level k of the persistent `reflection_probes.radiance`, one roughness a level.
+//!   into level k of the persistent `reflection_probes.radiance`, one roughness a level; with
+//!   `compress`, into this frame's `reflection_probes.radiance` (the relit probes only), then
+//!   `reflection_probes.bc6h_encode{k}` and `.bc6h_copy{k}` into the persistent
+//!   `reflection_probes.radiance_bc6h` (docs/bc6h.md).
 //! * [`ReflectionLookup`]: what the deferred lighting reads the probes through
 //!   (`direct_lighting/shade.wgsl`'s `reflection_probe_radiance`, with the per-probe math of
 //!   `common.wgsl`).
@@ -33,6 +36,8 @@ use super::clouds::CloudsFrame;
 use super::gbuffer::GBufferPass;
 use super::irradiance_probes::ProbesFrame;
 use super::sky::SkyFrame;
+use crate::bc6h::reference::BLOCK_BYTES;
+use crate::bc6h::{Bc6hEncoder, BlockLayout, Quality};
 use crate::context::GpuContext;
 use crate::error::{RenderError, Result};
 use crate::graph::{Buf, FrameGraph, SamplerKind, Tex, TextureDesc};
@@ -325,6 +330,8 @@ pub struct ReflectionProbes {
     relight: ComputePipeline,
     downsample: ComputePipeline,
     prefilter: ComputePipeline,
+    /// BC6H for the prefiltered maps (`compress`).
+    bc6h: Bc6hEncoder,
     /// Stand-ins for the lookup with no probes.
     empty_probe: wgpu::Buffer,
     empty_light: wgpu::Buffer,
@@ -335,9 +342,22 @@ pub fn mip_count(n: u32) -> u32 {
     32 - n.max(1).leading_zeros()
 }
 
+/// The compressed copy's format: BC6H, unsigned (radiance has no sign).
+pub const COMPRESSED_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Bc6hRgbUfloat;
+
+/// Whether the prefiltered maps are kept as BC6H: asked for, sampled by the adapter, and
+/// every level whole 4x4 blocks (the smallest at least 4 texels wide).
+pub fn compresses(ctx: &GpuContext, s: &ReflectionProbesSettings) -> bool {
+    s.compress
+        && ctx.has(wgpu::Features::TEXTURE_COMPRESSION_BC)
+        && s.resolution >> s.levels.saturating_sub(1) >= 4
+        && s.resolution.is_multiple_of(4 << s.levels.saturating_sub(1))
+}
+
 impl ReflectionProbes {
     pub fn new(ctx: &GpuContext, lib: &mut ShaderLibrary) -> Result<Self> {
         Ok(Self {
+            bc6h: Bc6hEncoder::with_library(ctx, lib)?,
             capture: ComputePipeline::new(ctx, lib, "reflection_probes/capture.wgsl", "main", &[])?,
             relight: ComputePipeline::new(ctx, lib, "reflection_probes/relight.wgsl", "main", &[])?,
             downsample: ComputePipeline::new(
@@ -360,6 +380,78 @@ impl ReflectionProbes {
             )?,
             empty_light: ctx.storage_buffer("reflection_probes.empty_light", &[0; 16])?,
         })
+    }
+
+    /// Encodes the relit probes' (`list`) prefiltered levels of `radiance` (their faces in
+    /// list order) into `compressed`: per level, the probes' six faces into a block buffer,
+    /// copied into the BC6H texture at the probes' own layers.
+    fn compress<'r>(
+        &'r self,
+        g: &mut FrameGraph<'r>,
+        radiance: Tex,
+        compressed: Tex,
+        list: &[u32],
+        n: u32,
+        levels: u32,
+    ) -> Result<()> {
+        for level in 0..levels {
+            let side = n >> level;
+            let layout = BlockLayout::for_copy([side, side]);
+            let face_bytes = u64::from(layout.layer_stride) * BLOCK_BYTES as u64;
+            let blocks = g.buffer(
+                &format!("reflection_probes.bc6h{level}"),
+                face_bytes * 6 * list.len() as u64,
+            )?;
+            for k in 0..list.len() {
+                self.bc6h.record(
+                    g,
+                    &format!("reflection_probes.bc6h_encode{level}"),
+                    radiance,
+                    blocks,
+                    [side, side],
+                    (6 * k as u32, 6, level),
+                    BlockLayout {
+                        first_block: 6 * k as u32 * layout.layer_stride,
+                        ..layout
+                    },
+                    Quality::Fast,
+                )?;
+            }
+            let list = list.to_vec();
+            g.pass(&format!("reflection_probes.bc6h_copy{level}"))
+                .uses(blocks, false)
+                .uses(compressed, true)
+                .encode(move |encoder, res| {
+                    for (k, &probe) in list.iter().enumerate() {
+                        encoder.copy_buffer_to_texture(
+                            wgpu::TexelCopyBufferInfo {
+                                buffer: res.buffer(blocks),
+                                layout: wgpu::TexelCopyBufferLayout {
+                                    offset: 6 * k as u64 * face_bytes,
+                                    bytes_per_row: Some(layout.row_stride * BLOCK_BYTES as u32),
+                                    rows_per_image: Some(side / 4),
+                                },
+                            },
+                            wgpu::TexelCopyTextureInfo {
+                                texture: res.texture(compressed),
+                                mip_level: level,
+                                origin: wgpu::Origin3d {
+                                    x: 0,
+                                    y: 0,
+                                    z: 6 * probe,
+                                },
+                                aspect: wgpu::TextureAspect::All,
+                            },
+                            wgpu::Extent3d {
+                                width: side,
+                                height: side,
+                                depth_or_array_layers: 6,
+                            },
+                        );
+                    }
+                })?;
+        }
+        Ok(())
     }
 
     fn disabled_frame(
@@ -429,10 +521,22 @@ impl ReflectionProbes {
             g.persistent_texture("reflection_probes.normal_depth", array(NORMAL_DEPTH_FORMAT))?;
         let (emission, f2) =
             g.persistent_texture("reflection_probes.emission", array(EMISSION_FORMAT))?;
-        let (radiance, f3) = g.persistent_texture(
-            "reflection_probes.radiance",
-            array(RADIANCE_FORMAT).with_mips(s.levels),
-        )?;
+        // The talk keeps the relit, prefiltered maps as BC6H: each relit probe's levels are
+        // prefiltered into a texture of this frame, encoded, and copied into the persistent
+        // compressed maps the lookup samples. Uncompressed, the prefilter writes the
+        // persistent RGBA16F maps themselves.
+        let (stored, fresh) = if compresses(g.ctx(), s) {
+            g.persistent_texture(
+                "reflection_probes.radiance_bc6h",
+                array(COMPRESSED_FORMAT).with_mips(s.levels),
+            )?
+        } else {
+            g.persistent_texture(
+                "reflection_probes.radiance",
+                array(RADIANCE_FORMAT).with_mips(s.levels),
+            )?
+        };
+        let compressed = compresses(g.ctx(), s);
         let probes = g.import_buffer("reflection_probes.probes", &u.probes);
         let capture_light = g.import_buffer("reflection_probes.capture_light", &u.capture_light);
 
@@ -502,7 +606,7 @@ impl ReflectionProbes {
             }
             None => true,
         };
-        let all = f3 || moved || inputs.relight_all;
+        let all = fresh || moved || inputs.relight_all;
         if all {
             progress.relit_all_with = Some((sun_dir, inputs.weather.to_owned()));
         }
@@ -548,12 +652,12 @@ impl ReflectionProbes {
             let lookup = ReflectionLookup {
                 params: lookup_params,
                 probes,
-                radiance,
+                radiance: stored,
                 capture_light,
             };
             return Ok(ReflectionProbesFrame {
                 lookup,
-                radiance: Some(radiance),
+                radiance: (!compressed).then_some(stored),
                 capture: Some([albedo, normal_depth, emission]),
                 relit: 0,
                 captured: captured_now,
@@ -609,12 +713,21 @@ impl ReflectionProbes {
                 .write_mip(relit, m + 1)
                 .dispatch_threads(&self.downsample, [side, side, 6 * k])?;
         }
+        // Compressed, the prefiltered levels of this frame's probes only, in list order.
+        let radiance = if compressed {
+            g.texture(
+                "reflection_probes.radiance",
+                TextureDesc::d2_array(n, n, 6 * k, RADIANCE_FORMAT).with_mips(s.levels),
+            )?
+        } else {
+            stored
+        };
         for level in 0..s.levels {
             let side = (n >> level).max(1);
             g.pass(&format!("reflection_probes.prefilter{level}"))
                 .constants(&PrefilterParams {
                     level: [level, s.levels, s.samples, n],
-                    probes: [0, count, k, 0],
+                    probes: [u32::from(compressed), count, k, 0],
                 })
                 .read(relit)
                 .sampler(SamplerKind::LinearClamp)
@@ -622,10 +735,13 @@ impl ReflectionProbes {
                 .read(relit_list)
                 .dispatch_threads(&self.prefilter, [side, side, 6 * k])?;
         }
+        if compressed {
+            self.compress(g, radiance, stored, &list, n, s.levels)?;
+        }
         let lookup = ReflectionLookup {
             params: lookup_params,
             probes,
-            radiance,
+            radiance: stored,
             capture_light,
         };
         Ok(ReflectionProbesFrame {

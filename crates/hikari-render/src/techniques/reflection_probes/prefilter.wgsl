@@ -10,7 +10,8 @@
 struct PrefilterParams {
     // x: output level; y: levels; z: samples; w: texels a side of relit level 0.
     level: vec4<u32>,
-    // x: unused; y: probes in all; z: probes relit (listed in `relit_list`).
+    // x: 1 to write the relit probes in list order, 0 at their own layers; y: probes in all;
+    // z: probes relit (listed in `relit_list`).
     probes: vec4<u32>,
 }
 
@@ -77,5 +78,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         value = sum / max(weight, 1e-6);
     }
-    textureStore(out_level, gid.xy, probe * 6u + face, vec4<f32>(value, 1.0));
+    // x = 1: the output holds this frame's probes only, in list order (to be compressed).
+    let layer = select(probe, cube, params.probes.x == 1u) * 6u + face;
+    textureStore(out_level, gid.xy, layer, vec4<f32>(value, 1.0));
 }

@@ -38,6 +38,10 @@ pub struct ReflectionProbesSettings {
     /// capture point (the talk's luminance normalisation), at most `max_normalization`.
     pub normalization: bool,
     pub max_normalization: f32,
+    /// Keep the prefiltered maps compressed to BC6H (encoded on the GPU as each probe is
+    /// relit, docs/bc6h.md), as the talk does, where the adapter samples BC formats and every
+    /// level is at least 4 texels wide; else they stay RGBA16F.
+    pub compress: bool,
 }
 
 impl Default for ReflectionProbesSettings {
@@ -56,6 +60,7 @@ impl Default for ReflectionProbesSettings {
             roughness_parallax: true,
             normalization: true,
             max_normalization: 2.0,
+            compress: true,
         }
     }
 }
