@@ -33,6 +33,19 @@ const TIMED_EVERY: Duration = Duration::from_millis(250);
 const RAYS_EVERY: Duration = Duration::from_secs(1);
 /// How long a message stays.
 const MESSAGE_FOR: Duration = Duration::from_secs(8);
+/// The panel is laid out again at least this often (its numbers move), at once after any
+/// input or while egui animates; in between, the last layout is painted again: egui's layout
+/// is most of the viewer's own CPU time.
+const UI_REFRESH: Duration = Duration::from_millis(100);
+
+/// The last layout of the panel, painted again until something changes.
+struct UiCache {
+    prims: Vec<egui::ClippedPrimitive>,
+    pixels_per_point: f32,
+    at: Instant,
+    /// What the layout was made for: the window's size, the panel shown, the message.
+    key: ([u32; 2], bool, Option<(String, bool)>),
+}
 
 enum LoadMsg {
     Stage(String),
@@ -107,6 +120,9 @@ pub struct App {
     speed: f32,
     fatal: Option<anyhow::Error>,
     frames: u64,
+    ui_cache: Option<UiCache>,
+    /// An input event came since the last layout (or egui asked to be laid out again).
+    ui_dirty: bool,
 }
 
 impl App {
@@ -129,6 +145,8 @@ impl App {
             speed: 1.0,
             fatal: None,
             frames: 0,
+            ui_cache: None,
+            ui_dirty: true,
         }
     }
 
@@ -138,13 +156,15 @@ impl App {
             return Err(e);
         }
         if let Some(live) = &self.live
-            && let Some(us) = live.stats.ui_cpu_us()
+            && let (Some(us), Some((mean, n))) =
+                (live.stats.ui_cpu_us(), live.stats.ui_cpu_mean_us())
         {
             log::info!(
                 "{} frames; the viewer's own CPU time a frame (egui layout, tessellation, paint \
-                 recording): median {:.3} ms over the last second",
+                 recording): median {:.3} ms over the last second, mean {:.3} ms over {n} frames",
                 self.frames,
-                us / 1000.0
+                us / 1000.0,
+                mean / 1000.0
             );
         }
         Ok(())
@@ -560,15 +580,36 @@ impl App {
         let Some(state) = self.egui_state.as_mut() else {
             return Ok(());
         };
-        let input = state.take_egui_input(window);
-        let mut out = self
-            .egui
-            .run_ui(input, |ui| super::ui::draw(ui, &mut model));
-        state.handle_platform_output(window, out.platform_output);
-        let prims = self.egui.tessellate(out.shapes, out.pixels_per_point);
+        let key = (size, show_panel, message.clone());
+        let fresh = !self.ui_dirty
+            && self
+                .ui_cache
+                .as_ref()
+                .is_some_and(|c| c.key == key && now.duration_since(c.at) < UI_REFRESH);
+        let mut textures = egui::TexturesDelta::default();
+        if !fresh {
+            let input = state.take_egui_input(window);
+            let out = self
+                .egui
+                .run_ui(input, |ui| super::ui::draw(ui, &mut model));
+            state.handle_platform_output(window, out.platform_output);
+            // egui animating (a header opening) wants the next frame laid out too.
+            self.ui_dirty = out
+                .viewport_output
+                .values()
+                .any(|v| v.repaint_delay.is_zero());
+            textures = out.textures_delta;
+            self.ui_cache = Some(UiCache {
+                prims: self.egui.tessellate(out.shapes, out.pixels_per_point),
+                pixels_per_point: out.pixels_per_point,
+                at: now,
+                key,
+            });
+        }
+        let cache = self.ui_cache.as_ref().expect("laid out");
         let ui_layout_us = super::stats::thread_cpu_us() - t_ui;
         let (ui_gpu, encode_us) =
-            presenter.paint(&mut out.textures_delta, &prims, out.pixels_per_point, timed)?;
+            presenter.paint(&mut textures, &cache.prims, cache.pixels_per_point, timed)?;
         let ui_cpu_us = ui_layout_us + encode_us;
 
         // What the panel changed.
@@ -777,6 +818,9 @@ impl ApplicationHandler for App {
         };
         if let Some(state) = self.egui_state.as_mut() {
             let _ = state.on_window_event(&window, &event);
+        }
+        if !matches!(event, WindowEvent::RedrawRequested) {
+            self.ui_dirty = true;
         }
         let egui_keys = self.egui.egui_wants_keyboard_input();
         let over_egui = self.egui.is_pointer_over_egui();

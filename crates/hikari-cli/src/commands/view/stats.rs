@@ -45,6 +45,8 @@ pub struct Stats {
     pub rays: Option<RayStats>,
     /// The viewer's own CPU time a frame (egui layout, tessellation, paint recording), µs.
     ui_cpu_us: VecDeque<(Instant, f64)>,
+    /// Every frame's viewer CPU time summed, and the frames.
+    ui_cpu_sum: (f64, u64),
 }
 
 /// The median of `v` (sorted in place); `None` when empty.
@@ -93,6 +95,8 @@ impl Stats {
     }
 
     pub fn add_ui_cpu(&mut self, now: Instant, us: f64) {
+        self.ui_cpu_sum.0 += us;
+        self.ui_cpu_sum.1 += 1;
         self.ui_cpu_us.push_back((now, us));
         trim(&mut self.ui_cpu_us, now, WINDOW);
     }
@@ -100,6 +104,12 @@ impl Stats {
     /// The viewer's median CPU time a frame over the last second, µs.
     pub fn ui_cpu_us(&self) -> Option<f64> {
         median(&mut self.ui_cpu_us.iter().map(|(_, v)| *v).collect::<Vec<_>>())
+    }
+
+    /// The viewer's mean CPU time a frame since it started, µs, and over how many frames.
+    pub fn ui_cpu_mean_us(&self) -> Option<(f64, u64)> {
+        let (sum, n) = self.ui_cpu_sum;
+        (n > 0).then(|| (sum / n as f64, n))
     }
 
     /// Frames that began within the last second.
