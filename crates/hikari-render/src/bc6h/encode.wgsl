@@ -76,8 +76,34 @@ fn unquantize(q: u32) -> u32 {
     return q * 64u + 32u;
 }
 
+// The nearest 10-bit endpoint: h / 31, or a neighbour at the ends (0 and 1023 stand for 0
+// and 0xffff), compared exactly in the space scaled by 31; a tie keeps the lower.
+fn quantize1(h: u32) -> u32 {
+    let q = min(h / 31u, 1023u);
+    var best = q;
+    var best_d = distance_to(q, h);
+    let lo = select(q, q - 1u, q > 0u);
+    let hi = min(q + 1u, 1023u);
+    let d_lo = distance_to(lo, h);
+    if d_lo < best_d || (d_lo == best_d && lo < best) {
+        best = lo;
+        best_d = d_lo;
+    }
+    let d_hi = distance_to(hi, h);
+    if d_hi < best_d || (d_hi == best_d && hi < best) {
+        best = hi;
+    }
+    return best;
+}
+
+fn distance_to(q: u32, h: u32) -> u32 {
+    let a = unquantize(q) * 31u;
+    let b = h * 64u;
+    return max(a, b) - min(a, b);
+}
+
 fn quantize(h: vec3<u32>) -> vec3<u32> {
-    return min(h / 31u, vec3<u32>(1023u));
+    return vec3<u32>(quantize1(h.x), quantize1(h.y), quantize1(h.z));
 }
 
 fn palette(q0: vec3<u32>, q1: vec3<u32>, i: u32) -> vec3<u32> {

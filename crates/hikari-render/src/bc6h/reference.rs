@@ -52,10 +52,20 @@ fn unquantize(q: u32) -> u32 {
     }
 }
 
-/// The 10-bit endpoint whose value is nearest half bits `h`: `h * 64 / 31` is its place in
-/// the interpolation space and the endpoints sit at `q * 64 + 32`, so `h / 31` is nearest.
+/// The 10-bit endpoint whose value is nearest half bits `h`. `h * 64 / 31` is its place in
+/// the interpolation space and the endpoints sit at `q * 64 + 32`, so `h / 31` is nearest but
+/// at the ends, where 0 and 1023 stand for 0 and 0xffff: its neighbours are compared too (in
+/// the space scaled by 31, exactly; a tie keeps the lower).
 pub fn quantize(h: u32) -> u32 {
-    (h / 31).min(1023)
+    let q = (h / 31).min(1023);
+    let distance = |q: u32| (unquantize(q) * 31).abs_diff(h * 64);
+    let mut best = q;
+    for c in [q.saturating_sub(1), (q + 1).min(1023)] {
+        if distance(c) < distance(best) || (distance(c) == distance(best) && c < best) {
+            best = c;
+        }
+    }
+    best
 }
 
 /// The colour index `i` decodes to between quantized endpoints `q0` and `q1`, half bits.
