@@ -482,21 +482,16 @@ fn a_lamp_lit_probe_is_normalised_by_the_lamp_at_the_surface() {
     assert!(checked > 150 && above > 20 && below > 20);
 }
 
-#[test]
-fn the_relit_cube_maps_are_the_twins_relighting_of_what_was_captured() {
-    // The boxes in the morning sun, a probe round them; the sky's light off (its SH has its own
-    // tests), so each texel is its emission plus its albedo lit by the sun through the talk's
-    // cube-map shadow. Level 0 of the prefiltered maps is the relit map itself.
+/// The boxes in the 10:00 sun with the sky on, and a 32-texel probe of 2 levels round them.
+fn morning_boxes_with_a_probe() -> (Scene, FrameSettings, ReflectionProbeBox) {
     let scene = hikari_scene::builtin::boxes();
     let mut s = common::small_frame_settings(&scene, 32, 24);
     s.settings.sky.enabled = true;
-    s.settings.sky.sky = false;
     s.settings.sky.table_quality = 0;
     s.settings.sky.time = "10:00".into();
     s.sun = hikari_render::SunSource::Sky;
     s.settings.area_lights.enabled = false;
-    let n = 32;
-    s.settings.reflection_probes.resolution = n;
+    s.settings.reflection_probes.resolution = 32;
     s.settings.reflection_probes.levels = 2;
     s.settings.reflection_probes.samples = 4;
     let b = probe(
@@ -505,6 +500,17 @@ fn the_relit_cube_maps_are_the_twins_relighting_of_what_was_captured() {
         Vec3::new(0.5, 1.2, 0.8),
         1.0,
     );
+    (scene, s, b)
+}
+
+#[test]
+fn the_relit_cube_maps_are_the_twins_relighting_of_what_was_captured() {
+    // The boxes in the morning sun, a probe round them; the sky's light off (its SH has its own
+    // tests), so each texel is its emission plus its albedo lit by the sun through the talk's
+    // cube-map shadow. Level 0 of the prefiltered maps is the relit map itself.
+    let (scene, mut s, b) = morning_boxes_with_a_probe();
+    s.settings.sky.sky = false;
+    let n = s.settings.reflection_probes.resolution;
     let mut r = Renderer::new(common::gpu_context(), &scene).unwrap();
     r.set_reflection_probes(std::slice::from_ref(&b)).unwrap();
     let mut out = r
@@ -770,24 +776,9 @@ fn only_probes_near_the_camera_are_captured_and_relit() {
 #[test]
 fn the_compressed_maps_are_the_twins_blocks_of_the_prefiltered_maps() {
     use hikari_render::bc6h::{Quality, reference as bc6h};
-    let scene = hikari_scene::builtin::boxes();
-    let mut s = common::small_frame_settings(&scene, 32, 24);
-    s.settings.sky.enabled = true;
-    s.settings.sky.table_quality = 0;
-    s.settings.sky.time = "10:00".into();
-    s.sun = hikari_render::SunSource::Sky;
-    s.settings.area_lights.enabled = false;
+    let (scene, mut s, b) = morning_boxes_with_a_probe();
     s.settings.taa.enabled = false;
-    let n = 32;
-    s.settings.reflection_probes.resolution = n;
-    s.settings.reflection_probes.levels = 2;
-    s.settings.reflection_probes.samples = 4;
-    let b = probe(
-        Vec3::new(-6.0, -0.5, -5.0),
-        Vec3::new(6.0, 6.0, 6.0),
-        Vec3::new(0.5, 1.2, 0.8),
-        1.0,
-    );
+    let n = s.settings.reflection_probes.resolution;
     let ctx = common::gpu_context();
     assert!(
         hikari_render::techniques::reflection_probes::compresses(

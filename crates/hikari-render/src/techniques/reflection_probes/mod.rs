@@ -525,7 +525,8 @@ impl ReflectionProbes {
         // prefiltered into a texture of this frame, encoded, and copied into the persistent
         // compressed maps the lookup samples. Uncompressed, the prefilter writes the
         // persistent RGBA16F maps themselves.
-        let (stored, fresh) = if compresses(g.ctx(), s) {
+        let compressed = compresses(g.ctx(), s);
+        let (stored, fresh) = if compressed {
             g.persistent_texture(
                 "reflection_probes.radiance_bc6h",
                 array(COMPRESSED_FORMAT).with_mips(s.levels),
@@ -536,7 +537,6 @@ impl ReflectionProbes {
                 array(RADIANCE_FORMAT).with_mips(s.levels),
             )?
         };
-        let compressed = compresses(g.ctx(), s);
         let probes = g.import_buffer("reflection_probes.probes", &u.probes);
         let capture_light = g.import_buffer("reflection_probes.capture_light", &u.capture_light);
 
