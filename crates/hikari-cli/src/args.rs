@@ -147,6 +147,22 @@ pub struct ConfigArgs {
     /// Wins over the preset and the file.
     #[arg(long = "set", value_name = "TABLE.KEY=VALUE", value_parser = crate::config::parse_override)]
     pub overrides: Vec<(String, String)>,
+    /// Renders at this fraction of the image's width and height, 0.5 to 1, and upsamples
+    /// temporally to it (`taa.render_scale`; docs/scaling.md) [default: the preset's: low
+    /// 0.5, medium 0.67, high and ultra 1]
+    #[arg(long, value_name = "S")]
+    pub render_scale: Option<f32>,
+}
+
+impl ConfigArgs {
+    /// `--set` overrides with `--render-scale` last, so that the flag wins.
+    pub fn all_overrides(&self) -> Vec<(String, String)> {
+        let mut o = self.overrides.clone();
+        if let Some(s) = self.render_scale {
+            o.push(("taa.render_scale".into(), format!("{s:?}")));
+        }
+        o
+    }
 }
 
 /// `--ev100`: a fixed exposure.

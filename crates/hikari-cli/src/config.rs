@@ -37,6 +37,11 @@ pub struct ConfigFile {
 const HEAD_KEYS: [&str; 5] = ["scene", "camera", "time", "width", "height"];
 
 impl ConfigFile {
+    /// Whether the file names a preset.
+    pub fn has_preset(&self) -> bool {
+        self.tables.contains_key("preset")
+    }
+
     /// The settings the file gives: its preset (default `high`) and its tables.
     #[cfg(test)]
     pub fn settings(&self) -> Settings {

@@ -102,6 +102,13 @@ pub fn set_quiet(quiet: bool) {
     }
 }
 
+/// A choice the command made for the user that changes what it draws (the CPU adapter's
+/// preset): printed on stderr above the bars, even with `--quiet` or without a terminal.
+pub fn note(message: &str) {
+    let line = format!("note: {message}\n");
+    let _ = multi().suspend(|| std::io::stderr().write_all(line.as_bytes()));
+}
+
 /// What `env_logger` writes through: each record printed above the bars.
 pub struct LogWriter;
 

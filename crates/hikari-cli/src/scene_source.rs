@@ -215,6 +215,8 @@ pub struct ResolvedFrame {
     pub scene: Scene,
     pub settings: FrameSettings,
     pub description: FrameDescription,
+    /// Whether `--preset` or the config file chose the preset (else the default did).
+    pub preset_given: bool,
 }
 
 /// Which light a scene gets, and the time it shows (`None`: the scene's own sun).
@@ -294,6 +296,33 @@ fn check_size(args: &FrameArgs, width: u32, height: u32) -> anyhow::Result<()> {
 
 /// The scene and the frame settings: from the flags, then the config file, then defaults.
 pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
+    resolve_loaded(args, None)
+}
+
+/// What a CPU adapter gets by default: a frame resolved without a preset from the flags or
+/// the file is resolved again at `low` (a quarter of the pixels, rendered at scale 0.5 and
+/// upsampled), so that the first picture on a machine without a GPU takes about a minute;
+/// said on stderr. Any other frame is returned as it is.
+pub fn fit_to_adapter(
+    frame: ResolvedFrame,
+    args: &FrameArgs,
+    ctx: &hikari_render::GpuContext,
+) -> anyhow::Result<ResolvedFrame> {
+    if frame.preset_given || ctx.info.device_type != hikari_render::wgpu::DeviceType::Cpu {
+        return Ok(frame);
+    }
+    let mut low = args.clone();
+    low.config.preset = Some(hikari_render::Preset::Low);
+    let frame = resolve_loaded(&low, Some(frame.scene))?;
+    crate::progress::note(&format!(
+        "CPU adapter ({}): preset low, render scale {} (--preset high for the full frame)",
+        ctx.info.name, frame.settings.settings.taa.render_scale
+    ));
+    Ok(frame)
+}
+
+/// [`resolve`], with the scene already loaded when `loaded` has it.
+fn resolve_loaded(args: &FrameArgs, loaded: Option<Scene>) -> anyhow::Result<ResolvedFrame> {
     let file = match &args.config.config {
         Some(p) => crate::config::load(p)?,
         None => crate::config::ConfigFile::default(),
@@ -308,7 +337,10 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
     let width = args.size.width.or(file.width).unwrap_or(DEFAULT_SIZE.0);
     let height = args.size.height.or(file.height).unwrap_or(DEFAULT_SIZE.1);
     check_size(args, width, height)?;
-    let scene = source.load()?;
+    let scene = match loaded {
+        Some(scene) => scene,
+        None => source.load()?,
+    };
     let (camera, camera_origin) = choose_camera(
         &scene,
         args.camera.camera.as_deref(),
@@ -316,9 +348,8 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
     )?;
     let overrides: Vec<(String, String)> = args
         .config
-        .overrides
-        .iter()
-        .cloned()
+        .all_overrides()
+        .into_iter()
         .chain(args.tonemap.overrides()?)
         .collect();
     let mut settings = file
@@ -365,6 +396,7 @@ pub fn resolve(args: &FrameArgs) -> anyhow::Result<ResolvedFrame> {
             settings,
         },
         description,
+        preset_given: args.config.preset.is_some() || file.has_preset(),
     })
 }
 

@@ -27,10 +27,15 @@ pub fn gpu() -> anyhow::Result<GpuContext> {
 /// when its settings use the probes (`bake`: `--bake`, else the cache, baked on a miss);
 /// each step shown as progress.
 pub fn renderer(frame: &ResolvedFrame, bake: Option<&Path>) -> anyhow::Result<Renderer> {
+    renderer_on(start_gpu(frame)?, frame, bake)
+}
+
+/// A new GPU context for `frame`, shown as a step; an image larger than the GPU's limit is
+/// refused now, not after the renderer's set-up and the bake.
+pub fn start_gpu(frame: &ResolvedFrame) -> anyhow::Result<GpuContext> {
     let step = Step::start("starting the GPU");
     let ctx = gpu()?;
     step.done(format!("GPU: {}", ctx.info.name));
-    // Too large for this GPU: said now, not after the renderer's set-up and the bake.
     let max = ctx.limits.max_texture_dimension_2d;
     for (what, v) in [
         ("width", frame.settings.width),
@@ -40,6 +45,15 @@ pub fn renderer(frame: &ResolvedFrame, bake: Option<&Path>) -> anyhow::Result<Re
             anyhow::bail!("image {what} of {v} exceeds this GPU's limit of {max}");
         }
     }
+    Ok(ctx)
+}
+
+/// [`renderer`] on a GPU context already started ([`start_gpu`]).
+pub fn renderer_on(
+    ctx: GpuContext,
+    frame: &ResolvedFrame,
+    bake: Option<&Path>,
+) -> anyhow::Result<Renderer> {
     let step = Step::start("preparing the renderer");
     let mut renderer = Renderer::new(ctx, &frame.scene)?;
     step.done("renderer ready");

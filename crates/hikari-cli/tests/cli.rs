@@ -45,9 +45,15 @@ fn render_writes_png_exr_and_dumps() {
     );
     assert!(dir.join("gbuffer.normal.exr").exists());
     assert!(
-        // The last of two frames: the still view's shadow maps are cached, TAA blends.
-        text(&o).contains("gbuffer.resolve") && text(&o).contains("taa.resolve"),
+        // The last of two frames: the still view's shadow maps are cached, TAA blends; on the
+        // CPU driver, at the low preset's render scale, upsampling to the image's size.
+        text(&o).contains("gbuffer.resolve") && text(&o).contains("taa.upsample"),
         "timing table: {}",
+        text(&o)
+    );
+    assert!(
+        text(&o).contains("CPU adapter") && text(&o).contains("preset low, render scale 0.5"),
+        "the CPU adapter's default is said: {}",
         text(&o)
     );
     // Atomic writes leave no temporary files behind.

@@ -261,8 +261,12 @@ fn mean_png(path: &Path) -> f64 {
 fn render_into(dir: &Path, extra: &[&str]) -> Output {
     std::fs::create_dir_all(dir).unwrap();
     let png = dir.join("out.png");
+    // The `high` preset, as on a GPU: the CPU driver's default (`low`) renders at half the
+    // size, and these tests count the output's pixels.
     let mut args = vec![
         "render",
+        "--preset",
+        "high",
         "--width",
         "64",
         "--height",

@@ -14,6 +14,7 @@ use crate::scene::raster::{RasterQueues, Rasterizer};
 use crate::scene::rt::SceneRt;
 use crate::scene::upload::SceneGpu;
 use crate::shader;
+use crate::steady_light::{FrameLight, LightKey};
 use crate::techniques::area_lights::{
     AreaLightParams, AreaLightScene, AreaLights, DenoisedShadows, ShadowDenoiseInputs,
     ShadowDenoiseParams,
@@ -236,7 +237,12 @@ pub fn record<'r>(
     )?;
 
     // 5. Irradiance probes: this frame's share relit from the sky's SH and the sun or moon,
-    //    whose bounce the clouds shadow.
+    //    whose bounce the clouds shadow; none once a whole round holds an unchanged light.
+    let light_key = LightKey::new(cx, &s.settings, &clouds.params);
+    let light = FrameLight {
+        key: &light_key,
+        settled: clouds.settled,
+    };
     let probes = t.irradiance_probes.record(
         g,
         &mut state.techniques.irradiance_probes,
@@ -244,6 +250,7 @@ pub fn record<'r>(
         &s.settings.irradiance_probes,
         &sky,
         clouds.lookup,
+        light,
     )?;
 
     // 6. Reflection probes (after the clouds, which shadow and cover their sky): captured
@@ -256,7 +263,15 @@ pub fn record<'r>(
         scene,
         &mut state.raster_queues,
         &s.settings.reflection_probes,
-        &ReflectionProbeInputs::for_frame(cx, &s.settings, &sky, &probes, &clouds, scene.lights),
+        &ReflectionProbeInputs::for_frame(
+            cx,
+            &s.settings,
+            &sky,
+            &probes,
+            &clouds,
+            scene.lights,
+            light,
+        ),
     )?;
 
     // 7. Sun shadow maps (cascades redrawn only where the view or the sun moved).
@@ -452,14 +467,32 @@ pub fn record<'r>(
         )?;
     }
 
-    // 12. TAA.
-    let hdr = if s.settings.taa.enabled {
+    // 12. TAA; below render scale 1, temporal upsampling to the output's size, which every
+    //     step after this works at.
+    let out_size = cx.output_size;
+    let taa_settings = &s.settings.taa;
+    let hdr = if size != out_size {
+        let valid = history && taa_settings.enabled;
         t.taa
-            .record(g, hazed, gbuffer.motion, size, &s.settings.taa, history)?
+            .record_upsampled(
+                g,
+                hazed,
+                gbuffer.motion,
+                size,
+                out_size,
+                taa_settings,
+                valid,
+                cx.jitter,
+            )?
+            .output
+    } else if taa_settings.enabled {
+        t.taa
+            .record(g, hazed, gbuffer.motion, size, taa_settings, history)?
             .output
     } else {
         hazed
     };
+    let size = out_size;
 
     // 13. Exposure, metered on the illuminance; the local tonemap's grid; the tonemap: the local
     //     gain from that grid, Purkinje shift, white balance, the curve in the tonemapping
@@ -468,7 +501,7 @@ pub fn record<'r>(
         g,
         hdr,
         lit_frame.illuminance,
-        size,
+        cx.size,
         &ExposureParams::new(&s.settings.exposure, sky.knobs.exposure_bias_ev, cx.ev100),
     )?;
     let local_tonemap = t.local_tonemap.record(

@@ -153,7 +153,10 @@ impl HistoryValidity {
 /// One frame's facts; see the module's documentation.
 #[derive(Clone, Debug)]
 pub struct FrameContext {
+    /// The size every pass before TAA renders at: the output's at `taa.render_scale`.
     pub size: [u32; 2],
+    /// The output's size (`FrameSettings::width`, `height`): TAA's output and what follows.
+    pub output_size: [u32; 2],
     pub aspect: f32,
     /// The graph's frame index: frames committed before this one.
     pub frame_index: u64,
@@ -191,10 +194,13 @@ impl FrameContext {
         history: HistoryValidity,
     ) -> Result<Self> {
         let settings = &s.settings;
-        let size = [s.width, s.height];
+        let output_size = [s.width, s.height];
+        let scale = settings.taa.render_scale;
+        let size = taa::render_size(output_size, scale);
         let aspect = s.width as f32 / s.height.max(1) as f32;
         let jitter = if settings.taa.enabled {
-            taa::reference::jitter(frame_index, settings.taa.jitter_samples)
+            let cycle = taa::jitter_cycle(settings.taa.jitter_samples, scale);
+            taa::reference::jitter(frame_index, cycle)
         } else {
             [0.0; 2]
         };
@@ -204,6 +210,7 @@ impl FrameContext {
             s.width,
             s.height,
         )
+        .with_viewport(size[0], size[1])
         .jittered(jitter);
         let sun = s.directional_light()?;
         let fixed = match &s.sun {
@@ -227,6 +234,7 @@ impl FrameContext {
             .map_or(0.0, |t| f64::from(t.seconds_of_day()));
         Ok(Self {
             size,
+            output_size,
             aspect,
             frame_index,
             jitter,
@@ -254,6 +262,7 @@ impl FrameContext {
         let metered_lux = 1000.0;
         Self {
             size,
+            output_size: size,
             aspect: view.viewport[0] / view.viewport[1].max(1.0),
             frame_index,
             jitter: [view.jitter[0], view.jitter[1]],

@@ -229,7 +229,7 @@ pub fn all() -> Vec<StructLayout> {
         gpu_layout!(
             taa::TaaParams,
             "taa/resolve.wgsl",
-            [history_valid, clip, max_history, _pad]
+            [history_valid, clip, max_history, _pad, jitter, ratio]
         ),
         gpu_layout!(
             exposure::ExposureParams,
@@ -367,6 +367,10 @@ pub fn all() -> Vec<StructLayout> {
 pub fn constants() -> Vec<SharedConstant> {
     vec![
         gpu_const!(crate::bc6h::reference::MAX_HALF_BITS, "bc6h/encode.wgsl"),
+        gpu_const!(
+            crate::techniques::taa::reference::SPREAD,
+            "taa/resolve.wgsl"
+        ),
         gpu_const!(
             crate::techniques::haze::reference::AIR_INTERIOR_MASK,
             "haze/light.wgsl"

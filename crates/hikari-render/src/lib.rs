@@ -19,6 +19,7 @@ pub mod renderer;
 pub mod scene;
 pub mod settings;
 pub mod shader;
+pub mod steady_light;
 pub mod techniques;
 pub mod view;
 

@@ -58,8 +58,9 @@ pub struct Renderer {
     interactive_clock: Option<Option<std::time::Instant>>,
     /// The live frame that [`Renderer::frame`] draws, changed by the setters between frames.
     live: Option<FrameSettings>,
-    /// The camera pose and size of the last frame rendered, to tell a cut or a resize.
-    last_pose: Option<([f32; 6], [u32; 2])>,
+    /// The camera pose, size and render scale (bits) of the last frame rendered, to tell a
+    /// cut or a resize.
+    last_pose: Option<([f32; 6], [u32; 3])>,
     /// A reason to drop temporal history that the next frame takes up.
     pending_reset: Option<HistoryReset>,
     /// The context of the last frame rendered.
@@ -295,7 +296,12 @@ impl Renderer {
     /// given by a setter, the first frame, a new size, or a camera that moved while claiming
     /// it did not (a cut).
     fn history_for(&mut self, settings: &FrameSettings) -> HistoryValidity {
-        let size = [settings.width, settings.height];
+        // The output's size and the size rendered at: a new render scale is a new size.
+        let size = [
+            settings.width,
+            settings.height,
+            settings.settings.taa.render_scale.to_bits(),
+        ];
         let pose = camera_pose(&settings.camera);
         let reset = self.pending_reset.take().or(match self.last_pose {
             None => Some(HistoryReset::FirstFrame),

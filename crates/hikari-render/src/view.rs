@@ -48,6 +48,19 @@ impl View {
         }
     }
 
+    /// This view drawn into a `width` x `height` image, its projection unchanged (a frame
+    /// rendered below the output's size keeps the output's aspect exactly).
+    pub fn with_viewport(mut self, width: u32, height: u32) -> Self {
+        self.viewport = Vec4::new(
+            width as f32,
+            height as f32,
+            1.0 / width as f32,
+            1.0 / height as f32,
+        )
+        .to_array();
+        self
+    }
+
     /// This view with its image shifted by `jitter` pixels (x right, y down): a surface at
     /// pixel position `q` without jitter is drawn at `q + jitter`.
     pub fn jittered(mut self, jitter: [f32; 2]) -> Self {

@@ -69,6 +69,7 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         scene,
         mut settings,
         description,
+        ..
     } = scene_source::resolve(&a.frame)?;
     // What runs, stated before the (possibly long) run, from what was resolved rather than
     // from the flags alone: a config file can name the scene, camera, time and size too.

@@ -125,6 +125,7 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         scene,
         settings,
         description,
+        ..
     } = scene_source::resolve(&a.frame)?;
     let s = &settings.settings;
     anyhow::ensure!(
@@ -160,6 +161,8 @@ pub fn run(mut a: BenchProbesArgs) -> anyhow::Result<()> {
         )
     })?;
     renderer.irradiance_probes_state().set_lookup_pass(true);
+    // The frame's relight is timed: its round robin runs even though the light stands still.
+    renderer.irradiance_probes_state().set_never_rest(true);
     renderer.runtime.set_timestamps(TimestampMode::Pass);
     let spec = RelightBenchSpec {
         grid_tiles: a.grid_tiles,

@@ -40,6 +40,10 @@ pub struct SoakArgs {
     /// (walking all of them in turn); the outputs must stay finite.
     #[arg(long)]
     pub poison: bool,
+    /// Also print, at the end, how the resident set of each kind of mapping grew after the
+    /// warm-up (`/proc/self/smaps`: the heap, anonymous memory, device files, libraries).
+    #[arg(long)]
+    pub smaps: bool,
     #[command(flatten)]
     pub output: JsonArgs,
 }
@@ -48,6 +52,7 @@ pub struct SoakArgs {
 struct Sample {
     frame: u32,
     resident_mb: Option<f64>,
+    heap_mb: Option<f64>,
     gpu_allocated_mb: Option<f64>,
     gpu_reserved_mb: Option<f64>,
     frame_ms: f64,
@@ -66,6 +71,54 @@ fn resident_mb() -> Option<f64> {
     let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
     let pages: f64 = statm.split_whitespace().nth(1)?.parse().ok()?;
     Some(pages * 4096.0 / 1e6)
+}
+
+/// The resident set by kind of mapping, MB (`/proc/self/smaps`; empty elsewhere): `[heap]`,
+/// anonymous memory (other threads' malloc arenas, drivers' own allocations), each device file
+/// (a GPU driver's mappings), shared libraries, and the rest. `--smaps` prints how each grew,
+/// to tell whose pages a growing resident set is.
+fn smaps_mb() -> std::collections::BTreeMap<String, f64> {
+    let mut out = std::collections::BTreeMap::new();
+    let Ok(text) = std::fs::read_to_string("/proc/self/smaps") else {
+        return out;
+    };
+    let mut kind = String::new();
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        let first = words.next().unwrap_or("");
+        if first.contains('-') && first.chars().next().is_some_and(|c| c.is_ascii_hexdigit()) {
+            let path = line.split_whitespace().nth(5).unwrap_or("");
+            kind = if path.is_empty() {
+                "anonymous".into()
+            } else if path.starts_with("/dev/") || path.starts_with("[") {
+                path.into()
+            } else if path.contains(".so") {
+                "libraries".into()
+            } else {
+                "other files".into()
+            };
+        } else if first == "Rss:" {
+            let kb: f64 = words.next().and_then(|v| v.parse().ok()).unwrap_or(0.0);
+            *out.entry(kind.clone()).or_insert(0.0) += kb / 1e3;
+        }
+    }
+    out
+}
+
+/// Bytes the allocator has handed out and not had back, MB (glibc; `None` elsewhere): the
+/// heap's own growth, which tells a leak of the process's allocations from memory a driver
+/// maps beside the heap (both count in the resident set).
+fn heap_mb() -> Option<f64> {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    {
+        // SAFETY: mallinfo2 only reads the allocator's counters.
+        let info = unsafe { libc::mallinfo2() };
+        Some((info.uordblks + info.hblkhd) as f64 / 1e6)
+    }
+    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+    {
+        None
+    }
 }
 
 /// What the GPU allocator holds for this device, MB: allocated and reserved (its blocks).
@@ -135,6 +188,7 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
         scene,
         settings,
         description,
+        ..
     } = scene_source::resolve(&a.frame)?;
     let switches: Vec<&'static str> = settings
         .settings
@@ -190,6 +244,8 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
     let ctx = crate::still::gpu()?;
     let adapter = ctx.describe();
     let mut renderer = Renderer::new(ctx.clone(), &scene)?;
+    // The viewer's mode: no frame waits for the rasteriser's queue counts.
+    renderer.set_interactive(true);
     probe_bake::attach(&mut renderer, &scene, &description.source, &settings, None)?;
     renderer.set_frame(settings.clone())?;
     // The clock moves the sky's sun or moon, as in the viewer, even in a scene with its own.
@@ -227,6 +283,8 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
         }
     }
     let mut samples: Vec<Sample> = Vec::new();
+    // The resident set by kind of mapping after the warm-up cycle and at the last sample.
+    let mut maps: Vec<std::collections::BTreeMap<String, f64>> = Vec::new();
     let mut live_settings = settings.settings.clone();
     let mut cycle_ms = 0.0;
     let mut poisoned = 0usize;
@@ -289,6 +347,7 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
             let s = Sample {
                 frame: i + 1,
                 resident_mb: resident_mb(),
+                heap_mb: heap_mb(),
                 gpu_allocated_mb,
                 gpu_reserved_mb,
                 frame_ms: cycle_ms / f64::from(a.cycle),
@@ -296,19 +355,38 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
             cycle_ms = 0.0;
             if !a.output.json {
                 println!(
-                    "frame {:>7}  resident {}  GPU allocated {}  reserved {}  {:.2} ms a frame",
+                    "frame {:>7}  resident {}  heap {}  GPU allocated {}  reserved {}  {:.2} ms a frame",
                     s.frame,
                     mb(s.resident_mb),
+                    mb(s.heap_mb),
                     mb(s.gpu_allocated_mb),
                     mb(s.gpu_reserved_mb),
                     s.frame_ms
                 );
             }
             samples.push(s);
+            if a.smaps {
+                let now = smaps_mb();
+                if maps.len() < 2 {
+                    maps.push(now);
+                } else {
+                    maps[1] = now;
+                }
+            }
+        }
+    }
+    if let [first, last] = &maps[..] {
+        println!("resident set by mapping, MB, after the warm-up and at the end:");
+        for (kind, mb) in last {
+            let was = first.get(kind).copied().unwrap_or(0.0);
+            if mb.max(was) >= 0.5 {
+                println!("  {kind:<32} {was:>9.1} {mb:>9.1}  {:+.1}", mb - was);
+            }
         }
     }
     let resident = max_growth(samples.iter().map(|s| s.resident_mb));
     let gpu = max_growth(samples.iter().map(|s| s.gpu_reserved_mb));
+    let heap = max_growth(samples.iter().map(|s| s.heap_mb));
     let flat = |g: Option<f64>| g.is_none_or(|g| g <= a.tolerance);
     let ok = flat(resident) && flat(gpu);
     let pct = |g: Option<f64>| g.map_or("not measured".to_string(), |g| format!("{g:+.2} %"));
@@ -322,11 +400,11 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
             "switches": switches, "poisoned": poisoned,
             "seconds": t_all.elapsed().as_secs_f64(),
             "samples": samples.iter().map(|s| json!({
-                "frame": s.frame, "resident_mb": s.resident_mb,
+                "frame": s.frame, "resident_mb": s.resident_mb, "heap_mb": s.heap_mb,
                 "gpu_allocated_mb": s.gpu_allocated_mb, "gpu_reserved_mb": s.gpu_reserved_mb,
                 "frame_ms": s.frame_ms,
             })).collect::<Vec<_>>(),
-            "max_growth_percent": { "resident": resident, "gpu_reserved": gpu },
+            "max_growth_percent": { "resident": resident, "heap": heap, "gpu_reserved": gpu },
             "tolerance_percent": a.tolerance,
             "flat": ok,
         });
@@ -334,9 +412,11 @@ pub fn run(a: SoakArgs) -> anyhow::Result<()> {
     } else {
         println!("adapter: {adapter}");
         println!(
-            "after the warm-up cycle, largest growth: resident {}, GPU reserved {} (tolerance \
-             {} %); every output finite, no GPU error; {} inputs poisoned; {:.0} s",
+            "after the warm-up cycle, largest growth: resident {}, allocator heap {}, GPU \
+             reserved {} (tolerance {} %); every output finite, no GPU error; {} inputs \
+             poisoned; {:.0} s",
             pct(resident),
+            pct(heap),
             pct(gpu),
             a.tolerance,
             poisoned,

@@ -77,6 +77,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let resolved = scene_source::resolve(&args.frame)?;
     log::info!("{}", resolved.description.line());
     step.done(resolved.description.line());
+    let ctx = still::start_gpu(&resolved)?;
+    let resolved = scene_source::fit_to_adapter(resolved, &args.frame, &ctx)?;
     let mut settings = resolved.settings.clone();
     let strip_lut = if args.lut_screenshot {
         if StripLayout::for_width(settings.width).is_none() {
@@ -94,7 +96,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         None
     };
-    let mut renderer = still::renderer(&resolved, args.bake.as_deref())?;
+    let mut renderer = still::renderer_on(ctx, &resolved, args.bake.as_deref())?;
     renderer.runtime.set_dumps(args.dumps.clone());
     // Timing each pass splits merged compute passes and costs the GPU about 10 us a pass.
     renderer.runtime.set_timestamps(if args.timings {

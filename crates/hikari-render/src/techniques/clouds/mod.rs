@@ -271,6 +271,9 @@ pub struct CloudsFrame {
     /// Whether the clouds are on and drawn this frame (what other techniques ask, rather than
     /// reading `params`' lanes).
     pub drawn: bool,
+    /// Whether every row of the map holds this frame's parameters (drawn whole, unchanged,
+    /// or its last slice drawn): what is lit through it has stopped changing.
+    pub settled: bool,
 }
 
 /// What the persistent map holds, kept between frames in the renderer's frame state.
@@ -323,6 +326,7 @@ fn disabled_frame(g: &mut FrameGraph<'_>, mut params: CloudParams) -> Result<Clo
         params,
         lookup,
         drawn: false,
+        settled: true,
     })
 }
 
@@ -411,6 +415,7 @@ impl Clouds {
                 .write(map)
                 .dispatch_threads(&self.march, [size, size.div_ceil(p.slice[0]), 1])?;
         }
+        let settled = state.whole == Some(params);
         let params = params.with_shadow_map(s.shadow_map_size, s.shadow_map_extent_m, camera);
         let n = params.shadow[3] as u32;
         let shadow_map = g.texture(
@@ -435,6 +440,7 @@ impl Clouds {
             params,
             lookup,
             drawn: true,
+            settled,
         })
     }
 }

@@ -29,7 +29,10 @@ fn main(
 ) {
     atomicStore(&local_bins[lid], 0u);
     workgroupBarrier();
-    let size = textureDimensions(radiance);
+    // One count a surface pixel of the illuminance (the render's size) and, at the same
+    // place, the radiance's pixel (the output's size, larger below render scale 1).
+    let size = textureDimensions(illuminance);
+    let out_size = textureDimensions(radiance);
     let y0 = id.y * ROWS;
     if id.x < size.x {
         var e_bin = NO_BIN;
@@ -51,7 +54,7 @@ fn main(
                 }
                 e_n += 1u;
             }
-            let lum = dot(textureLoad(radiance, p, 0).rgb, LUMA);
+            let lum = dot(textureLoad(radiance, p * out_size / size, 0).rgb, LUMA);
             let l = select(0.0, lum, lum >= 0.0);
             let b = HISTOGRAM_BINS
                 + histogram_bin(log2(max(l, 1e-30)), params.histogram.z, params.histogram.w);

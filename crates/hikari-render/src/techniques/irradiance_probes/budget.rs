@@ -59,6 +59,15 @@ pub fn frame_work(
     }
 }
 
+/// Frames of round robin that relight every tile and mesh once.
+pub fn cycle_frames(data: &ProbeGpuData, s: &IrradianceProbesSettings) -> u32 {
+    let tiles = data
+        .tiles
+        .len()
+        .div_ceil((s.tiles_per_frame as usize).max(1));
+    tiles.max(data.meshes.len()) as u32
+}
+
 /// The work as chunks of at most [`CHUNK`] consecutive probes: `(first probe, count)`.
 pub fn chunks(data: &ProbeGpuData, work: &FrameWork) -> Vec<[u32; 2]> {
     let mut out = Vec::new();

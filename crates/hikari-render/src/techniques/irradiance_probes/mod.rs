@@ -37,6 +37,7 @@ use crate::error::Result;
 use crate::graph::{BindingSet, Buf, FrameGraph, Tex, TextureDesc};
 use crate::pipeline::ComputePipeline;
 use crate::shader::ShaderLibrary;
+use crate::steady_light::FrameLight;
 use crate::view::View;
 use gpu_data::{PROBES_INTERIOR_MASK, ProbeGpuData, ProbeLookupParams};
 use relight_bench::RelightBench;
@@ -105,6 +106,9 @@ pub struct ProbesFrame {
     pub present: bool,
     /// Binding set `irradiance_probes` of `hikari::irradiance_probes`.
     pub lookup: BindingSet,
+    /// Whether every probe holds the frame's settled light (absent probes hold nothing that
+    /// changes).
+    pub settled: bool,
     /// `irradiance_probes.irradiance`: 9 RGB coefficients (vec4) a probe, lux.
     pub irradiance: Buf,
 }
@@ -126,8 +130,12 @@ pub struct IrradianceProbesState {
     uploaded: Option<Arc<Uploaded>>,
     /// Relights since the upload (0: the next relights everything).
     updates: u64,
+    /// Whether the round robin may rest (`crate::steady_light`).
+    steady: crate::steady_light::SteadyLight,
     /// Record [`LOOKUP_PASS`] every frame, not only for `--dump` (to time it).
     lookup_pass: bool,
+    /// Relight the round robin's share every frame, even at an unchanging light (to time it).
+    never_rest: bool,
 }
 
 impl std::fmt::Debug for IrradianceProbesState {
@@ -138,6 +146,7 @@ impl std::fmt::Debug for IrradianceProbesState {
                 &self.uploaded.as_ref().map(|u| u.data.probe_count()),
             )
             .field("updates", &self.updates)
+            .field("steady", &self.steady)
             .field("lookup_pass", &self.lookup_pass)
             .finish()
     }
@@ -164,6 +173,7 @@ impl IrradianceProbesState {
         });
         self.uploaded = uploaded.transpose()?.filter(|u| u.data.probe_count() > 0);
         self.updates = 0;
+        self.steady = Default::default();
         Ok(())
     }
 
@@ -177,6 +187,12 @@ impl IrradianceProbesState {
     /// deferred lighting's own lookup is unchanged.
     pub fn set_lookup_pass(&mut self, on: bool) {
         self.lookup_pass = on;
+    }
+
+    /// Whether the round robin runs every frame even when the light does not change (it
+    /// rests otherwise, `crate::steady_light`): for `hikari bench probes`, which times it.
+    pub fn set_never_rest(&mut self, on: bool) {
+        self.never_rest = on;
     }
 }
 
@@ -239,7 +255,9 @@ impl IrradianceProbes {
     }
 
     /// Relights this frame's share of the probes, lit by the frame context's sun or moon and
-    /// chosen around its camera, and makes the lookup's binding set.
+    /// chosen around its camera, and makes the lookup's binding set. The round robin rests
+    /// while `frame_light` stays settled and unchanged after a whole round (`crate::steady_light`).
+    #[allow(clippy::too_many_arguments)]
     pub fn record<'r>(
         &'r self,
         g: &mut FrameGraph<'r>,
@@ -248,6 +266,7 @@ impl IrradianceProbes {
         s: &IrradianceProbesSettings,
         sky: &SkyFrame,
         clouds: BindingSet,
+        frame_light: FrameLight,
     ) -> Result<ProbesFrame> {
         let light = cx.sun.as_ref();
         let camera = Vec3::from_slice(&cx.view.position[..3]);
@@ -269,8 +288,19 @@ impl IrradianceProbes {
         if s.interior_mask {
             params.grid_size[3] |= PROBES_INTERIOR_MASK;
         }
+        let mut settled = true;
         if let Some(update) = update {
-            let work = budget::frame_work(&u.data, update, [camera.x, camera.z], s);
+            let cycle = budget::cycle_frames(&u.data, s);
+            let rests = !state.never_rest && state.steady.rests(frame_light, cycle);
+            let work = if rests {
+                budget::FrameWork::default()
+            } else {
+                budget::frame_work(&u.data, update, [camera.x, camera.z], s)
+            };
+            if !rests {
+                state.steady.relit(update == 0, cycle);
+            }
+            settled = state.steady.done(cycle);
             let chunks = budget::chunks(&u.data, &work);
             if !chunks.is_empty() {
                 g.ctx()
@@ -303,6 +333,7 @@ impl IrradianceProbes {
         Ok(ProbesFrame {
             present: update.is_some(),
             lookup,
+            settled,
             irradiance,
         })
     }

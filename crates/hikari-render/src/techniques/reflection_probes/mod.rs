@@ -45,6 +45,7 @@ use crate::pipeline::ComputePipeline;
 use crate::scene::raster::{RasterQueues, Rasterizer};
 use crate::scene::upload::SceneInFrame;
 use crate::shader::ShaderLibrary;
+use crate::steady_light::{FrameLight, SteadyLight};
 use crate::view::View;
 use settings::ReflectionProbesSettings;
 
@@ -156,11 +157,14 @@ pub struct ReflectionProbeInputs<'a> {
     pub camera: Vec3,
     /// The sky lights the probes (`sky.sky`; off: a black sky and no sky light).
     pub sky_light: bool,
+    /// The frame's light, settled once the clouds and the irradiance probes are: the round
+    /// robin rests while it stays unchanged after a whole round (`crate::steady_light`).
+    pub light: FrameLight<'a>,
 }
 
 impl<'a> ReflectionProbeInputs<'a> {
     /// The inputs of a frame: the frame context's sun, lights, cut-off and history, the
-    /// camera where it sees from, and the frame's sky, probes, clouds and light table.
+    /// camera where it sees from, and the frame's sky, probes, clouds, light table and light.
     pub fn for_frame(
         cx: &'a crate::frame_context::FrameContext,
         s: &'a crate::settings::Settings,
@@ -168,6 +172,7 @@ impl<'a> ReflectionProbeInputs<'a> {
         probes: &'a ProbesFrame,
         clouds: &'a CloudsFrame,
         lights: Buf,
+        light: FrameLight<'a>,
     ) -> Self {
         Self {
             sky,
@@ -181,6 +186,10 @@ impl<'a> ReflectionProbeInputs<'a> {
             relight_all: cx.history.view_changed(),
             camera: Vec3::from_slice(&cx.view.position[..3]),
             sky_light: s.sky.sky,
+            light: FrameLight {
+                settled: light.settled && probes.settled,
+                ..light
+            },
         }
     }
 }
@@ -258,6 +267,8 @@ struct Progress {
     next: u32,
     /// The sun's direction and the weather at the last relight of every probe.
     relit_all_with: Option<(Vec3, String)>,
+    /// Whether the round robin may rest (`crate::steady_light`).
+    steady: SteadyLight,
 }
 
 /// What the reflection probes keep between frames in the renderer's frame state: the probe
@@ -613,7 +624,12 @@ impl ReflectionProbes {
         let mut list: Vec<u32> = (0..count)
             .filter(|&i| resident[i as usize] && (all || !progress.resident[i as usize]))
             .collect();
-        let mut budget = if all { 0 } else { s.per_frame };
+        let cycle = count.div_ceil(s.per_frame.max(1));
+        let rests = progress.steady.rests(inputs.light, cycle);
+        if !rests {
+            progress.steady.relit(all, cycle);
+        }
+        let mut budget = if all || rests { 0 } else { s.per_frame };
         for step in 0..count {
             if budget == 0 {
                 break;

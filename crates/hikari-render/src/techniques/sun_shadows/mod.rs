@@ -240,6 +240,25 @@ fn lookup_set(g: &mut FrameGraph<'_>, params: &ShadowParams, map: Tex) -> Bindin
 
 pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 
+/// Bytes of the rasteriser's depth buffer: `cascades * resolution^2` u32.
+fn depth_bytes(resolution: u32, cascades: u32) -> u64 {
+    resolution as u64 * resolution as u64 * cascades.max(1) as u64 * 4
+}
+
+/// `s` with its resolution halved until the rasteriser's depth buffer fits in one storage
+/// binding of `limit` bytes (WebGPU's default and the CPU driver's: 128 MiB, which `ultra`'s
+/// 4 x 4096^2 exceeds twice over).
+pub fn fit_to_binding(s: &SunShadowsSettings, limit: u64) -> SunShadowsSettings {
+    let mut res = s.resolution;
+    while res > 64 && depth_bytes(res, s.cascades) > limit {
+        res /= 2;
+    }
+    SunShadowsSettings {
+        resolution: res,
+        ..s.clone()
+    }
+}
+
 fn map_desc(resolution: u32, cascades: u32) -> TextureDesc {
     TextureDesc {
         size: [resolution, resolution, cascades.max(2)],
@@ -260,6 +279,8 @@ pub struct ShadowCache {
     drawn: Vec<Option<Cascade>>,
     /// The direction to the sun each cascade was drawn for.
     sun: Vec<Option<Vec3>>,
+    /// Whether the warning that the resolution was reduced to fit the adapter was given.
+    said_fitted: bool,
 }
 
 /// A sun (or moon) that turned less than this since a cascade was drawn keeps it: its shadows
@@ -404,6 +425,20 @@ impl SunShadows {
         s: &SunShadowsSettings,
         queues: &mut RasterQueues,
     ) -> Result<SunShadowMaps> {
+        let fitted = fit_to_binding(s, g.ctx().limits.max_storage_buffer_binding_size);
+        if fitted.resolution != s.resolution && !cache.said_fitted {
+            cache.said_fitted = true;
+            log::warn!(
+                "sun_shadows.resolution {} with {} cascades needs {} MiB in one storage binding, \
+                 past this adapter's {} MiB: using {}",
+                s.resolution,
+                s.cascades,
+                depth_bytes(s.resolution, s.cascades) >> 20,
+                g.ctx().limits.max_storage_buffer_binding_size >> 20,
+                fitted.resolution
+            );
+        }
+        let s = &fitted;
         let bounds = match scene.bounds {
             Some(b) if s.enabled && to_sun.length_squared() > 0.0 => b,
             _ => {
@@ -521,6 +556,22 @@ impl SunShadows {
 mod tests {
     use super::*;
     use glam::Quat;
+
+    #[test]
+    fn the_ultra_shadow_maps_fit_webgpus_default_storage_binding() {
+        use crate::settings::{Preset, TechniqueSettings};
+        let limit = 128 << 20;
+        let ultra = SunShadowsSettings::preset(Preset::Ultra);
+        assert!(ultra.resolution as u64 * ultra.resolution as u64 * 16 > limit);
+        let fitted = fit_to_binding(&ultra, limit);
+        assert_eq!(
+            fitted.resolution, 2048,
+            "halved until 4 x 2048^2 x 4 bytes fit"
+        );
+        assert_eq!(fit_to_binding(&ultra, u64::MAX).resolution, 4096);
+        let high = SunShadowsSettings::preset(Preset::High);
+        assert_eq!(fit_to_binding(&high, limit).resolution, high.resolution);
+    }
 
     fn camera(position: Vec3, forward: Vec3) -> Camera {
         Camera {

@@ -17,6 +17,10 @@ pub struct TaaSettings {
     /// Clip the history to the current frame's 3x3 neighbourhood in YCoCg (what keeps moving
     /// scenes from ghosting); off, a still view converges to the exact supersampled average.
     pub clip: bool,
+    /// The frame is rendered at this fraction of the output's width and height (0.5 to 1)
+    /// and upsampled to it temporally (`taa.upsample`; docs/scaling.md). Below 1 the jitter
+    /// cycle grows by 1 / scale^2; with TAA off the upsampling has no history.
+    pub render_scale: f32,
 }
 
 impl Default for TaaSettings {
@@ -26,6 +30,7 @@ impl Default for TaaSettings {
             jitter_samples: 8,
             max_history: 16,
             clip: true,
+            render_scale: 1.0,
         }
     }
 }
@@ -41,10 +46,23 @@ impl TechniqueSettings for TaaSettings {
                 key: "max_history",
                 range: Range::Int { lo: 1, hi: 256 },
             },
+            Field {
+                key: "render_scale",
+                range: Range::Float { lo: 0.5, hi: 1.0 },
+            },
         ]
     }
 
-    fn preset(_: Preset) -> Self {
-        Self::default()
+    /// Render scale is where the presets' cost goes first: `low` renders a quarter of the
+    /// pixels, `medium` under half.
+    fn preset(p: Preset) -> Self {
+        Self {
+            render_scale: match p {
+                Preset::Low => 0.5,
+                Preset::Medium => 0.67,
+                Preset::High | Preset::Ultra => 1.0,
+            },
+            ..Self::default()
+        }
     }
 }
