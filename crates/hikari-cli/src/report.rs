@@ -62,13 +62,15 @@ pub struct PassRow {
     pub gpu_ms: Option<Stats>,
     /// Microseconds to record and encode it.
     pub cpu_us: Stats,
+    /// Bytes it binds to read and write (the last frame's): its memory floor's numerator.
+    pub bytes: u64,
 }
 
 /// Timings gathered frame after frame.
 #[derive(Default)]
 pub struct FrameTimings {
     /// Per pass name: the index it first appeared at, GPU ms and CPU us samples.
-    per_pass: BTreeMap<String, (usize, Vec<f64>, Vec<f64>)>,
+    per_pass: BTreeMap<String, (usize, Vec<f64>, Vec<f64>, u64)>,
     spans: Vec<f64>,
     encode: Vec<f64>,
 }
@@ -81,6 +83,9 @@ pub struct FrameSummary {
     pub span_ms: Option<Stats>,
     /// CPU encode of the whole frame, us.
     pub encode_us: Stats,
+    /// The adapter's copy bandwidth, GB/s (read plus write), when measured: the table then
+    /// shows each pass's bytes and memory floor.
+    pub bandwidth_gbs: Option<f64>,
 }
 
 impl FrameTimings {
@@ -89,9 +94,10 @@ impl FrameTimings {
             let e = self
                 .per_pass
                 .entry(t.name.clone())
-                .or_insert((i, vec![], vec![]));
+                .or_insert((i, vec![], vec![], 0));
             e.1.extend(t.gpu_ms);
             e.2.push(t.cpu_us);
+            e.3 = t.traffic.total();
         }
         self.spans.extend(r.gpu_span_ms);
         self.encode.push(r.cpu_encode_us);
@@ -99,18 +105,20 @@ impl FrameTimings {
 
     pub fn summary(self) -> FrameSummary {
         let mut rows: Vec<_> = self.per_pass.into_iter().collect();
-        rows.sort_by_key(|(_, (i, _, _))| *i);
+        rows.sort_by_key(|(_, (i, _, _, _))| *i);
         FrameSummary {
             passes: rows
                 .into_iter()
-                .map(|(name, (_, gpu, cpu))| PassRow {
+                .map(|(name, (_, gpu, cpu, bytes))| PassRow {
                     name,
                     gpu_ms: Stats::of(gpu),
                     cpu_us: Stats::of(cpu).unwrap_or_default(),
+                    bytes,
                 })
                 .collect(),
             span_ms: Stats::of(self.spans),
             encode_us: Stats::of(self.encode).unwrap_or_default(),
+            bandwidth_gbs: None,
         }
     }
 }
@@ -140,28 +148,60 @@ impl FrameSummary {
                     "name": p.name,
                     "gpu_ms": p.gpu_ms.map(|s| s.json()),
                     "cpu_us": p.cpu_us.json(),
+                    "bytes": p.bytes,
+                    "floor_ms": self.floor_ms(p),
                 })
             })
             .collect()
     }
 
-    /// The per-pass table, the sums per technique and the whole frame.
+    /// A pass's memory floor, ms: its bytes at the measured bandwidth.
+    pub fn floor_ms(&self, p: &PassRow) -> Option<f64> {
+        self.bandwidth_gbs
+            .filter(|_| p.bytes > 0)
+            .map(|gbs| p.bytes as f64 / (gbs * 1e6))
+    }
+
+    /// The per-pass table, the sums per technique and the whole frame; with a measured
+    /// bandwidth, each pass's bytes, memory floor and how many floors its median is.
     pub fn print_table(&self) {
+        let floors = self.bandwidth_gbs.is_some();
+        let extra = if floors {
+            format!(" {:>9} {:>9} {:>7}", "MB", "floor ms", "x floor")
+        } else {
+            String::new()
+        };
         println!(
-            "{:<32} {:>10} {:>10} {:>10} {:>12}",
+            "{:<32} {:>10} {:>10} {:>10} {:>12}{extra}",
             "pass", "GPU med ms", "min", "max", "CPU med us"
         );
         for p in &self.passes {
+            let extra = match self.floor_ms(p) {
+                Some(f) => format!(
+                    " {:>9.2} {:>9.4} {:>7}",
+                    p.bytes as f64 / 1e6,
+                    f,
+                    p.gpu_ms
+                        .map_or(String::new(), |g| format!("{:.1}", g.median / f.max(1e-9)))
+                ),
+                None => String::new(),
+            };
             match p.gpu_ms {
                 Some(g) => println!(
-                    "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}",
+                    "{:<32} {:>10.4} {:>10.4} {:>10.4} {:>12.1}{extra}",
                     p.name, g.median, g.min, g.max, p.cpu_us.median
                 ),
                 None => println!(
-                    "{:<32} {:>10} {:>10} {:>10} {:>12.1}",
+                    "{:<32} {:>10} {:>10} {:>10} {:>12.1}{extra}",
                     p.name, "n/a", "", "", p.cpu_us.median
                 ),
             }
+        }
+        if let Some(gbs) = self.bandwidth_gbs {
+            println!(
+                "memory floor: bytes bound to read and write at {gbs:.0} GB/s (a buffer copy's \
+                 read plus write rate)"
+            );
         }
         for (t, ms) in self.technique_sums() {
             println!("{:<32} {:>10.4}", format!("{t} (sum of medians)"), ms);
@@ -208,6 +248,7 @@ mod tests {
                 max: m,
             }),
             cpu_us: Stats::default(),
+            bytes: 0,
         };
         let s = FrameSummary {
             passes: vec![
@@ -219,6 +260,7 @@ mod tests {
             ],
             span_ms: None,
             encode_us: Stats::default(),
+            bandwidth_gbs: None,
         };
         assert_eq!(
             s.technique_sums(),

@@ -399,6 +399,17 @@ fn bench_frame_names_the_scene_camera_time_and_size_that_ran() {
     );
     assert_eq!(v["frames"], 2);
     assert!(!v["passes"].as_array().unwrap().is_empty(), "{v}");
+    // Each pass's bytes and memory floor: TAA's resolve binds this frame's radiance, the
+    // motion vectors and last frame's history to read and the new history to write, four
+    // 64x48 Rgba16Float images (counted by hand from its WGSL).
+    let taa = v["passes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["name"] == "taa.resolve")
+        .unwrap_or_else(|| panic!("no taa.resolve: {v}"));
+    assert_eq!(taa["bytes"], 4 * 64 * 48 * 8, "{taa}");
+    assert!(taa["floor_ms"].as_f64().is_some_and(|f| f > 0.0), "{taa}");
 }
 
 #[test]

@@ -139,7 +139,10 @@ pub fn run(a: BenchFrameArgs) -> anyhow::Result<()> {
         timings.add(&f.result);
         bvh.add(renderer.scene_rt_stats());
     }
-    let summary = timings.summary();
+    let mut summary = timings.summary();
+    if !a.frame_only {
+        summary.bandwidth_gbs = Some(copy_bandwidth(&renderer.ctx)?);
+    }
     let triangles = renderer.scene().triangles;
     let rays = if settings.settings.ray_traced_gi.enabled {
         Some(gi_ray_counts(&mut renderer, &settings)?)
@@ -249,4 +252,38 @@ fn gi_ray_counts(
         traced: hits.iter().filter(|&&w| w != HIT_NOT_TRACED).count() as u64,
         queued: queue.first().copied().unwrap_or(0) as u64,
     })
+}
+
+/// The adapter's memory bandwidth as a large buffer copy sees it, GB/s of read plus write:
+/// the rate against which `bench frame` states each pass's memory floor. 256 MiB copied as
+/// many times as make about 50 ms (once on the CPU driver), timed on the host from submit to
+/// done, after one copy that is not timed.
+fn copy_bandwidth(ctx: &hikari_render::GpuContext) -> anyhow::Result<f64> {
+    use hikari_render::wgpu;
+    let size: u64 = (256u64 << 20).min(ctx.limits.max_buffer_size / 2 * 2);
+    let make = |label| {
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let (src, dst) = (make("bench.bandwidth.src"), make("bench.bandwidth.dst"));
+    let copies = |n: u32| -> anyhow::Result<f64> {
+        let mut enc = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        for _ in 0..n {
+            enc.copy_buffer_to_buffer(&src, 0, &dst, 0, size);
+        }
+        let t = Instant::now();
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait_idle()?;
+        Ok(t.elapsed().as_secs_f64())
+    };
+    let one = copies(1)?.max(1e-6);
+    let n = ((0.05 / one).ceil() as u32).clamp(1, 256);
+    let seconds = copies(n)?;
+    Ok(2.0 * size as f64 * f64::from(n) / seconds.max(1e-9) / 1e9)
 }

@@ -450,7 +450,7 @@ fn check_memory(
 /// What encoding the passes leaves for reading timings: per pass its name, its timestamp
 /// slot if timed, and its CPU encoding time.
 struct Encoded {
-    passes: Vec<(String, Option<u32>, f64)>,
+    passes: Vec<(String, Option<u32>, f64, super::Traffic)>,
     slots: u32,
     reads: Vec<poison::PassReads>,
     poisoned: Option<poison::Poison>,
@@ -504,6 +504,9 @@ fn encode_passes(
                 reads_out.push(reads);
             }
         }
+        let traffic = info.map_or_else(Default::default, |info| {
+            super::traffic::of_pass(info, &bindings, &set_bindings, textures, buffers)
+        });
         let tp = Instant::now();
         let res = PassResources { textures, buffers };
         let timed = is_timed(&kind);
@@ -615,6 +618,7 @@ fn encode_passes(
             name,
             timed.then_some(slot),
             tp.elapsed().as_secs_f64() * 1e6,
+            traffic,
         ));
         if timed {
             slot += 1;
@@ -718,10 +722,11 @@ fn read_timings(
     let timings = encoded
         .passes
         .into_iter()
-        .map(|(name, s, cpu_us)| PassTiming {
+        .map(|(name, s, cpu_us, traffic)| PassTiming {
             name,
             gpu_ms: s.and_then(|s| gpu[s as usize]),
             cpu_us,
+            traffic,
         })
         .collect();
     Ok((timings, gpu_span_ms))

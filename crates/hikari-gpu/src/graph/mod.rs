@@ -25,12 +25,14 @@ mod readback;
 mod resources;
 mod runtime;
 mod timing;
+mod traffic;
 
 pub use poison::{PassReads, Poison, ReadTexture};
 pub use readback::ImageRgba32;
 pub use resources::{Buf, PoolStats, Res, Tex, TextureDesc};
 pub use runtime::{FrameResult, GraphRuntime, History, TimestampMode};
 pub use timing::PassTiming;
+pub use traffic::Traffic;
 
 use std::sync::Arc;
 

@@ -11,6 +11,9 @@ pub struct PassTiming {
     pub gpu_ms: Option<f64>,
     /// CPU time spent encoding the pass (bind groups, commands), in microseconds.
     pub cpu_us: f64,
+    /// The bytes it binds to read and to write ([`super::Traffic`]): its memory floor with the
+    /// adapter's bandwidth. Zero for passes that are not a pipeline's (copies, clears).
+    pub traffic: super::Traffic,
 }
 
 pub(crate) struct GpuTimer {
