@@ -205,6 +205,8 @@ impl App {
                 .map_err(|e| anyhow::anyhow!("cannot open a window: {e}"))?,
         );
         let ctx = still::gpu()?;
+        // A CPU adapter gets the low preset unless one was asked for, as `render` does.
+        let resolved = scene_source::fit_to_adapter(resolved, &self.args.frame, &ctx)?;
         self.adapter = format!("{} ({:?})", ctx.info.name, ctx.info.backend);
         let presenter = Presenter::new(
             &ctx.instance,
