@@ -101,6 +101,18 @@ fn a_toggled_technique_is_named_and_changes_the_image_at_as_exposure() {
     assert_ne!(panel(&img, 0), panel(&img, 1));
 }
 
+/// `--preset-a` and `--preset-b` give each side its own preset: the settings that differ
+/// include the render scale (high 1, low 0.5), and the images differ.
+#[test]
+fn each_side_may_have_its_own_preset() {
+    let dir = tmp("compare-presets");
+    let (j, img) = compare(&dir, "presets", &["--preset-a", "high", "--preset-b", "low"]);
+    assert_eq!(j["a"]["settings"]["taa.render_scale"], "1.0", "{j}");
+    assert_eq!(j["b"]["settings"]["taa.render_scale"], "0.5", "{j}");
+    assert!(j["flip"]["mean"].as_f64().unwrap() > 0.0, "{j}");
+    assert_ne!(panel(&img, 0), panel(&img, 1));
+}
+
 /// `--own-exposure` meters each image: B's exposure compensation then moves B's EV100 (it
 /// would not at A's exposure, which B takes as `exposure.ev100`).
 #[test]

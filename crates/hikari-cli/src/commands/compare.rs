@@ -40,6 +40,13 @@ pub struct CompareArgs {
     /// A setting of B only, on top of the shared ones; repeatable.
     #[arg(long = "b", value_name = "TABLE.KEY=VALUE", value_parser = crate::config::parse_override)]
     pub b: Vec<(String, String)>,
+    /// A's preset instead of the shared one (`--preset`): `--preset-a ultra --preset-b low`
+    /// shows what a preset gives up.
+    #[arg(long, value_name = "PRESET")]
+    pub preset_a: Option<hikari_render::Preset>,
+    /// B's preset instead of the shared one.
+    #[arg(long, value_name = "PRESET")]
+    pub preset_b: Option<hikari_render::Preset>,
     /// Meter each image on its own instead of showing both at A's EV100.
     #[arg(long)]
     pub own_exposure: bool,
@@ -235,12 +242,15 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             );
         }
     }
-    let with = |extra: &[(String, String)]| {
+    let with = |extra: &[(String, String)], preset: Option<hikari_render::Preset>| {
         let mut f = args.frame.clone();
         f.config.overrides.extend(extra.iter().cloned());
+        if preset.is_some() {
+            f.config.preset = preset;
+        }
         f
     };
-    let a = scene_source::resolve(&with(&args.a)).context("A's settings (--a)")?;
+    let a = scene_source::resolve(&with(&args.a, args.preset_a)).context("A's settings (--a)")?;
     let a_tables = tables(&a.settings.settings);
     let mut b_extra = args.b.clone();
     for t in &args.toggle {
@@ -251,7 +261,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
             .with_context(|| format!("--toggle {t}: A has no `{t}.enabled`"))?;
         b_extra.push((format!("{t}.enabled"), (!on).to_string()));
     }
-    let b = scene_source::resolve(&with(&b_extra)).context("B's settings (--b, --toggle)")?;
+    let b = scene_source::resolve(&with(&b_extra, args.preset_b))
+        .context("B's settings (--b, --toggle)")?;
     log::info!("{}", a.description.line());
     let diff = differences(&a.settings.settings, &b.settings.settings);
     let frames = args.frames.unwrap_or_else(|| {
