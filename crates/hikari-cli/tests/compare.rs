@@ -106,7 +106,11 @@ fn a_toggled_technique_is_named_and_changes_the_image_at_as_exposure() {
 #[test]
 fn each_side_may_have_its_own_preset() {
     let dir = tmp("compare-presets");
-    let (j, img) = compare(&dir, "presets", &["--preset-a", "high", "--preset-b", "low"]);
+    let (j, img) = compare(
+        &dir,
+        "presets",
+        &["--preset-a", "high", "--preset-b", "low"],
+    );
     assert_eq!(j["a"]["settings"]["taa.render_scale"], "1.0", "{j}");
     assert_eq!(j["b"]["settings"]["taa.render_scale"], "0.5", "{j}");
     assert!(j["flip"]["mean"].as_f64().unwrap() > 0.0, "{j}");
