@@ -358,6 +358,29 @@ fn render_scaled(
     renderer.render(&s, true).unwrap().hdr.unwrap().rgba
 }
 
+/// The scene's view rendered at 4x the size without TAA and box-filtered 4x4: the
+/// supersampled image, and an exposure that puts its mean green at 0.5.
+fn supersampled(scene: &hikari_scene::Scene, w: u32, h: u32) -> (Vec<[f32; 4]>, f32) {
+    let big = render_frames(scene, w * 4, h * 4, false, false, 1);
+    let reference: Vec<[f32; 4]> = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let mut s = [0f32; 4];
+            for dy in 0..4 {
+                for dx in 0..4 {
+                    let p = big[((y * 4 + dy) * w * 4 + x * 4 + dx) as usize];
+                    for c in 0..4 {
+                        s[c] += p[c] / 16.0;
+                    }
+                }
+            }
+            s
+        })
+        .collect();
+    let mean: f32 = reference.iter().map(|p| p[1]).sum::<f32>() / reference.len() as f32;
+    (reference, 0.5 / mean.max(1e-6))
+}
+
 /// Mean FLIP between two HDR images shown through the same simple curve.
 fn flip(a: &[[f32; 4]], b: &[[f32; 4]], w: u32, exposure: f32) -> f32 {
     let ldr = |img: &[[f32; 4]]| -> Vec<u8> {
@@ -386,26 +409,7 @@ fn flip(a: &[[f32; 4]], b: &[[f32; 4]], w: u32, exposure: f32) -> f32 {
 fn taa_converges_to_the_supersampled_image() {
     let scene = hikari_scene::builtin::by_name("boxes").unwrap();
     let (w, h) = (64u32, 48u32);
-    let big = render_frames(&scene, w * 4, h * 4, false, false, 1);
-    let reference: Vec<[f32; 4]> = (0..w * h)
-        .map(|i| {
-            let (x, y) = (i % w, i / w);
-            let mut s = [0f32; 4];
-            for dy in 0..4 {
-                for dx in 0..4 {
-                    let p = big[((y * 4 + dy) * w * 4 + x * 4 + dx) as usize];
-                    for c in 0..4 {
-                        s[c] += p[c] / 16.0;
-                    }
-                }
-            }
-            s
-        })
-        .collect();
-    let exposure = {
-        let mean: f32 = reference.iter().map(|p| p[1]).sum::<f32>() / reference.len() as f32;
-        0.5 / mean.max(1e-6)
-    };
+    let (reference, exposure) = supersampled(&scene, w, h);
     let one = render_frames(&scene, w, h, false, false, 1);
     let converged = render_frames(&scene, w, h, true, true, 16);
     let unclipped = render_frames(&scene, w, h, true, false, 16);
@@ -456,26 +460,7 @@ fn taa_converges_to_the_supersampled_image() {
 fn taa_upsampling_at_two_thirds_converges_near_the_native_image() {
     let scene = hikari_scene::builtin::by_name("boxes").unwrap();
     let (w, h) = (64u32, 48u32);
-    let big = render_frames(&scene, w * 4, h * 4, false, false, 1);
-    let reference: Vec<[f32; 4]> = (0..w * h)
-        .map(|i| {
-            let (x, y) = (i % w, i / w);
-            let mut s = [0f32; 4];
-            for dy in 0..4 {
-                for dx in 0..4 {
-                    let p = big[((y * 4 + dy) * w * 4 + x * 4 + dx) as usize];
-                    for c in 0..4 {
-                        s[c] += p[c] / 16.0;
-                    }
-                }
-            }
-            s
-        })
-        .collect();
-    let exposure = {
-        let mean: f32 = reference.iter().map(|p| p[1]).sum::<f32>() / reference.len() as f32;
-        0.5 / mean.max(1e-6)
-    };
+    let (reference, exposure) = supersampled(&scene, w, h);
     let native = render_frames(&scene, w, h, true, true, 16);
     // 16 jitter positions at full scale are 36 at 0.67.
     let upsampled = render_scaled(&scene, w, h, true, true, 36, 0.67);
@@ -539,26 +524,7 @@ fn render_dolly(
 fn taa_upsampling_stays_near_native_taa_while_the_camera_moves() {
     let scene = hikari_scene::builtin::by_name("boxes").unwrap();
     let (w, h) = (64u32, 48u32);
-    let big = render_frames(&scene, w * 4, h * 4, false, false, 1);
-    let reference: Vec<[f32; 4]> = (0..w * h)
-        .map(|i| {
-            let (x, y) = (i % w, i / w);
-            let mut s = [0f32; 4];
-            for dy in 0..4 {
-                for dx in 0..4 {
-                    let p = big[((y * 4 + dy) * w * 4 + x * 4 + dx) as usize];
-                    for c in 0..4 {
-                        s[c] += p[c] / 16.0;
-                    }
-                }
-            }
-            s
-        })
-        .collect();
-    let exposure = {
-        let mean: f32 = reference.iter().map(|p| p[1]).sum::<f32>() / reference.len() as f32;
-        0.5 / mean.max(1e-6)
-    };
+    let (reference, exposure) = supersampled(&scene, w, h);
     let native = render_dolly(&scene, w, h, 24, 0.05, 1.0);
     let upsampled = render_dolly(&scene, w, h, 24, 0.05, 0.67);
     let (n, u) = (
