@@ -7,6 +7,38 @@ mod common;
 
 use common::{hikari, text, tmp};
 
+/// Every preset runs within WebGPU's default limits, which the CPU driver has too: `ultra`'s
+/// 4 x 4096^2 shadow cascades (256 MiB in one storage binding) are reduced to fit, with a
+/// warning naming the setting, instead of failing.
+#[test]
+fn the_ultra_preset_renders_within_the_cpu_drivers_limits() {
+    let dir = tmp("ultra");
+    let png = dir.join("ultra.png");
+    let o = hikari(&[
+        "render",
+        "--preset",
+        "ultra",
+        "--scene",
+        "boxes",
+        "--width",
+        "32",
+        "--height",
+        "18",
+        "--frames",
+        "1",
+        "--no-exr",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(
+        t.contains("sun_shadows.resolution 4096") && t.contains("using 2048"),
+        "{t}"
+    );
+    assert!(png.exists());
+}
+
 #[test]
 fn render_writes_png_exr_and_dumps() {
     let dir = tmp("render");
