@@ -40,6 +40,19 @@ impl Rig {
         illuminance: &[f32],
         p: &ExposureParams,
     ) -> FrameResult {
+        self.frame_sized(radiance, [SIZE, SIZE], illuminance, [SIZE, SIZE], p)
+    }
+
+    /// [`Rig::frame`] with the radiance at the output's size and the illuminance at the
+    /// render's, as below render scale 1.
+    fn frame_sized(
+        &mut self,
+        radiance: &[[f32; 3]],
+        [rw, rh]: [u32; 2],
+        illuminance: &[f32],
+        [w, h]: [u32; 2],
+        p: &ExposureParams,
+    ) -> FrameResult {
         let halves: Vec<half::f16> = radiance
             .iter()
             .flat_map(|c| [c[0], c[1], c[2], 1.0].map(half::f16::from_f32))
@@ -47,15 +60,15 @@ impl Rig {
         let hdr = common::texture_with_data(
             &self.ctx,
             wgpu::TextureFormat::Rgba16Float,
-            SIZE,
-            SIZE,
+            rw,
+            rh,
             bytemuck::cast_slice(&halves),
         );
         let lux = common::texture_with_data(
             &self.ctx,
             wgpu::TextureFormat::R32Float,
-            SIZE,
-            SIZE,
+            w,
+            h,
             bytemuck::cast_slice(illuminance),
         );
         let mut g = self.rt.begin_frame(&self.ctx);
@@ -63,7 +76,7 @@ impl Rig {
         let lux = g.import_texture("test.illuminance", &lux);
         let out = self
             .exposure
-            .record(&mut g, hdr, lux, [SIZE, SIZE], p)
+            .record(&mut g, hdr, lux, [w, h], p)
             .unwrap();
         g.readback(out.value);
         if let Some(h) = out.histogram {
@@ -131,6 +144,37 @@ fn meter_and_adapt_match_the_twin() {
             "value {got:?} vs twin {want:?}"
         );
     }
+}
+
+/// Below render scale 1 the illuminance is the render's size and the radiance the output's:
+/// both histograms count the render's pixels, the luminance one at the output pixel each maps
+/// to, as the twin does.
+#[test]
+fn the_meter_counts_the_renders_pixels_below_render_scale_one() {
+    let mut rng = SmallRng::seed_from_u64(23);
+    let (out, render) = ([SIZE, SIZE], [SIZE / 2 + 1, SIZE * 2 / 3]);
+    let radiance: Vec<[f32; 3]> = (0..out[0] * out[1])
+        .map(|_| {
+            std::array::from_fn(|_| {
+                half::f16::from_f32(10f32.powf(rng.random_range(-4.0..5.0))).to_f32()
+            })
+        })
+        .collect();
+    let illuminance: Vec<f32> = (0..render[0] * render[1])
+        .map(|_| 10f32.powf(rng.random_range(-3.0..5.5)))
+        .collect();
+    let p = ExposureParams::new(&ExposureSettings::default(), 0.0, 0.0);
+    let r = Rig::new().frame_sized(&radiance, out, &illuminance, render, &p);
+    let gpu: Vec<u32> = bytemuck::cast_slice(r.buffer("exposure.histogram").unwrap()).to_vec();
+    let cpu = reference::meter_scaled(&radiance, out, &illuminance, render, &p);
+    let pixels = render[0] * render[1];
+    assert_eq!(gpu[HISTOGRAM_BINS..].iter().sum::<u32>(), pixels);
+    let moved: i64 = gpu
+        .iter()
+        .zip(&cpu)
+        .map(|(&a, &b)| (a as i64 - b as i64).abs())
+        .sum();
+    assert!(moved <= 8, "{moved} counts differ from the twin");
 }
 
 /// A scene that turns 10 EV brighter, then back: EV100 rises at `adapt_up_ev_per_s` and

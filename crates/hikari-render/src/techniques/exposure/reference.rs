@@ -51,13 +51,30 @@ pub fn luminance(rgb: [f32; 3]) -> f32 {
 /// Twin of `exposure.meter`: the illuminance bins (pixels with `illuminance[i] >= 0`), then
 /// the luminance bins (every pixel).
 pub fn meter(radiance: &[[f32; 3]], illuminance: &[f32], params: &ExposureParams) -> Vec<u32> {
+    let n = [illuminance.len() as u32, 1];
+    meter_scaled(radiance, n, illuminance, n, params)
+}
+
+/// [`meter`] below render scale 1: `illuminance` at the render's `size`, `radiance` at the
+/// output's `radiance_size` (row-major); each illuminance pixel `p` counts the radiance pixel
+/// `p * radiance_size / size` (integer division, as the shader does), so both histograms
+/// count the render's pixels.
+pub fn meter_scaled(
+    radiance: &[[f32; 3]],
+    radiance_size: [u32; 2],
+    illuminance: &[f32],
+    size: [u32; 2],
+    params: &ExposureParams,
+) -> Vec<u32> {
     let h = params.histogram;
     let mut bins = vec![0u32; 2 * HISTOGRAM_BINS];
-    for (rgb, &e) in radiance.iter().zip(illuminance) {
+    for (i, &e) in illuminance.iter().enumerate() {
+        let (x, y) = (i as u32 % size[0], i as u32 / size[0]);
         if e >= 0.0 {
             bins[histogram_bin(e.max(1e-30).log2(), h[0], h[1])] += 1;
         }
-        let l = luminance(*rgb);
+        let (rx, ry) = (x * radiance_size[0] / size[0], y * radiance_size[1] / size[1]);
+        let l = luminance(radiance[(ry * radiance_size[0] + rx) as usize]);
         bins[HISTOGRAM_BINS + histogram_bin(l.max(1e-30).log2(), h[2], h[3])] += 1;
     }
     bins
