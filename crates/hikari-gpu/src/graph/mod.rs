@@ -96,6 +96,23 @@ pub(crate) enum Binding {
     Sampler(SamplerKind),
 }
 
+/// Each binding of a pass with the slot its pipeline declares for it: group 0's, then each
+/// binding set's, in group order.
+pub(crate) fn bound_slots<'a>(
+    info: &'a crate::pipeline::PipelineInfo,
+    bindings: &'a [Binding],
+    set_bindings: &'a [Vec<Binding>],
+) -> impl Iterator<Item = (&'a crate::pipeline::BindingSlot, &'a Binding)> {
+    std::iter::once((info.slots.as_slice(), bindings))
+        .chain(
+            info.sets
+                .iter()
+                .zip(set_bindings)
+                .map(|(s, b)| (s.slots.as_slice(), b.as_slice())),
+        )
+        .flat_map(|(slots, bindings)| slots.iter().zip(bindings))
+}
+
 /// The physical resources of a pass, for the closures of raster and custom passes.
 pub struct PassResources<'a> {
     pub(crate) textures: &'a [VirtualTexture],

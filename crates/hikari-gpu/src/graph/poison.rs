@@ -68,34 +68,26 @@ pub(crate) fn reads_of(
     textures: &[VirtualTexture],
 ) -> PassReads {
     let mut out = Vec::new();
-    let groups = std::iter::once((info.slots.as_slice(), bindings)).chain(
-        info.sets
-            .iter()
-            .zip(set_bindings)
-            .map(|(s, b)| (s.slots.as_slice(), b.as_slice())),
-    );
-    for (slots, bindings) in groups {
-        for (slot, b) in slots.iter().zip(bindings) {
-            let Binding::Texture(t, _) = b else { continue };
-            let reads = match slot.kind {
-                BindingKind::SampledTexture { .. } => true,
-                BindingKind::StorageTexture { access, .. } => {
-                    access != wgpu::StorageTextureAccess::WriteOnly
-                }
-                _ => false,
-            };
-            let v = &textures[t.0 as usize];
-            if !reads || out.iter().any(|r: &ReadTexture| r.name == v.name) {
-                continue;
+    for (slot, b) in super::bound_slots(info, bindings, set_bindings) {
+        let Binding::Texture(t, _) = b else { continue };
+        let reads = match slot.kind {
+            BindingKind::SampledTexture { .. } => true,
+            BindingKind::StorageTexture { access, .. } => {
+                access != wgpu::StorageTextureAccess::WriteOnly
             }
-            out.push(ReadTexture {
-                name: v.name.clone(),
-                history: matches!(v.source, TexSource::HistoryPrev),
-                cached: matches!(v.source, TexSource::Persistent),
-                poisonable: float_element(v.desc.format).is_some()
-                    && !matches!(v.source, TexSource::Imported),
-            });
+            _ => false,
+        };
+        let v = &textures[t.0 as usize];
+        if !reads || out.iter().any(|r: &ReadTexture| r.name == v.name) {
+            continue;
         }
+        out.push(ReadTexture {
+            name: v.name.clone(),
+            history: matches!(v.source, TexSource::HistoryPrev),
+            cached: matches!(v.source, TexSource::Persistent),
+            poisonable: float_element(v.desc.format).is_some()
+                && !matches!(v.source, TexSource::Imported),
+        });
     }
     PassReads {
         pass: pass.to_string(),

@@ -40,38 +40,30 @@ pub(crate) fn of_pass(
     buffers: &[VirtualBuffer],
 ) -> Traffic {
     let mut t = Traffic::default();
-    let groups = std::iter::once((info.slots.as_slice(), bindings)).chain(
-        info.sets
-            .iter()
-            .zip(set_bindings)
-            .map(|(s, b)| (s.slots.as_slice(), b.as_slice())),
-    );
-    for (slots, bindings) in groups {
-        for (slot, b) in slots.iter().zip(bindings) {
-            match (*b, &slot.kind) {
-                (Binding::Texture(tex, level), BindingKind::SampledTexture { .. }) => {
-                    t.read += level_bytes(&textures[tex.0 as usize], level.unwrap_or(0));
-                }
-                (Binding::Texture(tex, level), BindingKind::StorageTexture { access, .. }) => {
-                    let bytes = level_bytes(&textures[tex.0 as usize], level.unwrap_or(0));
-                    if *access != wgpu::StorageTextureAccess::WriteOnly {
-                        t.read += bytes;
-                    }
-                    if *access != wgpu::StorageTextureAccess::ReadOnly {
-                        t.written += bytes;
-                    }
-                }
-                (Binding::Buffer(buf), BindingKind::Storage { read_only }) => {
-                    let bytes = buffers[buf.0 as usize].size;
-                    // A read-write buffer is mostly an output (or counters): written once.
-                    if *read_only {
-                        t.read += bytes;
-                    } else {
-                        t.written += bytes;
-                    }
-                }
-                _ => {}
+    for (slot, b) in super::bound_slots(info, bindings, set_bindings) {
+        match (*b, &slot.kind) {
+            (Binding::Texture(tex, level), BindingKind::SampledTexture { .. }) => {
+                t.read += level_bytes(&textures[tex.0 as usize], level.unwrap_or(0));
             }
+            (Binding::Texture(tex, level), BindingKind::StorageTexture { access, .. }) => {
+                let bytes = level_bytes(&textures[tex.0 as usize], level.unwrap_or(0));
+                if *access != wgpu::StorageTextureAccess::WriteOnly {
+                    t.read += bytes;
+                }
+                if *access != wgpu::StorageTextureAccess::ReadOnly {
+                    t.written += bytes;
+                }
+            }
+            (Binding::Buffer(buf), BindingKind::Storage { read_only }) => {
+                let bytes = buffers[buf.0 as usize].size;
+                // A read-write buffer is mostly an output (or counters): written once.
+                if *read_only {
+                    t.read += bytes;
+                } else {
+                    t.written += bytes;
+                }
+            }
+            _ => {}
         }
     }
     t

@@ -74,10 +74,7 @@ impl Rig {
         let mut g = self.rt.begin_frame(&self.ctx);
         let hdr = g.import_texture("test.hdr", &hdr);
         let lux = g.import_texture("test.illuminance", &lux);
-        let out = self
-            .exposure
-            .record(&mut g, hdr, lux, [w, h], p)
-            .unwrap();
+        let out = self.exposure.record(&mut g, hdr, lux, [w, h], p).unwrap();
         g.readback(out.value);
         if let Some(h) = out.histogram {
             g.readback(h);

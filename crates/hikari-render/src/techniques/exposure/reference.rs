@@ -73,7 +73,10 @@ pub fn meter_scaled(
         if e >= 0.0 {
             bins[histogram_bin(e.max(1e-30).log2(), h[0], h[1])] += 1;
         }
-        let (rx, ry) = (x * radiance_size[0] / size[0], y * radiance_size[1] / size[1]);
+        let (rx, ry) = (
+            x * radiance_size[0] / size[0],
+            y * radiance_size[1] / size[1],
+        );
         let l = luminance(radiance[(ry * radiance_size[0] + rx) as usize]);
         bins[HISTOGRAM_BINS + histogram_bin(l.max(1e-30).log2(), h[2], h[3])] += 1;
     }
