@@ -260,7 +260,7 @@ fn gi_ray_counts(
 /// done, after one copy that is not timed.
 fn copy_bandwidth(ctx: &hikari_render::GpuContext) -> anyhow::Result<f64> {
     use hikari_render::wgpu;
-    let size: u64 = (256u64 << 20).min(ctx.limits.max_buffer_size / 2 * 2);
+    let size: u64 = (256u64 << 20).min(ctx.limits.max_buffer_size);
     let make = |label| {
         ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),

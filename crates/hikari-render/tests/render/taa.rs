@@ -41,6 +41,68 @@ fn half_texture_sized(
     )
 }
 
+/// `n` pixels of radiance over five decades (alpha 1), as the twins' tests feed them.
+fn random_radiance(rng: &mut SmallRng, n: usize) -> Vec<[f32; 4]> {
+    (0..n)
+        .map(|_| {
+            let mut c = [1.0f32; 4];
+            for v in c.iter_mut().take(3) {
+                *v = 10f32.powf(rng.random_range(-2.0..3.0));
+            }
+            c
+        })
+        .collect()
+}
+
+/// `n` motion vectors of up to 3 pixels, so that some reprojections leave the image.
+fn random_motion(rng: &mut SmallRng, n: usize) -> Vec<[f32; 4]> {
+    (0..n)
+        .map(|_| {
+            [
+                rng.random_range(-3.0..3.0),
+                rng.random_range(-3.0..3.0),
+                0.0,
+                0.0,
+            ]
+        })
+        .collect()
+}
+
+/// The radiance and motion as the GPU reads them from its f16 textures, for the twin.
+fn as_the_gpu_reads(current: &[[f32; 4]], motion: &[[f32; 4]]) -> (Vec<Vec3>, Vec<Vec2>) {
+    (
+        current
+            .iter()
+            .map(|c| Vec3::new(round_half(c[0]), round_half(c[1]), round_half(c[2])))
+            .collect(),
+        motion
+            .iter()
+            .map(|m| Vec2::new(round_half(m[0]), round_half(m[1])))
+            .collect(),
+    )
+}
+
+/// The largest difference of the first `channels` channels between the GPU's pixels and the
+/// twin's, relative to the twin's value (or to 1e-2 for small ones); every GPU value must be
+/// finite. Pixels past 4e-3 are printed.
+fn worst_relative_difference(got: &[[f32; 4]], want: &[Vec4], channels: usize, frame: u64) -> f32 {
+    let mut worst = 0f32;
+    for (i, (g, w)) in got.iter().zip(want).enumerate() {
+        assert!(
+            g.iter().all(|v| v.is_finite()),
+            "frame {frame} pixel {i}: {g:?}"
+        );
+        for c in 0..channels {
+            let err = (g[c] - w[c]).abs() / w[c].abs().max(1e-2);
+            if err > worst && err > 4e-3 {
+                eprintln!("frame {frame} px {i} c {c}: got {g:?} want {w:?}");
+            }
+            worst = worst.max(err);
+        }
+    }
+    worst
+}
+
 fn resolve_matches_twin(clip: bool) {
     let ctx = common::gpu_context();
     let mut lib = shader::library(shader::capabilities_for(ctx.features)).unwrap();
@@ -54,30 +116,12 @@ fn resolve_matches_twin(clip: bool) {
     let mut rt = GraphRuntime::new();
     let mut history: Option<Vec<Vec4>> = None;
     for frame in 0..3 {
-        let mut current: Vec<[f32; 4]> = (0..W * H)
-            .map(|_| {
-                let mut c = [1.0f32; 4];
-                for v in c.iter_mut().take(3) {
-                    *v = 10f32.powf(rng.random_range(-2.0..3.0));
-                }
-                c
-            })
-            .collect();
+        let mut current = random_radiance(&mut rng, (W * H) as usize);
         if frame == 2 {
             current[5] = [f32::NAN, f32::INFINITY, -3.0, 1.0];
             current[W as usize + 9] = [f32::NAN; 4];
         }
-        // Up to 3 pixels, so some reprojections leave the image.
-        let mut motion: Vec<[f32; 4]> = (0..W * H)
-            .map(|_| {
-                [
-                    rng.random_range(-3.0..3.0),
-                    rng.random_range(-3.0..3.0),
-                    0.0,
-                    0.0,
-                ]
-            })
-            .collect();
+        let mut motion = random_motion(&mut rng, (W * H) as usize);
         if frame == 2 {
             // Off the image: the NaN pixel's output is its sanitised current value alone.
             motion[5] = [-10.0, -10.0, 0.0, 0.0];
@@ -96,14 +140,7 @@ fn resolve_matches_twin(clip: bool) {
         let r = g.execute().unwrap();
         let got = &r.image("taa.history").unwrap().rgba;
 
-        let cur_in: Vec<Vec3> = current
-            .iter()
-            .map(|c| Vec3::new(round_half(c[0]), round_half(c[1]), round_half(c[2])))
-            .collect();
-        let mot_in: Vec<Vec2> = motion
-            .iter()
-            .map(|m| Vec2::new(round_half(m[0]), round_half(m[1])))
-            .collect();
+        let (cur_in, mot_in) = as_the_gpu_reads(&current, &motion);
         let params = TaaParams::new(&settings, history.is_some());
         let want = reference::resolve(
             &TaaInputs {
@@ -114,22 +151,9 @@ fn resolve_matches_twin(clip: bool) {
             },
             &params,
         );
-        let mut worst = 0f32;
-        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
-            assert!(
-                g.iter().all(|v| v.is_finite()),
-                "frame {frame} pixel {i}: {g:?}"
-            );
-            for c in 0..3 {
-                // The history is stored in f16 on both sides; the GPU's and the CPU's float
-                // arithmetic may round the stored value to neighbouring halves.
-                let err = (g[c] - w[c]).abs() / w[c].abs().max(1e-2);
-                if err > worst && err > 4e-3 {
-                    eprintln!("frame {frame} px {i} c {c}: got {g:?} want {w:?}");
-                }
-                worst = worst.max(err);
-            }
-        }
+        // The history is stored in f16 on both sides; the GPU's and the CPU's float arithmetic
+        // may round the stored value to neighbouring halves.
+        let worst = worst_relative_difference(got, &want, 3, frame as u64);
         assert!(
             worst < 4e-3,
             "frame {frame} clip {clip}: largest relative difference {worst}"
@@ -180,28 +204,11 @@ fn upsampling_matches_twin(render: [u32; 2]) {
     let mut rt = GraphRuntime::new();
     let mut history: Option<Vec<Vec4>> = None;
     for frame in 0..3u64 {
-        let mut current: Vec<[f32; 4]> = (0..n)
-            .map(|_| {
-                let mut c = [1.0f32; 4];
-                for v in c.iter_mut().take(3) {
-                    *v = 10f32.powf(rng.random_range(-2.0..3.0));
-                }
-                c
-            })
-            .collect();
+        let mut current = random_radiance(&mut rng, n);
         if frame == 2 {
             current[5] = [f32::NAN, f32::INFINITY, -3.0, 1.0];
         }
-        let motion: Vec<[f32; 4]> = (0..n)
-            .map(|_| {
-                [
-                    rng.random_range(-3.0..3.0),
-                    rng.random_range(-3.0..3.0),
-                    0.0,
-                    0.0,
-                ]
-            })
-            .collect();
+        let motion = random_motion(&mut rng, n);
         let jitter = reference::jitter(frame + 1, 16);
         let cur_tex = half_texture_sized(&ctx, &current, render);
         let motion_tex = half_texture_sized(&ctx, &motion, render);
@@ -214,14 +221,7 @@ fn upsampling_matches_twin(render: [u32; 2]) {
         g.readback(out.output);
         let r = g.execute().unwrap();
         let got = &r.image("taa.history").unwrap().rgba;
-        let cur_in: Vec<Vec3> = current
-            .iter()
-            .map(|c| Vec3::new(round_half(c[0]), round_half(c[1]), round_half(c[2])))
-            .collect();
-        let mot_in: Vec<Vec2> = motion
-            .iter()
-            .map(|m| Vec2::new(round_half(m[0]), round_half(m[1])))
-            .collect();
+        let (cur_in, mot_in) = as_the_gpu_reads(&current, &motion);
         let params = TaaParams::upsampling(&settings, history.is_some(), jitter, render, output);
         let want = resolve_upsampled(
             &UpsampleInputs {
@@ -233,22 +233,8 @@ fn upsampling_matches_twin(render: [u32; 2]) {
             },
             &params,
         );
-        let mut worst = 0f32;
-        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
-            assert!(
-                g.iter().all(|v| v.is_finite()),
-                "frame {frame} pixel {i}: {g:?}"
-            );
-            for c in 0..4 {
-                // f16 storage on both sides, and exp() of two implementations: relative to
-                // the value, or to 1e-2 for small ones.
-                let err = (g[c] - w[c]).abs() / w[c].abs().max(1e-2);
-                if err > worst && err > 4e-3 {
-                    eprintln!("frame {frame} px {i} c {c}: got {g:?} want {w:?}");
-                }
-                worst = worst.max(err);
-            }
-        }
+        // Also the summed weight (alpha), and exp() of two implementations.
+        let worst = worst_relative_difference(got, &want, 4, frame);
         assert!(
             worst < 4e-3,
             "frame {frame} render {render:?}: largest relative difference {worst}"

@@ -291,15 +291,12 @@ impl IrradianceProbes {
         let mut settled = true;
         if let Some(update) = update {
             let cycle = budget::cycle_frames(&u.data, s);
-            let rests = !state.never_rest && state.steady.rests(frame_light, cycle);
-            let work = if rests {
+            let work = if !state.never_rest && state.steady.rests(frame_light, cycle) {
                 budget::FrameWork::default()
             } else {
+                state.steady.relit(update == 0, cycle);
                 budget::frame_work(&u.data, update, [camera.x, camera.z], s)
             };
-            if !rests {
-                state.steady.relit(update == 0, cycle);
-            }
             settled = state.steady.done(cycle);
             let chunks = budget::chunks(&u.data, &work);
             if !chunks.is_empty() {
